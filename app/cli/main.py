@@ -1,0 +1,76 @@
+"""The ``vtool`` command: a root click group whose subcommands load lazily.
+
+Each subcommand lives in its own module under :mod:`vtool.app.cli`; the
+table :data:`COMMANDS` maps its name to ``module:attribute`` so that
+``vtool --help`` imports none of the heavy numerical code.
+
+User mistakes (:class:`vtool.errors.InputError`, click usage errors) end with a
+one-line message on stderr and exit code 2; a failed run
+(:class:`vtool.errors.RunError`) ends with its message and exit code 1. No
+traceback is shown for either.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import sys
+
+import click
+
+from vtool import __version__
+from vtool.errors import InputError, RunError
+
+COMMANDS: dict[str, tuple[str, str]] = {
+    "solve": ("vtool.app.cli.solve", "solve"),
+    "modes": ("vtool.app.cli.modes", "modes"),
+    "presets": ("vtool.app.cli.presets", "presets"),
+    "boom": ("vtool.app.cli.boom", "boom"),
+    "plate": ("vtool.app.cli.plate", "plate"),
+    "accuracy": ("vtool.app.cli.accuracy", "accuracy"),
+    "tui": ("vtool.app.cli.tui", "tui"),
+}
+
+
+def _installed_commands() -> list[str]:
+    return [name for name, (module, _) in COMMANDS.items() if importlib.util.find_spec(module)]
+
+
+class LazyGroup(click.Group):
+    """A group whose subcommands are imported only when invoked."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return _installed_commands()
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name not in COMMANDS or cmd_name not in _installed_commands():
+            return None
+        module, attribute = COMMANDS[cmd_name]
+        return getattr(importlib.import_module(module), attribute)
+
+    def invoke(self, ctx: click.Context):  # type: ignore[no-untyped-def]
+        try:
+            return super().invoke(ctx)
+        except InputError as exc:
+            click.echo(f"error: {exc.one_line()}", err=True)
+            ctx.exit(2)
+        except RunError as exc:
+            click.echo(f"run failed: {exc}", err=True)
+            ctx.exit(1)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="vtool")
+def cli() -> None:
+    """vtool: valve-train dynamics with clearances, sonic-boom and plate checks.
+
+    Presets are found by path or by shipped name (see `vtool presets list`).
+    """
+
+
+def main() -> None:
+    cli(prog_name="vtool")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,46 @@
+"""``vtool presets list | show NAME | copy NAME DEST``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from vtool.errors import InputError
+from vtool.files import write_atomic
+from vtool.presets import find_preset, list_presets
+
+
+@click.group()
+def presets() -> None:
+    """List, show and copy the shipped presets."""
+
+
+@presets.command("list")
+def list_command() -> None:
+    """List shipped presets: name, kind and title."""
+    infos = list_presets()
+    width = max((len(i.name) for i in infos), default=4)
+    for info in infos:
+        click.echo(f"{info.name:<{width}}  {info.kind:<11} {info.title}")
+
+
+@presets.command("show")
+@click.argument("name")
+def show_command(name: str) -> None:
+    """Print a preset's TOML text."""
+    click.echo(find_preset(name).read_text(encoding="utf-8"), nl=False)
+
+
+@presets.command("copy")
+@click.argument("name")
+@click.argument("dest", type=click.Path(dir_okay=True, path_type=Path))
+@click.option("--force", is_flag=True, help="Overwrite an existing file.")
+def copy_command(name: str, dest: Path, force: bool) -> None:
+    """Copy a preset to DEST (a file, or a folder to copy into) to edit it."""
+    source = find_preset(name)
+    target = dest / source.name if dest.is_dir() else dest
+    if target.exists() and not force:
+        raise InputError("dest", str(target), "a path that does not exist yet (or --force)")
+    write_atomic(target, source.read_text(encoding="utf-8"))
+    click.echo(f"copied {source.stem} to {target}")

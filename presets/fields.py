@@ -1,0 +1,180 @@
+"""Typed, validated reads from a parsed TOML table.
+
+A :class:`Table` wraps one TOML table together with its dotted path, so every
+error names the full field (``members.pushrod.length``). Reading a key marks it
+as used; :meth:`Table.finish` then rejects any key nobody asked for, so a typo
+in a preset is an error rather than a silently ignored setting.
+
+Example::
+
+    t = Table(doc, "")
+    length = t.number("length", unit="in", min_exclusive=0.0)
+    t.finish()
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+from vtool.errors import InputError
+
+
+def _kind_of(value: Any) -> str:
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, int | float):
+        return "a number"
+    if isinstance(value, str):
+        return "a string"
+    if isinstance(value, list):
+        return "a list"
+    if isinstance(value, dict):
+        return "a table"
+    return type(value).__name__
+
+
+class Table:
+    """One TOML table with its dotted path; reads keys with validation."""
+
+    def __init__(self, data: Any, path: str) -> None:
+        if not isinstance(data, dict):
+            raise InputError(path or "<preset>", _kind_of(data), "a table")
+        self.data = data
+        self.path = path
+        self._used: set[str] = set()
+
+    def field(self, key: str) -> str:
+        return f"{self.path}.{key}" if self.path else key
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def _get(self, key: str, default: Any, required: bool) -> Any:
+        self._used.add(key)
+        if key in self.data:
+            return self.data[key]
+        if required:
+            raise InputError(self.field(key), None, "a value (required field)")
+        return default
+
+    def number(
+        self,
+        key: str,
+        *,
+        unit: str = "",
+        default: float | None = None,
+        required: bool | None = None,
+        min_value: float | None = None,
+        min_exclusive: float | None = None,
+        max_value: float | None = None,
+        max_exclusive: float | None = None,
+    ) -> float:
+        """A finite float within the given bounds (ints are accepted)."""
+        required = default is None if required is None else required
+        value = self._get(key, default, required)
+        if value is None:
+            return None  # type: ignore[return-value]
+        expected = _range_text(min_value, min_exclusive, max_value, max_exclusive)
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise InputError(self.field(key), value, f"a number {expected}".strip(), unit)
+        value = float(value)
+        bad = (
+            not math.isfinite(value)
+            or (min_value is not None and value < min_value)
+            or (min_exclusive is not None and value <= min_exclusive)
+            or (max_value is not None and value > max_value)
+            or (max_exclusive is not None and value >= max_exclusive)
+        )
+        if bad:
+            raise InputError(self.field(key), value, expected or "a finite number", unit)
+        return value
+
+    def integer(
+        self,
+        key: str,
+        *,
+        default: int | None = None,
+        min_value: int | None = None,
+        max_value: int | None = None,
+    ) -> int:
+        value = self._get(key, default, default is None)
+        expected = _range_text(min_value, None, max_value, None)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise InputError(self.field(key), value, f"an integer {expected}".strip())
+        if (min_value is not None and value < min_value) or (
+            max_value is not None and value > max_value
+        ):
+            raise InputError(self.field(key), value, f"an integer {expected}")
+        return value
+
+    def string(self, key: str, *, default: str | None = None, choices: tuple[str, ...] = ()) -> str:
+        value = self._get(key, default, default is None)
+        if not isinstance(value, str):
+            expected = f"one of: {', '.join(choices)}" if choices else "a string"
+            raise InputError(self.field(key), value, expected)
+        if choices and value not in choices:
+            raise InputError(self.field(key), value, f"one of: {', '.join(choices)}")
+        return value
+
+    def boolean(self, key: str, *, default: bool | None = None) -> bool:
+        value = self._get(key, default, default is None)
+        if not isinstance(value, bool):
+            raise InputError(self.field(key), value, "true or false")
+        return value
+
+    def table(self, key: str, *, required: bool = True) -> Table | None:
+        value = self._get(key, None, required)
+        if value is None:
+            return None
+        return Table(value, self.field(key))
+
+    def tables(self, key: str, *, required: bool = True) -> Iterator[tuple[str, Table]]:
+        """Sub-tables of a table of tables, e.g. ``[members.pushrod]``."""
+        outer = self.table(key, required=required)
+        if outer is None:
+            return iter(())
+        return ((name, outer.table(name)) for name in list(outer.data))  # type: ignore[misc]
+
+    def array_of_tables(self, key: str, *, required: bool = True) -> list[Table]:
+        """Entries of an array of tables, e.g. ``[[clearances]]``."""
+        value = self._get(key, [], required)
+        if not isinstance(value, list):
+            raise InputError(self.field(key), _kind_of(value), "an array of tables")
+        return [Table(item, f"{self.field(key)}[{i}]") for i, item in enumerate(value)]
+
+    def numbers(self, key: str, *, unit: str = "", default: list[float] | None = None) -> list[float]:
+        value = self._get(key, default, default is None)
+        if not isinstance(value, list) or any(
+            isinstance(v, bool) or not isinstance(v, int | float) for v in value
+        ):
+            raise InputError(self.field(key), value, "a list of numbers", unit)
+        return [float(v) for v in value]
+
+    def raw(self, key: str, default: Any = None) -> Any:
+        return self._get(key, default, False)
+
+    def finish(self) -> None:
+        """Reject keys that were never read (typos, unsupported settings)."""
+        for key in self.data:
+            if key not in self._used:
+                raise InputError(self.field(key), self.data[key], "no such field (unknown key)")
+
+
+def _range_text(
+    min_value: float | None,
+    min_exclusive: float | None,
+    max_value: float | None,
+    max_exclusive: float | None,
+) -> str:
+    parts = []
+    if min_value is not None:
+        parts.append(f">= {min_value:g}")
+    if min_exclusive is not None:
+        parts.append(f"> {min_exclusive:g}")
+    if max_value is not None:
+        parts.append(f"<= {max_value:g}")
+    if max_exclusive is not None:
+        parts.append(f"< {max_exclusive:g}")
+    return " and ".join(parts)

@@ -1,0 +1,3 @@
+from vtool.app.cli.main import main
+
+main()
