@@ -1,0 +1,67 @@
+"""``vtool modes PRESET``: natural frequencies and mode shapes per contact layer."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import click
+
+
+@click.command()
+@click.argument("preset")
+@click.option("--json", "as_json", is_flag=True, help="Print the same as JSON.")
+def modes(preset: str, as_json: bool) -> None:
+    """Natural frequencies (rad/s, Hz) and mass-normalised mode shapes of every
+    contact layer, with the static start (cam offset XZERO, follower force FZERO)."""
+    from vtool.presets import load_preset
+    from vtool.solvers.model import assemble
+
+    spec = load_preset(preset)
+    if getattr(spec, "kind", "") != "valvetrain":
+        raise click.BadParameter(f"{preset} is a {spec.kind} preset; `vtool modes` needs a valvetrain preset",
+                                 param_hint="PRESET")
+    mechanism = assemble(spec)
+    units = spec.unit_system
+    report = {
+        "preset": preset,
+        "title": spec.title,
+        "units": spec.units,
+        "cam_offset_XZERO": {"value": mechanism.start.cam_offset, "unit": units.length},
+        "follower_force_FZERO": {"value": mechanism.start.follower_force, "unit": units.force},
+        "follower_stiffness": {"value": mechanism.start.follower_stiffness, "unit": units.stiffness},
+        "layers": [],
+    }
+    for layer in mechanism.all_layers():
+        report["layers"].append(
+            {
+                "closed": sorted(layer.closed),
+                "coordinates": [f"q{k}" for k in layer.kept],
+                "omega_rad_s": layer.modes.omega.tolist(),
+                "frequency_hz": (layer.modes.omega / (2 * math.pi)).tolist(),
+                "damping_ratio": [
+                    0.0 if w == 0.0 else z for w, z in zip(layer.modes.omega, layer.damping_ratios, strict=True)
+                ],
+                "mode_shapes_columns": layer.modes.shapes.tolist(),
+            }
+        )
+    if as_json:
+        click.echo(json.dumps(report, indent=2))
+        return
+    click.echo(f"{spec.title}  [{spec.units}]")
+    click.echo(f"cam offset XZERO   = {mechanism.start.cam_offset:.8f} {units.length}")
+    click.echo(f"follower force FZERO = {mechanism.start.follower_force:.8g} {units.force}")
+    for layer, entry in zip(mechanism.all_layers(), report["layers"], strict=True):
+        click.echo("")
+        click.echo(f"Layer {layer.label()}  ({layer.size} coordinates)")
+        click.echo(f"  {'mode':>4} {'omega (rad/s)':>14} {'f (Hz)':>12} {'zeta':>6}")
+        for i, (w, f, z) in enumerate(
+            zip(entry["omega_rad_s"], entry["frequency_hz"], entry["damping_ratio"], strict=True), start=1
+        ):
+            click.echo(f"  {i:>4} {w:>14.6g} {f:>12.6g} {z:>6.3g}")
+        click.echo("  mode shapes (mass-normalised, columns = modes):")
+        header = "".join(f"{i:>11}" for i in range(1, layer.size + 1))
+        click.echo(f"  {'':>4}{header}")
+        for row, k in enumerate(layer.kept):
+            values = "".join(f"{v:>11.4g}" for v in layer.modes.shapes[row])
+            click.echo(f"  q{k:<3}{values}")

@@ -1,0 +1,267 @@
+"""Centre response of a reduced model to a step load: RK4 and exact modal integration.
+
+Equation of motion of the reduced model from rest (thesis eqs. 37, 38, 43)::
+
+    M_R q̈ + K_R q = F H(t),   q(0) = q̇(0) = 0,   so   q̈ = M_R⁻¹ (F − K_R q)
+
+Two back ends:
+
+``rk4``
+    The classical fourth-order Runge–Kutta method on y = (q, q̇) with step
+    h = (ω_max h) / ω_max, ω_max the largest frequency of the reduced model.
+    It is stable for ω_max h < 2√2 ≈ 2.83 (the thesis' 2.8), adequate near 1.
+    For this linear, constant-coefficient system the RK4 step is the matrix
+    polynomial y ← R y + r with R = I + hL + (hL)²/2 + (hL)³/6 + (hL)⁴/24,
+    L = [[0, I], [−M⁻¹K, 0]]: the same iterates as the four-stage form
+    (:func:`rk4_reference`), one matrix-vector product per step.
+``modal``
+    Exact integration of the reduced model through its own modes
+    (K_R φ = ω² M_R φ, mass-normalized): q = Σ φ (φᵀF/ω²)(1 − cos ωt). No
+    step limit; it is the h → 0 limit of ``rk4``.
+
+Results are non-dimensional as in the thesis: time t/T (T the exact
+fundamental period), displacement w/(p0/(ρh ω₁₁²)), velocity
+ẇ/(p0/(ρh ω₁₁)), acceleration ẅ/(p0/ρh). A point force P is measured by its
+mean pressure p0 = P/(ab).
+
+Peak error (thesis, Figs. 9 and 10): the percentage error (eq. 40) of the
+largest positive and the largest negative value of a history against the
+exact ones; the one of larger magnitude is reported. An extreme whose exact
+magnitude is below 10 % of the history's peak (the displacement's minimum,
+zero at t = 0) is left out: its relative error means nothing.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from vtool.assessments.plate.assembly import Plate
+from vtool.assessments.plate.exact import ExactResponse, lowest_modes, step_response
+from vtool.assessments.plate.model import ReducedModel
+
+LOADS = ("uniform", "point")
+SCHEMES = ("rk4", "modal")
+#: RK4 is stable on the imaginary axis up to |z| = 2√2.
+RK4_STABILITY_LIMIT = 2.0 * np.sqrt(2.0)
+#: The thesis' rounded limit (eq. 44); ω_max h above it is rejected.
+RK4_LIMIT_THESIS = 2.8
+
+
+@dataclass(frozen=True)
+class Scales:
+    """Non-dimensionalizing scales (SI or consistent inch units)."""
+
+    period: float  # T = 2π/ω₁₁ (exact)
+    displacement: float  # p0 / (ρh ω₁₁²)
+    velocity: float  # p0 / (ρh ω₁₁)
+    acceleration: float  # p0 / ρh
+    load: float  # the load amplitude used: p0 (uniform) or P = p0 ab (point)
+
+
+def scales(plate: Plate, load: str, p0: float = 1.0) -> Scales:
+    omega = lowest_modes(plate, 1)[0].omega
+    m = plate.mass_per_area
+    amplitude = p0 if load == "uniform" else p0 * plate.a * plate.b
+    return Scales(2 * np.pi / omega, p0 / (m * omega**2), p0 / (m * omega), p0 / m, amplitude)
+
+
+@dataclass(frozen=True)
+class Response:
+    """Non-dimensional centre histories of one run and what it cost."""
+
+    case: str
+    size: int
+    load: str
+    scheme: str
+    omega_max_h: float  # NaN for the modal back end
+    step: float  # h in seconds (NaN for modal)
+    steps: int
+    tau: np.ndarray  # t / T
+    displacement: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    seconds: float
+    operations: float  # multiply-adds of the time loop (RK4: steps × (2 KS)²)
+
+
+def _load_vector(model: ReducedModel, load: str, s: Scales) -> np.ndarray:
+    if load == "uniform":
+        return s.load * model.f_uniform
+    if load == "point":
+        return s.load * model.f_point
+    raise ValueError(f"load: {load!r} is not one of: {', '.join(LOADS)}")
+
+
+def omega_max(model: ReducedModel) -> float:
+    lam = sla.eigh(model.K, model.M, eigvals_only=True)
+    return float(np.sqrt(lam[-1]))
+
+
+def rk4_propagator(A: np.ndarray, g: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """(R, r) with y_{n+1} = R y_n + r for one RK4 step of q̈ = g − A q, y = (q, q̇)."""
+    n = A.shape[0]
+    L = np.zeros((2 * n, 2 * n))
+    L[:n, n:] = np.eye(n)
+    L[n:, :n] = -A
+    c = np.concatenate([np.zeros(n), g])
+    hL = h * L
+    hL2 = hL @ hL
+    hL3 = hL2 @ hL
+    eye = np.eye(2 * n)
+    R = eye + hL + hL2 / 2 + hL3 / 6 + hL3 @ hL / 24
+    r = h * (eye + hL / 2 + hL2 / 6 + hL3 / 24) @ c
+    return R, r
+
+
+def rk4_reference(A: np.ndarray, g: np.ndarray, h: float, steps: int) -> np.ndarray:
+    """Textbook four-stage RK4 for q̈ = g − A q from rest; returns q at every step (tests)."""
+    n = A.shape[0]
+
+    def f(y: np.ndarray) -> np.ndarray:
+        return np.concatenate([y[n:], g - A @ y[:n]])
+
+    y = np.zeros(2 * n)
+    out = np.zeros((steps + 1, n))
+    for k in range(steps):
+        k1 = f(y)
+        k2 = f(y + h / 2 * k1)
+        k3 = f(y + h / 2 * k2)
+        k4 = f(y + h * k3)
+        y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        out[k + 1] = y[:n]
+    return out
+
+
+def run_rk4(plate: Plate, model: ReducedModel, load: str, omega_max_h: float,
+            periods: float = 1.5) -> Response:
+    """RK4 from rest at the given ω_max·h over ``periods`` exact fundamental periods."""
+    if not 0.0 < omega_max_h <= RK4_LIMIT_THESIS:
+        raise ValueError(f"omega_max_h: {omega_max_h} is outside (0, {RK4_LIMIT_THESIS}] (RK4 stability)")
+    s = scales(plate, load)
+    F = _load_vector(model, load, s)
+    start = time.perf_counter()
+    w_max = omega_max(model)
+    h = omega_max_h / w_max
+    steps = int(np.ceil(periods * s.period / h))
+    cho = sla.cho_factor(model.M)
+    A = sla.cho_solve(cho, model.K)
+    g = sla.cho_solve(cho, F)
+    R, r = rk4_propagator(A, g, h)
+    n = model.size
+    Y = np.zeros((steps + 1, 2 * n))
+    y = np.zeros(2 * n)
+    for k in range(steps):
+        y = R @ y + r
+        Y[k + 1] = y
+    q, v = Y[:, :n], Y[:, n:]
+    acc = g[None, :] - q @ A.T
+    c = model.centre_row
+    seconds = time.perf_counter() - start
+    t = np.arange(steps + 1) * h
+    return Response(
+        model.case.name, n, load, "rk4", omega_max_h, h, steps, t / s.period,
+        (q @ c) / s.displacement, (v @ c) / s.velocity, (acc @ c) / s.acceleration,
+        seconds, float(steps) * (2 * n) ** 2,
+    )
+
+
+def run_modal(plate: Plate, model: ReducedModel, load: str, tau: np.ndarray) -> Response:
+    """Exact modal integration of the reduced model at times ``tau`` (= t/T)."""
+    s = scales(plate, load)
+    F = _load_vector(model, load, s)
+    start = time.perf_counter()
+    lam, Phi = sla.eigh(model.K, model.M)
+    omega = np.sqrt(np.clip(lam, 0.0, None))
+    coeff = (model.centre_row @ Phi) * (Phi.T @ F)  # centre reading of each mode × modal force
+    t = np.asarray(tau, dtype=float) * s.period
+    wt = np.outer(t, omega)
+    cos = np.cos(wt)
+    disp = (1.0 - cos) @ (coeff / omega**2)
+    vel = np.sin(wt) @ (coeff / omega)
+    acc = cos @ coeff
+    seconds = time.perf_counter() - start
+    return Response(
+        model.case.name, model.size, load, "modal", float("nan"), float("nan"), t.size,
+        np.asarray(tau, dtype=float), disp / s.displacement, vel / s.velocity,
+        acc / s.acceleration, seconds, float(t.size) * model.size,
+    )
+
+
+@dataclass(frozen=True)
+class ExactHistories:
+    """Exact (Navier) non-dimensional centre histories and their mode-count convergence."""
+
+    load: str
+    tau: np.ndarray
+    displacement: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    n_modes: int
+    change_pct: dict[str, float]  # largest change when the modes are halved, % of peak
+    acceleration_converged: bool
+
+
+def exact_histories(plate: Plate, load: str, periods: float = 1.5, n_modes: int = 200,
+                    samples_per_period: int = 40) -> ExactHistories:
+    """The exact reference on a grid fine enough for its highest mode."""
+    s = scales(plate, load)
+    top = lowest_modes(plate, n_modes)[-1].omega
+    w11 = lowest_modes(plate, 1)[0].omega
+    n = int(np.ceil(periods * samples_per_period * top / w11)) + 1
+    tau = np.linspace(0.0, periods, n)
+    r: ExactResponse = step_response(plate, load, tau * s.period, n_modes)
+    return ExactHistories(
+        load, tau, s.load * r.displacement / s.displacement, s.load * r.velocity / s.velocity,
+        s.load * r.acceleration / s.acceleration, n_modes,
+        {"displacement": 100 * r.change_displacement, "velocity": 100 * r.change_velocity,
+         "acceleration": 100 * r.change_acceleration},
+        r.acceleration_converged,
+    )
+
+
+def peak_error_pct(approx: np.ndarray, exact: np.ndarray, floor: float = 0.1) -> float:
+    """Percentage error of the extremes (see module docstring); signed."""
+    peak = float(np.max(np.abs(exact)))
+    best = 0.0
+    for pick in (np.max, np.min):
+        e = float(pick(exact))
+        if abs(e) < floor * peak:
+            continue
+        err = (float(pick(approx)) - e) / abs(e) * 100.0
+        if abs(err) > abs(best):
+            best = err
+    return best
+
+
+QUANTITIES = ("displacement", "velocity", "acceleration")
+
+
+def peak_errors(resp: Response, exact: ExactHistories) -> dict[str, float]:
+    """Peak errors of displacement, velocity and acceleration against the exact reference.
+
+    The point-load acceleration has no converged exact value: NaN.
+    """
+    out = {}
+    for name in QUANTITIES:
+        if name == "acceleration" and not exact.acceleration_converged:
+            out[name] = float("nan")
+            continue
+        out[name] = peak_error_pct(getattr(resp, name), getattr(exact, name))
+    return out
+
+
+def halving_change_pct(plate: Plate, model: ReducedModel, load: str, omega_max_h: float,
+                       periods: float = 1.5) -> dict[str, float]:
+    """The thesis' accuracy check: rerun with h/2, largest change as % of each peak."""
+    coarse = run_rk4(plate, model, load, omega_max_h, periods)
+    fine = run_rk4(plate, model, load, omega_max_h / 2.0, periods)
+    out = {}
+    for name in QUANTITIES:
+        a = getattr(coarse, name)
+        b = np.interp(coarse.tau, fine.tau, getattr(fine, name))
+        out[name] = float(np.max(np.abs(a - b)) / np.max(np.abs(b)) * 100.0)
+    return out

@@ -1,0 +1,309 @@
+"""Valve-train presets: TOML document <-> :class:`vtool.solvers.spec.MechanismSpec`.
+
+``load(doc)`` validates every field once, at this boundary, and raises
+:class:`vtool.errors.InputError` naming the field, value, allowed range and
+unit. ``dump(spec)`` writes the same structure back, so a loaded-then-saved
+preset round-trips. See ``presets/gnilka-1a.toml`` for a commented example.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from vtool.errors import InputError
+from vtool.presets.fields import Table
+from vtool.solvers.spec import (
+    BAR,
+    BEAM,
+    ELEMENT_SIZE,
+    ENABLED,
+    EXTERNAL,
+    INTERNAL,
+    PINNED,
+    REMOVED,
+    CamSpec,
+    ClearanceSpec,
+    CoordinateSpec,
+    DampingSpec,
+    InitialSpec,
+    LayerDampingSpec,
+    MechanismSpec,
+    MemberSpec,
+    RunSpec,
+    SeatSpec,
+)
+from vtool.solvers.units import UNIT_SYSTEMS, UnitSystem
+
+STATIC_START = "static-start"
+MAX_DAMPING_RATIO = 1.0
+
+
+def load(doc: dict[str, Any]) -> MechanismSpec:
+    """Validate a parsed valve-train preset and return its frozen spec."""
+    top = Table(doc, "")
+    top.string("kind", choices=("valvetrain",))
+    title = top.string("title", default="")
+    notes = top.string("notes", default="")
+    units_name = top.string("units", choices=tuple(UNIT_SYSTEMS))
+    units = UNIT_SYSTEMS[units_name]
+    gravity = top.number("gravity", unit=units.acceleration, default=units.gravity, min_exclusive=0.0)
+
+    coordinates = _coordinates(top)
+    n = len(coordinates)
+    cam = _cam(top.table("cam"), n, units)  # type: ignore[arg-type]
+    seat_table = top.table("seat", required=False)
+    seat = _seat(seat_table, n, cam, units) if seat_table is not None else None
+    prescribed = {cam.coordinate} | ({seat.coordinate} if seat else set())
+    members = _members(top, n, units)
+    clearances = _clearances(top, n, prescribed, cam.coordinate)
+    names = {c.name: c for c in clearances}
+    initial = _initial(top.table("initial"), names, units)  # type: ignore[arg-type]
+    damping = _damping(top.table("damping", required=False), names)
+    run = _run(top.table("run"))  # type: ignore[arg-type]
+    top.finish()
+    return MechanismSpec(
+        title=title,
+        units=units_name,
+        gravity=gravity,
+        coordinates=coordinates,
+        members=members,
+        cam=cam,
+        seat=seat,
+        clearances=clearances,
+        initial=initial,
+        damping=damping,
+        run=run,
+        notes=notes,
+    )
+
+
+def _coordinates(top: Table) -> tuple[CoordinateSpec, ...]:
+    tables = top.array_of_tables("coordinates")
+    if not tables:
+        raise InputError("coordinates", [], "at least one [[coordinates]] entry")
+    result = []
+    for number, t in enumerate(tables, start=1):
+        name = t.string("name")
+        motion = t.string("motion", choices=("translation", "rotation"))
+        t.finish()
+        result.append(CoordinateSpec(number, name, motion))
+    return tuple(result)
+
+
+def _coordinate_ref(t: Table, key: str, allowed: set[int], what: str) -> int:
+    value = t.integer(key)
+    if value not in allowed:
+        raise InputError(t.field(key), value, f"one of the {what}: {sorted(allowed)}")
+    return value
+
+
+def _cam(t: Table, n: int, units: UnitSystem) -> CamSpec:
+    coordinate = t.integer("coordinate", min_value=n + 1)
+    name = t.string("name", default="cam")
+    profile = t.string("profile", default="harmonic", choices=("harmonic",))
+    amplitude = t.number("amplitude", unit=units.length, min_exclusive=0.0)
+    raw_offset = t.raw("offset", STATIC_START)
+    if raw_offset == STATIC_START:
+        offset = None
+    elif isinstance(raw_offset, int | float) and not isinstance(raw_offset, bool):
+        offset = t.number("offset", unit=units.length)
+    else:
+        raise InputError(t.field("offset"), raw_offset, f'"{STATIC_START}" or a number', units.length)
+    t.finish()
+    return CamSpec(coordinate, amplitude, offset, name, profile)
+
+
+def _seat(t: Table, n: int, cam: CamSpec, units: UnitSystem) -> SeatSpec:
+    coordinate = t.integer("coordinate", min_value=n + 1)
+    if coordinate == cam.coordinate:
+        raise InputError(t.field("coordinate"), coordinate, f"a number other than the cam's ({cam.coordinate})")
+    name = t.string("name", default="seat")
+    position = t.number("position", unit=units.length)
+    t.finish()
+    return SeatSpec(coordinate, position, name)
+
+
+def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
+    members = []
+    for name, t in top.tables("members"):
+        element = t.string("element", choices=(BAR, BEAM))
+        length = t.number("length", unit=units.length, min_exclusive=0.0)
+        coords = t.raw("coordinates")
+        size = ELEMENT_SIZE[element]
+        valid = (
+            isinstance(coords, list)
+            and len(coords) == size
+            and all(isinstance(c, int) and not isinstance(c, bool) and abs(c) <= n for c in coords)
+        )
+        if not valid:
+            raise InputError(
+                t.field("coordinates"), coords,
+                f"{size} signed coordinate numbers, each in -{n}..{n} (0 = ground)",
+            )
+        opt = dict(required=False, min_exclusive=0.0)
+        diameter = t.number("diameter", unit=units.length, **opt)  # type: ignore[arg-type]
+        area = t.number("area", unit=f"{units.length}^2", **opt)  # type: ignore[arg-type]
+        inertia = t.number("inertia", unit=f"{units.length}^4", **opt)  # type: ignore[arg-type]
+        modulus = t.number("modulus", unit=units.pressure, **opt)  # type: ignore[arg-type]
+        specific_weight = t.number("specific_weight", unit=units.specific_weight, **opt)  # type: ignore[arg-type]
+        density = t.number("density", unit=units.density, **opt)  # type: ignore[arg-type]
+        stiffness = t.number("stiffness", unit=units.stiffness, **opt)  # type: ignore[arg-type]
+        mass = t.number("mass", unit=units.mass, **opt)  # type: ignore[arg-type]
+        t.finish()
+        where = t.path
+        if element == BEAM and stiffness is not None:
+            raise InputError(f"{where}.stiffness", stiffness, "no explicit stiffness on a beam (give modulus and section)")
+        if diameter is None and area is None and (mass is None or (element == BAR and stiffness is None)):
+            raise InputError(f"{where}.diameter", None, "a diameter or an area", units.length)
+        if element == BEAM and diameter is None and inertia is None:
+            raise InputError(f"{where}.inertia", None, "an inertia (or a diameter) for a beam", f"{units.length}^4")
+        if modulus is None and not (element == BAR and stiffness is not None):
+            raise InputError(f"{where}.modulus", None, "a modulus > 0", units.pressure)
+        if mass is None and specific_weight is None and density is None:
+            raise InputError(f"{where}.specific_weight", None, "a specific_weight, density or mass > 0", units.specific_weight)
+        members.append(
+            MemberSpec(name, element, length, tuple(coords), modulus, diameter, area, inertia,
+                       specific_weight, density, stiffness, mass)
+        )
+    if not members:
+        raise InputError("members", {}, "at least one [members.NAME] table")
+    used = {abs(c) for m in members for c in m.coordinates if c}
+    for number in range(1, n + 1):
+        if number not in used:
+            raise InputError("coordinates", number, "every coordinate used by at least one member")
+    return tuple(members)
+
+
+def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int) -> tuple[ClearanceSpec, ...]:
+    result = []
+    elastic = set(range(1, n + 1))
+    for t in top.array_of_tables("clearances"):
+        name = t.string("name")
+        if any(c.name == name for c in result):
+            raise InputError(t.field("name"), name, "a name not used by another clearance")
+        kind = t.string("kind", choices=(EXTERNAL, INTERNAL))
+        ahead = _coordinate_ref(t, "ahead", elastic, "elastic coordinates")
+        if kind == EXTERNAL:
+            behind = _coordinate_ref(t, "behind", prescribed, "prescribed coordinates (cam, seat)")
+        else:
+            behind = _coordinate_ref(t, "behind", elastic - {ahead}, "other elastic coordinates")
+        state = t.string("state", default=ENABLED, choices=(ENABLED, PINNED, REMOVED))
+        if state == PINNED and kind == EXTERNAL:
+            raise InputError(t.field("state"), state, "enabled or removed for an external clearance")
+        restitution = t.number("restitution", default=0.0, min_value=0.0, max_value=1.0)
+        t.finish()
+        result.append(ClearanceSpec(name, ahead, behind, kind, state, restitution))
+    if sum(c.behind == cam_coordinate for c in result) != 1:
+        raise InputError("clearances", [c.name for c in result], f"exactly one clearance with behind = {cam_coordinate} (the cam)")
+    return tuple(result)
+
+
+def _initial(t: Table, names: dict[str, ClearanceSpec], units: UnitSystem) -> InitialSpec:
+    closed = _names(t, "closed", names)
+    for name in closed:
+        if names[name].state == REMOVED:
+            raise InputError(t.field("closed"), name, "clearances that are not removed")
+    preload = t.number("spring_preload", unit=units.force, min_value=0.0)
+    ratio = t.number("lever_ratio", min_exclusive=0.0)
+    t.finish()
+    return InitialSpec(closed, preload, ratio)
+
+
+def _names(t: Table, key: str, names: dict[str, ClearanceSpec], kinds: tuple[str, ...] = (EXTERNAL, INTERNAL)) -> tuple[str, ...]:
+    value = t.raw(key, None)
+    allowed = [n for n, c in names.items() if c.kind in kinds]
+    if not isinstance(value, list) or any(v not in allowed for v in value):
+        raise InputError(t.field(key), value, f"a list of clearance names from: {', '.join(allowed)}")
+    return tuple(value)
+
+
+def _ratio(t: Table, key: str, default: float | None = None) -> float:
+    return t.number(key, default=default, min_value=0.0, max_value=MAX_DAMPING_RATIO)
+
+
+def _damping(t: Table | None, names: dict[str, ClearanceSpec]) -> DampingSpec:
+    if t is None:
+        return DampingSpec()
+    factor = t.number("factor", default=1.0, min_value=0.0)
+    default_ratio = _ratio(t, "default_ratio", 0.1)
+    layers = []
+    for lt in t.array_of_tables("layers", required=False):
+        closed = _names(lt, "closed", names, (INTERNAL,))
+        ratio = _ratio(lt, "default_ratio", default_ratio)
+        overrides = []
+        mt = lt.table("mode_ratios", required=False)
+        if mt is not None:
+            for key in list(mt.data):
+                if not key.isdigit() or int(key) < 1:
+                    raise InputError(mt.field(key), key, "a mode number 1, 2, ... (ascending frequency)")
+                overrides.append((int(key), _ratio(mt, key)))
+            mt.finish()
+        lt.finish()
+        layers.append(LayerDampingSpec(tuple(sorted(closed)), ratio, tuple(sorted(overrides))))
+    t.finish()
+    return DampingSpec(factor, default_ratio, tuple(layers))
+
+
+def _run(t: Table) -> RunSpec:
+    rpm = t.number("rpm", unit="rev/min", min_exclusive=0.0)
+    degrees = t.number("degrees", unit="deg", min_exclusive=0.0)
+    time_step = t.number("time_step", unit="s", min_exclusive=0.0)
+    backend = t.string("backend", default="newmark")
+    output_interval = t.number("output_interval", unit="deg", default=1.0, min_exclusive=0.0)
+    beta = t.number("beta", default=1.0 / 6.0, min_exclusive=0.0, max_value=0.5)
+    gamma = t.number("gamma", default=0.5, min_value=0.5, max_value=1.0)
+    t.finish()
+    return RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma)
+
+
+def dump(spec: MechanismSpec) -> dict[str, Any]:
+    """The preset document for a spec (inverse of :func:`load`)."""
+    doc: dict[str, Any] = {"kind": "valvetrain", "title": spec.title}
+    if spec.notes:
+        doc["notes"] = spec.notes
+    doc["units"] = spec.units
+    doc["gravity"] = spec.gravity
+    doc["coordinates"] = [{"name": c.name, "motion": c.motion} for c in spec.coordinates]
+    members: dict[str, Any] = {}
+    for m in spec.members:
+        entry: dict[str, Any] = {"element": m.element, "length": m.length}
+        for key in ("diameter", "area", "inertia", "modulus", "specific_weight", "density", "stiffness", "mass"):
+            value = getattr(m, key)
+            if value is not None:
+                entry[key] = value
+        entry["coordinates"] = list(m.coordinates)
+        members[m.name] = entry
+    doc["members"] = members
+    cam = spec.cam
+    doc["cam"] = {
+        "coordinate": cam.coordinate, "name": cam.name, "profile": cam.profile,
+        "amplitude": cam.amplitude, "offset": STATIC_START if cam.offset is None else cam.offset,
+    }
+    if spec.seat is not None:
+        doc["seat"] = {"coordinate": spec.seat.coordinate, "name": spec.seat.name, "position": spec.seat.position}
+    doc["clearances"] = [
+        {"name": c.name, "ahead": c.ahead, "behind": c.behind, "kind": c.kind,
+         "state": c.state, "restitution": c.restitution}
+        for c in spec.clearances
+    ]
+    doc["initial"] = {
+        "closed": list(spec.initial.closed),
+        "spring_preload": spec.initial.spring_preload,
+        "lever_ratio": spec.initial.lever_ratio,
+    }
+    damping: dict[str, Any] = {"factor": spec.damping.factor, "default_ratio": spec.damping.default_ratio}
+    layers = []
+    for layer in spec.damping.layers:
+        entry = {"closed": list(layer.closed), "default_ratio": layer.default_ratio}
+        if layer.mode_ratios:
+            entry["mode_ratios"] = {str(k): v for k, v in layer.mode_ratios}
+        layers.append(entry)
+    if layers:
+        damping["layers"] = layers
+    doc["damping"] = damping
+    r = spec.run
+    doc["run"] = {
+        "rpm": r.rpm, "degrees": r.degrees, "time_step": r.time_step, "backend": r.backend,
+        "output_interval": r.output_interval, "beta": r.beta, "gamma": r.gamma,
+    }
+    return doc

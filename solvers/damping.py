@@ -1,0 +1,68 @@
+"""Modal damping of one contact layer (Gnilka 1971, section III.C).
+
+With the undamped modes of the layer, K φ_i = ω_i² M φ_i, the modal mass
+m_i = φ_iᵀ M φ_i, modal stiffness k_i = φ_iᵀ K φ_i and a ratio ζ_i per mode,
+
+    c_i = 2 ζ_i √(k_i m_i)                          (eq. 3.24)
+    C   = Φ⁻ᵀ diag(c_i) Φ⁻¹                         (eq. 3.26)
+
+With mass-normalised modes (m_i = 1), Φ⁻¹ = Φᵀ M, so C = M Φ diag(2 ζ_i ω_i) Φᵀ M
+without any inverse. Rigid-body modes (ω_i = 0) get no damping, whatever ζ_i.
+The result is multiplied by the global damping factor (thesis COFD).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+#: A mode whose ω is below this fraction of the largest ω is a rigid-body mode.
+RIGID_BODY_TOLERANCE = 1e-7
+
+
+@dataclass(frozen=True)
+class Modes:
+    """Undamped modes of (M, K), ascending: omega (rad/s) and mass-normalised columns."""
+
+    omega: np.ndarray
+    shapes: np.ndarray
+
+    @property
+    def n_rigid(self) -> int:
+        return int(np.count_nonzero(self.omega == 0.0))
+
+
+def undamped_modes(M: np.ndarray, K: np.ndarray) -> Modes:
+    """Solve K φ = ω² M φ; rigid-body eigenvalues are set to exactly zero.
+
+    Each shape is signed so that its largest-magnitude entry is positive, which
+    makes printed shapes reproducible.
+    """
+    eigenvalues, shapes = scipy.linalg.eigh(K, M)
+    scale = max(float(np.max(np.abs(eigenvalues))), 1e-300)
+    eigenvalues = np.where(np.abs(eigenvalues) < RIGID_BODY_TOLERANCE**2 * scale, 0.0, eigenvalues)
+    omega = np.sqrt(np.clip(eigenvalues, 0.0, None))
+    for j in range(shapes.shape[1]):
+        k = int(np.argmax(np.abs(shapes[:, j])))
+        if shapes[k, j] < 0:
+            shapes[:, j] *= -1.0
+    return Modes(omega, shapes)
+
+
+def modal_damping(M: np.ndarray, modes: Modes, ratios: np.ndarray, factor: float = 1.0) -> np.ndarray:
+    """C = factor · M Φ diag(2 ζ_i ω_i) Φᵀ M for mass-normalised Φ (see module doc)."""
+    ratios = np.asarray(ratios, dtype=float)
+    MPhi = M @ modes.shapes
+    C = MPhi @ np.diag(2.0 * ratios * modes.omega) @ MPhi.T
+    return factor * 0.5 * (C + C.T)
+
+
+def mode_ratios(n_modes: int, default_ratio: float, overrides: tuple[tuple[int, float], ...]) -> np.ndarray:
+    """ζ per mode (ascending frequency): the default with 1-based per-mode overrides."""
+    ratios = np.full(n_modes, float(default_ratio))
+    for mode_number, ratio in overrides:
+        if 1 <= mode_number <= n_modes:
+            ratios[mode_number - 1] = ratio
+    return ratios

@@ -1,0 +1,88 @@
+"""The static start (Gnilka 1971, subroutines THESIS and INITAL; appendix E).
+
+The thesis starts at omega t = 0, cam at mid-stroke, in configuration VII
+(cam and rocker in contact), from a static state. The linear model's q = 0 is
+the unloaded mechanism; the spring preload enters through the cam offset:
+
+1. k_eff, the static stiffness seen at the follower in the starting layer
+   (rocker closed, everything else free): k_eff = 1 / (K_L⁻¹)_ff, with f the
+   follower (the ``ahead`` coordinate of the cam clearance).
+2. On the base circle (cam at q_cam = XZERO - A) the follower force must equal
+   the spring preload carried through the rocker:
+   k_eff (XZERO - A) = F_s · R, so
+
+       XZERO = A + F_s R / k_eff
+
+3. At omega t = 0 the cam is at mid-stroke, q_cam = XZERO, so the initial
+   follower force is FZERO = k_eff · XZERO.
+
+With the thesis data (A = 0.5 in, F_s = 145 lbf, R = 1.5 in / 1.0 in, spring
+rate 254 lbf/in) this gives XZERO = 0.88245022 in and FZERO = 501.85073 lbf,
+the values of the thesis' sample printout for the 11,000 RPM run.
+
+The initial displacements are the static deflection under FZERO at the
+follower, q_L = K_L⁻¹ e_f FZERO (so q_f = XZERO). Choice where the thesis is
+silent: the initial velocities and accelerations are the quasi-static ones,
+the same deflection shape moving with the cam (q̇ = q/XZERO · q̇_cam(0),
+q̈ = q/XZERO · q̈_cam(0)), so the follower moves with the cam and no member
+starts with a spurious velocity jump.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vtool.errors import InputError
+from vtool.solvers.layers import Layer
+from vtool.solvers.spec import MechanismSpec
+
+
+@dataclass(frozen=True)
+class StaticStart:
+    """Cam offset, initial follower force and the initial state over the full coordinates."""
+
+    cam_offset: float  # XZERO, length
+    follower_force: float  # FZERO, force
+    follower_stiffness: float  # k_eff, force/length
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+
+
+def cam_clearance(spec: MechanismSpec):  # type: ignore[no-untyped-def]
+    for c in spec.clearances:
+        if c.behind == spec.cam.coordinate:
+            return c
+    raise InputError("clearances", "no clearance on the cam", f"one clearance with behind = {spec.cam.coordinate}")
+
+
+def static_start(spec: MechanismSpec, layer: Layer, omega: float) -> StaticStart:
+    """Apply the thesis' static-start rule in the starting layer (see module doc)."""
+    follower = cam_clearance(spec).ahead
+    f = int(np.argmax(layer.T[follower - 1]))  # the follower's column in the layer
+    try:
+        flexibility = np.linalg.solve(layer.K, np.eye(layer.size)[:, f])
+    except np.linalg.LinAlgError:
+        raise InputError(
+            "members", "no spring to ground", "a mechanism that is statically stable with the cam released"
+        ) from None
+    follower_stiffness = 1.0 / flexibility[f]
+    amplitude = spec.cam.amplitude
+    if spec.cam.offset is None:
+        cam_offset = amplitude + spec.initial.spring_preload * spec.initial.lever_ratio / follower_stiffness
+    else:
+        cam_offset = spec.cam.offset
+    follower_force = follower_stiffness * cam_offset
+    shape = layer.T @ (flexibility * follower_stiffness)  # q per unit follower displacement
+    cam_velocity = amplitude * omega  # d/dt (A sin wt) at t = 0
+    cam_acceleration = 0.0  # -A w² sin(0)
+    return StaticStart(
+        cam_offset=cam_offset,
+        follower_force=follower_force,
+        follower_stiffness=follower_stiffness,
+        q=shape * cam_offset,
+        qd=shape * cam_velocity,
+        qdd=shape * cam_acceleration,
+    )

@@ -1,0 +1,212 @@
+"""The valve-train mechanism as data: frozen specs built from a preset.
+
+A :class:`MechanismSpec` says everything the solver needs and nothing about
+how it is solved: the system coordinates, the members and how their element
+coordinates map onto system coordinates (the thesis' beta matrix, Gnilka
+1971 eq. 3.4, given row by row as signed coordinate numbers), the cam and
+the seat (prescribed coordinates), the clearances, the modal damping per
+contact layer, the static start and the run settings.
+
+Specs are built and validated by :mod:`vtool.presets.valvetrain`; nothing
+here reads files. All numbers are in the preset's unit system
+(:mod:`vtool.solvers.units`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from vtool.solvers.units import UNIT_SYSTEMS, UnitSystem
+
+BAR = "bar"
+BEAM = "beam"
+ELEMENT_SIZE = {BAR: 2, BEAM: 4}
+
+EXTERNAL = "external"
+INTERNAL = "internal"
+
+ENABLED = "enabled"
+PINNED = "pinned"
+REMOVED = "removed"
+
+
+@dataclass(frozen=True)
+class CoordinateSpec:
+    """One elastic system coordinate q_i (1-based ``number``)."""
+
+    number: int
+    name: str
+    motion: str  # "translation" (length) or "rotation" (rad)
+
+
+@dataclass(frozen=True)
+class MemberSpec:
+    """One finite element: an axial bar (2 DOF) or an Euler–Bernoulli beam (4 DOF).
+
+    ``coordinates`` maps element coordinates to system coordinates, one signed
+    number per element coordinate: ``+i`` is q_i, ``-i`` is -q_i, ``0`` is a
+    grounded (fixed) end. Element coordinate order follows the thesis: bar
+    (u_a, u_b); beam (w_a, w_b, theta_a, theta_b).
+
+    The section is given by ``diameter`` (solid circle) or by ``area`` (and
+    ``inertia`` for beams). The mass per volume by ``specific_weight`` (divided
+    by g) or ``density``. ``stiffness`` (bars: axial stiffness) and ``mass``
+    (total member mass), when given, override the values from the section,
+    as the valve spring needs.
+    """
+
+    name: str
+    element: str
+    length: float
+    coordinates: tuple[int, ...]
+    modulus: float | None = None
+    diameter: float | None = None
+    area: float | None = None
+    inertia: float | None = None
+    specific_weight: float | None = None
+    density: float | None = None
+    stiffness: float | None = None
+    mass: float | None = None
+
+
+@dataclass(frozen=True)
+class ClearanceSpec:
+    """A clearance between two coordinates.
+
+    The gap is ``q[ahead] - q[behind]``: positive while open, contact when it
+    reaches zero. ``kind`` is ``external`` when ``behind`` is a prescribed
+    coordinate (cam, seat) and ``internal`` between two elastic coordinates,
+    where the contact force acts equal and opposite on the pair. ``state``:
+    ``enabled`` (opens and closes), ``pinned`` (always closed: the pair is one
+    coordinate) or ``removed`` (never closes, not monitored).
+    """
+
+    name: str
+    ahead: int
+    behind: int
+    kind: str
+    state: str = ENABLED
+    restitution: float = 0.0
+
+
+@dataclass(frozen=True)
+class CamSpec:
+    """Harmonic cam: q_cam = amplitude * sin(omega t) + offset.
+
+    ``offset = None`` applies the thesis' static-start rule (XZERO, see
+    :mod:`vtool.solvers.initial`).
+    """
+
+    coordinate: int
+    amplitude: float
+    offset: float | None = None
+    name: str = "cam"
+    profile: str = "harmonic"
+
+
+@dataclass(frozen=True)
+class SeatSpec:
+    """A fixed seat: q_seat = position (thesis CLEAR)."""
+
+    coordinate: int
+    position: float
+    name: str = "seat"
+
+
+@dataclass(frozen=True)
+class InitialSpec:
+    """The static start at omega t = 0 (thesis INITAL).
+
+    ``closed`` names the clearances in contact at the start (thesis:
+    configuration VII, cam and rocker). ``spring_preload`` is the valve-spring
+    force with the cam on its base circle, ``lever_ratio`` the follower force
+    per unit spring force (the rocker arm ratio).
+    """
+
+    closed: tuple[str, ...]
+    spring_preload: float
+    lever_ratio: float
+
+
+@dataclass(frozen=True)
+class LayerDampingSpec:
+    """Modal damping ratios of one contact layer.
+
+    A layer is named by the internal clearances closed in it. ``mode_ratios``
+    overrides the ratio of single modes, numbered 1, 2, ... in ascending
+    natural frequency (rigid-body modes included, and always undamped).
+    """
+
+    closed: tuple[str, ...]
+    default_ratio: float
+    mode_ratios: tuple[tuple[int, float], ...] = ()
+
+
+@dataclass(frozen=True)
+class DampingSpec:
+    """Modal damping (thesis section III.C) and the global factor (thesis COFD)."""
+
+    factor: float = 1.0
+    default_ratio: float = 0.1
+    layers: tuple[LayerDampingSpec, ...] = ()
+
+    def for_layer(self, closed: frozenset[str]) -> LayerDampingSpec:
+        for layer in self.layers:
+            if frozenset(layer.closed) == closed:
+                return layer
+        return LayerDampingSpec(tuple(sorted(closed)), self.default_ratio)
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Run settings: cam speed, length of run, time step, back end, output."""
+
+    rpm: float
+    degrees: float
+    time_step: float
+    backend: str = "newmark"
+    output_interval: float = 1.0  # degrees of cam rotation between output rows
+    beta: float = 1.0 / 6.0
+    gamma: float = 0.5
+
+
+@dataclass(frozen=True)
+class MechanismSpec:
+    """A whole valve-train study: mechanism, clearances, damping, start and run."""
+
+    title: str
+    units: str
+    gravity: float
+    coordinates: tuple[CoordinateSpec, ...]
+    members: tuple[MemberSpec, ...]
+    cam: CamSpec
+    seat: SeatSpec | None
+    clearances: tuple[ClearanceSpec, ...]
+    initial: InitialSpec
+    damping: DampingSpec
+    run: RunSpec
+    notes: str = ""
+    kind: str = field(default="valvetrain", init=False)
+
+    @property
+    def unit_system(self) -> UnitSystem:
+        return UNIT_SYSTEMS[self.units]
+
+    @property
+    def n_coordinates(self) -> int:
+        return len(self.coordinates)
+
+    def clearance(self, name: str) -> ClearanceSpec:
+        for c in self.clearances:
+            if c.name == name:
+                return c
+        raise KeyError(name)
+
+    def coordinate_name(self, number: int) -> str:
+        if 1 <= number <= self.n_coordinates:
+            return self.coordinates[number - 1].name
+        if number == self.cam.coordinate:
+            return self.cam.name
+        if self.seat is not None and number == self.seat.coordinate:
+            return self.seat.name
+        raise KeyError(number)
