@@ -6,6 +6,7 @@ import json
 import math
 
 import click
+import numpy as np
 
 
 @click.command()
@@ -62,6 +63,8 @@ def modes(preset: str, as_json: bool) -> None:
         click.echo("  mode shapes (mass-normalised, columns = modes):")
         header = "".join(f"{i:>11}" for i in range(1, layer.size + 1))
         click.echo(f"  {'':>4}{header}")
+        shapes = layer.modes.shapes
+        shown = np.where(np.abs(shapes) < 1e-9 * np.abs(shapes).max(axis=0), 0.0, shapes)  # round-off noise
         for row, k in enumerate(layer.kept):
-            values = "".join(f"{v:>11.4g}" for v in layer.modes.shapes[row])
+            values = "".join(f"{v:>11.4g}" for v in shown[row])
             click.echo(f"  q{k:<3}{values}")

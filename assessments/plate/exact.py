@@ -104,8 +104,8 @@ class ExactResponse:
 
     ``displacement``, ``velocity`` and ``acceleration`` are per unit load
     (p0 = 1 for the uniform pressure, P = 1 for the point force).
-    ``change_*`` is the largest change of each history, relative to its peak,
-    when the number of modes is halved: the reported convergence.
+    ``change_*`` is the relative change of each history's peak magnitude when
+    the number of modes is halved: the reported convergence.
     ``acceleration_converged`` is False for a point force, whose modal
     acceleration series diverges.
     """
@@ -148,7 +148,7 @@ def step_response(
 
     def change(a: np.ndarray, b: np.ndarray) -> float:
         peak = float(np.max(np.abs(a)))
-        return float(np.max(np.abs(a - b)) / peak) if peak > 0 else 0.0
+        return abs(peak - float(np.max(np.abs(b)))) / peak if peak > 0 else 0.0
 
     changes = [change(f, c) for f, c in zip(full, coarse, strict=True)]
     return ExactResponse(

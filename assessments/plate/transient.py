@@ -25,10 +25,12 @@ fundamental period), displacement w/(p0/(ρh ω₁₁²)), velocity
 mean pressure p0 = P/(ab).
 
 Peak error (thesis, Figs. 9 and 10): the percentage error (eq. 40) of the
-largest positive and the largest negative value of a history against the
-exact ones; the one of larger magnitude is reported. An extreme whose exact
-magnitude is below 10 % of the history's peak (the displacement's minimum,
-zero at t = 0) is left out: its relative error means nothing.
+largest positive or negative value of a history, whichever is larger in
+magnitude in the exact history, against the approximate extreme of the
+same sign. (Read as "the larger of the errors of the positive and the
+negative extremes" the velocity under a uniform load would be judged on
+its smaller, later negative swing; the thesis' ~2 % velocity error of the
+full model at ω_max h = 1 matches the reading used here.)
 """
 
 from __future__ import annotations
@@ -201,7 +203,7 @@ class ExactHistories:
     velocity: np.ndarray
     acceleration: np.ndarray
     n_modes: int
-    change_pct: dict[str, float]  # largest change when the modes are halved, % of peak
+    change_pct: dict[str, float]  # change of the peak when the modes are halved, %
     acceleration_converged: bool
 
 
@@ -223,18 +225,14 @@ def exact_histories(plate: Plate, load: str, periods: float = 1.5, n_modes: int 
     )
 
 
-def peak_error_pct(approx: np.ndarray, exact: np.ndarray, floor: float = 0.1) -> float:
-    """Percentage error of the extremes (see module docstring); signed."""
-    peak = float(np.max(np.abs(exact)))
-    best = 0.0
-    for pick in (np.max, np.min):
-        e = float(pick(exact))
-        if abs(e) < floor * peak:
-            continue
-        err = (float(pick(approx)) - e) / abs(e) * 100.0
-        if abs(err) > abs(best):
-            best = err
-    return best
+def peak_error_pct(approx: np.ndarray, exact: np.ndarray) -> float:
+    """Signed percentage error of the peak (see module docstring)."""
+    k = int(np.argmax(np.abs(exact)))
+    e = float(exact[k])
+    if e == 0.0:
+        return 0.0
+    a = float(np.max(approx)) if e > 0 else float(np.min(approx))
+    return (a - e) / abs(e) * 100.0
 
 
 QUANTITIES = ("displacement", "velocity", "acceleration")
