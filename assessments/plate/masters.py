@@ -21,7 +21,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-
 from vtool.assessments.plate.assembly import Mesh
 
 

@@ -10,7 +10,8 @@
 * Table 5: transient peak errors of each transient case, load and ω_max h
   against the exact reference, the reduced model's own exact (modal)
   result, the halving-h check, and the cheapest acceptable combination:
-  |error| ≤ |error of the full model, modal| + tolerance.
+  |error| ≤ |error of the full model, modal| + tolerance, with the
+  halving-h change within the tolerance.
 """
 
 from __future__ import annotations
@@ -20,7 +21,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-
 from vtool.assessments.plate.assembly import Plate
 from vtool.assessments.plate.model import Case, MasterSelection, ReducedModel, build_model
 from vtool.assessments.plate.transient import (
@@ -79,7 +79,7 @@ class TransientRow:
     load: str
     omega_max_h: float  # NaN: exact modal integration of the reduced model
     steps: int
-    seconds: float
+    seconds: float  # RK4: the time loop alone; modal: the modal sums
     operations: float
     errors_pct: dict[str, float]
     halving_pct: dict[str, float] = field(default_factory=dict)
@@ -107,14 +107,16 @@ class StudyResult:
     seconds: float
 
 
-def _eigen_time(model: ReducedModel, repeats: int = 5) -> float:
+def _eigen_time(model: ReducedModel, repeats: int = 5, budget: float = 0.02) -> float:
+    """Best-of time of the eigenproblem (at least ``repeats`` runs and ``budget`` seconds)."""
     import scipy.linalg as sla
 
-    best = math.inf
-    for _ in range(repeats):
+    best, spent, runs = math.inf, 0.0, 0
+    while runs < repeats or (spent < budget and runs < 200):
         start = time.perf_counter()
         sla.eigh(model.K, model.M)
-        best = min(best, time.perf_counter() - start)
+        elapsed = time.perf_counter() - start
+        best, spent, runs = min(best, elapsed), spent + elapsed, runs + 1
     return best
 
 
@@ -140,8 +142,11 @@ def run_transient_case(plate: Plate, model: ReducedModel, settings: TransientSet
         ex = exact[load]
         for wh in settings.omega_max_h:
             r = run_rk4(plate, model, load, wh, settings.periods)
+            again = run_rk4(plate, model, load, wh, settings.periods)  # time the warm run too
+            if again.loop_seconds < r.loop_seconds:
+                r = again
             halving = halving_change_pct(plate, model, load, wh, settings.periods)
-            rows.append(TransientRow(model.case.name, model.size, load, wh, r.steps, r.seconds,
+            rows.append(TransientRow(model.case.name, model.size, load, wh, r.steps, r.loop_seconds,
                                      r.operations, peak_errors(r, ex), halving))
         mo = run_modal(plate, model, load, ex.tau)
         rows.append(TransientRow(model.case.name, model.size, load, float("nan"), mo.steps,
@@ -150,7 +155,13 @@ def run_transient_case(plate: Plate, model: ReducedModel, settings: TransientSet
 
 
 def optima(rows: list[TransientRow], settings: TransientSettings, full_case: str) -> list[Optimum]:
-    """Cheapest RK4 (case, ω_max h) per load and quantity within the acceptance limit."""
+    """Cheapest RK4 (case, ω_max h) per load and quantity that is acceptable.
+
+    Acceptable: the peak error is within the full model's own (modal) error
+    plus the tolerance, and halving h changes the history by no more than
+    the tolerance (the thesis' check, which rejects a lucky coarse step).
+    Cost is the operation count steps × (2 KS)².
+    """
     out = []
     for load in settings.loads:
         for q in QUANTITIES:
@@ -162,7 +173,8 @@ def optima(rows: list[TransientRow], settings: TransientSettings, full_case: str
                 continue
             limit = abs(ref[0].errors_pct[q]) + settings.tolerance_pct
             ok = [r for r in rows if r.load == load and not math.isnan(r.omega_max_h)
-                  and abs(r.errors_pct[q]) <= limit]
+                  and abs(r.errors_pct[q]) <= limit
+                  and r.halving_pct.get(q, 0.0) <= settings.tolerance_pct]
             best = min(ok, key=lambda r: (r.operations, r.size)) if ok else None
             out.append(Optimum(load, q, best, limit, "" if best else "none acceptable"))
     return out

@@ -53,6 +53,7 @@ from vtool.errors import InputError
 
 #: pulse types in the thesis' order (VELDAF's KOM = 1..5).
 PULSE_TYPES: tuple[str, ...] = ("N", "P", "Q", "R", "T")
+_NARROWEST = 1e-9  # segments shorter than this (units of tau) are treated as jumps
 
 
 @dataclass(frozen=True)
@@ -243,7 +244,9 @@ def make_pulse(params: PulseParams) -> Pulse:
         segs.append(Segment(r1, s, alpha * (1.0 - r1), -alpha))
         if r2 > 0.0 and beta != 0.0:
             segs.append(Segment(s, s + r2, beta, -beta / r2))
-    return Pulse(p.label(), tuple(seg for seg in segs if seg.end > seg.start))
+    # A ramp narrower than 1e-9 tau is a jump for any oscillator this tool
+    # models; dropping it avoids slopes of 1e14 that no arithmetic survives.
+    return Pulse(p.label(), tuple(seg for seg in segs if seg.length > _NARROWEST))
 
 
 def idealized(kind: str, s: float = 2.0, r1: float = 0.0, r2: float | None = None,
@@ -317,6 +320,9 @@ def read_pulse_csv(path: str | os.PathLike[str]) -> Pulse:
                              "two numbers: time, pressure") from None
         if len(values) != 2:
             raise InputError(f"{path.name} row {number}", ",".join(row), "two columns: time, pressure")
+        if times and values[0] <= times[-1]:
+            raise InputError(f"{path.name} row {number}", values[0],
+                             f"a time > {times[-1]:g} (strictly increasing)", "s")
         times.append(values[0])
         pressures.append(values[1])
     return tabulated(np.array(times), np.array(pressures), label=f"csv:{path.name}",

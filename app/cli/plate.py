@@ -1,0 +1,245 @@
+"""``vtool plate modes | transient | study PRESET``: condensed-plate checks.
+
+Thin commands over :mod:`vtool.assessments.plate`: load the preset, build
+or run, print the report, write CSV through :func:`vtool.files.write_atomic`
+and draw charts through :func:`vtool.app.plots.line_chart`.
+:func:`solve_preset` is what ``vtool solve PRESET`` calls for a plate preset.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+from typing import Any
+
+import click
+
+from vtool.errors import InputError
+
+RK4_LIMIT = 2.8  # thesis eq. 44; kept here so --help needs no numerics
+
+
+def _load_plate_spec(preset: str) -> Any:
+    from vtool.presets import load_preset
+
+    spec = load_preset(preset)
+    if getattr(spec, "kind", "") != "plate":
+        raise InputError("preset", preset, f"a plate preset (this one is kind {spec.kind!r})")
+    return spec
+
+
+def _cases(spec: Any, case_name: str | None) -> list[Any]:
+    cases = list(spec.study.cases)
+    if case_name is None:
+        return cases
+    for case in cases:
+        if case.name == case_name:
+            return [case]
+    raise InputError("--case", case_name, f"one of: {', '.join(c.name for c in cases)}")
+
+
+def _wh(ctx: click.Context, param: click.Parameter, value: float) -> float:
+    if not 0.0 < value <= RK4_LIMIT:
+        raise InputError("--wh", value, f"> 0 and <= {RK4_LIMIT} (omega_max*h, RK4 stability limit, thesis eq. 44)")
+    return value
+
+
+def _width() -> int:
+    return max(60, min(shutil.get_terminal_size((100, 24)).columns, 140))
+
+
+csv_option = click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+                          help="Also write the results to this CSV file (header names units).")
+json_option = click.option("--json", "as_json", is_flag=True, help="Print JSON instead of tables.")
+
+
+@click.group()
+def plate() -> None:
+    """Condensed-plate checks: 16/24-DOF elements, Irons/Guyan and IRS reduction,
+    exact Navier references, transient accuracy against cost (thesis 001, Part II)."""
+
+
+@plate.command("modes")
+@click.argument("preset")
+@click.option("--case", "case_name", help="Only this case (default: every case of the preset).")
+@click.option("--count", type=click.IntRange(1, 500), help="Number of lowest modes (default: the preset's).")
+@csv_option
+@json_option
+def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path | None, as_json: bool) -> None:
+    """Lowest natural frequencies of each case against the exact ones (eq. 40), and omega_max."""
+    from vtool.assessments.plate.model import build_model
+    from vtool.assessments.plate.report import modes_csv, modes_text
+    from vtool.assessments.plate.vibration import free_vibration
+
+    from vtool.files import write_atomic
+
+    spec = _load_plate_spec(preset)
+    plate_ = spec.study.plate
+    n = count or spec.study.frequencies
+    results = [(c, free_vibration(plate_, build_model(plate_, c), n)) for c in _cases(spec, case_name)]
+    if as_json:
+        click.echo(json.dumps([
+            {"case": c.name, "KS": f.size, "modes": [[m.m, m.n] for m in f.exact],
+             "exact_omega_rad_s": [m.omega for m in f.exact],
+             "omega_rad_s": f.omega[: len(f.exact)].tolist(), "errors_pct": f.errors_pct.tolist(),
+             "omega_max_over_omega11": f.omega_max_ratio} for c, f in results], indent=2))
+    else:
+        click.echo("\n\n".join(modes_text(f, c) for c, f in results))
+    if csv_path is not None:
+        text = "case,KS," + modes_csv(results[0][1]).splitlines()[0] + "\n"
+        for c, f in results:
+            text += "".join(f"{c.name},{f.size},{line}\n" for line in modes_csv(f).splitlines()[1:])
+        write_atomic(csv_path, text)
+        click.echo(f"wrote {csv_path}", err=True)
+
+
+def _chart(resp: Any, exact: Any, quantity: str, label: str) -> str:
+    import numpy as np
+    from vtool.app.plots import line_chart
+
+    series = {f"{resp.case} {resp.scheme}": getattr(resp, quantity)}
+    if exact is not None and not (quantity == "acceleration" and not exact.acceleration_converged):
+        series["exact"] = np.interp(resp.tau, exact.tau, getattr(exact, quantity))
+    return line_chart(resp.tau, series, title=f"centre {quantity}, {resp.load} step load",
+                      xlabel="t / T (exact fundamental period)", ylabel=label, width=_width(), height=18)
+
+
+LABELS = {"displacement": "w / (p0/(m w11^2))", "velocity": "v / (p0/(m w11))", "acceleration": "a / (p0/m)"}
+
+
+@plate.command("transient")
+@click.argument("preset")
+@click.option("--case", "case_name", help="Case to run (default: the preset's first case).")
+@click.option("--load", type=click.Choice(["uniform", "point"]), default="uniform", show_default=True,
+              help="Step pressure over the plate, or step force P = p0*a*b at the centre.")
+@click.option("--scheme", type=click.Choice(["rk4", "modal"]), default="rk4", show_default=True,
+              help="RK4 at --wh, or exact modal integration of the reduced model.")
+@click.option("--wh", type=float, default=1.0, show_default=True, callback=_wh,
+              help="omega_max*h, the RK4 step parameter (stable up to 2.8; adequate at 1).")
+@click.option("--periods", type=click.FloatRange(0.0, 20.0, min_open=True), default=None,
+              help="Duration in exact fundamental periods (default: the preset's).")
+@click.option("--modes", "exact_modes", type=click.IntRange(2, 5000), default=None,
+              help="Modes of the exact reference (default: the preset's).")
+@click.option("--plot/--no-plot", default=True, show_default=True, help="Draw the histories.")
+@csv_option
+@json_option
+def transient(preset: str, case_name: str | None, load: str, scheme: str, wh: float,
+              periods: float | None, exact_modes: int | None, plot: bool, csv_path: Path | None,
+              as_json: bool) -> None:
+    """Centre displacement, velocity and acceleration under a step load, against exact."""
+    from vtool.assessments.plate.model import build_model
+    from vtool.assessments.plate.report import exact_note, response_csv
+    from vtool.assessments.plate.transient import (
+        exact_histories,
+        halving_change_pct,
+        peak_errors,
+        run_modal,
+        run_rk4,
+    )
+
+    from vtool.files import write_atomic
+
+    spec = _load_plate_spec(preset)
+    settings = spec.study.transient
+    periods = periods or settings.periods
+    n_modes = exact_modes or settings.exact_modes
+    case = _cases(spec, case_name)[0]
+    plate_ = spec.study.plate
+    model = build_model(plate_, case)
+    exact = exact_histories(plate_, load, periods, n_modes)
+    if scheme == "rk4":
+        resp = run_rk4(plate_, model, load, wh, periods)
+        halving = halving_change_pct(plate_, model, load, wh, periods)
+    else:
+        resp = run_modal(plate_, model, load, exact.tau)
+        halving = {}
+    errors = peak_errors(resp, exact)
+    if as_json:
+        click.echo(json.dumps({
+            "case": case.name, "KS": model.size, "load": load, "scheme": scheme,
+            "omega_max_h": wh if scheme == "rk4" else None, "steps": resp.steps,
+            "step_s": resp.step if scheme == "rk4" else None, "seconds": resp.seconds,
+            "peak_errors_pct": {k: (None if v != v else v) for k, v in errors.items()},
+            "halving_change_pct": halving, "exact_modes": n_modes,
+            "exact_peak_change_pct": exact.change_pct,
+            "exact_acceleration_converged": exact.acceleration_converged,
+        }, indent=2))
+    else:
+        step = f"omega_max*h = {wh:g}, h = {resp.step:.4g} s, {resp.steps} steps" if scheme == "rk4" \
+            else f"exact modal integration of the reduced model at {resp.steps} times"
+        click.echo(f"case {case.name} ({case.element} {case.nx}x{case.ny}, KS = {model.size}), {load} step load, "
+                   f"{scheme}: {step}, {resp.seconds * 1e3:.2f} ms")
+        click.echo(f"{'quantity':<13} {'peak':>10} {'exact peak':>11} {'error %':>9}" +
+                   (f" {'halving h %':>12}" if halving else ""))
+        for q in ("displacement", "velocity", "acceleration"):
+            a = getattr(resp, q)
+            e = getattr(exact, q)
+            k = int(abs(e).argmax())
+            peak = a.max() if e[k] > 0 else a.min()
+            err = errors[q]
+            shown = "n/a" if err != err else f"{err:.3f}"
+            exact_shown = "n/a" if err != err else f"{e[k]:.4f}"
+            line = f"{q:<13} {peak:>10.4f} {exact_shown:>11} {shown:>9}"
+            if halving:
+                line += f" {halving[q]:>12.3f}"
+            click.echo(line)
+        click.echo(exact_note(exact))
+        if plot:
+            for q in ("displacement", "velocity", "acceleration"):
+                click.echo(_chart(resp, exact, q, LABELS[q]))
+    if csv_path is not None:
+        write_atomic(csv_path, response_csv(resp, exact))
+        click.echo(f"wrote {csv_path}", err=True)
+
+
+@plate.command("study")
+@click.argument("preset")
+@click.option("--transient/--no-transient", default=True, show_default=True,
+              help="Include the transient runs (Tables 4 and 5).")
+@click.option("--plot", is_flag=True, help="Draw the full model's histories against exact.")
+@csv_option
+@json_option
+def study(preset: str, transient: bool, plot: bool, csv_path: Path | None, as_json: bool) -> None:
+    """The thesis' Tables 2-5 regenerated: every case, its KS, errors and cost."""
+    spec = _load_plate_spec(preset)
+    solve_preset(spec, csv_path, plot, as_json, transient=transient)
+
+
+def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *,
+                 transient: bool = True) -> None:
+    """Run a plate preset's study: print its tables (or JSON), write CSV, draw charts.
+
+    The batch entry point ``vtool solve PRESET`` calls this for plate presets.
+    """
+    from vtool.assessments.plate.report import study_csv, study_dict, study_text
+    from vtool.assessments.plate.study import run_study
+
+    from vtool.files import write_atomic
+
+    result = run_study(spec.study, transient=transient)
+    if as_json:
+        doc = {"title": spec.title, "units": spec.units, **study_dict(result)}
+        click.echo(json.dumps(doc, indent=2))
+    else:
+        click.echo(spec.title)
+        click.echo(study_text(result))
+    if csv_path is not None:
+        write_atomic(csv_path, study_csv(result))
+        click.echo(f"wrote {csv_path}", err=True)
+    if plot and result.exact:
+        _plot_full_model(spec, result)
+
+
+def _plot_full_model(spec: Any, result: Any) -> None:
+    from vtool.assessments.plate.model import build_model
+    from vtool.assessments.plate.transient import run_rk4
+
+    settings = spec.study.transient
+    sizes = {r.case: r.size for r in result.transient}
+    full = max(settings.cases, key=lambda name: sizes.get(name, 0))
+    model = build_model(spec.study.plate, spec.study.case(full))
+    for load, exact in result.exact.items():
+        resp = run_rk4(spec.study.plate, model, load, 1.0, settings.periods)
+        for q in ("displacement", "velocity", "acceleration"):
+            click.echo(_chart(resp, exact, q, LABELS[q]))

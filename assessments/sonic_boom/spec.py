@@ -1,0 +1,115 @@
+"""Frozen specs of a sonic-boom study (what a ``boom_wall`` / ``boom_floor`` preset holds).
+
+Validation happens in :mod:`vtool.presets.boom`; these classes only carry
+the values, with their units named by :class:`UnitSystem`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from vtool.assessments.sonic_boom.criteria import Criterion
+from vtool.assessments.sonic_boom.pulses import PulseParams
+from vtool.assessments.sonic_boom.spectra import EnvelopeSpec
+
+
+@dataclass(frozen=True)
+class UnitSystem:
+    """A consistent unit system: lengths, forces, pressures, and g."""
+
+    name: str
+    length: str
+    force: str
+    pressure: str
+    surface_weight: str
+    gravity: float
+    metres_per_length: float
+    alt_pressure: str  # a second pressure unit engineers quote booms in
+    alt_per_pressure: float
+
+    @property
+    def mass(self) -> str:
+        return f"{self.force} s^2/{self.length}"
+
+
+UNIT_SYSTEMS: dict[str, UnitSystem] = {
+    # the thesis' system; g = 386.4 in/s^2 as in its arithmetic (section 1.5.2)
+    "in-lbf-s": UnitSystem("in-lbf-s", "in", "lbf", "psi", "lbf/in^2", 386.4, 0.0254,
+                           "lb/ft^2", 144.0),
+    "m-N-s": UnitSystem("m-N-s", "m", "N", "Pa", "N/m^2", 9.80665, 1.0, "kPa", 1e-3),
+}
+
+
+@dataclass(frozen=True)
+class BoomLoading:
+    """The boom: positive durations ``tau`` (s), and the pulse or envelope used.
+
+    Exactly one of ``pulse`` (an idealized type), ``pulse_csv`` (a tabulated
+    history) and ``envelope`` is set.
+    """
+
+    positive_durations: tuple[float, ...] = (0.1,)
+    pulse: PulseParams | None = None
+    pulse_csv: str | None = None
+    envelope: EnvelopeSpec | None = field(default_factory=EnvelopeSpec)
+    damping: float = 0.0
+
+
+@dataclass(frozen=True)
+class WallSpec:
+    """One wall. The plate height is ``height`` or ``net_area / base_width``."""
+
+    name: str
+    base_width: float
+    thickness: float
+    youngs_modulus: float
+    poisson_ratio: float
+    surface_weight: float
+    net_area: float | None = None
+    height: float | None = None
+    measured_frequency: float | None = None  # Hz
+
+
+@dataclass(frozen=True)
+class FloorSpec:
+    """Top floor of a multi-storey building on ``columns`` fixed-fixed columns."""
+
+    name: str
+    columns: int
+    youngs_modulus: float
+    moment_of_inertia: float
+    storey_height: float
+    face_width: float
+    floor_weight: float
+    measured_frequency: float | None = None  # Hz
+
+
+@dataclass(frozen=True)
+class DesignRange:
+    """Frequencies (Hz) for the design curves."""
+
+    f_min: float = 1.0
+    f_max: float = 50.0
+    points: int = 200
+
+
+@dataclass(frozen=True)
+class BoomWallSpec:
+    title: str
+    units: UnitSystem
+    boom: BoomLoading
+    walls: tuple[WallSpec, ...]
+    criteria: tuple[Criterion, ...]
+    design: DesignRange = DesignRange()
+    kind: str = "boom_wall"
+
+
+@dataclass(frozen=True)
+class BoomFloorSpec:
+    title: str
+    units: UnitSystem
+    boom: BoomLoading
+    floors: tuple[FloorSpec, ...]
+    criteria: tuple[Criterion, ...]
+    design: DesignRange = DesignRange()
+    kind: str = "boom_floor"

@@ -1,0 +1,226 @@
+"""Configurations: which clearances are closed, and the matrices each one needs.
+
+n clearances give 2ⁿ configurations. A configuration is a bit mask with
+contact = 1; clearance 1 (the first in the preset) is the leading bit, so for
+the thesis' three clearances ``mask + 1`` is its configuration number I–VIII
+(Gnilka 1971, Fig. 3.1: VII = 110 = cam and rocker closed). Pinned
+clearances are always closed, removed ones never.
+
+Partitioning one configuration
+------------------------------
+Closed internal clearances select the contact layer (see
+:mod:`vtool.solvers.layers`), with layer matrices M_L, C_L, K_L over the m
+layer coordinates. Each closed external clearance prescribes the layer
+coordinate of its ``ahead`` end to follow its source (cam, seat). With P the
+prescribed and F the free layer coordinates,
+
+    ⎡M_FF M_FP⎤ ⎧ä_F⎫   ⎡C_FF C_FP⎤ ⎧v_F⎫   ⎡K_FF K_FP⎤ ⎧x_F⎫   ⎧0  ⎫
+    ⎣M_PF M_PP⎦ ⎩ä_P⎭ + ⎣C_PF C_PP⎦ ⎩v_P⎭ + ⎣K_PF K_PP⎦ ⎩x_P⎭ = ⎩F_P⎭
+
+The F rows are integrated (the P columns move to the right-hand side: the
+thesis' ΔP, eqs. 3.32–3.34); the P rows give the external contact forces
+(eqs. 3.35–3.36).
+
+Contact forces on full coordinates
+----------------------------------
+With T the layer expansion (q = T q_L), the force on every full coordinate is
+taken as r = M T ä_L + M T M_L⁻¹ C_L v̇_L + K T q_L: the stiffness and inertia
+forces of the full system, and the layer's modal damping forces distributed
+in proportion to mass. Summed over a tied pair, r gives exactly the layer
+equation (Tᵀr = M_L ä + C_L v + K_L x), so the internal contact force on the
+ahead coordinate and the one on the behind coordinate are equal and opposite
+(thesis F8 = −F2). A contact force is r at the clearance's ``ahead``
+coordinate, positive in compression. (A coordinate that is the ahead end of
+an external clearance must not also be tied by an internal one.)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vtool.solvers.layers import Layer
+from vtool.solvers.model import Mechanism
+from vtool.solvers.spec import ENABLED, EXTERNAL, INTERNAL, PINNED, REMOVED, MechanismSpec
+
+ROMAN = ("I", "II", "III", "IV", "V", "VI", "VII", "VIII")
+
+HARMONIC_SOURCE = 0
+FIXED_SOURCE = 1
+
+
+def clearance_bit(spec: MechanismSpec, index: int) -> int:
+    """Bit of clearance ``index`` (0-based, preset order): clearance 1 leads."""
+    return 1 << (len(spec.clearances) - 1 - index)
+
+
+def mask_of(spec: MechanismSpec, closed: set[str] | frozenset[str] | tuple[str, ...]) -> int:
+    """Configuration mask with these clearances (and every pinned one) closed."""
+    mask = 0
+    for index, c in enumerate(spec.clearances):
+        if (c.name in closed or c.state == PINNED) and c.state != REMOVED:
+            mask |= clearance_bit(spec, index)
+    return mask
+
+
+def closed_names(spec: MechanismSpec, mask: int) -> tuple[str, ...]:
+    return tuple(c.name for i, c in enumerate(spec.clearances) if mask & clearance_bit(spec, i))
+
+
+def thesis_number(spec: MechanismSpec, mask: int) -> int | None:
+    """The thesis' configuration number 1–8 where it applies (three clearances)."""
+    return mask + 1 if len(spec.clearances) == 3 else None
+
+
+def configuration_label(spec: MechanismSpec, mask: int) -> str:
+    """'VII (cam+rocker)' for the thesis' three clearances, else the closed names."""
+    closed = "+".join(closed_names(spec, mask)) or "none"
+    number = thesis_number(spec, mask)
+    return f"{ROMAN[number - 1]} ({closed})" if number is not None else closed
+
+
+def sources(spec: MechanismSpec) -> list[tuple[int, int, tuple[float, float, float]]]:
+    """Prescribed coordinates: (coordinate number, kind, parameters), cam first.
+
+    The cam's parameters need the cam speed and offset, filled in by
+    :func:`source_parameters`.
+    """
+    result = [(spec.cam.coordinate, HARMONIC_SOURCE, (spec.cam.amplitude, 0.0, 0.0))]
+    if spec.seat is not None:
+        result.append((spec.seat.coordinate, FIXED_SOURCE, (spec.seat.position, 0.0, 0.0)))
+    return result
+
+
+def source_parameters(mechanism: Mechanism) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """(kind[ns], par[ns, 3], coordinate numbers) of the prescribed sources."""
+    entries = sources(mechanism.spec)
+    kinds = np.array([kind for _, kind, _ in entries], dtype=np.int64)
+    par = np.zeros((len(entries), 3))
+    for s, (_, kind, values) in enumerate(entries):
+        par[s] = values
+        if kind == HARMONIC_SOURCE:
+            par[s] = (mechanism.spec.cam.amplitude, mechanism.omega, mechanism.start.cam_offset)
+    return kinds, par, [number for number, _, _ in entries]
+
+
+@dataclass(frozen=True)
+class Partition:
+    """One configuration split into its layer, free and prescribed layer coordinates."""
+
+    layer: Layer
+    group: np.ndarray  # layer column of each full coordinate
+    free: list[int]
+    prescribed: list[int]
+    sources: list[int]  # source index of each prescribed column
+
+
+def partition(mechanism: Mechanism, mask: int) -> Partition:
+    """Layer of the closed internal clearances; closed external ones prescribe their ahead end."""
+    spec = mechanism.spec
+    closed = closed_names(spec, mask)
+    layer = mechanism.layer(frozenset(n for n in closed if spec.clearance(n).kind == INTERNAL))
+    group = np.argmax(layer.T, axis=1)
+    source_of = {number: s for s, (number, _, _) in enumerate(sources(spec))}
+    prescribed: dict[int, int] = {}
+    for c in spec.clearances:
+        if c.kind == EXTERNAL and c.name in closed:
+            prescribed[int(group[c.ahead - 1])] = source_of[c.behind]
+    pres = sorted(prescribed)
+    free = [j for j in range(layer.size) if j not in prescribed]
+    return Partition(layer, group, free, pres, [prescribed[j] for j in pres])
+
+
+def pair_compliance(mechanism: Mechanism, mask: int, ahead: int, behind: int) -> float:
+    """d²(q_ahead - q_behind)/dt² per unit pair force (+1 on ahead, -1 on behind) in ``mask``."""
+    part = partition(mechanism, mask)
+    g = np.zeros(mechanism.spec.n_coordinates)
+    g[ahead - 1], g[behind - 1] = 1.0, -1.0
+    g_layer = part.layer.T.T @ g
+    free = part.free
+    response = np.linalg.solve(part.layer.M[np.ix_(free, free)], g_layer[free])
+    return float(g_layer[free] @ response)
+
+
+@dataclass
+class ConfigurationTables:
+    """Padded per-configuration arrays for the kernel, filled in lazily by :meth:`build`."""
+
+    built: np.ndarray
+    m: np.ndarray
+    kept: np.ndarray
+    group: np.ndarray
+    nf: np.ndarray
+    free: np.ndarray
+    npres: np.ndarray
+    pres: np.ndarray
+    pres_src: np.ndarray
+    ML: np.ndarray
+    CL: np.ndarray
+    KL: np.ndarray
+    Sinv: np.ndarray
+    MinvFF: np.ndarray
+    Ra: np.ndarray
+    Rv: np.ndarray
+    Rx: np.ndarray
+    Wacc: np.ndarray  # [mask, clearance]: relative acceleration per unit pair force, clearance open
+
+    @classmethod
+    def empty(cls, n_configurations: int, n: int, n_clearances: int) -> ConfigurationTables:
+        def ints() -> np.ndarray:
+            return np.zeros((n_configurations, n), dtype=np.int64)
+
+        def mats() -> np.ndarray:
+            return np.zeros((n_configurations, n, n))
+
+        counts = [np.zeros(n_configurations, dtype=np.int64) for _ in range(3)]
+        return cls(
+            built=np.zeros(n_configurations, dtype=np.int64),
+            m=counts[0], kept=ints(), group=ints(), nf=counts[1], free=ints(),
+            npres=counts[2], pres=ints(), pres_src=ints(),
+            ML=mats(), CL=mats(), KL=mats(), Sinv=mats(), MinvFF=mats(), Ra=mats(), Rv=mats(), Rx=mats(),
+            Wacc=np.zeros((n_configurations, n_clearances)),
+        )
+
+    def build(self, mechanism: Mechanism, mask: int, dt: float, beta: float, gamma: float) -> list[int]:
+        """Partition configuration ``mask`` and precompute its matrices (BMIV for dt).
+
+        Returns the configurations the contact forces of this one also need
+        (each enabled internal clearance opened in turn) that are not built yet.
+        """
+        spec = mechanism.spec
+        part = partition(mechanism, mask)
+        layer, free, pres = part.layer, part.free, part.prescribed
+        m = layer.size
+        M_L, C_L, K_L = layer.M, layer.C, layer.K
+        M_FF = M_L[np.ix_(free, free)]
+        S = M_FF + gamma * dt * C_L[np.ix_(free, free)] + beta * dt * dt * K_L[np.ix_(free, free)]
+        nf, npres = len(free), len(pres)
+        self.m[mask], self.nf[mask], self.npres[mask] = m, nf, npres
+        self.kept[mask, :m] = [k - 1 for k in layer.kept]
+        self.group[mask, :] = part.group
+        self.free[mask, :nf] = free
+        self.pres[mask, :npres] = pres
+        self.pres_src[mask, :npres] = part.sources
+        self.ML[mask, :m, :m] = M_L
+        self.CL[mask, :m, :m] = C_L
+        self.KL[mask, :m, :m] = K_L
+        if nf:
+            self.Sinv[mask, :nf, :nf] = np.linalg.inv(S)
+            self.MinvFF[mask, :nf, :nf] = np.linalg.inv(M_FF)
+        MT = mechanism.M @ layer.T
+        self.Ra[mask, :, :m] = MT
+        self.Rv[mask, :, :m] = MT @ np.linalg.solve(M_L, C_L)
+        self.Rx[mask, :, :m] = mechanism.K @ layer.T
+        needed = []
+        for index, c in enumerate(spec.clearances):
+            bit = clearance_bit(spec, index)
+            if c.kind == INTERNAL and c.state == ENABLED and mask & bit:
+                self.Wacc[mask, index] = pair_compliance(mechanism, mask & ~bit, c.ahead, c.behind)
+                if not self.built[mask & ~bit]:
+                    needed.append(mask & ~bit)
+        self.built[mask] = 1
+        return needed
+
+    def configurations_built(self) -> list[int]:
+        return [int(c) for c in np.flatnonzero(self.built)]

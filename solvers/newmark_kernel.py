@@ -1,0 +1,646 @@
+"""Compiled Newmark integration of the valve train with clearances (numba).
+
+Everything the run loop touches lives in this one module (the numba cache
+misses edits in other files). The same source, run with
+``NUMBA_DISABLE_JIT=1``, is the plain-NumPy reference the tests compare the
+compiled kernel with.
+
+Conventions
+-----------
+Full coordinates: the n elastic system coordinates q_1..q_n (0-based here).
+Sources: prescribed motions (0: harmonic cam ``p0 sin(p1 t) + p2``; 1: fixed
+seat at ``p0``). A configuration ``c`` is a bit mask over the clearances
+(contact = 1). In configuration c the layer coordinates x_L (size m) are the
+full ones with every closed internal pair tied; ``group[c, i]`` is the layer
+column of full coordinate i and ``kept[c, j]`` a full coordinate of layer
+column j. Layer columns tied to a source (closed external clearance) are
+prescribed (P); the others are free (F).
+
+Newmark step of length h in configuration c (general beta, gamma):
+
+    x̃ = x + h v + h²(1/2 - beta) a,   ṽ = v + h(1 - gamma) a
+    S a_F = -C_FF ṽ_F - K_FF x̃_F - (M_FP a_P + C_FP v_P + K_FP x_P)     (ΔP)
+    S = M_FF + gamma h C_FF + beta h² K_FF          (thesis BMIV = S⁻¹)
+    x_F = x̃_F + beta h² a_F,   v_F = ṽ_F + gamma h a_F
+
+with the prescribed values (x_P, v_P, a_P) taken from the sources at t + h.
+
+Contact forces: the force on full coordinate i is
+``r_i = Ra[i] · a_L + Rv[i] · v_L + Rx[i] · x_L`` (see
+:mod:`vtool.solvers.configurations`); a clearance's contact force is r at its
+``ahead`` coordinate (positive in compression).
+
+Status codes returned by :func:`run_chunk` are the ``STATUS_*`` values in
+:mod:`vtool.solvers.newmark`, passed in as plain integers.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+jit = njit(cache=True, nogil=True)
+
+Problem = namedtuple(
+    "Problem",
+    [
+        "n",  # number of full (elastic) coordinates
+        "beta",
+        "gamma",
+        "dt",  # standard time step, s
+        "t_end",  # end of the run, s
+        "out_dt",  # output interval, s (ignored when every_step)
+        "every_step",  # 1: record every accepted (sub)step
+        "cl_ahead",  # int[ncl]: full index of the coordinate ahead when open
+        "cl_behind",  # int[ncl]: full index behind (internal) or -1
+        "cl_src",  # int[ncl]: source index behind (external) or -1
+        "cl_monitored",  # int[ncl]: 1 for enabled clearances (pinned/removed: 0)
+        "cl_pinned",  # int[ncl]: 1 for pinned clearances
+        "cl_e",  # float[ncl]: restitution coefficient
+        "cl_bit",  # int[ncl]: bit of the clearance in the configuration mask
+        "src_kind",  # int[ns]
+        "src_par",  # float[ns, 3]
+        "Minv",  # float[n, n]: inverse of the full mass matrix (impacts)
+        "time_tol",  # event location tolerance in time, s
+        "zeno_window",  # events closer than this count as rapid, s
+        "zeno_stick",  # rapid events before contacts are made to stick
+        "zeno_stop",  # rapid events before the run stops
+        "x_limit",  # |q| beyond this is divergence
+        "rest_velocity",  # slower separations and impacts are resting contacts
+    ],
+)
+
+Configs = namedtuple(
+    "Configs",
+    ["built", "m", "kept", "group", "nf", "free", "npres", "pres", "pres_src",
+     "ML", "CL", "KL", "Sinv", "MinvFF", "Ra", "Rv", "Rx", "Wacc"],
+)
+
+Output = namedtuple(
+    "Output",
+    ["t", "x", "v", "a", "F", "cfg", "ev_t", "ev_k", "ev_kind", "ev_u", "ev_from", "ev_to", "F_peak"],
+)
+
+Work = namedtuple(
+    "Work",
+    ["xl", "vl", "al", "rhs", "S", "Sinv", "x0", "v0", "a0", "x1", "v1", "a1",
+     "phi", "tau", "xo", "vo", "ao", "ah", "xl2", "vl2", "al2", "rhs2"],
+)
+
+# istate / fstate slots (documented in vtool.solvers.newmark)
+I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_ACCEL, I_WANT_CFG = range(9)
+F_T, F_LAST_EVENT, F_CHUNK_END = range(3)
+
+
+@jit
+def source_state(src_kind, src_par, s, t):
+    """Displacement, velocity and acceleration of prescribed source s at time t."""
+    if src_kind[s] == 0:
+        amp = src_par[s, 0]
+        w = src_par[s, 1]
+        sw = np.sin(w * t)
+        return amp * sw + src_par[s, 2], amp * w * np.cos(w * t), -amp * w * w * sw
+    return src_par[s, 0], 0.0, 0.0
+
+
+@jit
+def gather(cfg, c, x, v, a, xl, vl, al):
+    """Layer values of configuration c from full arrays (tied coordinates are equal)."""
+    for j in range(cfg.m[c]):
+        i = cfg.kept[c, j]
+        xl[j] = x[i]
+        vl[j] = v[i]
+        al[j] = a[i]
+
+
+@jit
+def scatter(prob, cfg, c, xl, vl, al, x, v, a):
+    for i in range(prob.n):
+        j = cfg.group[c, i]
+        x[i] = xl[j]
+        v[i] = vl[j]
+        a[i] = al[j]
+
+
+@jit
+def set_prescribed(prob, cfg, c, t, xl, vl, al):
+    for p in range(cfg.npres[c]):
+        j = cfg.pres[c, p]
+        xl[j], vl[j], al[j] = source_state(prob.src_kind, prob.src_par, cfg.pres_src[c, p], t)
+
+
+@jit
+def effective_inverse(prob, cfg, c, h, S, Sinv):
+    """Sinv = (M_FF + gamma h C_FF + beta h² K_FF)⁻¹ for a non-standard step h."""
+    nf = cfg.nf[c]
+    for f in range(nf):
+        jf = cfg.free[c, f]
+        for g in range(nf):
+            jg = cfg.free[c, g]
+            S[f, g] = (cfg.ML[c, jf, jg] + prob.gamma * h * cfg.CL[c, jf, jg]
+                       + prob.beta * h * h * cfg.KL[c, jf, jg])
+    Sinv[:nf, :nf] = np.linalg.inv(S[:nf, :nf])
+
+
+@jit
+def newmark_step(prob, cfg, c, t, h, Sinv, x, v, a, w, x1, v1, a1):
+    """One Newmark step of length h in configuration c from full (x, v, a) at t.
+
+    Writes the full state at t + h into (x1, v1, a1) and leaves the layer
+    state at t + h in (w.xl, w.vl, w.al) for the contact forces.
+    """
+    beta, gamma = prob.beta, prob.gamma
+    m, nf, npres = cfg.m[c], cfg.nf[c], cfg.npres[c]
+    xl, vl, al = w.xl, w.vl, w.al
+    gather(cfg, c, x, v, a, xl, vl, al)
+    for j in range(m):  # predictors x̃, ṽ (overwritten for prescribed columns)
+        xl[j] += h * vl[j] + h * h * (0.5 - beta) * al[j]
+        vl[j] += h * (1.0 - gamma) * al[j]
+    set_prescribed(prob, cfg, c, t + h, xl, vl, al)
+    for f in range(nf):
+        jf = cfg.free[c, f]
+        s = 0.0
+        for g in range(nf):
+            jg = cfg.free[c, g]
+            s -= cfg.CL[c, jf, jg] * vl[jg] + cfg.KL[c, jf, jg] * xl[jg]
+        for p in range(npres):  # the thesis' ΔP terms
+            jp = cfg.pres[c, p]
+            s -= cfg.ML[c, jf, jp] * al[jp] + cfg.CL[c, jf, jp] * vl[jp] + cfg.KL[c, jf, jp] * xl[jp]
+        w.rhs[f] = s
+    for f in range(nf):
+        s = 0.0
+        for g in range(nf):
+            s += Sinv[f, g] * w.rhs[g]
+        jf = cfg.free[c, f]
+        al[jf] = s
+        xl[jf] += beta * h * h * s
+        vl[jf] += gamma * h * s
+    scatter(prob, cfg, c, xl, vl, al, x1, v1, a1)
+
+
+@jit
+def coordinate_force(cfg, c, i, xl, vl, al):
+    """Force on full coordinate i from the layer state (see module doc)."""
+    s = 0.0
+    for j in range(cfg.m[c]):
+        s += cfg.Ra[c, i, j] * al[j] + cfg.Rv[c, i, j] * vl[j] + cfg.Rx[c, i, j] * xl[j]
+    return s
+
+
+@jit
+def gap(prob, k, t, x):
+    """q[ahead] - q[behind] of clearance k (positive while open)."""
+    behind = 0.0
+    if prob.cl_behind[k] >= 0:
+        behind = x[prob.cl_behind[k]]
+    else:
+        behind = source_state(prob.src_kind, prob.src_par, prob.cl_src[k], t)[0]
+    return x[prob.cl_ahead[k]] - behind
+
+
+@jit
+def consistent_acceleration(prob, cfg, c, t, x, v, a, xl, vl, al, rhs):
+    """Accelerations (into a) from the equations of motion of configuration c at t.
+
+    Uses the layer scratch arrays (xl, vl, al, rhs) given, so a caller can
+    keep another layer state alive.
+    """
+    gather(cfg, c, x, v, a, xl, vl, al)
+    set_prescribed(prob, cfg, c, t, xl, vl, al)
+    nf, npres = cfg.nf[c], cfg.npres[c]
+    for f in range(nf):
+        jf = cfg.free[c, f]
+        s = 0.0
+        for g in range(nf):
+            jg = cfg.free[c, g]
+            s -= cfg.CL[c, jf, jg] * vl[jg] + cfg.KL[c, jf, jg] * xl[jg]
+        for p in range(npres):
+            jp = cfg.pres[c, p]
+            s -= cfg.ML[c, jf, jp] * al[jp] + cfg.CL[c, jf, jp] * vl[jp] + cfg.KL[c, jf, jp] * xl[jp]
+        rhs[f] = s
+    for f in range(nf):
+        s = 0.0
+        for g in range(nf):
+            s += cfg.MinvFF[c, f, g] * rhs[g]
+        al[cfg.free[c, f]] = s
+    for i in range(prob.n):
+        a[i] = al[cfg.group[c, i]]
+
+
+@jit
+def relative_acceleration(prob, k, t, a):
+    """d²(gap)/dt² of clearance k from full accelerations a."""
+    if prob.cl_behind[k] >= 0:
+        return a[prob.cl_ahead[k]] - a[prob.cl_behind[k]]
+    return a[prob.cl_ahead[k]] - source_state(prob.src_kind, prob.src_par, prob.cl_src[k], t)[2]
+
+
+@jit
+def open_relative_acceleration(prob, cfg, c, k, t, x, v, w):
+    """Relative acceleration clearance k would have if it opened now (config c without k)."""
+    c_open = c & ~prob.cl_bit[k]
+    consistent_acceleration(prob, cfg, c_open, t, x, v, w.ah, w.xl2, w.vl2, w.al2, w.rhs2)
+    return relative_acceleration(prob, k, t, w.ah)
+
+
+@jit
+def contact_force(prob, cfg, c, k, t, x, v, xl, vl, al, w):
+    """Contact force of closed clearance k, positive in compression.
+
+    External clearances: the prescribed row's force (thesis eqs. 3.35–3.36).
+    Enabled internal clearances: the pair force that keeps the clearance shut
+    under the equations of the configuration in which it is open,
+    -(relative acceleration there) / Wacc[c, k], Wacc being the relative
+    acceleration a unit pair force produces. The layers carry different modal
+    damping matrices, so this is the definition under which "the force
+    reaches zero" and "opening is consistent" are the same instant (with the
+    closed layer's own force the two disagree and the contact chatters).
+    Pinned internal clearances: the force on the ahead coordinate in the
+    tied layer.
+    """
+    if prob.cl_monitored[k] and prob.cl_behind[k] >= 0:
+        return -open_relative_acceleration(prob, cfg, c, k, t, x, v, w) / cfg.Wacc[c, k]
+    return coordinate_force(cfg, c, prob.cl_ahead[k], xl, vl, al)
+
+
+@jit
+def monitor(prob, cfg, c, k, t, x, v, xl, vl, al, w):
+    """The value whose sign change flips clearance k: its contact force if closed, its gap if open."""
+    if c & prob.cl_bit[k]:
+        return contact_force(prob, cfg, c, k, t, x, v, xl, vl, al, w)
+    return gap(prob, k, t, x)
+
+
+@jit
+def step_to(prob, cfg, c, t, h, x, v, a, w, x1, v1, a1):
+    """A Newmark step of any length h (standard steps reuse the stored inverse)."""
+    if abs(h - prob.dt) <= 1e-12 * prob.dt:
+        newmark_step(prob, cfg, c, t, h, cfg.Sinv[c], x, v, a, w, x1, v1, a1)
+    else:
+        effective_inverse(prob, cfg, c, h, w.S, w.Sinv)
+        newmark_step(prob, cfg, c, t, h, w.Sinv, x, v, a, w, x1, v1, a1)
+
+
+@jit
+def locate_event(prob, cfg, c, k, t, h, phi_lo, phi_hi, x, v, a, w):
+    """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from t.
+
+    Illinois (modified regula falsi) on phi(tau) = monitor after a Newmark
+    step of length tau, bracketed by phi(0) >= 0 > phi(h); returns the left
+    end of the final bracket (the monitor still non-negative), within
+    prob.time_tol of the crossing.
+    """
+    lo, hi = 0.0, h
+    flo, fhi = phi_lo, phi_hi
+    side = 0
+    for _ in range(200):
+        if hi - lo <= prob.time_tol:
+            break
+        tau = (lo * fhi - hi * flo) / (fhi - flo) if fhi != flo else 0.5 * (lo + hi)
+        margin = 0.01 * (hi - lo)
+        if not (lo + margin < tau < hi - margin):
+            tau = 0.5 * (lo + hi)
+        step_to(prob, cfg, c, t, tau, x, v, a, w, w.x1, w.v1, w.a1)
+        f = monitor(prob, cfg, c, k, t + tau, w.x1, w.v1, w.xl, w.vl, w.al, w)
+        if f < 0.0:
+            hi, fhi = tau, f
+            if side == -1:
+                flo *= 0.5
+            side = -1
+        else:
+            lo, flo = tau, f
+            if side == 1:
+                fhi *= 0.5
+            side = 1
+    return lo
+
+
+@jit
+def record(prob, cfg, c, t, x, v, a, w, out, row):
+    """Write one output row: coordinates, sources, and contact forces at t."""
+    n = prob.n
+    ns = prob.src_kind.shape[0]
+    out.t[row] = t
+    out.cfg[row] = c
+    for i in range(n):
+        out.x[row, i] = x[i]
+        out.v[row, i] = v[i]
+        out.a[row, i] = a[i]
+    for s in range(ns):
+        xs, vs, as_ = source_state(prob.src_kind, prob.src_par, s, t)
+        out.x[row, n + s] = xs
+        out.v[row, n + s] = vs
+        out.a[row, n + s] = as_
+    gather(cfg, c, x, v, a, w.xl, w.vl, w.al)
+    set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
+    for k in range(prob.cl_ahead.shape[0]):
+        if c & prob.cl_bit[k]:
+            out.F[row, k] = contact_force(prob, cfg, c, k, t, x, v, w.xl, w.vl, w.al, w)
+        else:
+            out.F[row, k] = 0.0
+
+
+@jit
+def record_outputs(prob, cfg, c, t0, h, istate, out, w):
+    """Record every output instant in (t0, t0 + h] by the linear-acceleration interpolant.
+
+    Within a step the acceleration is taken linear (exact for beta = 1/6),
+    so v and x are its quadratic and cubic integrals (thesis eqs. B.3–B.5).
+    Returns False when the output buffer is full.
+    """
+    n = prob.n
+    t1 = t0 + h
+    if prob.every_step:
+        row = istate[I_NOUT]
+        if row >= out.t.shape[0]:
+            return False
+        record(prob, cfg, c, t1, w.x1, w.v1, w.a1, w, out, row)
+        istate[I_NOUT] = row + 1
+        return True
+    while True:
+        j = istate[I_NEXT_OUT]
+        t_out = j * prob.out_dt
+        if t_out > t1 + 1e-9 * prob.dt or t_out > prob.t_end + 1e-9 * prob.dt:
+            return True
+        row = istate[I_NOUT]
+        if row >= out.t.shape[0]:
+            return False
+        tau = t_out - t0
+        r = tau / h if h > 0 else 0.0
+        for i in range(n):
+            da = w.a1[i] - w.a0[i]
+            w.ao[i] = w.a0[i] + da * r
+            w.vo[i] = w.v0[i] + w.a0[i] * tau + da * tau * r / 2.0
+            w.xo[i] = w.x0[i] + w.v0[i] * tau + w.a0[i] * tau * tau / 2.0 + da * tau * tau * r / 6.0
+        record(prob, cfg, c, t_out, w.xo, w.vo, w.ao, w, out, row)
+        istate[I_NOUT] = row + 1
+        istate[I_NEXT_OUT] = j + 1
+
+
+@jit
+def add_event(out, istate, t, k, kind, u, c_from, c_to):
+    row = istate[I_NEV]
+    if row < out.ev_t.shape[0]:
+        out.ev_t[row] = t
+        out.ev_k[row] = k
+        out.ev_kind[row] = kind
+        out.ev_u[row] = u
+        out.ev_from[row] = c_from
+        out.ev_to[row] = c_to
+    istate[I_NEV] = row + 1
+
+
+@jit
+def impact(prob, c, closing, t, x, v, stick, out, istate):
+    """Newton impact with restitution at the closing clearances; returns the new mask.
+
+    Contacts taking part: every clearance closed in c (persistent) and the
+    closing ones. With G their velocity-constraint rows (internal:
+    e_ahead - e_behind; external: e_ahead), relative velocities u = G v - w
+    (w: source velocity) and the Delassus matrix W = G M⁻¹ Gᵀ, the impulses P
+    solve the linear complementarity problem
+
+        u⁺ = u⁻ + W P,   P >= 0,   u⁺ - b >= 0,   P · (u⁺ - b) = 0
+
+    with b = -e u⁻ for a closing contact (Newton's law) and b = 0 for a
+    persistent one (it may separate, but not penetrate); pinned clearances are
+    equalities. Then v⁺ = v⁻ + M⁻¹ Gᵀ P conserves generalised momentum. The
+    LCP (W positive definite) has one solution, found by enumerating the
+    active sets. A contact is closed afterwards when it leaves with no
+    separating relative velocity (plastic or grazing); a closing contact that bounces
+    (e > 0) and a persistent one that the impulse pulls apart are open, and
+    the latter is recorded as released.
+
+    Resting contacts: with consistent mass matrices an impulse at one end of a
+    bar moves the other end backwards (M⁻¹ has negative off-diagonal terms),
+    so a cam impact on a pushrod squeezed against the rocker "releases" the
+    rocker at a tiny speed, the rocker re-impacts within picoseconds, releases
+    the cam, and so on without end. Any separation (or bounce) slower than
+    ``prob.rest_velocity`` is therefore a resting contact: it becomes an
+    equality with zero relative velocity (plastic), and whether it really
+    separates is then decided smoothly by its contact force at the next
+    step. The kinetic energy this can change is at most of order
+    m v_rest², and none is created (an equality row with u⁻ = u⁺ = 0 does no
+    work). In ``stick`` mode (chattering) restitution is taken as zero.
+    """
+    n = prob.n
+    ncl = prob.cl_ahead.shape[0]
+    idx = np.empty(ncl, dtype=np.int64)
+    nc = 0
+    for k in range(ncl):
+        if (c & prob.cl_bit[k]) or closing[k]:
+            idx[nc] = k
+            nc += 1
+    G = np.zeros((nc, n))
+    u = np.zeros(nc)
+    b = np.zeros(nc)
+    eq = np.zeros(nc, dtype=np.int64)
+    for r in range(nc):
+        k = idx[r]
+        G[r, prob.cl_ahead[k]] = 1.0
+        wsrc = 0.0
+        if prob.cl_behind[k] >= 0:
+            G[r, prob.cl_behind[k]] -= 1.0
+        else:
+            wsrc = source_state(prob.src_kind, prob.src_par, prob.cl_src[k], t)[1]
+        for i in range(n):
+            u[r] += G[r, i] * v[i]
+        u[r] -= wsrc
+        if closing[k]:
+            e = 0.0 if (stick or abs(u[r]) < prob.rest_velocity) else prob.cl_e[k]
+            b[r] = -e * u[r]
+        eq[r] = prob.cl_pinned[k]
+    MG = prob.Minv @ G.T
+    W = G @ MG
+    scale = 1e-12 + 1e-9 * np.max(np.abs(u)) if nc > 0 else 1e-12
+    P = np.zeros(nc)
+    uplus = u.copy()
+    for _ in range(nc + 1):
+        P, uplus = solve_impulse_lcp(W, u, b, eq, scale)
+        resting = False
+        for r in range(nc):  # slow separations are resting contacts: they stay closed
+            if not eq[r] and 10.0 * scale < uplus[r] < prob.rest_velocity:
+                eq[r] = 1
+                b[r] = 0.0
+                resting = True
+        if not resting:
+            break
+    dv = MG @ P
+    for i in range(n):
+        v[i] += dv[i]
+    mask = c
+    for r in range(nc):
+        k = idx[r]
+        if closing[k]:  # snap the gap shut at the event (it is within the time tolerance)
+            if prob.cl_behind[k] >= 0:
+                x[prob.cl_ahead[k]] = x[prob.cl_behind[k]]
+            else:
+                x[prob.cl_ahead[k]] = source_state(prob.src_kind, prob.src_par, prob.cl_src[k], t)[0]
+        stays = eq[r] or uplus[r] <= 10.0 * scale  # no separating velocity: in contact
+        if stays:
+            mask |= prob.cl_bit[k]
+        else:
+            mask &= ~prob.cl_bit[k]
+    for r in range(nc):
+        k = idx[r]
+        if closing[k]:
+            add_event(out, istate, t, k, 1, u[r], c, mask)
+        elif not (mask & prob.cl_bit[k]):
+            add_event(out, istate, t, k, 2, uplus[r], c, mask)
+    return mask
+
+
+@jit
+def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
+    """Integrate from fstate[F_T] until t_end, the chunk end, or something Python must do.
+
+    ``codes`` = (FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED,
+    CHATTER): the status returned. (x, v, a) is the full state at fstate[F_T]
+    in configuration istate[I_CFG]; everything needed to resume is in the
+    arguments, so Python may build a configuration or grow a buffer and
+    call again.
+    """
+    FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED, CHATTER = codes
+    ncl = prob.cl_ahead.shape[0]
+    n = prob.n
+    closing = np.zeros(ncl, dtype=np.int64)
+    while True:
+        t = fstate[F_T]
+        c = istate[I_CFG]
+        if not cfg.built[c]:
+            istate[I_WANT_CFG] = c
+            return NEED_CONFIG
+        if istate[I_NEED_ACCEL]:
+            consistent_acceleration(prob, cfg, c, t, x, v, a, w.xl, w.vl, w.al, w.rhs)
+            istate[I_NEED_ACCEL] = 0
+            if istate[I_NOUT] == 0 and istate[I_NEXT_OUT] == 0:
+                record(prob, cfg, c, t, x, v, a, w, out, 0)
+                istate[I_NOUT] = 1
+                istate[I_NEXT_OUT] = 1
+        if t >= prob.t_end - 1e-9 * prob.dt:
+            return FINISHED
+        if t >= fstate[F_CHUNK_END]:
+            return CHUNK_END
+        grid_next = (istate[I_GRID] + 1) * prob.dt
+        h = min(grid_next, prob.t_end) - t
+        if h <= 1e-9 * prob.dt:  # already on the grid point
+            istate[I_GRID] += 1
+            continue
+        step_to(prob, cfg, c, t, h, x, v, a, w, w.x1, w.v1, w.a1)
+        fired = False
+        for k in range(ncl):
+            w.tau[k] = 2.0 * h
+            if prob.cl_monitored[k]:
+                w.phi[k] = monitor(prob, cfg, c, k, t + h, w.x1, w.v1, w.xl, w.vl, w.al, w)
+                if w.phi[k] < 0.0:
+                    fired = True
+        if fired:  # locate every sign change; the earliest is taken
+            tau_min = 2.0 * h
+            for k in range(ncl):
+                if prob.cl_monitored[k] and w.phi[k] < 0.0:
+                    gather(cfg, c, x, v, a, w.xl, w.vl, w.al)
+                    set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
+                    phi0 = monitor(prob, cfg, c, k, t, x, v, w.xl, w.vl, w.al, w)
+                    if phi0 < 0.0:
+                        w.tau[k] = 0.0
+                    else:
+                        w.tau[k] = locate_event(prob, cfg, c, k, t, h, phi0, w.phi[k], x, v, a, w)
+                    tau_min = min(tau_min, w.tau[k])
+            h = tau_min
+            if h > 0.0:
+                step_to(prob, cfg, c, t, h, x, v, a, w, w.x1, w.v1, w.a1)
+            else:
+                w.x1[:] = x
+                w.v1[:] = v
+                w.a1[:] = a
+        # accept the (sub)step: peak forces at its end, outputs inside it
+        if h > 0.0:
+            for k in range(ncl):
+                if c & prob.cl_bit[k]:
+                    f = contact_force(prob, cfg, c, k, t + h, w.x1, w.v1, w.xl, w.vl, w.al, w)
+                    if f > out.F_peak[k]:
+                        out.F_peak[k] = f
+        w.x0[:] = x
+        w.v0[:] = v
+        w.a0[:] = a
+        if h > 0.0:
+            if not record_outputs(prob, cfg, c, t, h, istate, out, w):
+                return OUTPUT_FULL
+            istate[I_STEPS] += 1
+        x[:] = w.x1
+        v[:] = w.v1
+        a[:] = w.a1
+        t = t + h
+        fstate[F_T] = t
+        if abs(t - grid_next) <= 1e-9 * prob.dt:
+            istate[I_GRID] += 1
+            fstate[F_T] = grid_next
+            t = grid_next
+        for i in range(n):
+            if not (abs(x[i]) <= prob.x_limit):
+                return DIVERGED
+        if not fired:
+            continue
+        # the events at the earliest time (within the tolerance)
+        new_c = c
+        any_closing = False
+        for k in range(ncl):
+            closing[k] = 0
+            if prob.cl_monitored[k] and w.tau[k] <= h + prob.time_tol:
+                if c & prob.cl_bit[k]:
+                    new_c &= ~prob.cl_bit[k]
+                else:
+                    closing[k] = 1
+                    any_closing = True
+        rapid = t - fstate[F_LAST_EVENT] <= prob.zeno_window
+        istate[I_RAPID] = istate[I_RAPID] + 1 if rapid else 0
+        fstate[F_LAST_EVENT] = t
+        if istate[I_RAPID] >= prob.zeno_stop:
+            return CHATTER
+        stick = istate[I_RAPID] >= prob.zeno_stick
+        for k in range(ncl):
+            if (c & prob.cl_bit[k]) and not (new_c & prob.cl_bit[k]):
+                add_event(out, istate, t, k, 0, 0.0, c, new_c)
+        if any_closing:
+            new_c = impact(prob, new_c, closing, t, x, v, stick, out, istate)
+        istate[I_CFG] = new_c
+        istate[I_NEED_ACCEL] = 1
+
+
+@jit
+def solve_impulse_lcp(W, u, b, eq, scale):
+    """Impulses P >= 0 with u + W P - b >= 0 and complementarity (equalities: = b).
+
+    Enumerates active sets, most contacts first; W is positive definite, so
+    exactly one set satisfies the conditions (to the tolerance ``scale``).
+    Returns (P, u⁺).
+    """
+    nc = u.shape[0]
+    for pattern in range(2**nc - 1, -1, -1):
+        Pt = np.zeros(nc)
+        active = np.zeros(nc, dtype=np.int64)
+        na = 0
+        for r in range(nc):
+            if eq[r] or (pattern >> r) & 1:
+                active[na] = r
+                na += 1
+        if na > 0:
+            Wa = np.empty((na, na))
+            ra = np.empty(na)
+            for p in range(na):
+                ra[p] = b[active[p]] - u[active[p]]
+                for q in range(na):
+                    Wa[p, q] = W[active[p], active[q]]
+            sol = np.linalg.solve(Wa, ra)
+            for p in range(na):
+                Pt[active[p]] = sol[p]
+        ut = u + W @ Pt
+        ok = True
+        for r in range(nc):
+            if not eq[r] and (Pt[r] * W[r, r] < -10.0 * scale or ut[r] - b[r] < -10.0 * scale):
+                ok = False
+        if ok:
+            return Pt, ut
+    return np.zeros(nc), u.copy()
