@@ -131,15 +131,44 @@ def partition(mechanism: Mechanism, mask: int) -> Partition:
     return Partition(layer, group, free, pres, [prescribed[j] for j in pres])
 
 
-def pair_compliance(mechanism: Mechanism, mask: int, ahead: int, behind: int) -> float:
-    """d²(q_ahead - q_behind)/dt² per unit pair force (+1 on ahead, -1 on behind) in ``mask``."""
-    part = partition(mechanism, mask)
-    g = np.zeros(mechanism.spec.n_coordinates)
+def internal_force_coefficients(
+    mechanism: Mechanism, mask: int, ahead: int, behind: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Coefficients of an internal clearance's contact force while it is closed in ``mask``.
+
+    The force is the pair force (+λ on ahead, -λ on behind) that keeps the
+    clearance shut under the equations of the configuration in which it is
+    open (``mask`` without it): with that configuration's free accelerations
+    a_F = M_FF⁻¹ (f_F - C_FF v_F - K_FF x_F - M_FP a_P - C_FP v_P - K_FP x_P)
+    and w selecting ahead minus behind, λ = -(wᵀ a)|_(λ=0) / (w_Fᵀ M_FF⁻¹ w_F).
+    This is linear in the full state and the sources, so it is returned as
+    (fx[n], fv[n], fs[ns, 3]) with λ = fx·q + fv·q̇ + Σ_s fs[s]·(q_s, q̇_s, q̈_s).
+    """
+    spec = mechanism.spec
+    bit = next(clearance_bit(spec, i) for i, c in enumerate(spec.clearances)
+               if (c.ahead, c.behind) == (ahead, behind))
+    part = partition(mechanism, mask & ~bit)
+    layer, free, pres = part.layer, part.free, part.prescribed
+    g = np.zeros(spec.n_coordinates)
     g[ahead - 1], g[behind - 1] = 1.0, -1.0
-    g_layer = part.layer.T.T @ g
-    free = part.free
-    response = np.linalg.solve(part.layer.M[np.ix_(free, free)], g_layer[free])
-    return float(g_layer[free] @ response)
+    w = layer.T.T @ g  # selection over the open layer's coordinates
+    M, C, K = layer.M, layer.C, layer.K
+    row = np.linalg.solve(M[np.ix_(free, free)], w[free])  # M_FF⁻¹ w_F (M symmetric)
+    scale = -1.0 / float(w[free] @ row)  # λ = scale * (relative acceleration with λ = 0)
+    fx = np.zeros(spec.n_coordinates)
+    fv = np.zeros(spec.n_coordinates)
+    kept = [k - 1 for k in layer.kept]
+    coeff_x = -row @ K[np.ix_(free, free)]
+    coeff_v = -row @ C[np.ix_(free, free)]
+    for f, j in enumerate(free):
+        fx[kept[j]] += scale * coeff_x[f]
+        fv[kept[j]] += scale * coeff_v[f]
+    fs = np.zeros((len(sources(spec)), 3))
+    for p, (j, source) in enumerate(zip(pres, part.sources, strict=True)):
+        fs[source, 0] += scale * -(row @ K[free, j])
+        fs[source, 1] += scale * -(row @ C[free, j])
+        fs[source, 2] += scale * (w[j] - row @ M[free, j])
+    return fx, fv, fs
 
 
 @dataclass
@@ -160,13 +189,10 @@ class ConfigurationTables:
     KL: np.ndarray
     Sinv: np.ndarray
     MinvFF: np.ndarray
-    Ra: np.ndarray
-    Rv: np.ndarray
-    Rx: np.ndarray
-    Wacc: np.ndarray  # [mask, clearance]: relative acceleration per unit pair force, clearance open
+    Frow: np.ndarray  # [mask, clearance, 3n + 3ns]: contact force on (q, q̇, q̈, sources)
 
     @classmethod
-    def empty(cls, n_configurations: int, n: int, n_clearances: int) -> ConfigurationTables:
+    def empty(cls, n_configurations: int, n: int, n_clearances: int, n_sources: int) -> ConfigurationTables:
         def ints() -> np.ndarray:
             return np.zeros((n_configurations, n), dtype=np.int64)
 
@@ -178,16 +204,12 @@ class ConfigurationTables:
             built=np.zeros(n_configurations, dtype=np.int64),
             m=counts[0], kept=ints(), group=ints(), nf=counts[1], free=ints(),
             npres=counts[2], pres=ints(), pres_src=ints(),
-            ML=mats(), CL=mats(), KL=mats(), Sinv=mats(), MinvFF=mats(), Ra=mats(), Rv=mats(), Rx=mats(),
-            Wacc=np.zeros((n_configurations, n_clearances)),
+            ML=mats(), CL=mats(), KL=mats(), Sinv=mats(), MinvFF=mats(),
+            Frow=np.zeros((n_configurations, n_clearances, 3 * n + 3 * n_sources)),
         )
 
-    def build(self, mechanism: Mechanism, mask: int, dt: float, beta: float, gamma: float) -> list[int]:
-        """Partition configuration ``mask`` and precompute its matrices (BMIV for dt).
-
-        Returns the configurations the contact forces of this one also need
-        (each enabled internal clearance opened in turn) that are not built yet.
-        """
+    def build(self, mechanism: Mechanism, mask: int, dt: float, beta: float, gamma: float) -> None:
+        """Partition configuration ``mask`` and precompute its matrices (BMIV for dt)."""
         spec = mechanism.spec
         part = partition(mechanism, mask)
         layer, free, pres = part.layer, part.free, part.prescribed
@@ -197,7 +219,8 @@ class ConfigurationTables:
         S = M_FF + gamma * dt * C_L[np.ix_(free, free)] + beta * dt * dt * K_L[np.ix_(free, free)]
         nf, npres = len(free), len(pres)
         self.m[mask], self.nf[mask], self.npres[mask] = m, nf, npres
-        self.kept[mask, :m] = [k - 1 for k in layer.kept]
+        kept_full = [k - 1 for k in layer.kept]
+        self.kept[mask, :m] = kept_full
         self.group[mask, :] = part.group
         self.free[mask, :nf] = free
         self.pres[mask, :npres] = pres
@@ -208,19 +231,23 @@ class ConfigurationTables:
         if nf:
             self.Sinv[mask, :nf, :nf] = np.linalg.inv(S)
             self.MinvFF[mask, :nf, :nf] = np.linalg.inv(M_FF)
+        n = spec.n_coordinates
         MT = mechanism.M @ layer.T
-        self.Ra[mask, :, :m] = MT
-        self.Rv[mask, :, :m] = MT @ np.linalg.solve(M_L, C_L)
-        self.Rx[mask, :, :m] = mechanism.K @ layer.T
-        needed = []
+        row_x, row_v, row_a = mechanism.K @ layer.T, MT @ np.linalg.solve(M_L, C_L), MT
         for index, c in enumerate(spec.clearances):
-            bit = clearance_bit(spec, index)
-            if c.kind == INTERNAL and c.state == ENABLED and mask & bit:
-                self.Wacc[mask, index] = pair_compliance(mechanism, mask & ~bit, c.ahead, c.behind)
-                if not self.built[mask & ~bit]:
-                    needed.append(mask & ~bit)
+            if not mask & clearance_bit(spec, index):
+                continue
+            frow = self.Frow[mask, index]
+            if c.kind == INTERNAL and c.state == ENABLED:
+                fx, fv, fs = internal_force_coefficients(mechanism, mask, c.ahead, c.behind)
+                frow[:n], frow[n:2 * n], frow[3 * n:] = fx, fv, fs.ravel()
+            else:  # the row force r at the ahead coordinate, on layer values = full values at kept
+                i = c.ahead - 1
+                for j, full in enumerate(kept_full):
+                    frow[full] += row_x[i, j]
+                    frow[n + full] += row_v[i, j]
+                    frow[2 * n + full] += row_a[i, j]
         self.built[mask] = 1
-        return needed
 
     def configurations_built(self) -> list[int]:
         return [int(c) for c in np.flatnonzero(self.built)]

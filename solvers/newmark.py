@@ -177,7 +177,7 @@ class _KernelRun:
             x_limit=1e3 * x_scale,
             rest_velocity=options.rest_velocity or 1e-5 * spec.cam.amplitude * omega,
         )
-        self.tables = ConfigurationTables.empty(2**ncl, n, ncl)
+        self.tables = ConfigurationTables.empty(2**ncl, n, ncl, len(self.source_numbers))
         # the kernel sees the same arrays, so configurations built later are visible to it
         self.kernel_tables = kernel.Configs(*(getattr(self.tables, f) for f in kernel.Configs._fields))
         self.n_steps = int(math.ceil(t_end / dt - 1e-9))
@@ -189,8 +189,7 @@ class _KernelRun:
             xl=np.zeros(n), vl=np.zeros(n), al=np.zeros(n), rhs=np.zeros(n), S=np.zeros((n, n)),
             Sinv=np.zeros((n, n)), x0=np.zeros(n), v0=np.zeros(n), a0=np.zeros(n), x1=np.zeros(n),
             v1=np.zeros(n), a1=np.zeros(n), phi=np.zeros(ncl), tau=np.zeros(ncl), xo=np.zeros(n),
-            vo=np.zeros(n), ao=np.zeros(n), ah=np.zeros(n), xl2=np.zeros(n), vl2=np.zeros(n),
-            al2=np.zeros(n), rhs2=np.zeros(n),
+            vo=np.zeros(n), ao=np.zeros(n),
         )
         start = mechanism.start
         self.x, self.v, self.a = start.q.copy(), start.qd.copy(), start.qdd.copy()
@@ -257,13 +256,8 @@ class _KernelRun:
                 raise RunError(f"cancelled at t = {t:.6g} s")
 
     def _build(self, mask: int) -> None:
-        """Build a configuration and the ones its contact forces need."""
         o = self.options
-        pending = [mask]
-        while pending:
-            current = pending.pop()
-            if not self.tables.built[current]:
-                pending += self.tables.build(self.mechanism, current, o.time_step, o.beta, o.gamma)
+        self.tables.build(self.mechanism, mask, o.time_step, o.beta, o.gamma)
 
     def _where(self, what: str, t: float) -> str:
         spec = self.mechanism.spec

@@ -25,10 +25,9 @@ Newmark step of length h in configuration c (general beta, gamma):
 
 with the prescribed values (x_P, v_P, a_P) taken from the sources at t + h.
 
-Contact forces: the force on full coordinate i is
-``r_i = Ra[i] · a_L + Rv[i] · v_L + Rx[i] · x_L`` (see
-:mod:`vtool.solvers.configurations`); a clearance's contact force is r at its
-``ahead`` coordinate (positive in compression).
+Contact forces: one row of coefficients per (configuration, clearance) on
+the full state and the sources (see :mod:`vtool.solvers.configurations`),
+positive in compression.
 
 Status codes returned by :func:`run_chunk` are the ``STATUS_*`` values in
 :mod:`vtool.solvers.newmark`, passed in as plain integers.
@@ -42,6 +41,7 @@ import numpy as np
 from numba import njit
 
 jit = njit(cache=True, nogil=True)
+leaf = njit(cache=True, nogil=True, inline="always")
 
 Problem = namedtuple(
     "Problem",
@@ -75,7 +75,7 @@ Problem = namedtuple(
 Configs = namedtuple(
     "Configs",
     ["built", "m", "kept", "group", "nf", "free", "npres", "pres", "pres_src",
-     "ML", "CL", "KL", "Sinv", "MinvFF", "Ra", "Rv", "Rx", "Wacc"],
+     "ML", "CL", "KL", "Sinv", "MinvFF", "Frow"],
 )
 
 Output = namedtuple(
@@ -86,7 +86,7 @@ Output = namedtuple(
 Work = namedtuple(
     "Work",
     ["xl", "vl", "al", "rhs", "S", "Sinv", "x0", "v0", "a0", "x1", "v1", "a1",
-     "phi", "tau", "xo", "vo", "ao", "ah", "xl2", "vl2", "al2", "rhs2"],
+     "phi", "tau", "xo", "vo", "ao"],
 )
 
 # istate / fstate slots (documented in vtool.solvers.newmark)
@@ -94,7 +94,7 @@ I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_ACCEL, I_WANT
 F_T, F_LAST_EVENT, F_CHUNK_END = range(3)
 
 
-@jit
+@leaf
 def source_state(src_kind, src_par, s, t):
     """Displacement, velocity and acceleration of prescribed source s at time t."""
     if src_kind[s] == 0:
@@ -105,7 +105,7 @@ def source_state(src_kind, src_par, s, t):
     return src_par[s, 0], 0.0, 0.0
 
 
-@jit
+@leaf
 def gather(cfg, c, x, v, a, xl, vl, al):
     """Layer values of configuration c from full arrays (tied coordinates are equal)."""
     for j in range(cfg.m[c]):
@@ -115,7 +115,7 @@ def gather(cfg, c, x, v, a, xl, vl, al):
         al[j] = a[i]
 
 
-@jit
+@leaf
 def scatter(prob, cfg, c, xl, vl, al, x, v, a):
     for i in range(prob.n):
         j = cfg.group[c, i]
@@ -124,7 +124,7 @@ def scatter(prob, cfg, c, xl, vl, al, x, v, a):
         a[i] = al[j]
 
 
-@jit
+@leaf
 def set_prescribed(prob, cfg, c, t, xl, vl, al):
     for p in range(cfg.npres[c]):
         j = cfg.pres[c, p]
@@ -144,7 +144,7 @@ def effective_inverse(prob, cfg, c, h, S, Sinv):
     Sinv[:nf, :nf] = np.linalg.inv(S[:nf, :nf])
 
 
-@jit
+@leaf
 def newmark_step(prob, cfg, c, t, h, Sinv, x, v, a, w, x1, v1, a1):
     """One Newmark step of length h in configuration c from full (x, v, a) at t.
 
@@ -180,16 +180,7 @@ def newmark_step(prob, cfg, c, t, h, Sinv, x, v, a, w, x1, v1, a1):
     scatter(prob, cfg, c, xl, vl, al, x1, v1, a1)
 
 
-@jit
-def coordinate_force(cfg, c, i, xl, vl, al):
-    """Force on full coordinate i from the layer state (see module doc)."""
-    s = 0.0
-    for j in range(cfg.m[c]):
-        s += cfg.Ra[c, i, j] * al[j] + cfg.Rv[c, i, j] * vl[j] + cfg.Rx[c, i, j] * xl[j]
-    return s
-
-
-@jit
+@leaf
 def gap(prob, k, t, x):
     """q[ahead] - q[behind] of clearance k (positive while open)."""
     behind = 0.0
@@ -200,7 +191,7 @@ def gap(prob, k, t, x):
     return x[prob.cl_ahead[k]] - behind
 
 
-@jit
+@leaf
 def consistent_acceleration(prob, cfg, c, t, x, v, a, xl, vl, al, rhs):
     """Accelerations (into a) from the equations of motion of configuration c at t.
 
@@ -229,54 +220,36 @@ def consistent_acceleration(prob, cfg, c, t, x, v, a, xl, vl, al, rhs):
         a[i] = al[cfg.group[c, i]]
 
 
-@jit
-def relative_acceleration(prob, k, t, a):
-    """d²(gap)/dt² of clearance k from full accelerations a."""
-    if prob.cl_behind[k] >= 0:
-        return a[prob.cl_ahead[k]] - a[prob.cl_behind[k]]
-    return a[prob.cl_ahead[k]] - source_state(prob.src_kind, prob.src_par, prob.cl_src[k], t)[2]
+@leaf
+def contact_force(prob, cfg, c, k, t, x, v, a):
+    """Contact force of clearance k in configuration c, positive in compression.
 
-
-@jit
-def open_relative_acceleration(prob, cfg, c, k, t, x, v, w):
-    """Relative acceleration clearance k would have if it opened now (config c without k)."""
-    c_open = c & ~prob.cl_bit[k]
-    consistent_acceleration(prob, cfg, c_open, t, x, v, w.ah, w.xl2, w.vl2, w.al2, w.rhs2)
-    return relative_acceleration(prob, k, t, w.ah)
-
-
-@jit
-def contact_force(prob, cfg, c, k, t, x, v, xl, vl, al, w):
-    """Contact force of closed clearance k, positive in compression.
-
-    External clearances: the prescribed row's force (thesis eqs. 3.35–3.36).
-    Enabled internal clearances: the pair force that keeps the clearance shut
-    under the equations of the configuration in which it is open,
-    -(relative acceleration there) / Wacc[c, k], Wacc being the relative
-    acceleration a unit pair force produces. The layers carry different modal
-    damping matrices, so this is the definition under which "the force
-    reaches zero" and "opening is consistent" are the same instant (with the
-    closed layer's own force the two disagree and the contact chatters).
-    Pinned internal clearances: the force on the ahead coordinate in the
-    tied layer.
+    A row of coefficients per (configuration, clearance) on the full state
+    and the sources (see :mod:`vtool.solvers.configurations`); zero when open.
     """
-    if prob.cl_monitored[k] and prob.cl_behind[k] >= 0:
-        return -open_relative_acceleration(prob, cfg, c, k, t, x, v, w) / cfg.Wacc[c, k]
-    return coordinate_force(cfg, c, prob.cl_ahead[k], xl, vl, al)
+    n = prob.n
+    s = 0.0
+    for i in range(n):
+        s += cfg.Frow[c, k, i] * x[i] + cfg.Frow[c, k, n + i] * v[i] + cfg.Frow[c, k, 2 * n + i] * a[i]
+    for src in range(prob.src_kind.shape[0]):
+        xs, vs, as_ = source_state(prob.src_kind, prob.src_par, src, t)
+        j = 3 * n + 3 * src
+        s += cfg.Frow[c, k, j] * xs + cfg.Frow[c, k, j + 1] * vs + cfg.Frow[c, k, j + 2] * as_
+    return s
 
 
-@jit
-def monitor(prob, cfg, c, k, t, x, v, xl, vl, al, w):
+@leaf
+def monitor(prob, cfg, c, k, t, x, v, a):
     """The value whose sign change flips clearance k: its contact force if closed, its gap if open."""
     if c & prob.cl_bit[k]:
-        return contact_force(prob, cfg, c, k, t, x, v, xl, vl, al, w)
+        return contact_force(prob, cfg, c, k, t, x, v, a)
     return gap(prob, k, t, x)
 
 
-@jit
+@leaf
 def step_to(prob, cfg, c, t, h, x, v, a, w, x1, v1, a1):
     """A Newmark step of any length h (standard steps reuse the stored inverse)."""
-    if abs(h - prob.dt) <= 1e-12 * prob.dt:
+    if h == prob.dt:
         newmark_step(prob, cfg, c, t, h, cfg.Sinv[c], x, v, a, w, x1, v1, a1)
     else:
         effective_inverse(prob, cfg, c, h, w.S, w.Sinv)
@@ -303,7 +276,7 @@ def locate_event(prob, cfg, c, k, t, h, phi_lo, phi_hi, x, v, a, w):
         if not (lo + margin < tau < hi - margin):
             tau = 0.5 * (lo + hi)
         step_to(prob, cfg, c, t, tau, x, v, a, w, w.x1, w.v1, w.a1)
-        f = monitor(prob, cfg, c, k, t + tau, w.x1, w.v1, w.xl, w.vl, w.al, w)
+        f = monitor(prob, cfg, c, k, t + tau, w.x1, w.v1, w.a1)
         if f < 0.0:
             hi, fhi = tau, f
             if side == -1:
@@ -319,27 +292,28 @@ def locate_event(prob, cfg, c, k, t, h, phi_lo, phi_hi, x, v, a, w):
 
 @jit
 def record(prob, cfg, c, t, x, v, a, w, out, row):
-    """Write one output row: coordinates, sources, and contact forces at t."""
+    """Write one output row at t: coordinates, sources and contact forces.
+
+    The prescribed coordinates of configuration c are first set exactly from
+    their sources (an interpolated state only approximates them).
+    """
     n = prob.n
-    ns = prob.src_kind.shape[0]
+    gather(cfg, c, x, v, a, w.xl, w.vl, w.al)
+    set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
+    scatter(prob, cfg, c, w.xl, w.vl, w.al, x, v, a)
     out.t[row] = t
     out.cfg[row] = c
     for i in range(n):
         out.x[row, i] = x[i]
         out.v[row, i] = v[i]
         out.a[row, i] = a[i]
-    for s in range(ns):
+    for s in range(prob.src_kind.shape[0]):
         xs, vs, as_ = source_state(prob.src_kind, prob.src_par, s, t)
         out.x[row, n + s] = xs
         out.v[row, n + s] = vs
         out.a[row, n + s] = as_
-    gather(cfg, c, x, v, a, w.xl, w.vl, w.al)
-    set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
     for k in range(prob.cl_ahead.shape[0]):
-        if c & prob.cl_bit[k]:
-            out.F[row, k] = contact_force(prob, cfg, c, k, t, x, v, w.xl, w.vl, w.al, w)
-        else:
-            out.F[row, k] = 0.0
+        out.F[row, k] = contact_force(prob, cfg, c, k, t, x, v, a) if c & prob.cl_bit[k] else 0.0
 
 
 @jit
@@ -493,6 +467,45 @@ def impact(prob, c, closing, t, x, v, stick, out, istate):
 
 
 @jit
+def advance(prob, cfg, c, x, v, a, w, istate, fstate, out):
+    """Standard steps in configuration c while nothing happens (the hot loop).
+
+    Stops, without taking it, at the first step that would end off the grid
+    or past the chunk, cross an output instant, change a monitor's sign or
+    leave the divergence limit; :func:`run_chunk` then takes that step with
+    full handling. Kept small so numba can prune its reference counting.
+    """
+    ncl = prob.cl_ahead.shape[0]
+    dt = prob.dt
+    while True:
+        t = fstate[F_T]
+        k_grid = istate[I_GRID]
+        if t != k_grid * dt or t + dt > prob.t_end or t >= fstate[F_CHUNK_END]:
+            return
+        if prob.every_step or istate[I_NEXT_OUT] * prob.out_dt <= t + dt + 1e-9 * dt:
+            return
+        newmark_step(prob, cfg, c, t, dt, cfg.Sinv[c], x, v, a, w, w.x1, w.v1, w.a1)
+        for k in range(ncl):
+            if c & prob.cl_bit[k] or prob.cl_monitored[k]:
+                w.phi[k] = monitor(prob, cfg, c, k, t + dt, w.x1, w.v1, w.a1)
+                if prob.cl_monitored[k] and w.phi[k] < 0.0:
+                    return
+        for i in range(prob.n):
+            if not (abs(w.x1[i]) <= prob.x_limit):
+                return
+        for k in range(ncl):
+            if c & prob.cl_bit[k] and w.phi[k] > out.F_peak[k]:
+                out.F_peak[k] = w.phi[k]
+        for i in range(prob.n):
+            x[i] = w.x1[i]
+            v[i] = w.v1[i]
+            a[i] = w.a1[i]
+        istate[I_GRID] = k_grid + 1
+        istate[I_STEPS] += 1
+        fstate[F_T] = (k_grid + 1) * dt
+
+
+@jit
 def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
     """Integrate from fstate[F_T] until t_end, the chunk end, or something Python must do.
 
@@ -523,17 +536,27 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
             return FINISHED
         if t >= fstate[F_CHUNK_END]:
             return CHUNK_END
+        advance(prob, cfg, c, x, v, a, w, istate, fstate, out)
+        t = fstate[F_T]
+        if t >= prob.t_end - 1e-9 * prob.dt:
+            return FINISHED
+        if t >= fstate[F_CHUNK_END]:
+            return CHUNK_END
         grid_next = (istate[I_GRID] + 1) * prob.dt
-        h = min(grid_next, prob.t_end) - t
+        if t == istate[I_GRID] * prob.dt:  # on the grid: a standard step (exactly dt)
+            h = min(prob.dt, prob.t_end - t)
+        else:  # after an event: the rest of the step, back onto the grid
+            h = min(grid_next, prob.t_end) - t
         if h <= 1e-9 * prob.dt:  # already on the grid point
             istate[I_GRID] += 1
+            fstate[F_T] = istate[I_GRID] * prob.dt
             continue
         step_to(prob, cfg, c, t, h, x, v, a, w, w.x1, w.v1, w.a1)
         fired = False
         for k in range(ncl):
             w.tau[k] = 2.0 * h
             if prob.cl_monitored[k]:
-                w.phi[k] = monitor(prob, cfg, c, k, t + h, w.x1, w.v1, w.xl, w.vl, w.al, w)
+                w.phi[k] = monitor(prob, cfg, c, k, t + h, w.x1, w.v1, w.a1)
                 if w.phi[k] < 0.0:
                     fired = True
         if fired:  # locate every sign change; the earliest is taken
@@ -542,7 +565,7 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
                 if prob.cl_monitored[k] and w.phi[k] < 0.0:
                     gather(cfg, c, x, v, a, w.xl, w.vl, w.al)
                     set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
-                    phi0 = monitor(prob, cfg, c, k, t, x, v, w.xl, w.vl, w.al, w)
+                    phi0 = monitor(prob, cfg, c, k, t, x, v, a)
                     if phi0 < 0.0:
                         w.tau[k] = 0.0
                     else:
@@ -559,14 +582,17 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
         if h > 0.0:
             for k in range(ncl):
                 if c & prob.cl_bit[k]:
-                    f = contact_force(prob, cfg, c, k, t + h, w.x1, w.v1, w.xl, w.vl, w.al, w)
+                    f = w.phi[k]  # the monitor already holds it (unless an event moved the step end)
+                    if fired or not prob.cl_monitored[k]:
+                        f = contact_force(prob, cfg, c, k, t + h, w.x1, w.v1, w.a1)
                     if f > out.F_peak[k]:
                         out.F_peak[k] = f
         w.x0[:] = x
         w.v0[:] = v
         w.a0[:] = a
         if h > 0.0:
-            if not record_outputs(prob, cfg, c, t, h, istate, out, w):
+            due = prob.every_step or istate[I_NEXT_OUT] * prob.out_dt <= t + h + 1e-9 * prob.dt
+            if due and not record_outputs(prob, cfg, c, t, h, istate, out, w):
                 return OUTPUT_FULL
             istate[I_STEPS] += 1
         x[:] = w.x1
