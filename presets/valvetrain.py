@@ -8,6 +8,7 @@ preset round-trips. See ``presets/gnilka-1a.toml`` for a commented example.
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 from vtool.errors import InputError
@@ -59,7 +60,7 @@ def load(doc: dict[str, Any]) -> MechanismSpec:
     names = {c.name: c for c in clearances}
     initial = _initial(top.table("initial"), names, units)  # type: ignore[arg-type]
     damping = _damping(top.table("damping", required=False), names)
-    run = _run(top.table("run"))  # type: ignore[arg-type]
+    run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances))  # type: ignore[arg-type]
     top.finish()
     return MechanismSpec(
         title=title,
@@ -244,7 +245,32 @@ def _damping(t: Table | None, names: dict[str, ClearanceSpec]) -> DampingSpec:
     return DampingSpec(factor, default_ratio, tuple(layers))
 
 
-def _run(t: Table) -> RunSpec:
+def _quantity_names(coordinates, cam, seat, clearances) -> tuple[set[int], set[int]]:  # type: ignore[no-untyped-def]
+    numbers = {c.number for c in coordinates} | {cam.coordinate} | ({seat.coordinate} if seat else set())
+    return numbers, {c.ahead for c in clearances}
+
+
+QUANTITY = re.compile(r"q(\d+)(?:-q(\d+))?|F(\d+)")
+
+
+def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...]:
+    value = t.raw("quantities", [])
+    expected = (f"a list of 'q<i>', 'q<i>-q<j>' (i, j in {sorted(numbers)}) or 'F<i>' "
+                f"(i in {sorted(forces)})")
+    if not isinstance(value, list):
+        raise InputError(t.field("quantities"), value, expected)
+    for item in value:
+        match = QUANTITY.fullmatch(item) if isinstance(item, str) else None
+        ok = match is not None and (
+            (match[3] is not None and int(match[3]) in forces)
+            or (match[1] is not None and int(match[1]) in numbers and (match[2] is None or int(match[2]) in numbers))
+        )
+        if not ok:
+            raise InputError(t.field("quantities"), item, expected)
+    return tuple(value)
+
+
+def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
     rpm = t.number("rpm", unit="rev/min", min_exclusive=0.0)
     degrees = t.number("degrees", unit="deg", min_exclusive=0.0)
     time_step = t.number("time_step", unit="s", min_exclusive=0.0)
@@ -252,8 +278,9 @@ def _run(t: Table) -> RunSpec:
     output_interval = t.number("output_interval", unit="deg", default=1.0, min_exclusive=0.0)
     beta = t.number("beta", default=1.0 / 6.0, min_exclusive=0.0, max_value=0.5)
     gamma = t.number("gamma", default=0.5, min_value=0.5, max_value=1.0)
+    quantities = _quantities(t, *names)
     t.finish()
-    return RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma)
+    return RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities)
 
 
 def dump(spec: MechanismSpec) -> dict[str, Any]:
@@ -306,4 +333,17 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         "rpm": r.rpm, "degrees": r.degrees, "time_step": r.time_step, "backend": r.backend,
         "output_interval": r.output_interval, "beta": r.beta, "gamma": r.gamma,
     }
+    if r.quantities:
+        doc["run"]["quantities"] = list(r.quantities)
     return doc
+
+
+def with_run_overrides(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
+    """The spec with some [run] settings changed, validated like a preset.
+
+    ``changes`` uses the preset's [run] keys (rpm, degrees, time_step, backend,
+    output_interval, beta, gamma); ``None`` values are ignored.
+    """
+    doc = dump(spec)
+    doc["run"].update({key: value for key, value in changes.items() if value is not None})
+    return load(doc)

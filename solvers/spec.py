@@ -168,6 +168,7 @@ class RunSpec:
     output_interval: float = 1.0  # degrees of cam rotation between output rows
     beta: float = 1.0 / 6.0
     gamma: float = 0.5
+    quantities: tuple[str, ...] = ()  # extra CSV/plot columns: "q7", "q1-q9", "F2"
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from vtool.files import write_atomic
 from vtool.solvers.configurations import closed_names, configuration_label, thesis_number
 from vtool.solvers.spec import EXTERNAL, MechanismSpec
 
@@ -135,6 +136,10 @@ class Trace:
             buffer.write(f",{'' if number is None else number},{names}\n")
         return buffer.getvalue()
 
+    def write_csv(self, path: str, quantities: tuple[str, ...] | None = None) -> None:
+        """Write :meth:`csv_text` atomically (the preset's quantities by default)."""
+        write_atomic(path, self.csv_text(self.spec.run.quantities if quantities is None else quantities))
+
     # ----- summary -----
     def events_at(self, clearance: str, kinds: tuple[str, ...]) -> list[Event]:
         return [e for e in self.events if e.clearance == clearance and e.kind in kinds]
@@ -179,7 +184,13 @@ class Trace:
             "steps": stats.steps,
             "events": stats.events,
             "wall_time_s": stats.wall_time,
-            "configurations_visited": [configuration_label(self.spec, m) for m in stats.configurations_built],
+            "configurations_built": [configuration_label(self.spec, m) for m in stats.configurations_built],
+            "events_list": [
+                {"time_s": e.time, "cam_angle_deg": e.cam_angle, "clearance": e.clearance, "kind": e.kind,
+                 "relative_velocity": e.relative_velocity,
+                 "before": configuration_label(self.spec, e.before), "after": configuration_label(self.spec, e.after)}
+                for e in self.events
+            ],
             "clearances": clearances,
         }
 
@@ -189,7 +200,7 @@ class Trace:
         lines = [s["title"], f"back end {s['backend']}: " + ", ".join(f"{k} = {v}" for k, v in s["settings"].items())]
         lines.append(
             f"steps {s['steps']}, events {s['events']}, wall time {s['wall_time_s']:.3f} s, "
-            f"configurations visited: {', '.join(s['configurations_visited'])}"
+            f"configurations built: {', '.join(s['configurations_built'])}"
         )
         lines.append("")
         lines.append(f"{'clearance':<10} {'force':<6} {'state':<8} {'separations':>11} {'impacts':>8} "

@@ -1,0 +1,32 @@
+"""A progress bar for runs longer than a second (stderr, nothing for short runs)."""
+
+from __future__ import annotations
+
+import time
+
+import click
+
+
+class DelayedProgress:
+    """Callable taking the fraction done; draws a bar only once a second has passed."""
+
+    def __init__(self, label: str, delay: float = 1.0) -> None:
+        self.label = label
+        self.delay = delay
+        self.started = time.perf_counter()
+        self.bar = None
+        self.shown = 0
+
+    def __call__(self, fraction: float) -> None:
+        if self.bar is None:
+            if time.perf_counter() - self.started < self.delay:
+                return
+            self.bar = click.progressbar(length=1000, label=self.label, file=click.get_text_stream("stderr"))
+            self.bar.__enter__()
+        done = int(1000 * min(max(fraction, 0.0), 1.0))
+        self.bar.update(done - self.shown)
+        self.shown = done
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.__exit__(None, None, None)
