@@ -150,6 +150,13 @@ def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
         density = t.number("density", unit=units.density, **opt)  # type: ignore[arg-type]
         stiffness = t.number("stiffness", unit=units.stiffness, **opt)  # type: ignore[arg-type]
         mass = t.number("mass", unit=units.mass, **opt)  # type: ignore[arg-type]
+        position = None
+        if t.has("position"):
+            raw = t.numbers("position", unit=units.length)
+            if len(raw) != 2:
+                raise InputError(t.field("position"), raw, "two numbers [x, y]", units.length)
+            position = (raw[0], raw[1])
+        direction = t.number("direction", unit="deg", default=0.0)
         t.finish()
         where = t.path
         if element == BEAM and stiffness is not None:
@@ -164,7 +171,7 @@ def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
             raise InputError(f"{where}.specific_weight", None, "a specific_weight, density or mass > 0", units.specific_weight)
         members.append(
             MemberSpec(name, element, length, tuple(coords), modulus, diameter, area, inertia,
-                       specific_weight, density, stiffness, mass)
+                       specific_weight, density, stiffness, mass, position, direction)
         )
     if not members:
         raise InputError("members", {}, "at least one [members.NAME] table")
@@ -299,6 +306,9 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
             if value is not None:
                 entry[key] = value
         entry["coordinates"] = list(m.coordinates)
+        if m.position is not None:
+            entry["position"] = list(m.position)
+            entry["direction"] = m.direction
         members[m.name] = entry
     doc["members"] = members
     cam = spec.cam

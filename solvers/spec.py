@@ -52,7 +52,9 @@ class MemberSpec:
     ``inertia`` for beams). The mass per volume by ``specific_weight`` (divided
     by g) or ``density``. ``stiffness`` (bars: axial stiffness) and ``mass``
     (total member mass), when given, override the values from the section,
-    as the valve spring needs.
+    as the valve spring needs. ``position`` and ``direction`` place the member
+    in the plane for drawings and animations only (bars move along their axis,
+    beams deflect at +90 degrees to it); they do not enter the dynamics.
     """
 
     name: str
@@ -67,6 +69,8 @@ class MemberSpec:
     density: float | None = None
     stiffness: float | None = None
     mass: float | None = None
+    position: tuple[float, float] | None = None  # drawing only: end a in the plane (length units)
+    direction: float = 0.0  # drawing only: axis from end a to end b, degrees from +x
 
 
 @dataclass(frozen=True)
