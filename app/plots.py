@@ -62,3 +62,43 @@ def line_chart(
     if not color:
         text = plt.uncolorize(text)
     return text
+
+
+def shape_chart(
+    shapes: Mapping[str, tuple[Sequence[float] | np.ndarray, Sequence[float] | np.ndarray]],
+    *,
+    title: str = "",
+    xlabel: str = "",
+    ylabel: str = "",
+    width: int = 100,
+    height: int = 22,
+    color: bool = True,
+    xlim: tuple[float, float] | None = None,
+    ylim: tuple[float, float] | None = None,
+) -> str:
+    """Polylines in the plane (one series per named shape), as text.
+
+    For drawings such as a deformed mechanism: each shape is ``(x, y)``;
+    fixed ``xlim`` / ``ylim`` keep the frame still between animation frames.
+    """
+    import plotext as plt
+
+    with _LOCK:
+        plt.clf()
+        plt.plotsize(max(int(width), 20), max(int(height), 8))
+        plt.theme("pro" if color else "clear")
+        for label, (xs, ys) in shapes.items():
+            plt.plot(np.asarray(xs, dtype=float).tolist(), np.asarray(ys, dtype=float).tolist(),
+                     label=label, marker="braille")
+        if xlim is not None:
+            plt.xlim(*xlim)
+        if ylim is not None:
+            plt.ylim(*ylim)
+        plt.title(title)
+        plt.xlabel(xlabel)
+        plt.ylabel(ylabel)
+        text = plt.build()
+        plt.clf()
+    if not color:
+        text = plt.uncolorize(text)
+    return text

@@ -15,7 +15,7 @@ Method (see the kernel's docstring for the equations):
   the gap of every open one are checked. A sign change is located by
   re-stepping from the start of the step (Illinois root finding on the
   Newmark solution itself, not on an interpolant) to within
-  ``time_tolerance`` (default 1e-9 of the time step: 1e-15 s at 1 µs); when
+  ``time_tolerance`` (default 1e-6 of the time step: 1e-12 s at 1 µs); when
   several monitors change sign in one step the earliest event is taken first
   and the rest of the step is integrated in the new configuration.
 * Impacts: Newton's law with a restitution coefficient per clearance, with
@@ -81,7 +81,7 @@ class NewmarkOptions:
     gamma: float = 0.5
     output_interval: float = 1.0  # degrees of cam rotation
     every_step: bool = False
-    time_tolerance: float | None = None  # s; default 1e-9 * time_step
+    time_tolerance: float | None = None  # s; default 1e-6 * time_step
     rest_velocity: float | None = None  # length/s; default 1e-5 of the velocity scale (see _KernelRun)
     zeno_stick: int = 20
     zeno_stop: int = 400
@@ -178,7 +178,7 @@ class _KernelRun:
             cl_bit=np.array([clearance_bit(spec, i) for i in range(ncl)], dtype=np.int64),
             src_kind=kinds, src_par=par,
             Minv=np.linalg.inv(mechanism.M),
-            time_tol=options.time_tolerance or 1e-9 * dt,
+            time_tol=options.time_tolerance or 1e-6 * dt,
             zeno_window=1e-3 * dt, zeno_stick=options.zeno_stick, zeno_stop=options.zeno_stop,
             x_limit=1e3 * x_scale,
             rest_velocity=options.rest_velocity or 1e-5 * self.velocity_scale(),

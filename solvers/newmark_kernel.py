@@ -261,20 +261,28 @@ def locate_event(prob, cfg, c, k, t, h, phi_lo, phi_hi, x, v, a, w):
     """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from t.
 
     Illinois (modified regula falsi) on phi(tau) = monitor after a Newmark
-    step of length tau, bracketed by phi(0) >= 0 > phi(h); returns the left
-    end of the final bracket (the monitor still non-negative), within
+    step of length tau, bracketed by phi(0) >= 0 > phi(h), with a bisection
+    whenever two iterations have not halved the bracket; returns the left end
+    of the final bracket (the monitor still non-negative), within
     prob.time_tol of the crossing.
     """
     lo, hi = 0.0, h
     flo, fhi = phi_lo, phi_hi
     side = 0
-    for _ in range(200):
-        if hi - lo <= prob.time_tol:
+    width_before = 2.0 * h
+    for iteration in range(200):
+        width = hi - lo
+        if width <= prob.time_tol:
             break
-        tau = (lo * fhi - hi * flo) / (fhi - flo) if fhi != flo else 0.5 * (lo + hi)
-        margin = 0.01 * (hi - lo)
-        if not (lo + margin < tau < hi - margin):
-            tau = 0.5 * (lo + hi)
+        if iteration % 2 == 0:
+            if width > 0.5 * width_before:
+                tau = 0.5 * (lo + hi)  # slow progress: bisect
+            else:
+                tau = (lo * fhi - hi * flo) / (fhi - flo)
+            width_before = width
+        else:
+            tau = (lo * fhi - hi * flo) / (fhi - flo)
+        tau = min(max(tau, lo + 0.25 * prob.time_tol), hi - 0.25 * prob.time_tol)
         step_to(prob, cfg, c, t, tau, x, v, a, w, w.x1, w.v1, w.a1)
         f = monitor(prob, cfg, c, k, t + tau, w.x1, w.v1, w.a1)
         if f < 0.0:
@@ -566,6 +574,8 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
                     gather(cfg, c, x, v, a, w.xl, w.vl, w.al)
                     set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
                     phi0 = monitor(prob, cfg, c, k, t, x, v, a)
+                    if phi0 < 0.0 and not (c & prob.cl_bit[k]):
+                        phi0 = 0.0  # a gap a hair below zero at the start (just released): round-off
                     if phi0 < 0.0:
                         w.tau[k] = 0.0
                     else:
