@@ -1,0 +1,304 @@
+"""What every domain screen shares: the form, the run worker's life cycle, presets and export.
+
+A domain screen (valve train, sonic boom, plate) says which loader turns
+its document into a spec, which fields the form shows, how a run is done
+in a worker and how its results are drawn and exported. This base class
+does the rest the same way on every screen:
+
+* every edit re-validates the whole document through the preset loader
+  (the CLI's messages, shown beside the field); an invalid form blocks
+  the run, the save and shows why;
+* a run is a thread worker (``exclusive``: a new run cancels the old);
+  its failure reaches :meth:`on_worker_state_changed`, the one place that
+  turns worker errors into the error dialog;
+* results carry the run id, so a late message from a cancelled run is ignored.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, ClassVar
+
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Horizontal, Vertical
+from textual.screen import Screen
+from textual.widgets import Footer, ProgressBar, Static, TabbedContent
+from textual.worker import Worker, WorkerState
+
+from vtool.app.tui.dialogs import PathDialog
+from vtool.app.tui.form import Field, ParamForm
+from vtool.app.tui.messages import FieldEdited, RunProgressed
+from vtool.errors import InputError
+
+
+class FormProblem:
+    """A validation failure that is not an InputError (shown above the form)."""
+
+    def __init__(self, message: str) -> None:
+        self.field = ""
+        self.message = message
+
+    def one_line(self) -> str:
+        return self.message
+
+
+class DomainScreen(Screen[None]):
+    """Form on the left, results on the right, progress and keys at the bottom."""
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("ctrl+r", "run", "Run", priority=True),
+        Binding("escape", "cancel", "Cancel"),
+        Binding("ctrl+s", "save", "Save", priority=True),
+        Binding("ctrl+e", "export", "CSV", priority=True),
+        Binding("ctrl+f", "toggle_form", "Form", priority=True),
+        Binding("ctrl+t", "next_tab", "Tab", priority=True),
+    ]
+
+    #: mode name in the app, preset kinds this screen takes, and its default preset
+    MODE: ClassVar[str] = ""
+    KINDS: ClassVar[tuple[str, ...]] = ()
+    DEFAULT_PRESET: ClassVar[str] = ""
+    TITLE_TEXT: ClassVar[str] = ""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.source: str = ""
+        self.base_doc: dict[str, Any] = {}
+        self.spec: Any = None
+        self.problem: InputError | FormProblem | None = None
+        self.run_id = 0
+        self.worker: Worker[Any] | None = None
+        self.results: Any = None  # what the last finished run returned
+        self.results_spec: Any = None
+        self.messages_seen: list[Any] = []  # typed run messages, in order (tests read them)
+
+    # ----- layout -----
+    def compose(self) -> ComposeResult:
+        with Horizontal(id="body"):
+            with Vertical(id="form-panel"):
+                yield Static(self.TITLE_TEXT, id="screen-title", markup=False)
+                yield Static("", id="spec-title", markup=False)
+                yield ParamForm(id="form")
+            with Vertical(id="results"):
+                yield from self.compose_results()
+        with Horizontal(id="status-bar"):
+            yield ProgressBar(total=1.0, show_eta=False, id="progress")
+            yield Static("ready", id="status", markup=False)
+        yield Footer(show_command_palette=False, compact=True)
+
+    def compose_results(self) -> ComposeResult:
+        raise NotImplementedError
+
+    @property
+    def form(self) -> ParamForm:
+        return self.query_one("#form", ParamForm)
+
+    @property
+    def progress(self) -> ProgressBar:
+        return self.query_one("#progress", ProgressBar)
+
+    @property
+    def status(self) -> Static:
+        return self.query_one("#status", Static)
+
+    @property
+    def tabs(self) -> TabbedContent:
+        return self.query_one("#results-tabs", TabbedContent)
+
+    @property
+    def running(self) -> bool:
+        return self.worker is not None and self.worker.state in (WorkerState.PENDING, WorkerState.RUNNING)
+
+    def set_status(self, text: str) -> None:
+        self.status.update(text)
+
+    # ----- what a domain screen provides -----
+    def loader(self) -> Any:
+        """The preset module (``load(doc)``, ``dump(spec)``) of this screen's kind."""
+        raise NotImplementedError
+
+    def fields_for(self, spec: Any, doc: dict[str, Any]) -> list[Field]:
+        raise NotImplementedError
+
+    def extra_checks(self, spec: Any) -> None:
+        """Validation of run options that are not part of the preset (raise InputError)."""
+
+    def start_run(self, spec: Any, run_id: int) -> Worker[Any]:
+        raise NotImplementedError
+
+    def clear_results(self) -> None:
+        raise NotImplementedError
+
+    def write_csv(self, path: str) -> None:
+        raise NotImplementedError
+
+    # ----- presets -----
+    def on_mount(self) -> None:
+        pending = self.app.take_pending(self.MODE)  # type: ignore[attr-defined]
+        if pending is not None:
+            spec, source = pending
+        else:
+            from vtool.presets import load_preset
+
+            spec, source = load_preset(self.DEFAULT_PRESET), self.DEFAULT_PRESET
+        self.call_after_refresh(self.load_spec, spec, source)
+
+    async def load_spec(self, spec: Any, source: str) -> None:
+        """Show ``spec`` in the form (the document its loader dumps) and clear old results."""
+        if self.running and self.worker is not None:
+            self.worker.cancel()
+        self.source = source
+        self.base_doc = self.loader().dump(spec)
+        self.spec = spec
+        self.problem = None
+        await self.form.set_fields(self.fields_for(spec, self.base_doc), self.base_doc)
+        self.query_one("#spec-title", Static).update(f"{Path(source).stem}: {getattr(spec, 'title', '')}")
+        self.clear_results()
+        self.progress.update(progress=0)
+        self.set_status(f"loaded {source}; ctrl+r runs")
+        self.after_load()
+
+    def after_load(self) -> None:
+        """Hook: set up run options that depend on the spec."""
+
+    def current_document(self) -> dict[str, Any]:
+        return self.form.apply(self.base_doc)
+
+    def validate(self) -> Any:
+        """The spec of the form as it stands, or None (the problem shown beside its field)."""
+        try:
+            spec = self.loader().load(self.current_document())
+            self.extra_checks(spec)
+        except InputError as exc:
+            self.spec, self.problem = None, exc
+        except (TypeError, ValueError, KeyError, IndexError) as exc:
+            self.spec, self.problem = None, FormProblem(f"invalid form: {exc}")
+        else:
+            self.spec, self.problem = spec, None
+        self.form.show_error(self.problem)
+        return self.spec
+
+    def on_field_edited(self, message: FieldEdited) -> None:
+        message.stop()
+        self.validate()
+        self.field_edited(message.path)
+
+    def field_edited(self, path: tuple[str | int, ...]) -> None:
+        """Hook: react to an edit (e.g. show the fields of a chosen pulse type)."""
+
+    def _refuse(self, action: str) -> None:
+        problem = self.problem
+        text = problem.one_line() if problem is not None else "the form is not valid"
+        self.notify(text, title=f"cannot {action}", severity="error")
+        self.set_status(f"cannot {action}: {text}")
+        name = getattr(problem, "field", "")
+        if name and self.form.has_field(name):
+            self.form.row(name).editor.focus()
+
+    # ----- run -----
+    def action_run(self) -> None:
+        spec = self.validate()
+        if spec is None:
+            self._refuse("run")
+            return
+        self.run_id += 1
+        self.messages_seen.clear()
+        self.progress.update(total=1.0, progress=0)
+        self.set_status("running... (escape cancels)")
+        self.worker = self.start_run(spec, self.run_id)
+
+    def action_cancel(self) -> None:
+        if self.running and self.worker is not None:
+            self.worker.cancel()
+            self.set_status("cancelled")
+            self.progress.update(progress=0)
+
+    def on_run_progressed(self, message: RunProgressed) -> None:
+        message.stop()
+        if message.run_id == self.run_id and self.running:
+            self.messages_seen.append(message)
+            self.progress.update(progress=min(max(message.fraction, 0.0), 1.0))
+
+    def accept(self, message: Any) -> bool:
+        """True when a finished-run message belongs to the current run."""
+        if message.run_id != self.run_id:
+            return False
+        self.messages_seen.append(message)
+        self.results, self.results_spec = None, message.spec
+        self.progress.update(progress=1.0)
+        return True
+
+    def on_worker_state_changed(self, event: Worker.StateChanged) -> None:
+        """The one handler for worker errors: an error dialog (never a crash)."""
+        if event.worker is not self.worker:
+            return
+        if event.state == WorkerState.ERROR:
+            error = event.worker.error
+            self.progress.update(progress=0)
+            if isinstance(error, InputError):
+                self.problem = error
+                self.form.show_error(error)
+            self.set_status(f"failed: {self.app.error_text(error)}")  # type: ignore[attr-defined]
+            self.app.report_error("Run failed", error)  # type: ignore[attr-defined]
+        elif event.state == WorkerState.CANCELLED:
+            self.set_status("cancelled")
+
+    # ----- save / export -----
+    def action_save(self) -> None:
+        spec = self.validate()
+        if spec is None:
+            self._refuse("save")
+            return
+        default = Path(self.source).name if self.source.endswith(".toml") else f"{Path(self.source).stem}.toml"
+
+        def save(path: str | None) -> None:
+            if not path:
+                return
+            from vtool.presets import save_spec
+
+            try:
+                save_spec(spec, path)
+            except OSError as exc:
+                self.app.report_error("Save failed", exc)  # type: ignore[attr-defined]
+                return
+            full = str(Path(path).resolve())
+            self.app.remember(full)  # type: ignore[attr-defined]
+            self.source = full
+            self.set_status(f"saved {path}")
+            self.notify(f"saved {path}")
+
+        self.app.push_screen(PathDialog("Save preset as", default), save)
+
+    def action_export(self) -> None:
+        if self.results is None:
+            self.notify("run first (ctrl+r): there are no results to export", severity="warning")
+            return
+        default = f"{Path(self.source).stem}.csv"
+
+        def export(path: str | None) -> None:
+            if not path:
+                return
+            try:
+                self.write_csv(path)
+            except (OSError, InputError) as exc:
+                self.app.report_error("Export failed", exc)  # type: ignore[attr-defined]
+                return
+            self.set_status(f"wrote {path}")
+            self.notify(f"wrote {path}")
+
+        self.app.push_screen(PathDialog("Export CSV to", default), export)
+
+    # ----- view -----
+    def action_toggle_form(self) -> None:
+        self.toggle_class("-form-hidden")
+
+    def action_next_tab(self) -> None:
+        tabs = self.tabs
+        panes = [pane.id for pane in tabs.query("TabPane") if pane.id and pane.parent is not None
+                 and pane.parent.parent is tabs]
+        if not panes:
+            return
+        current = tabs.active
+        index = panes.index(current) if current in panes else -1
+        tabs.active = panes[(index + 1) % len(panes)]

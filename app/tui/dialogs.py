@@ -1,0 +1,152 @@
+"""Modal dialogs: error, open preset, file path (save / export), help."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Vertical, VerticalScroll
+from textual.screen import ModalScreen
+from textual.widgets import Button, Input, Label, OptionList, Static
+from textual.widgets.option_list import Option
+
+
+class ErrorDialog(ModalScreen[None]):
+    """One dialog for every failure: a title and the one-line reason."""
+
+    BINDINGS = [Binding("escape,enter", "dismiss", "Close")]
+
+    def __init__(self, title: str, message: str) -> None:
+        super().__init__(classes="dialog-screen")
+        self.title_text = title
+        self.message = message
+
+    def compose(self) -> ComposeResult:
+        with Vertical(id="error-dialog", classes="dialog"):
+            yield Label(self.title_text, classes="dialog-title")
+            yield Static(Text(self.message), id="error-message")
+            yield Button("OK", variant="error", id="error-ok")
+
+    def on_mount(self) -> None:
+        self.query_one(Button).focus()
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        self.dismiss(None)
+
+    async def action_dismiss(self, result: None = None) -> None:
+        self.dismiss(None)
+
+
+class OpenDialog(ModalScreen[str | None]):
+    """Pick a shipped or recently used preset, or type a path."""
+
+    BINDINGS = [Binding("escape", "cancel", "Cancel")]
+
+    def __init__(self, shipped: Sequence[tuple[str, str, str]], recent: Sequence[str]) -> None:
+        super().__init__(classes="dialog-screen")
+        self.shipped = shipped
+        self.recent = recent
+
+    def compose(self) -> ComposeResult:
+        with Vertical(id="open-dialog", classes="dialog"):
+            yield Label("Open preset (enter: load, esc: cancel)", classes="dialog-title")
+            options: list[Option | None] = []
+            if self.recent:
+                options.append(Option(Text("recent", style="bold"), disabled=True))
+                options += [Option(r, id=f"recent:{r}") for r in self.recent]
+                options.append(Option(Text("shipped", style="bold"), disabled=True))
+            for name, kind, title in self.shipped:
+                options.append(Option(Text(f"{name:<19}{kind:<11}{title}", no_wrap=True, overflow="ellipsis"),
+                                      id=f"name:{name}"))
+            yield OptionList(*options, id="open-list")
+            yield Input(placeholder="or a path to a .toml preset", id="open-path")
+
+    def on_mount(self) -> None:
+        option_list = self.query_one(OptionList)
+        option_list.focus()
+        for index in range(option_list.option_count):
+            if not option_list.get_option_at_index(index).disabled:
+                option_list.highlighted = index
+                break
+
+    def on_option_list_option_selected(self, event: OptionList.OptionSelected) -> None:
+        event.stop()
+        option_id = event.option.id or ""
+        self.dismiss(option_id.split(":", 1)[1] if ":" in option_id else None)
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        event.stop()
+        self.dismiss(event.value.strip() or None)
+
+    def action_cancel(self) -> None:
+        self.dismiss(None)
+
+
+class PathDialog(ModalScreen[str | None]):
+    """Ask for a file path (save a preset, export CSV)."""
+
+    BINDINGS = [Binding("escape", "cancel", "Cancel")]
+
+    def __init__(self, title: str, default: str) -> None:
+        super().__init__(classes="dialog-screen")
+        self.title_text = title
+        self.default = default
+
+    def compose(self) -> ComposeResult:
+        with Vertical(id="path-dialog", classes="dialog"):
+            yield Label(f"{self.title_text} (enter: write, esc: cancel)", classes="dialog-title")
+            yield Input(self.default, id="path-input")
+
+    def on_mount(self) -> None:
+        self.query_one(Input).focus()
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        event.stop()
+        self.dismiss(event.value.strip() or None)
+
+    def action_cancel(self) -> None:
+        self.dismiss(None)
+
+
+HELP = """\
+vtool: valve-train dynamics, sonic-boom and plate checks
+
+Screens
+  f2  valve train     f3  sonic boom     f4  plate
+
+Everywhere
+  ctrl+r  run (validated form; a bad field blocks the run)
+  escape  cancel the running job
+  ctrl+o  open a shipped or recent preset, or a path
+  ctrl+s  save the form as a preset (TOML)
+  ctrl+e  export the current results as CSV (same as `vtool solve --csv`)
+  ctrl+f  hide / show the form (full-width charts)
+  ctrl+t  next result tab (left / right also switch tabs when they have focus)
+  tab     next field        shift+tab  previous field
+  f1      this help         ctrl+q     quit
+
+Valve-train animation tab (focus it with ctrl+t, then tab)
+  space  play / pause     left / right  step one output row
+  + / -  deformation scale x2 / /2      home  first row
+
+Fields show their unit on the right; a bad value shows the same message as
+the CLI below the field. Forms edit the preset document, so a saved preset
+loads back to the same form.
+"""
+
+
+class HelpScreen(ModalScreen[None]):
+    BINDINGS = [Binding("escape,f1,q", "close", "Close")]
+
+    def __init__(self) -> None:
+        super().__init__(classes="dialog-screen")
+
+    def compose(self) -> ComposeResult:
+        with VerticalScroll(id="help-dialog", classes="dialog"):
+            yield Static(Text(HELP, no_wrap=True), id="help-text")
+
+    def action_close(self) -> None:
+        self.dismiss(None)

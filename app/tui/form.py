@@ -1,0 +1,276 @@
+"""A parameter form bound to a preset document (the dict that ``dump(spec)`` gives).
+
+Every field names a path in the document, its label and its unit. Editing
+never validates here: the screen applies the form to the document and calls
+the preset loader, so the messages are exactly the CLI's
+(:meth:`vtool.errors.InputError.one_line`), shown beside the field they name.
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+from textual.app import ComposeResult
+from textual.containers import Horizontal, VerticalScroll
+from textual.widget import Widget
+from textual.widgets import Input, Label, Select, Static
+
+from vtool.app.tui.messages import FieldEdited
+
+Path = tuple[str | int, ...]
+
+NUMBER = "number"
+INTEGER = "integer"
+NUMBERS = "numbers"  # a list of numbers, typed "0.05, 0.1"
+CHOICE = "choice"
+TEXT = "text"
+
+
+@dataclass(frozen=True)
+class Field:
+    """One form field: where it lives in the preset document and how it is shown."""
+
+    path: Path
+    label: str
+    unit: str = ""
+    kind: str = NUMBER
+    choices: tuple[str, ...] = ()
+    optional: bool = False  # empty text removes the key from the document
+    group: str = ""
+
+    @property
+    def name(self) -> str:
+        return dotted(self.path)
+
+    @property
+    def widget_id(self) -> str:
+        return "f-" + re.sub(r"[^A-Za-z0-9_-]", "_", self.name)
+
+
+def dotted(path: Path) -> str:
+    """The field name the preset loaders use: ``clearances[1].restitution``."""
+    text = ""
+    for key in path:
+        if isinstance(key, int):
+            text += f"[{key}]"
+        else:
+            text += f".{key}" if text else key
+    return text
+
+
+def get_path(doc: Any, path: Path, default: Any = None) -> Any:
+    node = doc
+    for key in path:
+        try:
+            node = node[key]
+        except (KeyError, IndexError, TypeError):
+            return default
+    return node
+
+
+def set_path(doc: Any, path: Path, value: Any, remove: bool = False) -> None:
+    node = doc
+    for key in path[:-1]:
+        if isinstance(key, str) and isinstance(node, dict) and key not in node:
+            node[key] = {}
+        node = node[key]
+    if remove:
+        if isinstance(node, dict):
+            node.pop(path[-1], None)
+    else:
+        node[path[-1]] = value
+
+
+def format_value(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return f"{value:.10g}"
+    if isinstance(value, list):
+        return ", ".join(format_value(v) for v in value)
+    return str(value)
+
+
+def _number(text: str) -> Any:
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        return float(text)
+    except ValueError:
+        return text  # the loader reports "got 'abc', expected a number ..."
+
+
+def parse_value(field: Field, text: str) -> Any:
+    """Text typed into a field -> the TOML value the loader will judge."""
+    text = text.strip()
+    if field.kind in (NUMBER, INTEGER):
+        return _number(text)
+    if field.kind == NUMBERS:
+        parts = [p for p in re.split(r"[,\s]+", text) if p]
+        return [_number(p) for p in parts]
+    return text
+
+
+class FieldRow(Widget):
+    """Label, editor and unit on one line; the error message below it."""
+
+    DEFAULT_CSS = """
+    FieldRow { height: auto; }
+    FieldRow > Horizontal { height: auto; }
+    FieldRow .field-label { width: 1fr; min-width: 10; height: 1; }
+    FieldRow Input, FieldRow Select { width: 14; }
+    FieldRow .field-unit { width: 12; height: 1; padding-left: 1; color: $text-muted; }
+    FieldRow .field-error { color: $error; height: auto; display: none; }
+    FieldRow.-invalid .field-error { display: block; }
+    FieldRow.-invalid Input { color: $error; }
+    """
+
+    def __init__(self, field: Field, value: Any) -> None:
+        super().__init__(id=field.widget_id)
+        self.field = field
+        self.initial = value
+
+    def compose(self) -> ComposeResult:
+        f = self.field
+        with Horizontal():
+            yield Label(f.label, classes="field-label")
+            if f.kind == CHOICE:
+                options = [(c, c) for c in f.choices]
+                value = self.initial if self.initial in f.choices else f.choices[0]
+                yield Select(options, value=value, allow_blank=False, compact=True, id=f"{f.widget_id}-editor")
+            else:
+                yield Input(format_value(self.initial), compact=True, id=f"{f.widget_id}-editor",
+                            select_on_focus=False)
+            yield Label(f.unit, classes="field-unit")
+        yield Static("", classes="field-error", markup=False)
+
+    @property
+    def editor(self) -> Input | Select:
+        return self.query_one(f"#{self.field.widget_id}-editor")  # type: ignore[return-value]
+
+    @property
+    def text(self) -> str:
+        editor = self.editor
+        if isinstance(editor, Select):
+            return "" if editor.value is Select.NULL else str(editor.value)
+        return editor.value
+
+    def set_text(self, text: str) -> None:
+        editor = self.editor
+        if isinstance(editor, Select):
+            if text in self.field.choices:
+                editor.value = text
+        else:
+            editor.value = text
+
+    def show_error(self, message: str | None) -> None:
+        self.set_class(bool(message), "-invalid")
+        self.query_one(".field-error", Static).update(message or "")
+
+
+class ParamForm(VerticalScroll):
+    """Grouped fields of one preset document; posts :class:`FieldEdited` on every edit."""
+
+    DEFAULT_CSS = """
+    ParamForm { height: 1fr; }
+    ParamForm .group-title { text-style: bold; color: $accent; margin-top: 1; }
+    ParamForm #form-error { color: $error; display: none; }
+    ParamForm.-invalid #form-error { display: block; }
+    """
+
+    def __init__(self, *, id: str | None = None) -> None:
+        super().__init__(id=id)
+        self.fields: list[Field] = []
+        self._filling = False
+
+    def compose(self) -> ComposeResult:
+        yield Static("", id="form-error", markup=False)
+
+    async def set_fields(self, fields: Iterable[Field], doc: dict[str, Any]) -> None:
+        """Replace the rows with ``fields``, filled from ``doc``."""
+        self.fields = list(fields)
+        self._filling = True
+        await self.query("FieldRow, .group-title").remove()
+        widgets: list[Widget] = []
+        group = None
+        for f in self.fields:
+            if f.group != group:
+                group = f.group
+                widgets.append(Static(group, classes="group-title", markup=False))
+            widgets.append(FieldRow(f, get_path(doc, f.path)))
+        await self.mount_all(widgets)
+        self.show_error(None)
+        self.call_after_refresh(self._done_filling)
+
+    def _done_filling(self) -> None:
+        self._filling = False
+
+    def row(self, path: Path | str) -> FieldRow:
+        name = path if isinstance(path, str) else dotted(path)
+        for row in self.query(FieldRow):
+            if row.field.name == name:
+                return row
+        raise KeyError(name)
+
+    def has_field(self, name: str) -> bool:
+        return any(f.name == name for f in self.fields)
+
+    def set_value(self, path: Path | str, text: str) -> None:
+        self.row(path).set_text(text)
+
+    def value(self, path: Path | str) -> str:
+        return self.row(path).text
+
+    def apply(self, doc: dict[str, Any]) -> dict[str, Any]:
+        """A copy of ``doc`` with every field's current text written into it."""
+        out = copy.deepcopy(doc)
+        for row in self.query(FieldRow):
+            f = row.field
+            text = row.text
+            if not text.strip():
+                set_path(out, f.path, None, remove=True)
+            else:
+                set_path(out, f.path, parse_value(f, text))
+        return out
+
+    def show_error(self, error: Any | None) -> str | None:
+        """Show an :class:`InputError` beside its field (or above the form); None clears.
+
+        Returns the name of the field it was shown beside, if any.
+        """
+        shown_at = None
+        message = None if error is None else error.one_line()
+        field_name = getattr(error, "field", None)
+        for row in self.query(FieldRow):
+            here = message is not None and row.field.name == field_name
+            row.show_error(message if here else None)
+            if here:
+                shown_at = row.field.name
+        general = message if (message is not None and shown_at is None) else None
+        self.set_class(general is not None, "-invalid")
+        self.query_one("#form-error", Static).update(general or "")
+        return shown_at
+
+    def on_input_changed(self, event: Input.Changed) -> None:
+        event.stop()
+        self._edited(event.input)
+
+    def on_select_changed(self, event: Select.Changed) -> None:
+        event.stop()
+        self._edited(event.select)
+
+    def _edited(self, editor: Widget) -> None:
+        if self._filling:
+            return
+        for ancestor in editor.ancestors:
+            if isinstance(ancestor, FieldRow):
+                self.post_message(FieldEdited(ancestor.field.path))
+                return

@@ -1,0 +1,79 @@
+"""Reusable widgets: a chart that redraws to its size, and a plain-text panel."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from rich.text import Text
+from textual.containers import ScrollableContainer
+from textual.widgets import Static
+
+ChartFunction = Callable[[int, int, bool], str]  # (width, height, color) -> chart text
+
+
+class ChartView(Static):
+    """A plotext chart (text) drawn by a function of the widget's size.
+
+    ``chart_text`` keeps the last string drawn, so tests compare it with the
+    library's chart for the same data and size.
+    """
+
+    DEFAULT_CSS = """
+    ChartView { width: 1fr; height: 1fr; min-height: 8; }
+    """
+
+    def __init__(self, placeholder: str = "", *, id: str | None = None, classes: str | None = None,
+                 color: bool = True) -> None:
+        super().__init__(placeholder, id=id, classes=classes, markup=False)
+        self.placeholder = placeholder
+        self.function: ChartFunction | None = None
+        self.chart_text = ""
+        self.chart_size = (0, 0)
+        self.color = color
+
+    def plot(self, function: ChartFunction | None) -> None:
+        """Draw ``function`` now (and again on every resize); None shows the placeholder."""
+        self.function = function
+        self.chart_size = (0, 0)
+        self.redraw()
+
+    def redraw(self) -> None:
+        if self.function is None:
+            self.chart_text = ""
+            self.update(self.placeholder)
+            return
+        width, height = self.size.width, self.size.height
+        if width <= 0 or height <= 0:
+            self.call_after_refresh(self.redraw)
+            return
+        if (width, height) == self.chart_size:
+            return
+        self.chart_size = (width, height)
+        self.chart_text = self.function(width, height, self.color)
+        self.update(Text.from_ansi(self.chart_text, no_wrap=True) if self.color else
+                    Text(self.chart_text, no_wrap=True))
+
+    def on_resize(self) -> None:
+        if self.function is not None:
+            self.redraw()
+
+
+class TextPanel(ScrollableContainer):
+    """Plain, unwrapped text (tables, summaries) that scrolls both ways."""
+
+    DEFAULT_CSS = """
+    TextPanel { height: 1fr; }
+    TextPanel > Static { width: auto; height: auto; }
+    """
+
+    def __init__(self, text: str = "", *, id: str | None = None, classes: str | None = None) -> None:
+        super().__init__(id=id, classes=classes, can_focus=True)
+        self._initial = text
+        self.text = text
+
+    def compose(self):  # type: ignore[no-untyped-def]
+        yield Static(Text(self._initial, no_wrap=True), markup=False)
+
+    def set_text(self, text: str) -> None:
+        self.text = text
+        self.query_one(Static).update(Text(text, no_wrap=True))

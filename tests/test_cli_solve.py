@@ -1,0 +1,118 @@
+"""`vtool solve` through click's CliRunner: summary, CSV, JSON, plots, errors, other preset kinds."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from tests.valvetrain_cases import thesis_doc
+from vtool.app.cli.main import cli
+
+
+def run(*args: str):
+    return CliRunner().invoke(cli, list(args))
+
+
+@pytest.mark.parametrize("name", ["gnilka-1a", "gnilka-1b", "gnilka-1c", "gnilka-1d", "gnilka-2", "gnilka-3"])
+def test_every_thesis_preset_solves_and_writes_csv(tmp_path: Path, name: str) -> None:
+    out = tmp_path / f"{name}.csv"
+    result = run("solve", name, "--csv", str(out))
+    assert result.exit_code == 0, result.output
+    assert "peak force (lbf)" in result.output and "wrote 851 rows" in result.output
+    rows = list(csv.reader(out.open()))
+    header = rows[0]
+    assert header[:3] == ["time (s)", "cam_angle (deg)", "q1 (in)"]
+    assert "q3 (rad)" in header and "F2 (lbf)" in header and "q1-q9 (in)" in header
+    assert header[-2:] == ["configuration", "closed"]
+    assert len(rows) == 852 and rows[1][-2:] == ["7", "cam+rocker"]
+    assert float(rows[-1][1]) == pytest.approx(850.0)
+
+
+def test_every_step_csv_has_a_row_per_step(tmp_path: Path) -> None:
+    out = tmp_path / "steps.csv"
+    result = run("solve", "gnilka-1d", "--degrees", "100", "--every-step", "--csv", str(out))
+    assert result.exit_code == 0, result.output
+    rows = out.read_text().splitlines()
+    assert len(rows) > 1500  # about 1,515 steps of 1 µs for 100 degrees at 11,000 RPM
+
+
+def test_json_summary_has_events_and_statistics() -> None:
+    result = run("solve", "gnilka-1a", "--degrees", "200", "--json")
+    assert result.exit_code == 0
+    summary = json.loads(result.output)
+    assert summary["backend"] == "newmark" and summary["steps"] > 3000
+    assert summary["events_list"][0]["clearance"] == "cam"
+    assert {c["clearance"] for c in summary["clearances"]} == {"cam", "rocker", "seat"}
+
+
+def test_plot_draws_force_displacement_and_configuration_charts() -> None:
+    result = run("solve", "gnilka-1b", "--degrees", "120", "--plot")
+    assert result.exit_code == 0
+    for title in ("contact forces (lbf)", "displacements", "configuration"):
+        assert title in result.output
+
+
+def test_overrides_change_the_run() -> None:
+    result = run("solve", "gnilka-1a", "--rpm", "9000", "--degrees", "90", "--dt", "2e-6", "--json")
+    settings = json.loads(result.output)["settings"]
+    assert settings == {"time_step_s": 2e-6, "beta": 1 / 6, "gamma": 0.5, "rpm": 9000.0, "degrees": 90.0}
+
+
+@pytest.mark.parametrize(
+    "args, text",
+    [
+        (["--dt", "0"], "run.time_step: got 0.0, expected > 0 s"),
+        (["--dt", "1e-5"], "stability limit"),
+        (["--rpm", "-1"], "run.rpm: got -1.0, expected > 0 rev/min"),
+        (["--degrees", "0"], "run.degrees: got 0.0, expected > 0 deg"),
+        (["--backend", "euler"], "one of the installed back ends"),
+    ],
+)
+def test_bad_settings_exit_2_with_one_line_and_write_nothing(tmp_path: Path, args: list[str], text: str) -> None:
+    out = tmp_path / "never.csv"
+    result = run("solve", "gnilka-1a", "--csv", str(out), *args)
+    assert result.exit_code == 2
+    assert result.output.strip().count("\n") == 0 and text in result.output
+    assert "Traceback" not in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_failed_run_exits_1_and_leaves_an_existing_file_untouched(tmp_path: Path, monkeypatch) -> None:
+    """A diverging run (step 1.2x the stability limit, the limit check switched off) writes nothing."""
+    import tomli_w
+
+    from tests.test_newmark import free_mechanism_doc
+    from vtool.solvers import newmark
+
+    doc = free_mechanism_doc(beta=1 / 6)
+    doc["run"]["degrees"] = 400.0
+    preset = tmp_path / "unstable.toml"
+    preset.write_text(tomli_w.dumps(doc))
+    from tests.test_newmark import diverging_run
+
+    _, options = diverging_run()
+
+    def unstable(run, every_step=False):  # noqa: ANN001, ANN202
+        return options
+
+    monkeypatch.setattr(newmark.NewmarkBackend, "options_from_run", staticmethod(unstable))
+    out = tmp_path / "old.csv"
+    out.write_text("previous results\n")
+    result = run("solve", str(preset), "--csv", str(out))
+    assert result.exit_code == 1 and result.output.startswith("run failed: diverged at t = ")
+    assert "in configuration III (rocker)" in result.output and "Traceback" not in result.output
+    assert out.read_text() == "previous results\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["old.csv", "unstable.toml"]
+
+
+def test_solve_dispatches_boom_and_plate_presets() -> None:
+    boom = run("solve", "boom-brick-wall")
+    assert boom.exit_code == 0, boom.output
+    plate = run("solve", "plate-irs")
+    assert plate.exit_code == 0, plate.output
+    refused = run("solve", "boom-brick-wall", "--dt", "1e-6")
+    assert refused.exit_code == 2 and "applies to valvetrain presets only" in refused.output
