@@ -1,0 +1,228 @@
+"""The valve-train screen: mechanism and run form, simulation worker, charts, animation."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from textual import work
+from textual.app import ComposeResult
+from textual.containers import Horizontal
+from textual.widgets import SelectionList, TabbedContent, TabPane
+from textual.worker import Worker, get_current_worker
+
+from vtool.app.tui.animation import MechanismAnimation
+from vtool.app.tui.base import DomainScreen
+from vtool.app.tui.form import CHOICE, Field
+from vtool.app.tui.messages import RunProgressed, SimulationFinished
+from vtool.app.tui.widgets import ChartView, TextPanel
+
+MEMBER_KEYS = (
+    ("length", "length", "length"),
+    ("diameter", "diameter", "length"),
+    ("area", "area", "area"),
+    ("inertia", "inertia", "inertia"),
+    ("modulus", "modulus E", "pressure"),
+    ("specific_weight", "spec. weight", "specific_weight"),
+    ("density", "density", "density"),
+    ("stiffness", "spring rate", "stiffness"),
+    ("mass", "mass", "mass"),
+)
+
+
+def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
+    """The form of a valve-train preset: run, cam, spring, clearances, members, damping."""
+    from vtool.solvers import backends
+
+    u = spec.unit_system
+    unit = {"length": u.length, "area": f"{u.length}^2", "inertia": f"{u.length}^4",
+            "pressure": u.pressure, "specific_weight": u.specific_weight, "density": u.density,
+            "stiffness": u.stiffness, "mass": u.mass}
+    installed = tuple(backends.available())
+    backend_choices = installed if doc["run"]["backend"] in installed else (doc["run"]["backend"], *installed)
+    fields = [
+        Field(("run", "rpm"), "cam speed", "rev/min", group="Run"),
+        Field(("run", "degrees"), "cam degrees", "deg", group="Run"),
+        Field(("run", "backend"), "back end", kind=CHOICE, choices=backend_choices, group="Run"),
+        Field(("run", "time_step"), "time step", "s", group="Run"),
+        Field(("run", "beta"), "Newmark beta", group="Run"),
+        Field(("run", "gamma"), "Newmark gamma", group="Run"),
+        Field(("run", "output_interval"), "output every", "deg", group="Run"),
+        Field(("cam", "amplitude"), "cam amplitude", u.length, group="Cam and spring"),
+        Field(("initial", "spring_preload"), "spring preload", u.force, group="Cam and spring"),
+        Field(("initial", "lever_ratio"), "lever ratio", group="Cam and spring"),
+    ]
+    for name, member in doc["members"].items():
+        if "stiffness" in member:
+            fields.append(Field(("members", name, "stiffness"), f"{name} rate", u.stiffness,
+                                group="Cam and spring"))
+    if "seat" in doc:
+        fields.append(Field(("seat", "position"), "seat position", u.length, group="Clearances"))
+    for i, c in enumerate(doc["clearances"]):
+        states = ("enabled", "removed") if c["kind"] == "external" else ("enabled", "pinned", "removed")
+        fields.append(Field(("clearances", i, "state"), f"{c['name']} state", kind=CHOICE, choices=states,
+                            group="Clearances"))
+        fields.append(Field(("clearances", i, "restitution"), f"{c['name']} restit.", group="Clearances"))
+    for name, member in doc["members"].items():
+        group = f"Member {name} ({member['element']})"
+        for key, label, kind in MEMBER_KEYS:
+            if key in member and key != "stiffness":
+                fields.append(Field(("members", name, key), label, unit[kind], group=group))
+    fields.append(Field(("damping", "factor"), "global factor", group="Damping (modal ratios)"))
+    fields.append(Field(("damping", "default_ratio"), "default ratio", group="Damping (modal ratios)"))
+    for i, layer in enumerate(doc["damping"].get("layers", [])):
+        closed = "+".join(layer["closed"]) or "none closed"
+        fields.append(Field(("damping", "layers", i, "default_ratio"), f"{closed}: ratio",
+                            group="Damping (modal ratios)"))
+        for mode in layer.get("mode_ratios", {}):
+            fields.append(Field(("damping", "layers", i, "mode_ratios", mode), f"{closed}: mode {mode}",
+                                group="Damping (modal ratios)"))
+    fields.append(Field(("gravity",), "gravity", u.acceleration, group="Mechanism"))
+    return fields
+
+
+def displacement_quantities(spec: Any) -> list[str]:
+    """The preset's plotted (non-force) quantities, else the elastic coordinates."""
+    chosen = [q for q in spec.run.quantities if not q.startswith("F")]
+    return chosen or [f"q{i}" for i in range(1, spec.n_coordinates + 1)]
+
+
+class ValveTrainScreen(DomainScreen):
+    MODE = "valvetrain"
+    KINDS = ("valvetrain",)
+    DEFAULT_PRESET = "gnilka-1a"
+    TITLE_TEXT = "VALVE TRAIN"
+
+    def compose_results(self) -> ComposeResult:
+        color = self.app.chart_color  # type: ignore[attr-defined]
+        with Horizontal(id="results-row"):
+            with TabbedContent(id="results-tabs"):
+                with TabPane("Forces", id="tab-forces"):
+                    yield ChartView("contact forces appear here after a run (ctrl+r)", id="force-chart",
+                                    color=color)
+                with TabPane("Displ.", id="tab-displacements"):
+                    with Horizontal():
+                        yield SelectionList[str](id="quantities")
+                        yield ChartView("displacements appear here after a run", id="displacement-chart",
+                                        color=color)
+                with TabPane("Config", id="tab-configuration"):
+                    yield ChartView("closed clearances against cam angle appear here after a run",
+                                    id="configuration-chart", color=color)
+                with TabPane("Events", id="tab-events"):
+                    yield TextPanel("no run yet", id="events")
+                with TabPane("Summary", id="tab-summary"):
+                    yield TextPanel("no run yet", id="summary")
+                with TabPane("Anim.", id="tab-animation"):
+                    yield MechanismAnimation(id="animation", color=color)
+            yield TextPanel("", id="side-panel")
+
+    # ----- typed access to the children -----
+    @property
+    def force_chart(self) -> ChartView:
+        return self.query_one("#force-chart", ChartView)
+
+    @property
+    def displacement_chart(self) -> ChartView:
+        return self.query_one("#displacement-chart", ChartView)
+
+    @property
+    def configuration_chart(self) -> ChartView:
+        return self.query_one("#configuration-chart", ChartView)
+
+    @property
+    def quantity_list(self) -> SelectionList[str]:
+        return self.query_one("#quantities", SelectionList)
+
+    @property
+    def animation(self) -> MechanismAnimation:
+        return self.query_one("#animation", MechanismAnimation)
+
+    @property
+    def trace(self) -> Any:
+        return self.results
+
+    # ----- spec -----
+    def loader(self) -> Any:
+        from vtool.presets import valvetrain
+
+        return valvetrain
+
+    def fields_for(self, spec: Any, doc: dict[str, Any]) -> list[Field]:
+        return valvetrain_fields(spec, doc)
+
+    def after_load(self) -> None:
+        quantities = displacement_quantities(self.spec)
+        selection = self.quantity_list
+        selection.clear_options()
+        selection.add_options([(q, q, i < 4) for i, q in enumerate(quantities)])
+
+    def selected_quantities(self) -> tuple[str, ...]:
+        return tuple(self.quantity_list.selected)
+
+    def clear_results(self) -> None:
+        self.results = None
+        for chart in (self.force_chart, self.displacement_chart, self.configuration_chart):
+            chart.plot(None)
+        self.query_one("#events", TextPanel).set_text("no run yet")
+        self.query_one("#summary", TextPanel).set_text("no run yet")
+        self.query_one("#side-panel", TextPanel).set_text("")
+        self.animation.clear()
+
+    # ----- run -----
+    def start_run(self, spec: Any, run_id: int) -> Worker[Any]:
+        return self.simulate(spec, run_id)
+
+    @work(thread=True, exclusive=True, exit_on_error=False, group="run")
+    def simulate(self, spec: Any, run_id: int) -> None:
+        """Run the library's :func:`simulate` in a thread; post progress and the trace."""
+        from vtool.solvers.run import simulate
+
+        worker = get_current_worker()
+
+        def progress(fraction: float) -> None:
+            self.post_message(RunProgressed(run_id, fraction))
+
+        trace = simulate(spec, progress=progress, cancel=lambda: worker.is_cancelled)
+        if not worker.is_cancelled:
+            self.post_message(SimulationFinished(run_id, spec, trace))
+
+    def on_simulation_finished(self, message: SimulationFinished) -> None:
+        message.stop()
+        if not self.accept(message):
+            return
+        trace = message.trace
+        self.results = trace
+        self.show_trace(trace)
+        stats = trace.statistics
+        self.set_status(f"done: {stats.steps} steps, {stats.events} events, {stats.wall_time:.2f} s "
+                        f"({stats.backend})")
+
+    def show_trace(self, trace: Any) -> None:
+        from vtool.app import valvetrain_charts as charts
+
+        self.force_chart.plot(lambda w, h, c: charts.force_chart(trace, w, h, color=c))
+        self.plot_displacements()
+        self.configuration_chart.plot(lambda w, h, c: charts.configuration_chart(trace, w, h, color=c))
+        summary = trace.summary_text()
+        events = trace.event_table() if trace.events else "no events"
+        self.query_one("#summary", TextPanel).set_text(summary)
+        self.query_one("#events", TextPanel).set_text(events)
+        self.query_one("#side-panel", TextPanel).set_text(f"{summary}\n\nevents\n{events}")
+        self.animation.show_trace(trace)
+
+    def plot_displacements(self) -> None:
+        trace = self.results
+        if trace is None:
+            return
+        from vtool.app import valvetrain_charts as charts
+
+        quantities = self.selected_quantities() or ("q1",)
+        self.displacement_chart.plot(
+            lambda w, h, c: charts.displacement_chart(trace, quantities, w, h, color=c))
+
+    def on_selection_list_selected_changed(self, event: SelectionList.SelectedChanged[str]) -> None:
+        event.stop()
+        self.plot_displacements()
+
+    # ----- export -----
+    def write_csv(self, path: str) -> None:
+        self.results.write_csv(path)
