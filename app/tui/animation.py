@@ -96,8 +96,7 @@ class MechanismAnimation(Static, can_focus=True):
             return
         width, height = self.size.width, self.size.height
         if width <= 0 or height <= 0:
-            self.call_after_refresh(self.draw)
-            return
+            return  # hidden: drawn on the resize that shows it
         from vtool.app.plots import shape_chart
 
         row = min(self.row, self.rows - 1)

@@ -48,7 +48,7 @@ class DomainScreen(Screen[None]):
 
     BINDINGS: ClassVar[list[BindingType]] = [
         Binding("ctrl+r", "run", "Run", priority=True),
-        Binding("escape", "cancel", "Cancel"),
+        Binding("escape", "cancel", "Stop"),
         Binding("ctrl+s", "save", "Save", priority=True),
         Binding("ctrl+e", "export", "CSV", priority=True),
         Binding("ctrl+f", "toggle_form", "Form", priority=True),
@@ -110,6 +110,14 @@ class DomainScreen(Screen[None]):
     def running(self) -> bool:
         return self.worker is not None and self.worker.state in (WorkerState.PENDING, WorkerState.RUNNING)
 
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """While a run goes: stop is offered; open, save and export wait for it."""
+        if action == "cancel":
+            return self.running
+        if action in ("save", "export"):
+            return not self.running
+        return True
+
     def set_status(self, text: str) -> None:
         self.status.update(text)
 
@@ -134,7 +142,8 @@ class DomainScreen(Screen[None]):
         raise NotImplementedError
 
     # ----- presets -----
-    def on_mount(self) -> None:
+    async def on_mount(self) -> None:
+        self.app.mounted_modes.add(self.MODE)  # type: ignore[attr-defined]
         pending = self.app.take_pending(self.MODE)  # type: ignore[attr-defined]
         if pending is not None:
             spec, source = pending
@@ -142,7 +151,7 @@ class DomainScreen(Screen[None]):
             from vtool.presets import load_preset
 
             spec, source = load_preset(self.DEFAULT_PRESET), self.DEFAULT_PRESET
-        self.call_after_refresh(self.load_spec, spec, source)
+        await self.load_spec(spec, source)
 
     async def load_spec(self, spec: Any, source: str) -> None:
         """Show ``spec`` in the form (the document its loader dumps) and clear old results."""
@@ -207,6 +216,7 @@ class DomainScreen(Screen[None]):
         self.progress.update(total=1.0, progress=0)
         self.set_status("running... (escape cancels)")
         self.worker = self.start_run(spec, self.run_id)
+        self.refresh_bindings()
 
     def action_cancel(self) -> None:
         if self.running and self.worker is not None:
@@ -233,6 +243,8 @@ class DomainScreen(Screen[None]):
         """The one handler for worker errors: an error dialog (never a crash)."""
         if event.worker is not self.worker:
             return
+        self.refresh_bindings()
+        self.app.refresh_bindings()
         if event.state == WorkerState.ERROR:
             error = event.worker.error
             self.progress.update(progress=0)

@@ -91,7 +91,7 @@ def format_value(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):
-        return f"{value:.10g}"
+        return repr(value)  # shortest text that reads back to the same float: the form loses nothing
     if isinstance(value, list):
         return ", ".join(format_value(v) for v in value)
     return str(value)
@@ -125,9 +125,9 @@ class FieldRow(Widget):
     DEFAULT_CSS = """
     FieldRow { height: auto; }
     FieldRow > Horizontal { height: auto; }
-    FieldRow .field-label { width: 1fr; min-width: 10; height: 1; }
-    FieldRow Input, FieldRow Select { width: 14; }
-    FieldRow .field-unit { width: 12; height: 1; padding-left: 1; color: $text-muted; }
+    FieldRow .field-label { width: 16; height: 1; padding-right: 1; }
+    FieldRow Input, FieldRow Select { width: 13; }
+    FieldRow .field-unit { width: 1fr; height: 1; padding-left: 1; color: $text-muted; }
     FieldRow .field-error { color: $error; height: auto; display: none; }
     FieldRow.-invalid .field-error { display: block; }
     FieldRow.-invalid Input { color: $error; }

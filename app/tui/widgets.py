@@ -44,8 +44,7 @@ class ChartView(Static):
             return
         width, height = self.size.width, self.size.height
         if width <= 0 or height <= 0:
-            self.call_after_refresh(self.redraw)
-            return
+            return  # hidden (an inactive tab): drawn on the resize that shows it
         if (width, height) == self.chart_size:
             return
         self.chart_size = (width, height)

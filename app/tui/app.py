@@ -1,0 +1,154 @@
+"""The vtool Textual application and the one factory that builds it.
+
+``create_app`` is used by ``vtool tui``, by the tests and by the screenshot
+script, so all three see the same app. One screen per domain, each a
+Textual mode (f2 / f3 / f4): switching keeps each screen's form and results.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, ClassVar
+
+from textual.app import App
+from textual.binding import Binding, BindingType
+
+from vtool.app.tui.boom import BoomScreen
+from vtool.app.tui.dialogs import ErrorDialog, HelpScreen, OpenDialog
+from vtool.app.tui.plate import PlateScreen
+from vtool.app.tui.recent import RecentFiles, default_path
+from vtool.app.tui.valvetrain import ValveTrainScreen
+from vtool.errors import InputError, RunError
+
+SCREENS_BY_MODE = {screen.MODE: screen for screen in (ValveTrainScreen, BoomScreen, PlateScreen)}
+
+
+def mode_for_kind(kind: str) -> str:
+    for mode, screen in SCREENS_BY_MODE.items():
+        if kind in screen.KINDS:
+            return mode
+    raise InputError("kind", kind, f"one of: {', '.join(k for s in SCREENS_BY_MODE.values() for k in s.KINDS)}")
+
+
+class VtoolApp(App[None]):
+    """Valve train, sonic boom and plate screens over the vtool library."""
+
+    CSS_PATH = "vtool.tcss"
+    TITLE = "vtool"
+    ENABLE_COMMAND_PALETTE = False
+    HORIZONTAL_BREAKPOINTS: ClassVar[list[tuple[int, str]] | None] = [(0, "-narrow"), (120, "-wide"), (170, "-huge")]
+    MODES: ClassVar[dict[str, Any]] = dict(SCREENS_BY_MODE)
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("ctrl+o", "open", "Open", priority=True),
+        Binding("f1", "help", "Help"),
+        Binding("f2", "switch_mode('valvetrain')", "Screen", key_display="f2-4",
+                tooltip="f2 valve train, f3 sonic boom, f4 plate"),
+        Binding("f3", "switch_mode('boom')", "Sonic boom", show=False),
+        Binding("f4", "switch_mode('plate')", "Plate", show=False),
+        Binding("ctrl+q", "quit", "Quit", priority=True),
+    ]
+
+    def __init__(self, preset: str | None = None, *, recent: RecentFiles | None = None,
+                 chart_color: bool = True) -> None:
+        super().__init__()
+        self.initial_preset = preset
+        self.recent = recent if recent is not None else RecentFiles(None)
+        self.chart_color = chart_color
+        self._pending: dict[str, tuple[Any, str]] = {}
+        self.mounted_modes: set[str] = set()
+        self.errors_shown: list[str] = []  # every error dialog's text, in order
+
+    # ----- start-up -----
+    async def on_mount(self) -> None:
+        mode = "valvetrain"
+        problem: Exception | None = None
+        if self.initial_preset:
+            try:
+                spec = self._load(self.initial_preset)
+                mode = mode_for_kind(spec.kind)
+                self._pending[mode] = (spec, self.initial_preset)
+            except InputError as exc:
+                problem = exc
+        await self.switch_mode(mode)
+        if problem is not None:
+            self.report_error("Cannot open preset", problem)
+
+    def take_pending(self, mode: str) -> tuple[Any, str] | None:
+        return self._pending.pop(mode, None)
+
+    # ----- errors -----
+    @staticmethod
+    def error_text(error: BaseException | None) -> str:
+        if isinstance(error, InputError):
+            return error.one_line()
+        if isinstance(error, RunError | OSError):
+            return str(error)
+        return f"{type(error).__name__}: {error}"
+
+    def report_error(self, title: str, error: BaseException | None) -> None:
+        """Show an error dialog (the app's one way of reporting a failure)."""
+        text = self.error_text(error)
+        self.errors_shown.append(text)
+        self.push_screen(ErrorDialog(title, text))
+
+    # ----- presets -----
+    def _load(self, name: str) -> Any:
+        from vtool.presets import load_preset
+
+        return load_preset(name)
+
+    def remember(self, item: str) -> None:
+        self.recent.add(item)
+
+    def action_open(self) -> None:
+        from vtool.presets import list_presets
+
+        shipped = [(i.name, i.kind, i.title) for i in list_presets()]
+        self.push_screen(OpenDialog(shipped, self.recent.items), self._open_chosen)
+
+    async def _open_chosen(self, choice: str | None) -> None:
+        if choice:
+            await self.open_preset(choice)
+
+    async def open_preset(self, name: str) -> bool:
+        """Load a preset (shipped name or path) into the screen of its kind."""
+        try:
+            spec = self._load(name)
+            mode = mode_for_kind(spec.kind)
+        except InputError as exc:
+            self.report_error("Cannot open preset", exc)
+            return False
+        item = name if not Path(name).is_file() else str(Path(name).resolve())
+        if mode in self.mounted_modes:
+            await self.switch_mode(mode)
+            await self.screen.load_spec(spec, item)  # type: ignore[attr-defined]
+        else:
+            self._pending[mode] = (spec, item)
+            await self.switch_mode(mode)
+        self.remember(item)
+        return True
+
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        if action == "open" and getattr(self.screen, "running", False):
+            return False  # finish or cancel the run first (escape)
+        return True
+
+    def action_help(self) -> None:
+        if not isinstance(self.screen, HelpScreen):
+            self.push_screen(HelpScreen())
+
+
+def create_app(preset: str | None = None, *, config_dir: Path | None = None, remember: bool = True,
+               chart_color: bool = True) -> VtoolApp:
+    """The app for the CLI, the tests and the screenshots.
+
+    ``config_dir`` holds ``recent.json`` (default: ``$XDG_CONFIG_HOME/vtool``);
+    ``remember=False`` keeps the recent-files list in memory only.
+    """
+    if not remember:
+        recent = RecentFiles(None)
+    elif config_dir is not None:
+        recent = RecentFiles(Path(config_dir) / "recent.json")
+    else:
+        recent = RecentFiles(default_path())
+    return VtoolApp(preset, recent=recent, chart_color=chart_color)

@@ -1,0 +1,303 @@
+"""The sonic-boom screen: pulse and structures, DAF and design curves, allowable pressures.
+
+The assessment is :func:`vtool.assessments.sonic_boom.assess.assess`, the
+call behind ``vtool boom wall|floor`` and ``vtool solve``; the DAF curve is
+:func:`vtool.assessments.sonic_boom.spectra.daf_at` over the source the
+assessment used (pulse or envelope).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from textual import work
+from textual.app import ComposeResult
+from textual.containers import VerticalScroll
+from textual.widgets import TabbedContent, TabPane
+from textual.worker import Worker, get_current_worker
+
+from vtool.app.tui.base import DomainScreen
+from vtool.app.tui.form import CHOICE, INTEGER, NUMBERS, TEXT, Field, dotted
+from vtool.app.tui.messages import AssessmentFinished
+from vtool.app.tui.widgets import ChartView, TextPanel
+
+PULSES = ("envelope", "N", "P", "Q", "R", "T", "csv")
+IDEALIZED_KEYS = ("s", "r1", "r2", "alpha", "beta")
+ENVELOPE_DEFAULT = {"types": ["N", "P", "Q", "R", "T"], "s": [1.6, 2.2, 0.1], "r1": [0.0, 0.5, 0.1]}
+
+
+def boom_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
+    u = spec.units
+    boom = doc["boom"]
+    g = "Boom"
+    fields = [
+        Field(("boom", "pulse"), "pulse", kind=CHOICE, choices=PULSES, group=g),
+        Field(("boom", "positive_durations"), "durations tau", "s", kind=NUMBERS, group=g),
+        Field(("boom", "damping"), "damping ratio", group=g),
+    ]
+    pulse = boom.get("pulse", "envelope")
+    if pulse == "envelope":
+        fields += [
+            Field(("boom", "envelope", "types"), "env. types", kind=TEXT, group=g),
+            Field(("boom", "envelope", "s"), "env. s", "first,last,step", kind=NUMBERS, group=g),
+            Field(("boom", "envelope", "r1"), "env. r1", "first,last,step", kind=NUMBERS, group=g),
+            Field(("boom", "envelope", "alpha"), "env. alpha", optional=True, group=g),
+            Field(("boom", "envelope", "beta"), "env. beta", optional=True, group=g),
+        ]
+    elif pulse == "csv":
+        fields.append(Field(("boom", "csv"), "pulse CSV file", kind=TEXT, group=g))
+    else:
+        fields += [
+            Field(("boom", "s"), "s (total/pos.)", group=g),
+            Field(("boom", "r1"), "r1 rise ratio", group=g),
+            Field(("boom", "r2"), "r2", optional=True, group=g),
+            Field(("boom", "alpha"), "alpha", optional=True, group=g),
+            Field(("boom", "beta"), "beta", optional=True, group=g),
+        ]
+    fields.append(Field(("criteria",), "criteria", kind=TEXT, group="Criteria"))
+    fields += [
+        Field(("design", "f_min"), "f min", "Hz", group="Design curves"),
+        Field(("design", "f_max"), "f max", "Hz", group="Design curves"),
+        Field(("design", "points"), "points", kind=INTEGER, group="Design curves"),
+    ]
+    for i, wall in enumerate(doc.get("walls", [])):
+        grp = f"Wall {wall.get('name', i)}"
+        fields += [
+            Field(("walls", i, "base_width"), "base width a", u.length, group=grp),
+            Field(("walls", i, "thickness"), "thickness h", u.length, group=grp),
+            Field(("walls", i, "youngs_modulus"), "modulus E", u.pressure, group=grp),
+            Field(("walls", i, "poisson_ratio"), "Poisson nu", group=grp),
+            Field(("walls", i, "surface_weight"), "surface wt.", u.surface_weight, group=grp),
+            Field(("walls", i, "net_area"), "net area", f"{u.length}^2", optional=True, group=grp),
+            Field(("walls", i, "height"), "height b", u.length, optional=True, group=grp),
+            Field(("walls", i, "measured_frequency"), "measured f", "Hz", optional=True, group=grp),
+        ]
+    for i, floor in enumerate(doc.get("floors", [])):
+        grp = f"Floor {floor.get('name', i)}"
+        fields += [
+            Field(("floors", i, "columns"), "columns n", kind=INTEGER, group=grp),
+            Field(("floors", i, "youngs_modulus"), "column E", u.pressure, group=grp),
+            Field(("floors", i, "moment_of_inertia"), "column I", f"{u.length}^4", group=grp),
+            Field(("floors", i, "storey_height"), "storey l", u.length, group=grp),
+            Field(("floors", i, "face_width"), "face width d", u.length, group=grp),
+            Field(("floors", i, "floor_weight"), "floor weight", u.force, group=grp),
+            Field(("floors", i, "measured_frequency"), "measured f", "Hz", optional=True, group=grp),
+        ]
+    return fields
+
+
+def _names(value: Any) -> Any:
+    if isinstance(value, str):
+        return [part.strip() for part in value.split(",") if part.strip()]
+    return value
+
+
+def switch_pulse(doc: dict[str, Any]) -> dict[str, Any]:
+    """Keep only the keys the chosen pulse kind reads (defaults for a newly chosen kind)."""
+    boom = doc["boom"]
+    pulse = boom.get("pulse", "envelope")
+    if pulse != "envelope":
+        boom.pop("envelope", None)
+    if pulse != "csv":
+        boom.pop("csv", None)
+    if pulse in ("envelope", "csv"):
+        for key in IDEALIZED_KEYS:
+            boom.pop(key, None)
+    if pulse == "envelope":
+        boom.setdefault("envelope", dict(ENVELOPE_DEFAULT))
+    elif pulse == "csv":
+        boom.setdefault("csv", "")
+    else:
+        boom.setdefault("s", 2.0)
+        boom.setdefault("r1", 0.0)
+    return doc
+
+
+def _fmt(value: float, digits: int = 4) -> str:
+    return f"{value:.{digits}g}" if math.isfinite(value) else "inf"
+
+
+def limits_text(a: Any) -> str:
+    """The assessment as the CLI's table: DAF source, structures, allowable pressures."""
+    u = a.units
+    lines = [a.title, f"DAF source: {a.source}",
+             f"units: {u.name} (pressure {u.pressure}, also {u.alt_pressure})", "structures:"]
+    for s in a.structures:
+        freqs = ", ".join(f"{k} {v:.3f} Hz" for k, v in s.frequencies.items())
+        lines.append(f"  {s.name}: f: {freqs}")
+    lines.append("allowable peak overpressure:")
+    header = ("structure", "f source", "f [Hz]", "tau [s]", "tau/T", "criterion", "DAF",
+              f"p+ [{u.pressure}]", f"p+ [{u.alt_pressure}]", "note")
+    table = [header]
+    for r in a.rows:
+        note = ", ".join(n for n, on in (("tentative", r.tentative), ("f outside criterion range", not r.in_range))
+                         if on)
+        table.append((r.structure, r.frequency_source, f"{r.frequency:.3f}", f"{r.tau:g}", f"{r.ratio:.4f}",
+                      r.criterion, f"{r.daf:.4f}", _fmt(r.pressure), _fmt(r.pressure_alt), note))
+    widths = [max(len(str(row[i])) for row in table) for i in range(len(header))]
+    for row in table:
+        lines.append("  " + "  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
+    return "\n".join(lines)
+
+
+def limits_csv_rows(a: Any) -> tuple[list[str], list[list[str]]]:
+    """Header and rows of ``vtool solve BOOM_PRESET --csv`` (written by the CLI's own writer)."""
+    from vtool.app.cli.boom import _ROW_HEADER
+
+    u = a.units
+    p_cols = [f"limit/DAF [{u.length}/s | {u.length}]", f"p+ [{u.pressure}]", f"p+ [{u.alt_pressure}]"]
+    rows = [[r.structure, r.frequency_source, f"{r.frequency:.10g}", f"{r.tau:.10g}", f"{r.ratio:.10g}",
+             r.criterion, r.response, f"{r.daf:.10g}", f"{r.normalized:.10g}", f"{r.pressure:.10g}",
+             f"{r.pressure_alt:.10g}"] for r in a.rows]
+    return [*_ROW_HEADER, *p_cols], rows
+
+
+def design_series(a: Any) -> list[tuple[str, Any, dict[str, Any]]]:
+    """(structure, frequencies, {label: p+ in the alternative unit}) per distinct set of curves."""
+    u = a.units
+    by_structure: dict[str, dict[str, Any]] = {}
+    for curve in a.curves:
+        by_structure.setdefault(curve.structure, {})[f"{curve.criterion}, tau={curve.tau:g}s"] = curve
+    shown: set[tuple[float, ...]] = set()
+    out = []
+    for name, curves in by_structure.items():
+        key = tuple(round(float(v), 12) for c in curves.values() for v in c.pressure[::20])
+        if key in shown:
+            continue
+        shown.add(key)
+        first = next(iter(curves.values()))
+        out.append((name, first.frequency, {label: c.pressure * u.alt_per_pressure for label, c in curves.items()}))
+    return out
+
+
+def daf_curves(spec: Any, assessment: Any) -> dict[str, Any]:
+    """The overall DAF of the assessment's source against tau/T, for each response its criteria use."""
+    import numpy as np
+    from vtool.assessments.sonic_boom.assess import boom_source
+    from vtool.assessments.sonic_boom.spectra import daf_at, ratio_grid
+
+    top = max([2.5, *(1.1 * r.ratio for r in assessment.rows)])
+    ratio = ratio_grid(0.0, float(np.ceil(top * 10) / 10), 0.01)
+    source = boom_source(spec.boom)
+    series = {}
+    statements = []
+    for quantity in dict.fromkeys(c.response for c in spec.criteria):
+        daf, statement = daf_at(source, ratio, quantity, spec.boom.damping)
+        series[f"{quantity} DAF"] = daf
+        statements.append(statement)
+    return {"ratio": ratio, "series": series, "statement": " | ".join(statements)}
+
+
+class BoomScreen(DomainScreen):
+    MODE = "boom"
+    KINDS = ("boom_wall", "boom_floor")
+    DEFAULT_PRESET = "boom-brick-wall"
+    TITLE_TEXT = "SONIC BOOM"
+
+    def compose_results(self) -> ComposeResult:
+        color = self.app.chart_color  # type: ignore[attr-defined]
+        with TabbedContent(id="results-tabs"):
+            with TabPane("Limits", id="tab-limits"):
+                yield TextPanel("allowable pressures appear here after a run (ctrl+r)", id="limits")
+            with TabPane("DAF", id="tab-daf"):
+                yield ChartView("the DAF curve appears here after a run", id="daf-chart", color=color)
+            with TabPane("Design curves", id="tab-design"):
+                yield VerticalScroll(id="design-charts", classes="chart-stack")
+
+    @property
+    def limits_panel(self) -> TextPanel:
+        return self.query_one("#limits", TextPanel)
+
+    @property
+    def daf_chart(self) -> ChartView:
+        return self.query_one("#daf-chart", ChartView)
+
+    @property
+    def design_charts(self) -> list[ChartView]:
+        return list(self.query_one("#design-charts").query(ChartView))
+
+    def loader(self) -> Any:
+        from vtool.presets import boom
+
+        return boom
+
+    def fields_for(self, spec: Any, doc: dict[str, Any]) -> list[Field]:
+        return boom_fields(spec, doc)
+
+    def current_document(self) -> dict[str, Any]:
+        doc = self.form.apply(self.base_doc)
+        doc["criteria"] = _names(doc.get("criteria", ""))
+        envelope = doc["boom"].get("envelope")
+        if isinstance(envelope, dict) and "types" in envelope:
+            envelope["types"] = _names(envelope["types"])
+        return doc
+
+    def field_edited(self, path: tuple[str | int, ...]) -> None:
+        if dotted(path) == "boom.pulse":
+            doc = switch_pulse(self.current_document())
+            self.call_later(self.rebuild_form, doc)
+
+    async def rebuild_form(self, doc: dict[str, Any]) -> None:
+        self.base_doc = doc
+        spec = self.spec if self.spec is not None else self.results_spec
+        if spec is None:
+            from vtool.presets import load_preset
+
+            spec = load_preset(self.DEFAULT_PRESET)
+        await self.form.set_fields(self.fields_for(spec, doc), doc)
+        self.validate()
+        self.form.row("boom.pulse").editor.focus()
+
+    def clear_results(self) -> None:
+        self.results = None
+        self.limits_panel.set_text("allowable pressures appear here after a run (ctrl+r)")
+        self.daf_chart.plot(None)
+        self.query_one("#design-charts").remove_children()
+
+    def start_run(self, spec: Any, run_id: int) -> Worker[Any]:
+        return self.assess(spec, run_id)
+
+    @work(thread=True, exclusive=True, exit_on_error=False, group="run")
+    def assess(self, spec: Any, run_id: int) -> None:
+        from vtool.assessments.sonic_boom.assess import assess
+
+        worker = get_current_worker()
+        assessment = assess(spec)
+        daf = daf_curves(spec, assessment)
+        if not worker.is_cancelled:
+            self.post_message(AssessmentFinished(run_id, spec, assessment, daf))
+
+    async def on_assessment_finished(self, message: AssessmentFinished) -> None:
+        message.stop()
+        if not self.accept(message):
+            return
+        from vtool.app.plots import line_chart
+
+        a, daf = message.assessment, message.daf
+        self.results = a
+        self.limits_panel.set_text(limits_text(a))
+        self.daf_chart.plot(lambda w, h, c: line_chart(daf["ratio"], daf["series"], title="overall DAF",
+                                                       xlabel="tau/T", ylabel="DAF", width=w, height=h,
+                                                       color=c))
+        stack = self.query_one("#design-charts")
+        await stack.remove_children()
+        color = self.app.chart_color  # type: ignore[attr-defined]
+        charts = []
+        u = a.units
+        for name, freq, series in design_series(a):
+            chart = ChartView(id=None, color=color)
+            chart.structure = name  # type: ignore[attr-defined]
+            charts.append((chart, name, freq, series))
+        await stack.mount_all([c for c, *_ in charts])
+        for chart, name, freq, series in charts:
+            chart.plot(lambda w, h, c, name=name, freq=freq, series=series: line_chart(
+                freq, series, title=f"{name}: allowable p+ against frequency", xlabel="f [Hz]",
+                ylabel=f"p+ [{u.alt_pressure}]", width=w, height=h, color=c))
+        self.set_status(f"done: {len(a.rows)} limits, {len(a.structures)} structure(s)")
+
+    def write_csv(self, path: str) -> None:
+        from vtool.app.cli.boom import _write_csv
+
+        header, rows = limits_csv_rows(self.results)
+        _write_csv(path, header, rows)  # type: ignore[arg-type]

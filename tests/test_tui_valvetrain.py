@@ -1,0 +1,359 @@
+"""Pilot tests of the valve-train screen: form -> worker -> charts, against the library.
+
+Every expected value comes from calling the library with the same inputs
+(the TUI holds no physics); runs are shortened (degrees) where the point is
+the wiring, not the response.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import numpy as np
+import pytest
+import tomli_w
+from click.testing import CliRunner
+
+from vtool.app import valvetrain_charts as charts
+from vtool.app.cli.main import cli
+from vtool.app.plots import shape_chart
+from vtool.app.tui.app import create_app
+from vtool.app.tui.dialogs import ErrorDialog, PathDialog
+from vtool.app.tui.messages import RunProgressed, SimulationFinished
+from vtool.app.tui.valvetrain import ValveTrainScreen
+from vtool.errors import InputError, RunError
+from vtool.presets import load_preset, valvetrain
+from vtool.presets.valvetrain import with_run_overrides
+from vtool.solvers.run import simulate
+from vtool.solvers.shapes import deformed_members
+
+pytestmark = pytest.mark.asyncio
+
+
+def make_app(preset: str | None = "gnilka-1c", tmp_path=None):  # type: ignore[no-untyped-def]
+    if tmp_path is None:
+        return create_app(preset, remember=False, chart_color=False)
+    return create_app(preset, config_dir=tmp_path, chart_color=False)
+
+
+async def set_field(pilot, screen, name: str, text: str) -> None:  # type: ignore[no-untyped-def]
+    """Type into a field as a user does: focus, clear, type, let validation run."""
+    editor = screen.form.row(name).editor
+    editor.focus()
+    await pilot.pause()
+    await pilot.press("end", "ctrl+u")
+    await pilot.press(*text)
+    await pilot.pause()
+
+
+async def run_and_wait(pilot, app) -> None:  # type: ignore[no-untyped-def]
+    await pilot.press("ctrl+r")
+    await pilot.pause()
+    await app.workers.wait_for_complete()
+    await pilot.pause()
+
+
+def summary_values(trace) -> dict:  # type: ignore[no-untyped-def]
+    s = trace.summary()
+    return {k: v for k, v in s.items() if k != "wall_time_s"}
+
+
+async def test_opens_on_valvetrain_and_1a_run_draws_the_library_charts() -> None:
+    app = make_app(None)
+    async with app.run_test(size=(100, 30)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        assert isinstance(screen, ValveTrainScreen)
+        # load 1A through the open dialog, as a user does
+        await pilot.press("ctrl+o")
+        await pilot.pause()
+        option_list = app.screen.query_one("#open-list")
+        index = next(i for i in range(option_list.option_count)
+                     if option_list.get_option_at_index(i).id == "name:gnilka-1a")
+        option_list.highlighted = index
+        await pilot.press("enter")
+        await pilot.pause()
+        assert app.screen is screen and screen.source == "gnilka-1a"
+        started = time.perf_counter()
+        await run_and_wait(pilot, app)
+        assert time.perf_counter() - started < 20.0
+        assert app.errors_shown == []
+        expected = simulate(load_preset("gnilka-1a"))
+        trace = screen.trace
+        assert trace.spec == expected.spec  # the form loses nothing of the preset
+        np.testing.assert_array_equal(trace.contact_force, expected.contact_force)
+        np.testing.assert_array_equal(trace.configuration, expected.configuration)
+        assert summary_values(trace) == summary_values(expected)
+        for tab, view, draw in (("tab-forces", screen.force_chart, charts.force_chart),
+                                ("tab-configuration", screen.configuration_chart, charts.configuration_chart)):
+            screen.tabs.active = tab
+            await pilot.pause()
+            w, h = view.chart_size
+            assert view.chart_text == draw(expected, w, h, color=False)
+            assert view.chart_text.strip()
+        screen.tabs.active = "tab-displacements"
+        await pilot.pause()
+        w, h = screen.displacement_chart.chart_size
+        quantities = tuple(q for q in expected.spec.run.quantities if not q.startswith("F"))[:4]
+        assert screen.selected_quantities() == quantities
+        assert screen.displacement_chart.chart_text == charts.displacement_chart(expected, quantities, w, h,
+                                                                                 color=False)
+        assert screen.query_one("#summary").text == expected.summary_text().replace(
+            f"wall time {expected.statistics.wall_time:.3f} s", f"wall time {trace.statistics.wall_time:.3f} s")
+        kinds = [type(m) for m in screen.messages_seen]
+        assert kinds[-1] is SimulationFinished
+        assert all(k is RunProgressed for k in kinds[:-1])
+
+
+async def test_edited_fields_run_what_the_library_runs() -> None:
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        await set_field(pilot, screen, "run.rpm", "9000")
+        await set_field(pilot, screen, "run.degrees", "200")
+        await set_field(pilot, screen, "members.valve_spring.stiffness", "300")
+        assert screen.problem is None
+        await run_and_wait(pilot, app)
+        doc = valvetrain.dump(load_preset("gnilka-1c"))
+        doc["run"].update(rpm=9000, degrees=200)
+        doc["members"]["valve_spring"]["stiffness"] = 300
+        spec = valvetrain.load(doc)
+        assert screen.trace.spec == spec
+        expected = simulate(spec)
+        np.testing.assert_array_equal(screen.trace.q, expected.q)
+        assert summary_values(screen.trace) == summary_values(expected)
+        w, h = screen.force_chart.chart_size
+        assert screen.force_chart.chart_text == charts.force_chart(expected, w, h, color=False)
+
+
+async def test_choosing_quantities_redraws_the_displacement_chart() -> None:
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(100, 30)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        await set_field(pilot, screen, "run.degrees", "120")
+        await run_and_wait(pilot, app)
+        screen.tabs.active = "tab-displacements"
+        await pilot.pause()
+        selection = screen.quantity_list
+        selection.deselect_all()
+        selection.select("q7")
+        await pilot.pause()
+        w, h = screen.displacement_chart.chart_size
+        assert screen.selected_quantities() == ("q7",)
+        assert screen.displacement_chart.chart_text == charts.displacement_chart(screen.trace, ("q7",), w, h,
+                                                                                 color=False)
+
+
+@pytest.mark.parametrize(("name", "text"), [("members.pushrod.length", "-5"), ("run.rpm", "fast"),
+                                            ("clearances[1].restitution", "1.5")])
+async def test_invalid_field_shows_the_cli_message_and_blocks_the_run(name: str, text: str,
+                                                                       tmp_path) -> None:  # type: ignore[no-untyped-def]
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        await set_field(pilot, screen, name, text)
+        doc = screen.current_document()
+        with pytest.raises(InputError) as info:
+            valvetrain.load(doc)
+        message = info.value.one_line()
+        assert message.startswith(name)
+        row = screen.form.row(name)
+        assert row.has_class("-invalid")
+        assert str(row.query_one(".field-error").render()) == message
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        assert screen.worker is None and screen.results is None
+        assert screen.form.row(name).editor.has_focus
+        # the CLI says the same about the same document
+        preset = tmp_path / "bad.toml"
+        preset.write_text(tomli_w.dumps(doc))
+        result = CliRunner().invoke(cli, ["solve", str(preset)])
+        assert result.exit_code == 2
+        assert result.output.strip() == f"error: {message}"
+        # fixing the value clears the message
+        good = {"members.pushrod.length": "9", "run.rpm": "11000", "clearances[1].restitution": "0"}[name]
+        await set_field(pilot, screen, name, good)
+        assert screen.problem is None and not row.has_class("-invalid")
+
+
+async def test_unstable_time_step_fails_in_an_error_dialog_and_the_app_lives_on() -> None:
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        await set_field(pilot, screen, "run.time_step", "0.001")
+        await set_field(pilot, screen, "run.degrees", "30")
+        await run_and_wait(pilot, app)
+        assert isinstance(app.screen, ErrorDialog)
+        with pytest.raises(InputError) as info:
+            simulate(with_run_overrides(load_preset("gnilka-1c"), time_step=0.001, degrees=30))
+        assert app.errors_shown == [info.value.one_line()]
+        assert app.screen.message == info.value.one_line()
+        await pilot.press("escape")
+        await pilot.pause()
+        assert app.screen is screen and screen.results is None
+        assert screen.form.row("run.time_step").has_class("-invalid")
+        # the app still works: fix the step and run
+        await set_field(pilot, screen, "run.time_step", "1e-6")
+        await run_and_wait(pilot, app)
+        assert screen.results is not None and app.errors_shown == [info.value.one_line()]
+
+
+async def test_a_diverging_run_shows_the_run_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    import vtool.solvers.run as run_module
+
+    def diverging(spec, **kwargs):  # type: ignore[no-untyped-def]
+        raise RunError("diverged at t = 0.001 s (cam angle 66 deg) in configuration VII (cam+rocker)")
+
+    monkeypatch.setattr(run_module, "simulate", diverging)
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        await run_and_wait(pilot, app)
+        assert isinstance(app.screen, ErrorDialog)
+        assert app.errors_shown == ["diverged at t = 0.001 s (cam angle 66 deg) in configuration VII (cam+rocker)"]
+
+
+async def test_keys_work_during_a_long_run_and_cancel_stops_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    import vtool.solvers.run as run_module
+
+    real = run_module.simulate
+    ended = threading.Event()
+    outcome: list[BaseException | None] = []
+
+    def watched(spec, **kwargs):  # type: ignore[no-untyped-def]
+        try:
+            trace = real(spec, **kwargs)
+        except BaseException as exc:
+            outcome.append(exc)
+            raise
+        else:
+            outcome.append(None)
+            return trace
+        finally:
+            ended.set()
+
+    monkeypatch.setattr(run_module, "simulate", watched)
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        await set_field(pilot, screen, "run.time_step", "1e-8")
+        await set_field(pilot, screen, "run.degrees", "20000")  # minutes of work if left alone
+        await pilot.press("ctrl+r")
+        for _ in range(200):
+            await pilot.pause(0.05)
+            if screen.messages_seen:
+                break
+        assert screen.running
+        # the UI responds while the worker runs: switch tabs, edit a field
+        before = screen.tabs.active
+        await pilot.press("ctrl+t")
+        await pilot.pause()
+        assert screen.tabs.active != before
+        await set_field(pilot, screen, "run.rpm", "10000")
+        assert screen.form.value("run.rpm") == "10000"
+        assert screen.running and not ended.is_set()
+        await pilot.press("escape")
+        await pilot.pause()
+        assert not screen.running
+        assert ended.wait(10.0), "the simulation thread did not stop after cancel"
+        assert isinstance(outcome[0], RunError) and "cancelled" in str(outcome[0])
+        await pilot.pause(0.2)
+        assert screen.results is None and app.errors_shown == []
+        assert "cancelled" in str(screen.status.render())
+
+
+async def test_csv_export_equals_vtool_solve_csv(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        await pilot.press("ctrl+e")  # nothing to export yet: a warning, no dialog
+        await pilot.pause()
+        assert not isinstance(app.screen, PathDialog)
+        await run_and_wait(pilot, app)
+        await pilot.press("ctrl+e")
+        await pilot.pause()
+        assert isinstance(app.screen, PathDialog)
+        app.screen.query_one("#path-input").value = str(tmp_path / "tui.csv")
+        await pilot.press("enter")
+        await pilot.pause()
+        assert app.screen is screen
+    result = CliRunner().invoke(cli, ["solve", "gnilka-1c", "--csv", str(tmp_path / "cli.csv")])
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "tui.csv").read_text() == (tmp_path / "cli.csv").read_text()
+
+
+async def test_save_then_load_round_trips_and_is_remembered(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    app = make_app("gnilka-1c", tmp_path)
+    path = tmp_path / "my-valve.toml"
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        await set_field(pilot, screen, "run.rpm", "9500")
+        await set_field(pilot, screen, "clearances[2].restitution", "0.25")
+        edited = screen.spec
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        app.screen.query_one("#path-input").value = str(path)
+        await pilot.press("enter")
+        await pilot.pause()
+        assert load_preset(path) == edited
+        assert edited.run.rpm == 9500 and edited.clearances[2].restitution == 0.25
+        await app.open_preset("gnilka-1a")
+        await pilot.pause()
+        assert screen.form.value("run.rpm") == "11000"
+        await app.open_preset(str(path))
+        await pilot.pause()
+        assert screen.form.value("run.rpm") == "9500"
+        assert screen.form.value("clearances[2].restitution") == "0.25"
+        assert screen.validate() == edited
+    again = make_app(None, tmp_path)
+    assert again.recent.items[0] == str(path.resolve())
+    assert "gnilka-1a" in again.recent.items
+
+
+async def test_animation_steps_through_the_deformed_mechanism() -> None:
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(100, 30)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        await set_field(pilot, screen, "run.degrees", "60")
+        await run_and_wait(pilot, app)
+        screen.tabs.active = "tab-animation"
+        await pilot.pause()
+        animation = screen.animation
+        animation.focus()
+        await pilot.pause()
+        await pilot.press("right", "right", "plus")
+        await pilot.pause()
+        assert animation.row == 2 and animation.scale == 2.0
+        trace = screen.trace
+        n = trace.spec.n_coordinates
+        shapes = deformed_members(trace.spec, trace.q[2, :n], 2.0)
+        xlim, ylim = animation.limits()
+        w, h = animation.size
+        title = f"cam {trace.cam_angle[2]:.1f} deg, row 3/{len(trace.time)}, scale x2, paused"
+        assert animation.frame_text == shape_chart(shapes, title=title, xlabel="in", width=w, height=h,
+                                                   color=False, xlim=xlim, ylim=ylim)
+        await pilot.press("space")
+        await pilot.pause(0.5)
+        assert animation.playing and animation.row > 2
+        await pilot.press("space")
+        assert not animation.playing
+
+
+async def test_unknown_preset_on_the_command_line_shows_an_error_and_opens_the_default() -> None:
+    app = make_app("no-such-preset")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        assert isinstance(app.screen, ErrorDialog)
+        assert app.errors_shown[0].startswith("preset: got 'no-such-preset'")
+        await pilot.press("escape")
+        await pilot.pause()
+        assert isinstance(app.screen, ValveTrainScreen) and app.screen.source == "gnilka-1a"
