@@ -17,7 +17,9 @@ Method (see the kernel's docstring for the equations):
   Newmark solution itself, not on an interpolant) to within
   ``time_tolerance`` (default 1e-6 of the time step: 1e-12 s at 1 µs); when
   several monitors change sign in one step the earliest event is taken first
-  and the rest of the step is integrated in the new configuration.
+  and the rest of the step is integrated in the new configuration. A gap that
+  starts at zero (a contact just released) has a round-off sign, so no
+  closing is looked for in its first 1e-3 of a step.
 * Impacts: Newton's law with a restitution coefficient per clearance, with
   the impulses of all contacts involved solved together as a linear
   complementarity problem on the full consistent mass matrix (see
@@ -182,6 +184,8 @@ class _KernelRun:
             zeno_window=1e-3 * dt, zeno_stick=options.zeno_stick, zeno_stop=options.zeno_stop,
             x_limit=1e3 * x_scale,
             rest_velocity=options.rest_velocity or 1e-5 * self.velocity_scale(),
+            gap_noise=1e-13 * x_scale,
+            guard_time=1e-3 * dt,
         )
         self.tables = ConfigurationTables.empty(2**ncl, n, ncl, len(self.source_numbers))
         # the kernel sees the same arrays, so configurations built later are visible to it

@@ -69,6 +69,8 @@ Problem = namedtuple(
         "zeno_stop",  # rapid events before the run stops
         "x_limit",  # |q| beyond this is divergence
         "rest_velocity",  # slower separations and impacts are resting contacts
+        "gap_noise",  # gaps within this of zero are round-off (length)
+        "guard_time",  # after a gap starts at zero, no closing is looked for within this time (s)
     ],
 )
 
@@ -257,16 +259,16 @@ def step_to(prob, cfg, c, t, h, x, v, a, w, x1, v1, a1):
 
 
 @jit
-def locate_event(prob, cfg, c, k, t, h, phi_lo, phi_hi, x, v, a, w):
-    """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from t.
+def locate_event(prob, cfg, c, k, t, lo, h, phi_lo, phi_hi, x, v, a, w):
+    """Earliest tau in (lo, h] where monitor k crosses zero, re-stepping from t.
 
     Illinois (modified regula falsi) on phi(tau) = monitor after a Newmark
-    step of length tau, bracketed by phi(0) >= 0 > phi(h), with a bisection
+    step of length tau, bracketed by phi(lo) >= 0 > phi(h), with a bisection
     whenever two iterations have not halved the bracket; returns the left end
     of the final bracket (the monitor still non-negative), within
     prob.time_tol of the crossing.
     """
-    lo, hi = 0.0, h
+    hi = h
     flo, fhi = phi_lo, phi_hi
     side = 0
     width_before = 2.0 * h
@@ -574,12 +576,17 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
                     gather(cfg, c, x, v, a, w.xl, w.vl, w.al)
                     set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
                     phi0 = monitor(prob, cfg, c, k, t, x, v, a)
-                    if phi0 < 0.0 and not (c & prob.cl_bit[k]):
-                        phi0 = 0.0  # a gap a hair below zero at the start (just released): round-off
+                    lo = 0.0
+                    if not (c & prob.cl_bit[k]) and phi0 <= prob.gap_noise:
+                        # a gap that starts at zero (just released, or just snapped shut and bounced):
+                        # its sign is round-off until it has moved, so the bracket starts a little later
+                        lo = min(0.5 * h, prob.guard_time)
+                        step_to(prob, cfg, c, t, lo, x, v, a, w, w.x1, w.v1, w.a1)
+                        phi0 = monitor(prob, cfg, c, k, t + lo, w.x1, w.v1, w.a1)
                     if phi0 < 0.0:
-                        w.tau[k] = 0.0
+                        w.tau[k] = lo
                     else:
-                        w.tau[k] = locate_event(prob, cfg, c, k, t, h, phi0, w.phi[k], x, v, a, w)
+                        w.tau[k] = locate_event(prob, cfg, c, k, t, lo, h, phi0, w.phi[k], x, v, a, w)
                     tau_min = min(tau_min, w.tau[k])
             h = tau_min
             if h > 0.0:

@@ -91,6 +91,8 @@ def format_value(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):
+        if value.is_integer() and abs(value) < 1e15:
+            return str(int(value))  # reads back as the same number (the loaders take ints)
         return repr(value)  # shortest text that reads back to the same float: the form loses nothing
     if isinstance(value, list):
         return ", ".join(format_value(v) for v in value)
