@@ -58,7 +58,8 @@ def load(doc: dict[str, Any]) -> MechanismSpec:
     members = _members(top, n, units)
     clearances = _clearances(top, n, prescribed, cam.coordinate)
     names = {c.name: c for c in clearances}
-    initial = _initial(top.table("initial"), names, units)  # type: ignore[arg-type]
+    cam_name = next(c.name for c in clearances if c.behind == cam.coordinate)
+    initial = _initial(top.table("initial"), names, cam_name, units)  # type: ignore[arg-type]
     damping = _damping(top.table("damping", required=False), names)
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances))  # type: ignore[arg-type]
     top.finish()
@@ -107,7 +108,9 @@ def _cam(t: Table, n: int, units: UnitSystem) -> CamSpec:
     if raw_offset == STATIC_START:
         offset = None
     elif isinstance(raw_offset, int | float) and not isinstance(raw_offset, bool):
-        offset = t.number("offset", unit=units.length)
+        # the static start puts the follower on the cam with force k_eff * offset: a negative
+        # offset would start with the cam contact in tension
+        offset = t.number("offset", unit=units.length, min_value=0.0)
     else:
         raise InputError(t.field("offset"), raw_offset, f'"{STATIC_START}" or a number', units.length)
     t.finish()
@@ -206,11 +209,14 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int) -
     return tuple(result)
 
 
-def _initial(t: Table, names: dict[str, ClearanceSpec], units: UnitSystem) -> InitialSpec:
+def _initial(t: Table, names: dict[str, ClearanceSpec], cam_name: str, units: UnitSystem) -> InitialSpec:
     closed = _names(t, "closed", names)
     for name in closed:
         if names[name].state == REMOVED:
             raise InputError(t.field("closed"), name, "clearances that are not removed")
+        if names[name].kind == EXTERNAL and name != cam_name:
+            # the static start loads the mechanism at the follower only; it cannot put the valve on its seat
+            raise InputError(t.field("closed"), name, f"only the cam clearance ('{cam_name}') and internal clearances")
     preload = t.number("spring_preload", unit=units.force, min_value=0.0)
     ratio = t.number("lever_ratio", min_exclusive=0.0)
     t.finish()

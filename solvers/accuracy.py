@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vtool.errors import InputError
+from vtool.errors import InputError, RunError
 from vtool.files import write_atomic
 from vtool.presets.valvetrain import with_run_overrides
 from vtool.solvers.model import assemble
@@ -108,6 +108,9 @@ def accuracy_study(
                 trace = simulate(with_run_overrides(spec, backend="newmark", time_step=dt, beta=beta))
             except InputError as error:
                 rows.append(AccuracyRow("newmark", setting, note=f"refused: {error.expected}"))
+                continue
+            except RunError as error:
+                rows.append(AccuracyRow("newmark", setting, note=f"failed: {error}"))
                 continue
             rows.append(compare(trace, reference, "newmark", setting))
     mechanism = assemble(spec)

@@ -407,7 +407,9 @@ def impact(prob, c, closing, t, x, v, stick, out, istate):
     separates is then decided smoothly by its contact force at the next
     step. The kinetic energy this can change is at most of order
     m v_rest², and none is created (an equality row with u⁻ = u⁺ = 0 does no
-    work). In ``stick`` mode (chattering) restitution is taken as zero.
+    work). In ``stick`` mode (chattering) restitution is taken as zero and
+    every contact involved is held shut (equality), so the chattering ends in
+    sticking contact whose forces then decide any separation.
     """
     n = prob.n
     ncl = prob.cl_ahead.shape[0]
@@ -435,7 +437,7 @@ def impact(prob, c, closing, t, x, v, stick, out, istate):
         if closing[k]:
             e = 0.0 if (stick or abs(u[r]) < prob.rest_velocity) else prob.cl_e[k]
             b[r] = -e * u[r]
-        eq[r] = prob.cl_pinned[k]
+        eq[r] = prob.cl_pinned[k] or stick  # chattering: every contact involved sticks
     MG = prob.Minv @ G.T
     W = G @ MG
     scale = 1e-12 + 1e-9 * np.max(np.abs(u)) if nc > 0 else 1e-12

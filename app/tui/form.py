@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from textual.app import ComposeResult
-from textual.containers import Horizontal, VerticalScroll
+from textual.containers import VerticalScroll
 from textual.widget import Widget
 from textual.widgets import Input, Label, Select, Static
 
@@ -125,12 +125,10 @@ class FieldRow(Widget):
     """Label, editor and unit on one line; the error message below it."""
 
     DEFAULT_CSS = """
-    FieldRow { height: auto; }
-    FieldRow > Horizontal { height: auto; }
-    FieldRow .field-label { width: 16; height: 1; padding-right: 1; }
-    FieldRow Input, FieldRow Select { width: 13; }
-    FieldRow .field-unit { width: 1fr; height: 1; padding-left: 1; color: $text-muted; }
-    FieldRow .field-error { color: $error; height: auto; display: none; }
+    FieldRow { height: auto; layout: grid; grid-size: 3; grid-columns: 16 13 1fr; grid-rows: 1 auto; }
+    FieldRow .field-label { height: 1; padding-right: 1; }
+    FieldRow .field-unit { height: 1; padding-left: 1; color: $text-muted; }
+    FieldRow .field-error { color: $error; height: auto; display: none; column-span: 3; }
     FieldRow.-invalid .field-error { display: block; }
     FieldRow.-invalid Input { color: $error; }
     """
@@ -142,16 +140,15 @@ class FieldRow(Widget):
 
     def compose(self) -> ComposeResult:
         f = self.field
-        with Horizontal():
-            yield Label(f.label, classes="field-label")
-            if f.kind == CHOICE:
-                options = [(c, c) for c in f.choices]
-                value = self.initial if self.initial in f.choices else f.choices[0]
-                yield Select(options, value=value, allow_blank=False, compact=True, id=f"{f.widget_id}-editor")
-            else:
-                yield Input(format_value(self.initial), compact=True, id=f"{f.widget_id}-editor",
-                            select_on_focus=False)
-            yield Label(f.unit, classes="field-unit")
+        yield Label(f.label, classes="field-label", markup=False)
+        if f.kind == CHOICE:
+            options = [(c, c) for c in f.choices]
+            value = self.initial if self.initial in f.choices else f.choices[0]
+            yield Select(options, value=value, allow_blank=False, compact=True, id=f"{f.widget_id}-editor")
+        else:
+            yield Input(format_value(self.initial), compact=True, id=f"{f.widget_id}-editor",
+                        select_on_focus=False)
+        yield Label(f.unit, classes="field-unit", markup=False)
         yield Static("", classes="field-error", markup=False)
 
     @property
