@@ -18,8 +18,8 @@ Method (see the kernel's docstring for the equations):
   ``time_tolerance`` (default 1e-6 of the time step: 1e-12 s at 1 µs); when
   several monitors change sign in one step the earliest event is taken first
   and the rest of the step is integrated in the new configuration. A gap that
-  starts at zero (a contact just released) has a round-off sign, so no
-  closing is looked for in its first 1e-3 of a step.
+  starts at zero (a contact just released) has a round-off sign, so a gap
+  closes when it falls below -1e-13 of the mechanism's size.
 * Impacts: Newton's law with a restitution coefficient per clearance, with
   the impulses of all contacts involved solved together as a linear
   complementarity problem on the full consistent mass matrix (see
@@ -33,10 +33,11 @@ Method (see the kernel's docstring for the equations):
   the lowest natural frequency) are resting contacts that stay
   closed until their contact force says otherwise: together these keep the
   examples from chattering.
-* Chattering: ``zeno_stick`` events each within ``zeno_window`` of the
-  previous one switch restitution to zero (the contacts stick);
-  ``zeno_stop`` such events stop the run with a message. A run never loops
-  forever.
+* Chattering: ``zeno_stick`` (20) events each within ten event-location
+  tolerances of the previous one (events piling up at one instant) make
+  every contact involved stick (restitution zero, held shut; their forces
+  then decide separation); ``zeno_stop`` (400) such events stop the run with
+  a message naming the time and configuration. A run never loops forever.
 * Stability: for gamma = 1/2 and beta < 1/4 the step must satisfy
   omega_max dt <= 1 / sqrt(gamma/2 - beta) (2 sqrt 3 for linear acceleration:
   dt <= sqrt(3)/pi T_min), with omega_max the highest natural frequency of
@@ -181,11 +182,11 @@ class _KernelRun:
             src_kind=kinds, src_par=par,
             Minv=np.linalg.inv(mechanism.M),
             time_tol=options.time_tolerance or 1e-6 * dt,
-            zeno_window=1e-3 * dt, zeno_stick=options.zeno_stick, zeno_stop=options.zeno_stop,
+            zeno_window=10 * (options.time_tolerance or 1e-6 * dt), zeno_stick=options.zeno_stick,
+            zeno_stop=options.zeno_stop,
             x_limit=1e3 * x_scale,
             rest_velocity=options.rest_velocity or 1e-5 * self.velocity_scale(),
             gap_noise=1e-13 * x_scale,
-            guard_time=1e-3 * dt,
         )
         self.tables = ConfigurationTables.empty(2**ncl, n, ncl, len(self.source_numbers))
         # the kernel sees the same arrays, so configurations built later are visible to it

@@ -70,7 +70,6 @@ Problem = namedtuple(
         "x_limit",  # |q| beyond this is divergence
         "rest_velocity",  # slower separations and impacts are resting contacts
         "gap_noise",  # gaps within this of zero are round-off (length)
-        "guard_time",  # after a gap starts at zero, no closing is looked for within this time (s)
     ],
 )
 
@@ -242,10 +241,15 @@ def contact_force(prob, cfg, c, k, t, x, v, a):
 
 @leaf
 def monitor(prob, cfg, c, k, t, x, v, a):
-    """The value whose sign change flips clearance k: its contact force if closed, its gap if open."""
+    """The value whose sign change flips clearance k: its contact force if closed, its gap if open.
+
+    A gap counts as closed when it is below -gap_noise (1e-13 of the
+    mechanism's size): a gap that starts at zero (a contact just released,
+    or separating tangentially) has a round-off sign until it has moved.
+    """
     if c & prob.cl_bit[k]:
         return contact_force(prob, cfg, c, k, t, x, v, a)
-    return gap(prob, k, t, x)
+    return gap(prob, k, t, x) + prob.gap_noise
 
 
 @leaf
@@ -579,12 +583,6 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
                     set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
                     phi0 = monitor(prob, cfg, c, k, t, x, v, a)
                     lo = 0.0
-                    if not (c & prob.cl_bit[k]) and phi0 <= prob.gap_noise:
-                        # a gap that starts at zero (just released, or just snapped shut and bounced):
-                        # its sign is round-off until it has moved, so the bracket starts a little later
-                        lo = min(0.5 * h, prob.guard_time)
-                        step_to(prob, cfg, c, t, lo, x, v, a, w, w.x1, w.v1, w.a1)
-                        phi0 = monitor(prob, cfg, c, k, t + lo, w.x1, w.v1, w.a1)
                     if phi0 < 0.0:
                         w.tau[k] = lo
                     else:

@@ -208,7 +208,7 @@ class PiecewiseRun(ABC):
                 values[k] = frow[k] @ state
             else:
                 behind = x[self.prob.cl_behind[k]] if self.prob.cl_behind[k] >= 0 else sources[self.prob.cl_src[k], 0]
-                values[k] = x[self.prob.cl_ahead[k]] - behind
+                values[k] = x[self.prob.cl_ahead[k]] - behind + self.prob.gap_noise  # as the kernel's monitor
         return values
 
     def full_state(self, ss: StateSpace, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -87,7 +87,8 @@ class MechanismAnimation(Static, can_focus=True):
             y_all = np.concatenate(ys) if ys else np.zeros(1)
             pad_x = 0.1 * max(float(np.ptp(x_all)), 1e-9)
             pad_y = 0.05 * max(float(np.ptp(y_all)), 1e-9)
-            self._limits = ((float(x_all.min()) - pad_x, float(x_all.max()) + pad_x),
+            # the legend sits in the top left corner: leave it room
+            self._limits = ((float(x_all.min()) - 4.0 * pad_x, float(x_all.max()) + pad_x),
                             (float(y_all.min()) - pad_y, float(y_all.max()) + pad_y))
         return self._limits
 

@@ -223,6 +223,7 @@ class DomainScreen(Screen[None]):
             self.worker.cancel()
             self.set_status("cancelled")
             self.progress.update(progress=0)
+            self.refresh_bindings()
 
     def on_run_progressed(self, message: RunProgressed) -> None:
         message.stop()

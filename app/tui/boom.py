@@ -174,6 +174,7 @@ def design_series(a: Any) -> list[tuple[str, Any, dict[str, Any]]]:
 def daf_curves(spec: Any, assessment: Any) -> dict[str, Any]:
     """The overall DAF of the assessment's source against tau/T, for each response its criteria use."""
     import numpy as np
+
     from vtool.assessments.sonic_boom.assess import boom_source
     from vtool.assessments.sonic_boom.spectra import daf_at, ratio_grid
 

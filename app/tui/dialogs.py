@@ -59,8 +59,8 @@ class OpenDialog(ModalScreen[str | None]):
                 options += [Option(r, id=f"recent:{r}") for r in self.recent]
                 options.append(Option(Text("shipped", style="bold"), disabled=True))
             for name, kind, title in self.shipped:
-                options.append(Option(Text(f"{name:<19}{kind:<11}{title}", no_wrap=True, overflow="ellipsis"),
-                                      id=f"name:{name}"))
+                line = f"{name:<19}{kind:<11}{title}"
+                options.append(Option(line if len(line) <= 68 else line[:67] + "…", id=f"name:{name}"))
             yield OptionList(*options, id="open-list")
             yield Input(placeholder="or a path to a .toml preset", id="open-path")
 

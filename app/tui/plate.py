@@ -178,6 +178,7 @@ def run_plate(spec: Any, options: dict[str, Any]) -> PlateRun:
 def transient_chart(run: PlateRun, quantity: str, width: int, height: int, color: bool) -> str:
     """Centre history of the chosen case against exact (the chart of ``vtool plate transient``)."""
     import numpy as np
+
     from vtool.app.plots import line_chart
 
     resp, exact = run.response, run.exact
@@ -325,7 +326,6 @@ class PlateScreen(DomainScreen):
 
     def write_csv(self, path: str) -> None:
         from vtool.assessments.plate.report import study_csv
-
         from vtool.files import write_atomic
 
         write_atomic(path, study_csv(self.results.study))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from typing import Any
 
 from textual import work
@@ -15,6 +16,8 @@ from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, Field
 from vtool.app.tui.messages import RunProgressed, SimulationFinished
 from vtool.app.tui.widgets import ChartView, TextPanel
+
+PROGRESS_INTERVAL = 0.05  # s between progress messages
 
 MEMBER_KEYS = (
     ("length", "length", "length"),
@@ -177,9 +180,13 @@ class ValveTrainScreen(DomainScreen):
         from vtool.solvers.run import simulate
 
         worker = get_current_worker()
+        last = [0.0]
 
         def progress(fraction: float) -> None:
-            self.post_message(RunProgressed(run_id, fraction))
+            now = time.monotonic()
+            if now - last[0] >= PROGRESS_INTERVAL:  # the bar needs no more; the UI keeps the GIL
+                last[0] = now
+                self.post_message(RunProgressed(run_id, fraction))
 
         trace = simulate(spec, progress=progress, cancel=lambda: worker.is_cancelled)
         if not worker.is_cancelled:

@@ -1,0 +1,66 @@
+"""Snapshots at fixed terminal sizes: the screen as text (from Textual's SVG screenshot).
+
+Not pixel comparisons (a theme tweak would break those); the assertions say
+what an engineer must see at 80 x 24 and what a wide terminal adds.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from vtool.app.tui.app import create_app
+from vtool.app.tui.screenshots import svg_text
+
+pytestmark = pytest.mark.asyncio
+
+
+async def shot(app, pilot, width: int) -> str:  # type: ignore[no-untyped-def]
+    await pilot.pause(0.1)
+    return svg_text(app.export_screenshot(), width)
+
+
+async def test_valvetrain_at_80x24_shows_form_units_chart_status_and_keys() -> None:
+    app = create_app("gnilka-1d", remember=False, chart_color=False)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        app.screen.form.row("run.degrees").editor.value = "90"
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        await app.workers.wait_for_complete()
+        text = await shot(app, pilot, 80)
+        lines = text.splitlines()
+        assert len(lines) == 24
+        assert lines[0].startswith(" VALVE TRAIN") and "Forces" in lines[0] and "Config" in lines[0]
+        assert any("cam speed" in line and "11000" in line and "rev/min" in line for line in lines)
+        assert any("cam degrees" in line and "90" in line and "deg" in line for line in lines)
+        assert "contact forces (lbf)" in text and "cam angle (deg)" in text
+        assert "done:" in lines[-2] and "100%" in lines[-2]
+        for key in ("^r Run", "^s Save", "^e CSV", "^f Form", "^t Tab", "^q Quit", "^o Open", "f1 Help",
+                    "f2-4 Screen"):
+            assert key in lines[-1], key
+        # the help screen lists every key
+        await pilot.press("f1")
+        text = await shot(app, pilot, 80)
+        assert "ctrl+r  run" in text and "escape  cancel" in text and "f2  valve train" in text
+        await pilot.press("escape")
+        # form hidden: the chart takes the full width
+        await pilot.press("ctrl+f")
+        text = await shot(app, pilot, 80)
+        assert "VALVE TRAIN" not in text and "contact forces (lbf)" in text
+        assert max(len(line) for line in text.splitlines()) > 75
+
+
+async def test_wide_terminal_adds_the_summary_beside_the_charts() -> None:
+    app = create_app("gnilka-1d", remember=False, chart_color=False)
+    async with app.run_test(size=(180, 40)) as pilot:
+        await pilot.pause()
+        app.screen.form.row("run.degrees").editor.value = "90"
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        await app.workers.wait_for_complete()
+        text = await shot(app, pilot, 180)
+        lines = text.splitlines()
+        assert len(lines) == 40
+        header = next(line for line in lines if "clearance" in line and "separations" in line)
+        assert header.index("clearance") > header.index("▕") + 40  # right of the form and the charts
+        assert "contact forces (lbf)" in text and "events" in text
