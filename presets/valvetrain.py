@@ -255,6 +255,11 @@ def _damping(t: Table | None, names: dict[str, ClearanceSpec]) -> DampingSpec:
         lt.finish()
         layers.append(LayerDampingSpec(tuple(sorted(closed)), ratio, tuple(sorted(overrides))))
     t.finish()
+    largest = max([default_ratio] + [lay.default_ratio for lay in layers]
+                  + [r for lay in layers for _, r in lay.mode_ratios])
+    if largest > 0 and factor * largest > MAX_DAMPING_RATIO:
+        raise InputError("damping.factor", factor,
+                         f"<= {MAX_DAMPING_RATIO / largest:.6g} (factor x largest ratio {largest:g} must be <= 1)")
     return DampingSpec(factor, default_ratio, tuple(layers))
 
 

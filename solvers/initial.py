@@ -36,7 +36,7 @@ import numpy as np
 
 from vtool.errors import InputError
 from vtool.solvers.layers import Layer
-from vtool.solvers.spec import MechanismSpec
+from vtool.solvers.spec import ENABLED, MechanismSpec
 
 
 @dataclass(frozen=True)
@@ -56,6 +56,24 @@ def cam_clearance(spec: MechanismSpec):  # type: ignore[no-untyped-def]
         if c.behind == spec.cam.coordinate:
             return c
     raise InputError("clearances", "no clearance on the cam", f"one clearance with behind = {spec.cam.coordinate}")
+
+
+def check_open_gaps(spec: MechanismSpec, q: np.ndarray) -> None:
+    """Refuse a start in which a clearance that is not closed would already be penetrated."""
+    length = spec.unit_system.length
+    for c in spec.clearances:
+        if c.state != ENABLED or c.name in spec.initial.closed:
+            continue
+        ahead = q[c.ahead - 1]
+        if spec.seat is not None and c.behind == spec.seat.coordinate:
+            if ahead - spec.seat.position < -1e-12 * max(abs(ahead), 1.0):
+                raise InputError("seat.position", spec.seat.position,
+                                 f"<= {ahead:.6g} (where the static start puts q{c.ahead}; the run would "
+                                 f"start inside the seat)", length)
+        elif c.behind <= spec.n_coordinates and ahead - q[c.behind - 1] < -1e-12 * max(abs(ahead), 1.0):
+            raise InputError("initial.closed", list(spec.initial.closed),
+                             f"a start with clearance {c.name} open or closed consistently (its gap would be "
+                             f"{ahead - q[c.behind - 1]:.3g} {length})")
 
 
 def static_start(spec: MechanismSpec, layer: Layer, omega: float) -> StaticStart:
@@ -78,6 +96,7 @@ def static_start(spec: MechanismSpec, layer: Layer, omega: float) -> StaticStart
     shape = layer.T @ (flexibility * follower_stiffness)  # q per unit follower displacement
     cam_velocity = amplitude * omega  # d/dt (A sin wt) at t = 0
     cam_acceleration = 0.0  # -A w² sin(0)
+    check_open_gaps(spec, shape * cam_offset)
     return StaticStart(
         cam_offset=cam_offset,
         follower_force=follower_force,

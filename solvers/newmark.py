@@ -33,8 +33,8 @@ Method (see the kernel's docstring for the equations):
   the lowest natural frequency) are resting contacts that stay
   closed until their contact force says otherwise: together these keep the
   examples from chattering.
-* Chattering: ``zeno_stick`` (20) events each within ten event-location
-  tolerances of the previous one (events piling up at one instant) make
+* Chattering: ``zeno_stick`` (20) events each within 1e-3 of the shortest
+  natural period of the previous one (events piling up) make
   every contact involved stick (restitution zero, held shut; their forces
   then decide separation); ``zeno_stop`` (400) such events stop the run with
   a message naming the time and configuration. A run never loops forever.
@@ -103,6 +103,12 @@ def stability_limit(beta: float, gamma: float, omega_max: float) -> float:
     return 1.0 / math.sqrt(gamma / 2.0 - beta) / omega_max
 
 
+def round_down(value: float, digits: int) -> float:
+    """``value`` rounded down to ``digits`` significant digits (a printed limit never exceeds the limit)."""
+    unit = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return math.floor(value / unit) * unit
+
+
 def highest_frequency(mechanism: Mechanism) -> float:
     """omega_max of the unconstrained system: no configuration is stiffer."""
     return float(undamped_modes(mechanism.M, mechanism.K).omega.max())
@@ -121,7 +127,7 @@ def check_settings(mechanism: Mechanism, options: NewmarkOptions) -> None:
     if dt > limit and options.enforce_stability_limit:
         raise InputError(
             "run.time_step", dt,
-            f"<= {limit:.4g} (stability limit of Newmark beta={options.beta:.4g}, gamma={options.gamma:.4g} "
+            f"<= {round_down(limit, 6):.6g} (stability limit of Newmark beta={options.beta:.4g}, gamma={options.gamma:.4g} "
             f"for the stiffest configuration; use beta=1/4 for no limit)", "s",
         )
 
@@ -182,7 +188,7 @@ class _KernelRun:
             src_kind=kinds, src_par=par,
             Minv=np.linalg.inv(mechanism.M),
             time_tol=options.time_tolerance or 1e-6 * dt,
-            zeno_window=10 * (options.time_tolerance or 1e-6 * dt), zeno_stick=options.zeno_stick,
+            zeno_window=1e-3 * 2 * math.pi / highest_frequency(mechanism), zeno_stick=options.zeno_stick,
             zeno_stop=options.zeno_stop,
             x_limit=1e3 * x_scale,
             rest_velocity=options.rest_velocity or 1e-5 * self.velocity_scale(),
@@ -247,8 +253,6 @@ class _KernelRun:
         chunk = self.options.chunk_steps * prob.dt
         while True:
             self.fstate[kernel.F_CHUNK_END] = self.fstate[kernel.F_T] + chunk
-            if self.istate[kernel.I_NEV] > self.out.ev_t.shape[0] - 64:
-                self._flush()
             status = kernel.run_chunk(prob, self.kernel_tables, self.out, self.work, self.x, self.v, self.a,
                                       self.istate, self.fstate, STATUS_CODES)
             t = float(self.fstate[kernel.F_T])

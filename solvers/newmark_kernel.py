@@ -546,12 +546,16 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
             istate[I_NEED_ACCEL] = 0
             if istate[I_NOUT] == 0 and istate[I_NEXT_OUT] == 0:
                 record(prob, cfg, c, t, x, v, a, w, out, 0)
+                for k in range(ncl):  # the start counts for the peaks too
+                    out.F_peak[k] = max(out.F_peak[k], out.F[0, k])
                 istate[I_NOUT] = 1
                 istate[I_NEXT_OUT] = 1
         if t >= prob.t_end - 1e-9 * prob.dt:
             return FINISHED
         if t >= fstate[F_CHUNK_END]:
             return CHUNK_END
+        if istate[I_NEV] + 2 * ncl >= out.ev_t.shape[0]:  # room for the events of one step
+            return OUTPUT_FULL
         advance(prob, cfg, c, x, v, a, w, istate, fstate, out)
         t = fstate[F_T]
         if t >= prob.t_end - 1e-9 * prob.dt:

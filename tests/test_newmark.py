@@ -149,7 +149,7 @@ def test_stability_limit_of_linear_acceleration() -> None:
     [
         ({"time_step": 0.0}, "run.time_step", "> 0"),
         ({"time_step": -1e-6}, "run.time_step", "> 0"),
-        ({"time_step": 3e-6}, "run.time_step", "<= 2.527e-06 (stability limit"),
+        ({"time_step": 3e-6}, "run.time_step", "<= 2.52654e-06 (stability limit"),
         ({"rpm": 0.0}, "run.rpm", "> 0 rev/min"),
         ({"degrees": -5.0}, "run.degrees", "> 0 deg"),
     ],
