@@ -16,6 +16,38 @@ import numpy as np
 _LOCK = threading.Lock()
 
 
+Curve = tuple[str, np.ndarray, np.ndarray]
+
+
+def _render(curves: list[Curve], *, title: str, xlabel: str, ylabel: str, width: int, height: int,
+            color: bool, xlim: tuple[float, float] | None = None, ylim: tuple[float, float] | None = None,
+            xlog: bool = False) -> str:
+    """Draw labelled (x, y) curves with plotext and return the text (the one place plotext is used)."""
+    import plotext as plt
+
+    with _LOCK:
+        plt.clf()
+        plt.plotsize(max(int(width), 20), max(int(height), 8))
+        plt.theme("pro" if color else "clear")
+        for label, xs, ys in curves:
+            plt.plot(np.asarray(xs, dtype=float).tolist(), np.asarray(ys, dtype=float).tolist(),
+                     label=label, marker="braille")
+        if xlim is not None:
+            plt.xlim(*xlim)
+        if ylim is not None:
+            plt.ylim(*ylim)
+        if xlog:
+            plt.xscale("log")
+        plt.title(title)
+        plt.xlabel(xlabel)
+        plt.ylabel(ylabel)
+        text = plt.build()
+        plt.clf()
+    if not color:
+        text = plt.uncolorize(text)
+    return text
+
+
 def line_chart(
     x: Sequence[float] | np.ndarray,
     series: Mapping[str, Sequence[float] | np.ndarray],
@@ -35,33 +67,16 @@ def line_chart(
     ``step=True`` draws the series as a staircase (for configuration traces);
     ``color=False`` gives plain text for files and tests.
     """
-    import plotext as plt
-
     xs = np.asarray(x, dtype=float)
-    with _LOCK:
-        plt.clf()
-        plt.plotsize(max(int(width), 20), max(int(height), 8))
-        plt.theme("pro" if color else "clear")
-        for label, values in series.items():
-            ys = np.asarray(values, dtype=float)
-            if step:
-                xs_s = np.repeat(xs, 2)[1:]
-                ys_s = np.repeat(ys, 2)[:-1]
-                plt.plot(xs_s.tolist(), ys_s.tolist(), label=label, marker="braille")
-            else:
-                plt.plot(xs.tolist(), ys.tolist(), label=label, marker="braille")
-        if ylim is not None:
-            plt.ylim(*ylim)
-        if xlog:
-            plt.xscale("log")
-        plt.title(title)
-        plt.xlabel(xlabel)
-        plt.ylabel(ylabel)
-        text = plt.build()
-        plt.clf()
-    if not color:
-        text = plt.uncolorize(text)
-    return text
+    curves = []
+    for label, values in series.items():
+        ys = np.asarray(values, dtype=float)
+        if step:
+            curves.append((label, np.repeat(xs, 2)[1:], np.repeat(ys, 2)[:-1]))
+        else:
+            curves.append((label, xs, ys))
+    return _render(curves, title=title, xlabel=xlabel, ylabel=ylabel, width=width, height=height, color=color,
+                   ylim=ylim, xlog=xlog)
 
 
 def shape_chart(
@@ -81,24 +96,6 @@ def shape_chart(
     For drawings such as a deformed mechanism: each shape is ``(x, y)``;
     fixed ``xlim`` / ``ylim`` keep the frame still between animation frames.
     """
-    import plotext as plt
-
-    with _LOCK:
-        plt.clf()
-        plt.plotsize(max(int(width), 20), max(int(height), 8))
-        plt.theme("pro" if color else "clear")
-        for label, (xs, ys) in shapes.items():
-            plt.plot(np.asarray(xs, dtype=float).tolist(), np.asarray(ys, dtype=float).tolist(),
-                     label=label, marker="braille")
-        if xlim is not None:
-            plt.xlim(*xlim)
-        if ylim is not None:
-            plt.ylim(*ylim)
-        plt.title(title)
-        plt.xlabel(xlabel)
-        plt.ylabel(ylabel)
-        text = plt.build()
-        plt.clf()
-    if not color:
-        text = plt.uncolorize(text)
-    return text
+    curves = [(label, np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)) for label, (xs, ys) in shapes.items()]
+    return _render(curves, title=title, xlabel=xlabel, ylabel=ylabel, width=width, height=height, color=color,
+                   xlim=xlim, ylim=ylim)

@@ -18,6 +18,7 @@ import math
 import time
 
 import numpy as np
+
 from vtool.assessments.sonic_boom.pulses import PULSE_TYPES, idealized
 from vtool.assessments.sonic_boom.response import history, peak_response
 from vtool.assessments.sonic_boom.spectra import THESIS_ENVELOPE, envelope

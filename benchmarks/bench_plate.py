@@ -23,6 +23,7 @@ import time
 
 import numpy as np
 import scipy.linalg as sla
+
 from vtool.assessments.plate.assembly import Plate
 from vtool.assessments.plate.model import Case, MasterSelection, build_model
 from vtool.assessments.plate.transient import exact_histories, peak_errors, run_rk4

@@ -110,5 +110,5 @@ def save_spec(spec: Any, path: str | os.PathLike[str]) -> None:
     """Save a spec as a preset TOML (tomli-w), atomically."""
     import tomli_w
 
-    kind = getattr(spec, "kind")
+    kind = spec.kind
     write_atomic(path, tomli_w.dumps(loader_for(kind).dump(spec)))

@@ -43,9 +43,8 @@ from vtool.assessments.sonic_boom.spec import (
     WallSpec,
 )
 from vtool.assessments.sonic_boom.spectra import EnvelopeSpec, _steps
-from vtool.presets.fields import Table
-
 from vtool.errors import InputError
+from vtool.presets.fields import Table
 
 KINDS = ("boom_wall", "boom_floor")
 PULSES = ("envelope", "csv", *PULSE_TYPES)

@@ -20,9 +20,8 @@ from vtool.assessments.plate.masters import NAMED_SETS, MasterSetError, labelled
 from vtool.assessments.plate.model import METHODS, Case, MasterSelection
 from vtool.assessments.plate.study import Study, TransientSettings
 from vtool.assessments.plate.transient import LOADS, RK4_LIMIT_THESIS
-from vtool.presets.fields import Table
-
 from vtool.errors import InputError
+from vtool.presets.fields import Table
 
 
 @dataclass(frozen=True)

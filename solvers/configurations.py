@@ -164,7 +164,7 @@ def internal_force_coefficients(
         fx[kept[j]] += scale * coeff_x[f]
         fv[kept[j]] += scale * coeff_v[f]
     fs = np.zeros((len(sources(spec)), 3))
-    for p, (j, source) in enumerate(zip(pres, part.sources, strict=True)):
+    for j, source in zip(pres, part.sources, strict=True):
         fs[source, 0] += scale * -(row @ K[free, j])
         fs[source, 1] += scale * -(row @ C[free, j])
         fs[source, 2] += scale * (w[j] - row @ M[free, j])

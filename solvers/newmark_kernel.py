@@ -132,6 +132,22 @@ def set_prescribed(prob, cfg, c, t, xl, vl, al):
         xl[j], vl[j], al[j] = source_state(prob.src_kind, prob.src_par, cfg.pres_src[c, p], t)
 
 
+@leaf
+def free_rhs(cfg, c, xl, vl, al, rhs):
+    """rhs_F = -C_FF v_F - K_FF x_F - (M_FP a_P + C_FP v_P + K_FP x_P): the thesis' ΔP on the right."""
+    nf, npres = cfg.nf[c], cfg.npres[c]
+    for f in range(nf):
+        jf = cfg.free[c, f]
+        s = 0.0
+        for g in range(nf):
+            jg = cfg.free[c, g]
+            s -= cfg.CL[c, jf, jg] * vl[jg] + cfg.KL[c, jf, jg] * xl[jg]
+        for p in range(npres):
+            jp = cfg.pres[c, p]
+            s -= cfg.ML[c, jf, jp] * al[jp] + cfg.CL[c, jf, jp] * vl[jp] + cfg.KL[c, jf, jp] * xl[jp]
+        rhs[f] = s
+
+
 @jit
 def effective_inverse(prob, cfg, c, h, S, Sinv):
     """Sinv = (M_FF + gamma h C_FF + beta h² K_FF)⁻¹ for a non-standard step h."""
@@ -153,23 +169,14 @@ def newmark_step(prob, cfg, c, t, h, Sinv, x, v, a, w, x1, v1, a1):
     state at t + h in (w.xl, w.vl, w.al) for the contact forces.
     """
     beta, gamma = prob.beta, prob.gamma
-    m, nf, npres = cfg.m[c], cfg.nf[c], cfg.npres[c]
+    m, nf = cfg.m[c], cfg.nf[c]
     xl, vl, al = w.xl, w.vl, w.al
     gather(cfg, c, x, v, a, xl, vl, al)
     for j in range(m):  # predictors x̃, ṽ (overwritten for prescribed columns)
         xl[j] += h * vl[j] + h * h * (0.5 - beta) * al[j]
         vl[j] += h * (1.0 - gamma) * al[j]
     set_prescribed(prob, cfg, c, t + h, xl, vl, al)
-    for f in range(nf):
-        jf = cfg.free[c, f]
-        s = 0.0
-        for g in range(nf):
-            jg = cfg.free[c, g]
-            s -= cfg.CL[c, jf, jg] * vl[jg] + cfg.KL[c, jf, jg] * xl[jg]
-        for p in range(npres):  # the thesis' ΔP terms
-            jp = cfg.pres[c, p]
-            s -= cfg.ML[c, jf, jp] * al[jp] + cfg.CL[c, jf, jp] * vl[jp] + cfg.KL[c, jf, jp] * xl[jp]
-        w.rhs[f] = s
+    free_rhs(cfg, c, xl, vl, al, w.rhs)
     for f in range(nf):
         s = 0.0
         for g in range(nf):
@@ -201,17 +208,8 @@ def consistent_acceleration(prob, cfg, c, t, x, v, a, xl, vl, al, rhs):
     """
     gather(cfg, c, x, v, a, xl, vl, al)
     set_prescribed(prob, cfg, c, t, xl, vl, al)
-    nf, npres = cfg.nf[c], cfg.npres[c]
-    for f in range(nf):
-        jf = cfg.free[c, f]
-        s = 0.0
-        for g in range(nf):
-            jg = cfg.free[c, g]
-            s -= cfg.CL[c, jf, jg] * vl[jg] + cfg.KL[c, jf, jg] * xl[jg]
-        for p in range(npres):
-            jp = cfg.pres[c, p]
-            s -= cfg.ML[c, jf, jp] * al[jp] + cfg.CL[c, jf, jp] * vl[jp] + cfg.KL[c, jf, jp] * xl[jp]
-        rhs[f] = s
+    nf = cfg.nf[c]
+    free_rhs(cfg, c, xl, vl, al, rhs)
     for f in range(nf):
         s = 0.0
         for g in range(nf):

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+
 from vtool.assessments.sonic_boom.assess import assess
 from vtool.assessments.sonic_boom.criteria import BUILTIN, Criterion, allowable_pressure
 from vtool.assessments.sonic_boom.pulses import idealized, make_pulse
@@ -17,9 +18,8 @@ from vtool.assessments.sonic_boom.structures import (
     plate_omega,
     pseudo_height,
 )
-from vtool.presets import load_preset
-
 from vtool.errors import InputError
+from vtool.presets import load_preset
 
 # thesis section 1.5.1: a = 207 in, h = 4.5 in, E = 1.5e6 psi, nu = 0.15,
 # surface weight 0.2473 lb/in^2, g = 386.4 in/s^2

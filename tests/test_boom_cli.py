@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+
 from vtool.app.cli.boom import solve_preset
 from vtool.app.cli.main import cli
-from vtool.presets import PRESET_DIR, load_preset, loader_for, read_document
-
 from vtool.errors import InputError
+from vtool.presets import PRESET_DIR, load_preset, loader_for, read_document
 
 FIXTURES = Path(__file__).parent / "fixtures" / "boom"
 BOOM_PRESETS = sorted(p.stem for p in PRESET_DIR.glob("boom-*.toml"))

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+
 from vtool.assessments.sonic_boom.pulses import (
     PulseParams,
     idealized,
@@ -13,7 +14,6 @@ from vtool.assessments.sonic_boom.pulses import (
     read_pulse_csv,
     tabulated,
 )
-
 from vtool.errors import InputError
 
 

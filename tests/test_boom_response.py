@@ -10,10 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
+
 from vtool.assessments.sonic_boom import fourier
 from vtool.assessments.sonic_boom.pulses import PULSE_TYPES, Pulse, idealized
 from vtool.assessments.sonic_boom.response import end_state, history, peak_response
-
 from vtool.errors import InputError
 
 

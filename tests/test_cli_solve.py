@@ -9,7 +9,6 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from tests.valvetrain_cases import thesis_doc
 from vtool.app.cli.main import cli
 
 

@@ -7,7 +7,7 @@ import copy
 import numpy as np
 import pytest
 
-from vtool.presets import load_document, load_preset, read_document, PRESET_DIR
+from vtool.presets import PRESET_DIR, load_document, load_preset, read_document
 from vtool.presets.valvetrain import dump
 from vtool.solvers.layers import possible_layers
 from vtool.solvers.model import assemble

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+
 from vtool.app.cli.main import cli
 from vtool.app.cli.plate import solve_preset
 from vtool.presets import PRESET_DIR, load_preset

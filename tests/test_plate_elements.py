@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
 from vtool.assessments.plate.elements import (
     BFS16,
     CORNERS,

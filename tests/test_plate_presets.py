@@ -9,10 +9,10 @@ import pytest
 import tomli_w
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from vtool.presets import PRESET_DIR, load_document, read_document
-from vtool.presets import plate as plate_presets
 
 from vtool.errors import InputError
+from vtool.presets import PRESET_DIR, load_document, read_document
+from vtool.presets import plate as plate_presets
 
 FIXTURES = Path(__file__).parent / "fixtures" / "plate"
 SHIPPED = sorted(PRESET_DIR.glob("plate-*.toml"))

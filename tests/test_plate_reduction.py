@@ -15,6 +15,7 @@ import pytest
 import scipy.linalg as sla
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
 from vtool.assessments.plate.assembly import Plate, make_mesh
 from vtool.assessments.plate.constraints import restrict
 from vtool.assessments.plate.model import Case, MasterSelection, build_model

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
 from vtool.assessments.plate.assembly import Plate
 from vtool.assessments.plate.exact import step_response
 from vtool.assessments.plate.model import Case, MasterSelection, build_model

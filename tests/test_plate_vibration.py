@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from vtool.assessments.plate.assembly import Plate, make_mesh
 from vtool.assessments.plate.constraints import free_dofs, restrict
 from vtool.assessments.plate.exact import lowest_modes, navier_frequency, static_deflection

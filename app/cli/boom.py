@@ -77,6 +77,7 @@ def daf_command(kind: str, s: float, r1: float, r2: float | None, alpha: float |
                 grid: tuple[float, float, float], csv_path: Path | None, plot: bool) -> None:
     """DAF against tau/T (forced, free and overall) for one pulse, or an envelope."""
     import numpy as np
+
     from vtool.assessments.sonic_boom import fourier, pulses, response, spectra
 
     response.check_damping(damping)
@@ -273,35 +274,48 @@ def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool) ->
         for row in table:
             click.echo("  " + "  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
     if csv_path is not None:
-        rows = [[r.structure, r.frequency_source, f"{r.frequency:.10g}", f"{r.tau:.10g}",
-                 f"{r.ratio:.10g}", r.criterion, r.response, f"{r.daf:.10g}", f"{r.normalized:.10g}",
-                 f"{r.pressure:.10g}", f"{r.pressure_alt:.10g}"] for r in a.rows]
-        _write_csv(csv_path, [*_ROW_HEADER, *p_cols], rows)
+        _write_csv(csv_path, *limits_csv_rows(a))
         if not as_json:
             click.echo(f"wrote {csv_path}")
     if plot:
         _plot(a)
 
 
-def _plot(a: Any) -> None:
-    """Design curves (thesis Figures 4 and 7): allowable p+ against frequency, per structure.
+def limits_csv_rows(a: Any) -> tuple[list[str], list[list[str]]]:
+    """Header and rows of the allowable-pressure CSV (``vtool solve BOOM_PRESET --csv``, the TUI export)."""
+    u = a.units
+    p_cols = [f"limit/DAF [{u.length}/s | {u.length}]", f"p+ [{u.pressure}]", f"p+ [{u.alt_pressure}]"]
+    rows = [[r.structure, r.frequency_source, f"{r.frequency:.10g}", f"{r.tau:.10g}", f"{r.ratio:.10g}",
+             r.criterion, r.response, f"{r.daf:.10g}", f"{r.normalized:.10g}", f"{r.pressure:.10g}",
+             f"{r.pressure_alt:.10g}"] for r in a.rows]
+    return [*_ROW_HEADER, *p_cols], rows
 
-    Structures with the same mass have identical curves; each distinct set is drawn once.
+
+def design_series(a: Any) -> list[tuple[str, Any, dict[str, Any]]]:
+    """(structure, frequencies, {label: p+ in the alternative unit}) per distinct set of design curves.
+
+    Structures with the same mass have identical curves; each distinct set is listed once.
     """
-    from vtool.app.plots import line_chart
-
     u = a.units
     by_structure: dict[str, dict[str, Any]] = {}
     for curve in a.curves:
-        label = f"{curve.criterion}, tau={curve.tau:g}s"
-        by_structure.setdefault(curve.structure, {})[label] = curve
+        by_structure.setdefault(curve.structure, {})[f"{curve.criterion}, tau={curve.tau:g}s"] = curve
     shown: set[tuple[float, ...]] = set()
+    out = []
     for name, curves in by_structure.items():
         key = tuple(round(float(v), 12) for c in curves.values() for v in c.pressure[::20])
         if key in shown:
             continue
         shown.add(key)
         first = next(iter(curves.values()))
-        series = {label: c.pressure * u.alt_per_pressure for label, c in curves.items()}
-        click.echo(line_chart(first.frequency, series, title=f"{name}: allowable p+ against frequency",
-                              xlabel="f [Hz]", ylabel=f"p+ [{u.alt_pressure}]"))
+        out.append((name, first.frequency, {label: c.pressure * u.alt_per_pressure for label, c in curves.items()}))
+    return out
+
+
+def _plot(a: Any) -> None:
+    """Design curves (thesis Figures 4 and 7): allowable p+ against frequency, per structure."""
+    from vtool.app.plots import line_chart
+
+    for name, frequency, series in design_series(a):
+        click.echo(line_chart(frequency, series, title=f"{name}: allowable p+ against frequency",
+                              xlabel="f [Hz]", ylabel=f"p+ [{a.units.alt_pressure}]"))

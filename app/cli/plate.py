@@ -71,7 +71,6 @@ def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path 
     from vtool.assessments.plate.model import build_model
     from vtool.assessments.plate.report import modes_csv, modes_text
     from vtool.assessments.plate.vibration import free_vibration
-
     from vtool.files import write_atomic
 
     spec = _load_plate_spec(preset)
@@ -96,6 +95,7 @@ def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path 
 
 def _chart(resp: Any, exact: Any, quantity: str, label: str) -> str:
     import numpy as np
+
     from vtool.app.plots import line_chart
 
     series = {f"{resp.case} {resp.scheme}": getattr(resp, quantity)}
@@ -137,7 +137,6 @@ def transient(preset: str, case_name: str | None, load: str, scheme: str, wh: fl
         run_modal,
         run_rk4,
     )
-
     from vtool.files import write_atomic
 
     spec = _load_plate_spec(preset)
@@ -214,7 +213,6 @@ def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *,
     """
     from vtool.assessments.plate.report import study_csv, study_dict, study_text
     from vtool.assessments.plate.study import run_study
-
     from vtool.files import write_atomic
 
     result = run_study(spec.study, transient=transient)

@@ -17,6 +17,7 @@ from textual.containers import VerticalScroll
 from textual.widgets import TabbedContent, TabPane
 from textual.worker import Worker, get_current_worker
 
+from vtool.app.cli.boom import design_series, limits_csv_rows
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, INTEGER, NUMBERS, TEXT, Field, dotted
 from vtool.app.tui.messages import AssessmentFinished
@@ -139,36 +140,6 @@ def limits_text(a: Any) -> str:
     for row in table:
         lines.append("  " + "  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
     return "\n".join(lines)
-
-
-def limits_csv_rows(a: Any) -> tuple[list[str], list[list[str]]]:
-    """Header and rows of ``vtool solve BOOM_PRESET --csv`` (written by the CLI's own writer)."""
-    from vtool.app.cli.boom import _ROW_HEADER
-
-    u = a.units
-    p_cols = [f"limit/DAF [{u.length}/s | {u.length}]", f"p+ [{u.pressure}]", f"p+ [{u.alt_pressure}]"]
-    rows = [[r.structure, r.frequency_source, f"{r.frequency:.10g}", f"{r.tau:.10g}", f"{r.ratio:.10g}",
-             r.criterion, r.response, f"{r.daf:.10g}", f"{r.normalized:.10g}", f"{r.pressure:.10g}",
-             f"{r.pressure_alt:.10g}"] for r in a.rows]
-    return [*_ROW_HEADER, *p_cols], rows
-
-
-def design_series(a: Any) -> list[tuple[str, Any, dict[str, Any]]]:
-    """(structure, frequencies, {label: p+ in the alternative unit}) per distinct set of curves."""
-    u = a.units
-    by_structure: dict[str, dict[str, Any]] = {}
-    for curve in a.curves:
-        by_structure.setdefault(curve.structure, {})[f"{curve.criterion}, tau={curve.tau:g}s"] = curve
-    shown: set[tuple[float, ...]] = set()
-    out = []
-    for name, curves in by_structure.items():
-        key = tuple(round(float(v), 12) for c in curves.values() for v in c.pressure[::20])
-        if key in shown:
-            continue
-        shown.add(key)
-        first = next(iter(curves.values()))
-        out.append((name, first.frequency, {label: c.pressure * u.alt_per_pressure for label, c in curves.items()}))
-    return out
 
 
 def daf_curves(spec: Any, assessment: Any) -> dict[str, Any]:

@@ -27,6 +27,7 @@ and columns of the constrained ones (thesis eq. 19).
 from __future__ import annotations
 
 import numpy as np
+
 from vtool.assessments.plate.assembly import Mesh
 
 #: Unknowns set to zero at nodes of an edge parallel to x / parallel to y.

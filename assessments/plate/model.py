@@ -14,6 +14,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+
 from vtool.assessments.plate.assembly import Mesh, Plate, make_mesh
 from vtool.assessments.plate.constraints import restrict
 from vtool.assessments.plate.masters import MasterSetError, labelled_set, named_set

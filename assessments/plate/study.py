@@ -21,6 +21,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+
 from vtool.assessments.plate.assembly import Plate
 from vtool.assessments.plate.model import Case, MasterSelection, ReducedModel, build_model
 from vtool.assessments.plate.transient import (

@@ -40,6 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
+
 from vtool.assessments.plate.assembly import Plate
 from vtool.assessments.plate.exact import ExactResponse, lowest_modes, step_response
 from vtool.assessments.plate.model import ReducedModel

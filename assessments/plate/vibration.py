@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
+
 from vtool.assessments.plate.assembly import Plate
 from vtool.assessments.plate.exact import NavierMode, lowest_modes
 from vtool.assessments.plate.model import ReducedModel

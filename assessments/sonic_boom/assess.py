@@ -10,6 +10,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+
 from vtool.assessments.sonic_boom.criteria import Criterion, allowable_pressure
 from vtool.assessments.sonic_boom.pulses import Pulse, make_pulse, read_pulse_csv
 from vtool.assessments.sonic_boom.response import check_damping
@@ -29,7 +30,6 @@ from vtool.assessments.sonic_boom.structures import (
     plate_omega,
     pseudo_height,
 )
-
 from vtool.errors import InputError
 
 

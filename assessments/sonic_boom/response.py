@@ -48,8 +48,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from vtool.assessments.sonic_boom.pulses import Pulse, Segment
 
+from vtool.assessments.sonic_boom.pulses import Pulse, Segment
 from vtool.errors import InputError
 
 QUANTITIES: tuple[str, ...] = ("displacement", "velocity")

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+
 from vtool.assessments.sonic_boom.pulses import (
     PULSE_TYPES,
     Pulse,
@@ -21,7 +22,6 @@ from vtool.assessments.sonic_boom.pulses import (
     validate,
 )
 from vtool.assessments.sonic_boom.response import QUANTITIES, peak_response
-
 from vtool.errors import InputError
 
 
