@@ -206,7 +206,7 @@ class _KernelRun:
             xl=np.zeros(n), vl=np.zeros(n), al=np.zeros(n), rhs=np.zeros(n), S=np.zeros((n, n)),
             Sinv=np.zeros((n, n)), x0=np.zeros(n), v0=np.zeros(n), a0=np.zeros(n), x1=np.zeros(n),
             v1=np.zeros(n), a1=np.zeros(n), phi=np.zeros(ncl), tau=np.zeros(ncl), xo=np.zeros(n),
-            vo=np.zeros(n), ao=np.zeros(n),
+            vo=np.zeros(n), ao=np.zeros(n), src=np.zeros(3 * len(self.source_numbers)),
         )
         start = mechanism.start
         self.x, self.v, self.a = start.q.copy(), start.qd.copy(), start.qdd.copy()

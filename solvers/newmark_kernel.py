@@ -87,7 +87,7 @@ Output = namedtuple(
 Work = namedtuple(
     "Work",
     ["xl", "vl", "al", "rhs", "S", "Sinv", "x0", "v0", "a0", "x1", "v1", "a1",
-     "phi", "tau", "xo", "vo", "ao"],
+     "phi", "tau", "xo", "vo", "ao", "src"],
 )
 
 # istate / fstate slots (documented in vtool.solvers.newmark)
@@ -189,14 +189,18 @@ def newmark_step(prob, cfg, c, t, h, Sinv, x, v, a, w, x1, v1, a1):
 
 
 @leaf
-def gap(prob, k, t, x):
-    """q[ahead] - q[behind] of clearance k (positive while open)."""
-    behind = 0.0
+def fill_sources(prob, t, src):
+    """src[3s : 3s + 3] = (x, v, a) of every prescribed source s at time t."""
+    for s in range(prob.src_kind.shape[0]):
+        src[3 * s], src[3 * s + 1], src[3 * s + 2] = source_state(prob.src_kind, prob.src_par, s, t)
+
+
+@leaf
+def gap(prob, k, x, src):
+    """q[ahead] - q[behind] of clearance k (positive while open); src from :func:`fill_sources`."""
     if prob.cl_behind[k] >= 0:
-        behind = x[prob.cl_behind[k]]
-    else:
-        behind = source_state(prob.src_kind, prob.src_par, prob.cl_src[k], t)[0]
-    return x[prob.cl_ahead[k]] - behind
+        return x[prob.cl_ahead[k]] - x[prob.cl_behind[k]]
+    return x[prob.cl_ahead[k]] - src[3 * prob.cl_src[k]]
 
 
 @leaf
@@ -220,25 +224,24 @@ def consistent_acceleration(prob, cfg, c, t, x, v, a, xl, vl, al, rhs):
 
 
 @leaf
-def contact_force(prob, cfg, c, k, t, x, v, a):
+def contact_force(prob, cfg, c, k, x, v, a, src):
     """Contact force of clearance k in configuration c, positive in compression.
 
     A row of coefficients per (configuration, clearance) on the full state
     and the sources (see :mod:`vtool.solvers.configurations`); zero when open.
+    ``src`` holds the sources at the same instant (:func:`fill_sources`).
     """
     n = prob.n
-    s = 0.0
+    f = 0.0
     for i in range(n):
-        s += cfg.Frow[c, k, i] * x[i] + cfg.Frow[c, k, n + i] * v[i] + cfg.Frow[c, k, 2 * n + i] * a[i]
-    for src in range(prob.src_kind.shape[0]):
-        xs, vs, as_ = source_state(prob.src_kind, prob.src_par, src, t)
-        j = 3 * n + 3 * src
-        s += cfg.Frow[c, k, j] * xs + cfg.Frow[c, k, j + 1] * vs + cfg.Frow[c, k, j + 2] * as_
-    return s
+        f += cfg.Frow[c, k, i] * x[i] + cfg.Frow[c, k, n + i] * v[i] + cfg.Frow[c, k, 2 * n + i] * a[i]
+    for j in range(src.shape[0]):
+        f += cfg.Frow[c, k, 3 * n + j] * src[j]
+    return f
 
 
 @leaf
-def monitor(prob, cfg, c, k, t, x, v, a):
+def monitor(prob, cfg, c, k, x, v, a, src):
     """The value whose sign change flips clearance k: its contact force if closed, its gap if open.
 
     A gap counts as closed when it is below -gap_noise (1e-13 of the
@@ -246,8 +249,8 @@ def monitor(prob, cfg, c, k, t, x, v, a):
     or separating tangentially) has a round-off sign until it has moved.
     """
     if c & prob.cl_bit[k]:
-        return contact_force(prob, cfg, c, k, t, x, v, a)
-    return gap(prob, k, t, x) + prob.gap_noise
+        return contact_force(prob, cfg, c, k, x, v, a, src)
+    return gap(prob, k, x, src) + prob.gap_noise
 
 
 @leaf
@@ -288,7 +291,8 @@ def locate_event(prob, cfg, c, k, t, lo, h, phi_lo, phi_hi, x, v, a, w):
             tau = (lo * fhi - hi * flo) / (fhi - flo)
         tau = min(max(tau, lo + 0.25 * prob.time_tol), hi - 0.25 * prob.time_tol)
         step_to(prob, cfg, c, t, tau, x, v, a, w, w.x1, w.v1, w.a1)
-        f = monitor(prob, cfg, c, k, t + tau, w.x1, w.v1, w.a1)
+        fill_sources(prob, t + tau, w.src)
+        f = monitor(prob, cfg, c, k, w.x1, w.v1, w.a1, w.src)
         if f < 0.0:
             hi, fhi = tau, f
             if side == -1:
@@ -319,13 +323,13 @@ def record(prob, cfg, c, t, x, v, a, w, out, row):
         out.x[row, i] = x[i]
         out.v[row, i] = v[i]
         out.a[row, i] = a[i]
+    fill_sources(prob, t, w.src)
     for s in range(prob.src_kind.shape[0]):
-        xs, vs, as_ = source_state(prob.src_kind, prob.src_par, s, t)
-        out.x[row, n + s] = xs
-        out.v[row, n + s] = vs
-        out.a[row, n + s] = as_
+        out.x[row, n + s] = w.src[3 * s]
+        out.v[row, n + s] = w.src[3 * s + 1]
+        out.a[row, n + s] = w.src[3 * s + 2]
     for k in range(prob.cl_ahead.shape[0]):
-        out.F[row, k] = contact_force(prob, cfg, c, k, t, x, v, a) if c & prob.cl_bit[k] else 0.0
+        out.F[row, k] = contact_force(prob, cfg, c, k, x, v, a, w.src) if c & prob.cl_bit[k] else 0.0
 
 
 @jit
@@ -499,11 +503,14 @@ def advance(prob, cfg, c, x, v, a, w, istate, fstate, out):
         if prob.every_step or istate[I_NEXT_OUT] * prob.out_dt <= t + dt + 1e-9 * dt:
             return
         newmark_step(prob, cfg, c, t, dt, cfg.Sinv[c], x, v, a, w, w.x1, w.v1, w.a1)
-        for k in range(ncl):
-            if c & prob.cl_bit[k] or prob.cl_monitored[k]:
-                w.phi[k] = monitor(prob, cfg, c, k, t + dt, w.x1, w.v1, w.a1)
-                if prob.cl_monitored[k] and w.phi[k] < 0.0:
-                    return
+        fill_sources(prob, t + dt, w.src)  # once per step
+        for k in range(ncl):  # monitor() written out: numba runs this loop four times faster so
+            if c & prob.cl_bit[k]:
+                w.phi[k] = contact_force(prob, cfg, c, k, w.x1, w.v1, w.a1, w.src)
+            elif prob.cl_monitored[k]:
+                w.phi[k] = gap(prob, k, w.x1, w.src) + prob.gap_noise
+            if prob.cl_monitored[k] and w.phi[k] < 0.0:
+                return
         for i in range(prob.n):
             if not (abs(w.x1[i]) <= prob.x_limit):
                 return
@@ -570,11 +577,12 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
             fstate[F_T] = istate[I_GRID] * prob.dt
             continue
         step_to(prob, cfg, c, t, h, x, v, a, w, w.x1, w.v1, w.a1)
+        fill_sources(prob, t + h, w.src)
         fired = False
         for k in range(ncl):
             w.tau[k] = 2.0 * h
             if prob.cl_monitored[k]:
-                w.phi[k] = monitor(prob, cfg, c, k, t + h, w.x1, w.v1, w.a1)
+                w.phi[k] = monitor(prob, cfg, c, k, w.x1, w.v1, w.a1, w.src)
                 if w.phi[k] < 0.0:
                     fired = True
         if fired:  # locate every sign change; the earliest is taken
@@ -583,7 +591,8 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
                 if prob.cl_monitored[k] and w.phi[k] < 0.0:
                     gather(cfg, c, x, v, a, w.xl, w.vl, w.al)
                     set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
-                    phi0 = monitor(prob, cfg, c, k, t, x, v, a)
+                    fill_sources(prob, t, w.src)
+                    phi0 = monitor(prob, cfg, c, k, x, v, a, w.src)
                     lo = 0.0
                     if phi0 < 0.0:
                         w.tau[k] = lo
@@ -603,7 +612,8 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
                 if c & prob.cl_bit[k]:
                     f = w.phi[k]  # the monitor already holds it (unless an event moved the step end)
                     if fired or not prob.cl_monitored[k]:
-                        f = contact_force(prob, cfg, c, k, t + h, w.x1, w.v1, w.a1)
+                        fill_sources(prob, t + h, w.src)
+                        f = contact_force(prob, cfg, c, k, w.x1, w.v1, w.a1, w.src)
                     if f > out.F_peak[k]:
                         out.F_peak[k] = f
         w.x0[:] = x
