@@ -85,7 +85,7 @@ class NewmarkOptions:
     output_interval: float = 1.0  # degrees of cam rotation
     every_step: bool = False
     time_tolerance: float | None = None  # s; default 1e-6 * time_step
-    rest_velocity: float | None = None  # length/s; default 1e-5 of the velocity scale (see _KernelRun)
+    rest_velocity: float | None = None  # length/s; default 1e-5 of the velocity scale (see KernelRun)
     zeno_stick: int = 20
     zeno_stop: int = 400
     chunk_steps: int = 5000
@@ -154,13 +154,17 @@ class NewmarkBackend:
         options = options or NewmarkOptions.from_run(spec.run)
         check_settings(mechanism, options)
         started = wallclock.perf_counter()
-        run = _KernelRun(mechanism, options)
+        run = KernelRun(mechanism, options)
         run.execute(progress, cancel)
         return run.trace(wallclock.perf_counter() - started)
 
 
-class _KernelRun:
-    """Arrays and chunked calls of one kernel run."""
+class KernelRun:
+    """The contact problem as kernel arrays, and the chunked calls of one run.
+
+    Also used by the exact and scipy back ends (:mod:`vtool.solvers.piecewise`)
+    for the clearances, sources, configuration tables and the impact law.
+    """
 
     def __init__(self, mechanism: Mechanism, options: NewmarkOptions) -> None:
         spec = mechanism.spec

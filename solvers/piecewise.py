@@ -34,7 +34,7 @@ from vtool.errors import RunError
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.configurations import HARMONIC_SOURCE, configuration_label, mask_of
 from vtool.solvers.model import Mechanism
-from vtool.solvers.newmark import EVENT_KINDS, NewmarkOptions, _KernelRun
+from vtool.solvers.newmark import EVENT_KINDS, NewmarkOptions, KernelRun
 from vtool.solvers.trace import Event, RunStatistics, Trace
 
 Progress = Callable[[float], None]
@@ -81,7 +81,7 @@ class StateSpace:
         return coefficients @ basis
 
 
-def state_space(run: _KernelRun, mask: int) -> StateSpace:
+def state_space(run: KernelRun, mask: int) -> StateSpace:
     """Build the state-space form of configuration ``mask`` from the kernel tables."""
     tables, prob = run.tables, run.problem
     if not tables.built[mask]:
@@ -139,7 +139,7 @@ class PiecewiseRun(ABC):
         spec = mechanism.spec
         # the contact problem (clearances, sources, impact law, configuration tables) of the kernel
         nominal = NewmarkOptions(1e-6, output_interval=output_interval, rest_velocity=rest_velocity)
-        self.setup = _KernelRun(mechanism, nominal)
+        self.setup = KernelRun(mechanism, nominal)
         self.prob = self.setup.problem
         self.n = spec.n_coordinates
         self.ncl = len(spec.clearances)

@@ -17,7 +17,7 @@ from vtool.presets import load_preset
 from vtool.presets.valvetrain import with_run_overrides
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.model import assemble
-from vtool.solvers.newmark import NewmarkBackend, NewmarkOptions, _KernelRun, stability_limit
+from vtool.solvers.newmark import NewmarkBackend, NewmarkOptions, KernelRun, stability_limit
 from vtool.solvers.run import simulate
 
 
@@ -82,7 +82,7 @@ def single_impact(restitution: float) -> tuple[float, float, float]:
     for c in doc["clearances"]:
         c["restitution"] = restitution
     mechanism = assemble(spec_from(doc))
-    run = _KernelRun(mechanism, NewmarkOptions(1e-6))
+    run = KernelRun(mechanism, NewmarkOptions(1e-6))
     v = np.random.default_rng(7).normal(size=mechanism.spec.n_coordinates)
     v[6] = -50.0  # the valve (q7) approaches the seat at 50 in/s
     x = np.zeros_like(v)
