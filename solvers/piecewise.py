@@ -34,7 +34,7 @@ from vtool.errors import RunError
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.configurations import HARMONIC_SOURCE, configuration_label, mask_of
 from vtool.solvers.model import Mechanism
-from vtool.solvers.newmark import EVENT_KINDS, NewmarkOptions, KernelRun
+from vtool.solvers.newmark import EVENT_KINDS, KernelRun, NewmarkOptions
 from vtool.solvers.trace import Event, RunStatistics, Trace
 
 Progress = Callable[[float], None]

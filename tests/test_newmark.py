@@ -17,7 +17,7 @@ from vtool.presets import load_preset
 from vtool.presets.valvetrain import with_run_overrides
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.model import assemble
-from vtool.solvers.newmark import NewmarkBackend, NewmarkOptions, KernelRun, stability_limit
+from vtool.solvers.newmark import KernelRun, NewmarkBackend, NewmarkOptions, stability_limit
 from vtool.solvers.run import simulate
 
 
