@@ -88,7 +88,8 @@ class DomainScreen(Screen[None]):
         yield Footer(show_command_palette=False, compact=True)
 
     def compose_results(self) -> ComposeResult:
-        raise NotImplementedError
+        """The result panes of the domain screen (each subclass provides its own)."""
+        raise NotImplementedError(f"{type(self).__name__} provides compose_results")
 
     @property
     def form(self) -> ParamForm:
