@@ -38,6 +38,14 @@ Method (see the kernel's docstring for the equations):
   every contact involved stick (restitution zero, held shut; their forces
   then decide separation); ``zeno_stop`` (400) such events stop the run with
   a message naming the time and configuration. A run never loops forever.
+* Refinement after events: an impact excites the highest modes, which the
+  step resolves poorly (omega_max dt = 1.37 at 1 µs in the thesis examples),
+  and their error moves the events that follow. For two periods of the
+  highest natural frequency after every event the step is divided by
+  ``refine`` (10); the rest of the run keeps the user's step. On example 1A
+  at 1 µs this takes the largest event-angle error against the exact back end
+  from 0.33° to 0.005° and the peak-force error from 3.6 % to 0.08 %, for
+  16 ms → 27 ms. ``refine = 1`` is the plain thesis scheme.
 * Stability: for gamma = 1/2 and beta < 1/4 the step must satisfy
   omega_max dt <= 1 / sqrt(gamma/2 - beta) (2 sqrt 3 for linear acceleration:
   dt <= sqrt(3)/pi T_min), with omega_max the highest natural frequency of
@@ -90,6 +98,8 @@ class NewmarkOptions:
     zeno_stop: int = 400
     chunk_steps: int = 5000
     enforce_stability_limit: bool = True  # False only to study divergence (tests)
+    refine: int = 10  # after each event, steps of time_step / refine ...
+    refine_periods: float = 2.0  # ... for this many periods of the highest natural frequency
 
     @classmethod
     def from_run(cls, run: RunSpec, every_step: bool = False) -> NewmarkOptions:
@@ -197,6 +207,8 @@ class KernelRun:
             x_limit=1e3 * x_scale,
             rest_velocity=options.rest_velocity or 1e-5 * self.velocity_scale(),
             gap_noise=1e-13 * x_scale,
+            refine=float(options.refine),
+            refine_window=options.refine_periods * 2 * math.pi / highest_frequency(mechanism),
         )
         self.tables = ConfigurationTables.empty(2**ncl, n, ncl, len(self.source_numbers))
         # the kernel sees the same arrays, so configurations built later are visible to it
@@ -217,7 +229,7 @@ class KernelRun:
         self.istate = np.zeros(10, dtype=np.int64)
         self.istate[kernel.I_CFG] = mask_of(spec, spec.initial.closed)
         self.istate[kernel.I_NEED_ACCEL] = 1
-        self.fstate = np.zeros(3)
+        self.fstate = np.zeros(4)
         self.fstate[kernel.F_LAST_EVENT] = -1.0
         self.rows: list[tuple[np.ndarray, ...]] = []
         self.event_rows: list[tuple[np.ndarray, ...]] = []

@@ -70,6 +70,8 @@ Problem = namedtuple(
         "x_limit",  # |q| beyond this is divergence
         "rest_velocity",  # slower separations and impacts are resting contacts
         "gap_noise",  # gaps within this of zero are round-off (length)
+        "refine",  # after an event, steps are dt / refine ...
+        "refine_window",  # ... for this long (s)
     ],
 )
 
@@ -92,7 +94,7 @@ Work = namedtuple(
 
 # istate / fstate slots (documented in vtool.solvers.newmark)
 I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_ACCEL, I_WANT_CFG = range(9)
-F_T, F_LAST_EVENT, F_CHUNK_END = range(3)
+F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
 
 
 @leaf
@@ -498,7 +500,7 @@ def advance(prob, cfg, c, x, v, a, w, istate, fstate, out):
     while True:
         t = fstate[F_T]
         k_grid = istate[I_GRID]
-        if t != k_grid * dt or t + dt > prob.t_end or t >= fstate[F_CHUNK_END]:
+        if t != k_grid * dt or t + dt > prob.t_end or t >= fstate[F_CHUNK_END] or t < fstate[F_FINE_UNTIL]:
             return
         if prob.every_step or istate[I_NEXT_OUT] * prob.out_dt <= t + dt + 1e-9 * dt:
             return
@@ -572,6 +574,8 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
             h = min(prob.dt, prob.t_end - t)
         else:  # after an event: the rest of the step, back onto the grid
             h = min(grid_next, prob.t_end) - t
+        if t < fstate[F_FINE_UNTIL]:  # just after an event: refined steps
+            h = min(h, prob.dt / prob.refine)
         if h <= 1e-9 * prob.dt:  # already on the grid point
             istate[I_GRID] += 1
             fstate[F_T] = istate[I_GRID] * prob.dt
@@ -662,6 +666,7 @@ def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
             new_c = impact(prob, new_c, closing, t, x, v, stick, out, istate)
         istate[I_CFG] = new_c
         istate[I_NEED_ACCEL] = 1
+        fstate[F_FINE_UNTIL] = t + prob.refine_window
 
 
 @jit

@@ -326,16 +326,18 @@ def test_the_seat_cannot_be_closed_at_the_static_start() -> None:
 
 # ----- damping -----
 
-@pytest.mark.parametrize("ratio, seat_impacts", [(0.0, 3), (1.0, 1)])
-def test_damping_extremes_bounce_the_valve_or_not(ratio: float, seat_impacts: int) -> None:
-    """Undamped, the valve bounces on its seat; critically damped, it seats once per revolution."""
-    trace, mechanism = run(variant(damping=ratio))
-    assert_sane(trace, mechanism)
-    (per_revolution,) = trace.bounces_per_revolution("seat")  # the revolution 360-720 deg
-    if ratio == 0.0:
-        assert per_revolution >= seat_impacts
-    else:
-        assert per_revolution == seat_impacts
+def test_damping_extremes_make_a_restless_or_a_quiet_valve_train() -> None:
+    """Undamped, the contacts keep separating and re-closing (the exact back end: 1,060 events in
+    850 degrees); critically damped, the valve seats once per revolution and little else happens
+    (53 events). (A plain 1 µs Newmark run showed six seat bounces per revolution undamped: its
+    high-mode error after impacts, which the refinement after events removes.)"""
+    undamped, mechanism = run(variant(damping=0.0))
+    assert_sane(undamped, mechanism)
+    damped, mechanism = run(variant(damping=1.0))
+    assert_sane(damped, mechanism)
+    assert damped.bounces_per_revolution("seat") == [1]  # the revolution 360-720 deg
+    assert undamped.bounces_per_revolution("seat")[0] >= 1
+    assert len(undamped.events) > 5 * len(damped.events)
 
 
 def free_vibration_doc(ratio: float, **run_settings: float) -> dict:
