@@ -188,6 +188,7 @@ class ConfigurationTables:
     CL: np.ndarray
     KL: np.ndarray
     Sinv: np.ndarray
+    SinvFine: np.ndarray  # the same for the refined step after events
     MinvFF: np.ndarray
     Frow: np.ndarray  # [mask, clearance, 3n + 3ns]: contact force on (q, q̇, q̈, sources)
 
@@ -204,19 +205,23 @@ class ConfigurationTables:
             built=np.zeros(n_configurations, dtype=np.int64),
             m=counts[0], kept=ints(), group=ints(), nf=counts[1], free=ints(),
             npres=counts[2], pres=ints(), pres_src=ints(),
-            ML=mats(), CL=mats(), KL=mats(), Sinv=mats(), MinvFF=mats(),
+            ML=mats(), CL=mats(), KL=mats(), Sinv=mats(), SinvFine=mats(), MinvFF=mats(),
             Frow=np.zeros((n_configurations, n_clearances, 3 * n + 3 * n_sources)),
         )
 
-    def build(self, mechanism: Mechanism, mask: int, dt: float, beta: float, gamma: float) -> None:
-        """Partition configuration ``mask`` and precompute its matrices (BMIV for dt)."""
+    def build(self, mechanism: Mechanism, mask: int, dt: float, beta: float, gamma: float,
+              fine_dt: float | None = None) -> None:
+        """Partition configuration ``mask`` and precompute its matrices (BMIV for dt and for fine_dt)."""
         spec = mechanism.spec
         part = partition(mechanism, mask)
         layer, free, pres = part.layer, part.free, part.prescribed
         m = layer.size
         M_L, C_L, K_L = layer.M, layer.C, layer.K
         M_FF = M_L[np.ix_(free, free)]
-        S = M_FF + gamma * dt * C_L[np.ix_(free, free)] + beta * dt * dt * K_L[np.ix_(free, free)]
+
+        def effective(h: float) -> np.ndarray:
+            return M_FF + gamma * h * C_L[np.ix_(free, free)] + beta * h * h * K_L[np.ix_(free, free)]
+
         nf, npres = len(free), len(pres)
         self.m[mask], self.nf[mask], self.npres[mask] = m, nf, npres
         kept_full = [k - 1 for k in layer.kept]
@@ -229,7 +234,8 @@ class ConfigurationTables:
         self.CL[mask, :m, :m] = C_L
         self.KL[mask, :m, :m] = K_L
         if nf:
-            self.Sinv[mask, :nf, :nf] = np.linalg.inv(S)
+            self.Sinv[mask, :nf, :nf] = np.linalg.inv(effective(dt))
+            self.SinvFine[mask, :nf, :nf] = np.linalg.inv(effective(fine_dt or dt))
             self.MinvFF[mask, :nf, :nf] = np.linalg.inv(M_FF)
         n = spec.n_coordinates
         MT = mechanism.M @ layer.T

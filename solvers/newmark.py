@@ -294,7 +294,7 @@ class KernelRun:
 
     def _build(self, mask: int) -> None:
         o = self.options
-        self.tables.build(self.mechanism, mask, o.time_step, o.beta, o.gamma)
+        self.tables.build(self.mechanism, mask, o.time_step, o.beta, o.gamma, o.time_step / o.refine)
 
     def _where(self, what: str, t: float) -> str:
         spec = self.mechanism.spec

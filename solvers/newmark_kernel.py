@@ -78,7 +78,7 @@ Problem = namedtuple(
 Configs = namedtuple(
     "Configs",
     ["built", "m", "kept", "group", "nf", "free", "npres", "pres", "pres_src",
-     "ML", "CL", "KL", "Sinv", "MinvFF", "Frow"],
+     "ML", "CL", "KL", "Sinv", "SinvFine", "MinvFF", "Frow"],
 )
 
 Output = namedtuple(
@@ -260,6 +260,8 @@ def step_to(prob, cfg, c, t, h, x, v, a, w, x1, v1, a1):
     """A Newmark step of any length h (standard steps reuse the stored inverse)."""
     if h == prob.dt:
         newmark_step(prob, cfg, c, t, h, cfg.Sinv[c], x, v, a, w, x1, v1, a1)
+    elif h == prob.dt / prob.refine:
+        newmark_step(prob, cfg, c, t, h, cfg.SinvFine[c], x, v, a, w, x1, v1, a1)
     else:
         effective_inverse(prob, cfg, c, h, w.S, w.Sinv)
         newmark_step(prob, cfg, c, t, h, w.Sinv, x, v, a, w, x1, v1, a1)
@@ -488,24 +490,35 @@ def impact(prob, c, closing, t, x, v, stick, out, istate):
 
 @jit
 def advance(prob, cfg, c, x, v, a, w, istate, fstate, out):
-    """Standard steps in configuration c while nothing happens (the hot loop).
+    """Standard (or, after an event, refined) steps in configuration c while nothing happens: the hot loop.
 
-    Stops, without taking it, at the first step that would end off the grid
-    or past the chunk, cross an output instant, change a monitor's sign or
-    leave the divergence limit; :func:`run_chunk` then takes that step with
+    Stops, without taking it, at the first step that would reach the next grid
+    point from off the grid, end past the chunk, cross an output instant,
+    change a monitor's sign or leave the divergence limit; :func:`run_chunk` then takes that step with
     full handling. Kept small so numba can prune its reference counting.
     """
     ncl = prob.cl_ahead.shape[0]
     dt = prob.dt
+    fine = dt / prob.refine
     while True:
         t = fstate[F_T]
         k_grid = istate[I_GRID]
-        if t != k_grid * dt or t + dt > prob.t_end or t >= fstate[F_CHUNK_END] or t < fstate[F_FINE_UNTIL]:
+        on_grid = t == k_grid * dt
+        if t < fstate[F_FINE_UNTIL]:  # refined steps after an event, up to the next grid point
+            h = fine
+            if t + h >= (k_grid + 1) * dt:
+                return
+        elif on_grid:
+            h = dt
+        else:
             return
-        if prob.every_step or istate[I_NEXT_OUT] * prob.out_dt <= t + dt + 1e-9 * dt:
+        if t + h > prob.t_end or t >= fstate[F_CHUNK_END]:
             return
-        newmark_step(prob, cfg, c, t, dt, cfg.Sinv[c], x, v, a, w, w.x1, w.v1, w.a1)
-        fill_sources(prob, t + dt, w.src)  # once per step
+        if prob.every_step or istate[I_NEXT_OUT] * prob.out_dt <= t + h + 1e-9 * dt:
+            return
+        newmark_step(prob, cfg, c, t, h, cfg.Sinv[c] if h == dt else cfg.SinvFine[c], x, v, a, w,
+                     w.x1, w.v1, w.a1)
+        fill_sources(prob, t + h, w.src)  # once per step
         for k in range(ncl):  # monitor() written out: numba runs this loop four times faster so
             if c & prob.cl_bit[k]:
                 w.phi[k] = contact_force(prob, cfg, c, k, w.x1, w.v1, w.a1, w.src)
@@ -523,9 +536,12 @@ def advance(prob, cfg, c, x, v, a, w, istate, fstate, out):
             x[i] = w.x1[i]
             v[i] = w.v1[i]
             a[i] = w.a1[i]
-        istate[I_GRID] = k_grid + 1
         istate[I_STEPS] += 1
-        fstate[F_T] = (k_grid + 1) * dt
+        if h == dt:
+            istate[I_GRID] = k_grid + 1
+            fstate[F_T] = (k_grid + 1) * dt
+        else:
+            fstate[F_T] = t + h
 
 
 @jit
