@@ -314,8 +314,8 @@ class KernelRun:
         )
         numbers = tuple(range(1, spec.n_coordinates + 1)) + tuple(self.source_numbers)
         o = self.options
-        settings = {"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma, "rpm": spec.run.rpm,
-                    "degrees": spec.run.degrees}
+        settings = {"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
+                    "refine_after_events": o.refine, "rpm": spec.run.rpm, "degrees": spec.run.degrees}
         stats = RunStatistics("newmark", int(self.istate[kernel.I_STEPS]), len(events), wall_time,
                               tuple(self.tables.configurations_built()), settings)
         return Trace(spec, t, t * omega * 180 / math.pi, numbers, x, v, a, F, cfg, events, self.out.F_peak.copy(), stats)
