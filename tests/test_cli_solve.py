@@ -58,7 +58,8 @@ def test_plot_draws_force_displacement_and_configuration_charts() -> None:
 def test_overrides_change_the_run() -> None:
     result = run("solve", "gnilka-1a", "--rpm", "9000", "--degrees", "90", "--dt", "2e-6", "--json")
     settings = json.loads(result.output)["settings"]
-    assert settings == {"time_step_s": 2e-6, "beta": 1 / 6, "gamma": 0.5, "rpm": 9000.0, "degrees": 90.0}
+    assert settings == {"time_step_s": 2e-6, "beta": 1 / 6, "gamma": 0.5, "refine_after_events": 10,
+                        "rpm": 9000.0, "degrees": 90.0}
 
 
 @pytest.mark.parametrize(
