@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from tests.tui_helpers import put, run_and_wait
 from vtool.app.cli.main import cli
 from vtool.app.plots import line_chart
 from vtool.app.tui.app import create_app
@@ -27,16 +28,6 @@ from vtool.presets import boom, load_preset, plate
 pytestmark = pytest.mark.asyncio
 
 
-async def put(pilot, screen, name: str, text: str) -> None:  # type: ignore[no-untyped-def]
-    screen.form.row(name).editor.value = text
-    await pilot.pause()
-
-
-async def run_and_wait(pilot, app) -> None:  # type: ignore[no-untyped-def]
-    await pilot.press("ctrl+r")
-    await pilot.pause()
-    await app.workers.wait_for_complete()
-    await pilot.pause()
 
 
 async def export(pilot, app, path) -> None:  # type: ignore[no-untyped-def]

@@ -17,6 +17,7 @@ import tomli_w
 from click.testing import CliRunner
 from textual import events
 
+from tests.tui_helpers import put, run_and_wait
 from vtool.app import valvetrain_charts as charts
 from vtool.app.cli.main import cli
 from vtool.app.plots import shape_chart
@@ -49,17 +50,6 @@ async def set_field(pilot, screen, name: str, text: str) -> None:  # type: ignor
     await pilot.pause()
 
 
-async def put(pilot, screen, name: str, text: str) -> None:  # type: ignore[no-untyped-def]
-    """Replace a field's text in one edit (what a paste does); validation runs as for typing."""
-    screen.form.row(name).editor.value = text
-    await pilot.pause()
-
-
-async def run_and_wait(pilot, app) -> None:  # type: ignore[no-untyped-def]
-    await pilot.press("ctrl+r")
-    await pilot.pause()
-    await app.workers.wait_for_complete()
-    await pilot.pause()
 
 
 def summary_values(trace) -> dict:  # type: ignore[no-untyped-def]

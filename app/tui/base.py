@@ -16,6 +16,7 @@ does the rest the same way on every screen:
 
 from __future__ import annotations
 
+from abc import ABCMeta, abstractmethod
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -43,7 +44,11 @@ class FormProblem:
         return self.message
 
 
-class DomainScreen(Screen[None]):
+class _AbstractScreenMeta(ABCMeta, type(Screen)):  # type: ignore[misc]
+    """Screen's metaclass with abstract-method checks, so a domain screen must provide its hooks."""
+
+
+class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
     """Form on the left, results on the right, progress and keys at the bottom."""
 
     BINDINGS: ClassVar[list[BindingType]] = [
@@ -87,9 +92,9 @@ class DomainScreen(Screen[None]):
             yield Static("ready", id="status", markup=False)
         yield Footer(show_command_palette=False, compact=True)
 
+    @abstractmethod
     def compose_results(self) -> ComposeResult:
-        """The result panes of the domain screen (each subclass provides its own)."""
-        raise NotImplementedError(f"{type(self).__name__} provides compose_results")
+        """The result panes of the domain screen."""
 
     @property
     def form(self) -> ParamForm:
@@ -123,24 +128,28 @@ class DomainScreen(Screen[None]):
         self.status.update(text)
 
     # ----- what a domain screen provides -----
+    @abstractmethod
     def loader(self) -> Any:
         """The preset module (``load(doc)``, ``dump(spec)``) of this screen's kind."""
-        raise NotImplementedError
 
+    @abstractmethod
     def fields_for(self, spec: Any, doc: dict[str, Any]) -> list[Field]:
-        raise NotImplementedError
+        """The form fields of a spec."""
 
     def extra_checks(self, spec: Any) -> None:
         """Validation of run options that are not part of the preset (raise InputError)."""
 
+    @abstractmethod
     def start_run(self, spec: Any, run_id: int) -> Worker[Any]:
-        raise NotImplementedError
+        """Start the screen's worker for a validated spec."""
 
+    @abstractmethod
     def clear_results(self) -> None:
-        raise NotImplementedError
+        """Empty the result panes."""
 
+    @abstractmethod
     def write_csv(self, path: str) -> None:
-        raise NotImplementedError
+        """Export the current results as CSV (the CLI's writer)."""
 
     # ----- presets -----
     async def on_mount(self) -> None:

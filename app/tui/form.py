@@ -100,14 +100,13 @@ def format_value(value: Any) -> str:
 
 
 def _number(text: str) -> Any:
-    try:
-        return int(text)
-    except ValueError:
-        pass
-    try:
-        return float(text)
-    except ValueError:
-        return text  # the loader reports "got 'abc', expected a number ..."
+    """An int or float when the text is one; otherwise the text (the loader reports it)."""
+    for convert in (int, float):
+        try:
+            return convert(text)
+        except ValueError:
+            continue
+    return text  # the loader reports "got 'abc', expected a number ..."
 
 
 def parse_value(field: Field, text: str) -> Any:

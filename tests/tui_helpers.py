@@ -1,0 +1,16 @@
+"""Shared Pilot helpers for the TUI tests."""
+
+from __future__ import annotations
+
+
+async def put(pilot, screen, name: str, text: str) -> None:  # type: ignore[no-untyped-def]
+    """Replace a field's text in one edit (what a paste does); validation runs as for typing."""
+    screen.form.row(name).editor.value = text
+    await pilot.pause()
+
+
+async def run_and_wait(pilot, app) -> None:  # type: ignore[no-untyped-def]
+    await pilot.press("ctrl+r")
+    await pilot.pause()
+    await app.workers.wait_for_complete()
+    await pilot.pause()
