@@ -76,7 +76,7 @@ def test_brick_wall_preset_reproduces_the_worked_example():
     rows = {(r.structure, r.frequency_source, r.criterion): r for r in a.rows}
     measured = rows[("left", "measured", "damage-threshold")]
     assert measured.ratio == pytest.approx(1.75)
-    assert "envelope of types N,P,Q,R,T" in a.source
+    assert "envelope (thesis family) of types N,P,Q,R,T" in a.source
     env = envelope(THESIS_ENVELOPE, np.array([1.75]))
     assert measured.daf == pytest.approx(env.daf[0])
     m_omega = M_WALL * 2 * math.pi * 17.5
