@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vtool.assessments.cancel import Cancel
 from vtool.assessments.sonic_boom.criteria import Criterion, allowable_pressure
 from vtool.assessments.sonic_boom.pulses import Pulse, make_pulse, read_pulse_csv
 from vtool.assessments.sonic_boom.response import check_damping
@@ -166,13 +167,14 @@ def _static_per_pressure(structure: Structure, frequency: np.ndarray | float) ->
 
 
 def _daf_table(source: Pulse | EnvelopeSpec, ratios: dict[str, list[np.ndarray]],
-               damping: float) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], str]:
+               damping: float, cancel: Cancel | None = None
+               ) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], str]:
     """One DAF evaluation per quantity over every ``tau/T`` any result needs."""
     table: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     statements = []
     for quantity, parts in ratios.items():
         grid = np.unique(np.concatenate(parts))
-        daf, statement = daf_at(source, grid, quantity, damping)
+        daf, statement = daf_at(source, grid, quantity, damping, cancel)
         table[quantity] = (grid, daf)
         statements.append(statement)
     return table, " | ".join(statements)
@@ -184,8 +186,11 @@ def _lookup(table: dict[str, tuple[np.ndarray, np.ndarray]], quantity: str,
     return daf[np.searchsorted(grid, ratio)]
 
 
-def assess(spec: BoomWallSpec | BoomFloorSpec) -> Assessment:
-    """Allowable peak overpressures for every structure, frequency, tau and criterion."""
+def assess(spec: BoomWallSpec | BoomFloorSpec, cancel: Cancel | None = None) -> Assessment:
+    """Allowable peak overpressures for every structure, frequency, tau and criterion.
+
+    ``cancel`` is polled between DAF evaluations (:mod:`vtool.assessments.cancel`).
+    """
     source = boom_source(spec.boom)
     units = spec.units
     if isinstance(spec, BoomWallSpec):
@@ -208,7 +213,7 @@ def assess(spec: BoomWallSpec | BoomFloorSpec) -> Assessment:
             parts.append(tau * freqs)
             for st in structures:
                 parts.append(tau * np.array(list(st.frequencies.values())))
-    table, statement = _daf_table(source, needed, spec.boom.damping)
+    table, statement = _daf_table(source, needed, spec.boom.damping, cancel)
 
     rows: list[LimitRow] = []
     for st in structures:

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from vtool.assessments.cancel import Cancel, check
 from vtool.assessments.sonic_boom.pulses import (
     PULSE_TYPES,
     Pulse,
@@ -160,17 +161,17 @@ class Envelope:
 
 
 def envelope(spec: EnvelopeSpec, ratio: np.ndarray | float, quantity: str = "velocity",
-             damping: float = 0.0) -> Envelope:
-    """Overall-DAF envelope of the family ``spec`` at each ``tau/T``."""
+             damping: float = 0.0, cancel: Cancel | None = None) -> Envelope:
+    """Overall-DAF envelope of the family ``spec`` at each ``tau/T`` (``cancel`` polled per member)."""
     if quantity not in QUANTITIES:
         raise InputError("quantity", quantity, f"one of: {', '.join(QUANTITIES)}")
     ratio = np.atleast_1d(np.asarray(ratio, dtype=float))
     pulses: list[Pulse] = [make_pulse(p) for p in spec.members()]
     check_cost(pulses, ratio, MAX_ENVELOPE_SAMPLES)
-    curves = np.array([
-        peak_response(p, ratio, damping, quantities=(quantity,)).peaks[quantity].overall
-        for p in pulses
-    ])
+    curves = np.empty((len(pulses), ratio.size))
+    for k, p in enumerate(pulses):
+        check(cancel)
+        curves[k] = peak_response(p, ratio, damping, quantities=(quantity,)).peaks[quantity].overall
     which = np.argmax(curves, axis=0)
     labels = tuple(pulses[i].label for i in which)
     return Envelope(spec, quantity, float(damping), ratio, curves[which, np.arange(ratio.size)],
@@ -178,11 +179,12 @@ def envelope(spec: EnvelopeSpec, ratio: np.ndarray | float, quantity: str = "vel
 
 
 def daf_at(source: Pulse | EnvelopeSpec, ratio: np.ndarray | float, quantity: str,
-           damping: float = 0.0) -> tuple[np.ndarray, str]:
+           damping: float = 0.0, cancel: Cancel | None = None) -> tuple[np.ndarray, str]:
     """Overall DAF of a pulse or an envelope at ``tau/T``, with the statement of its source."""
     ratio = np.atleast_1d(np.asarray(ratio, dtype=float))
+    check(cancel)
     if isinstance(source, EnvelopeSpec):
-        env = envelope(source, ratio, quantity, damping)
+        env = envelope(source, ratio, quantity, damping, cancel)
         return env.daf, env.statement
     res = peak_response(source, ratio, damping, quantities=(quantity,))
     damped = "undamped" if damping == 0.0 else f"damping ratio {damping:g}"
