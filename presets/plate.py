@@ -10,7 +10,6 @@ round-trips. See ``presets/plate-table2.toml`` for a commented example.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 from vtool.assessments.plate.assembly import Mesh, Plate
@@ -18,6 +17,7 @@ from vtool.assessments.plate.constraints import free_dofs
 from vtool.assessments.plate.elements import ELEMENTS
 from vtool.assessments.plate.masters import NAMED_SETS, MasterSetError, labelled_set, named_set
 from vtool.assessments.plate.model import METHODS, Case, MasterSelection
+from vtool.assessments.plate.spec import UNIT_SYSTEMS, PlateSpec, PlateUnits
 from vtool.assessments.plate.study import (
     DEFAULT_PERIODS,
     MAX_EXACT_MODES,
@@ -30,26 +30,7 @@ from vtool.assessments.plate.transient import LOADS, MIN_OMEGA_MAX_H, RK4_LIMIT_
 from vtool.errors import InputError
 from vtool.presets.fields import Table
 
-
-@dataclass(frozen=True)
-class PlateUnits:
-    """Unit names of one consistent system, as a plate preset uses them, and their SI factors."""
-
-    length: str
-    pressure: str
-    density: str
-    force: str
-    metres: float = 1.0  # per length unit
-    pascals: float = 1.0  # per pressure unit
-    kg_per_m3: float = 1.0  # per density unit
-
-
-#: Same system names as the valve-train presets.
-UNIT_SYSTEMS: dict[str, PlateUnits] = {
-    "in-lbf-s": PlateUnits("in", "lbf/in^2", "lbf*s^2/in^4", "lbf", 0.0254, 6894.757293168361,
-                           4.4482216152605 / 0.0254**4),
-    "SI": PlateUnits("m", "Pa", "kg/m^3", "N"),
-}
+__all__ = ["UNIT_SYSTEMS", "PlateSpec", "PlateUnits", "dump", "load"]  # specs live in assessments.plate.spec
 
 MAX_MESH = 64
 #: Physical bounds in SI, checked before any numerics (docs/plate.md, "Limits").
@@ -69,24 +50,6 @@ def _si_scale(units: PlateUnits, key: str) -> float:
     """SI value per preset unit of ``key``."""
     return {"a": units.metres, "b": units.metres, "thickness": units.metres,
             "youngs_modulus": units.pascals, "density": units.kg_per_m3}[key]
-
-
-@dataclass(frozen=True)
-class PlateSpec:
-    """A validated plate preset: a study with its title and units."""
-
-    title: str
-    units: str
-    study: Study
-    element: str  # default element of the cases
-    nx: int  # default mesh of the cases
-    ny: int
-    notes: str = ""
-    kind: str = "plate"
-
-    @property
-    def unit_system(self) -> PlateUnits:
-        return UNIT_SYSTEMS[self.units]
 
 
 def _mesh(t: Table, key: str, default: tuple[int, int] | None) -> tuple[int, int]:

@@ -14,7 +14,7 @@ import numpy as np
 
 from vtool.assessments.plate.exact import NavierMode
 from vtool.assessments.plate.model import Case
-from vtool.assessments.plate.study import StudyResult, TransientRow
+from vtool.assessments.plate.study import CaseRun, StudyResult, TransientRow
 from vtool.assessments.plate.transient import SIGNED_PEAK_FLOOR, SIGNS, ExactHistories, Response
 from vtool.assessments.plate.vibration import FreeVibration
 
@@ -302,3 +302,46 @@ def response_csv(resp: Response, exact: ExactHistories | None) -> str:
     rows = np.column_stack(cols)
     body = "\n".join(",".join(f"{v:.8g}" for v in row) for row in rows)
     return head + "\n" + body + "\n"
+
+
+def case_run_text(run: CaseRun) -> str:
+    """``vtool plate transient``'s table: peaks, exact peaks, errors (both signs), halving check."""
+    resp = run.response
+    step = (f"omega_max*h = {run.omega_max_h:g}, h = {resp.step:.4g} s, {resp.steps} steps"
+            if resp.scheme == "rk4" else f"exact modal integration of the reduced model at {resp.steps} times")
+    c = run.case
+    lines = [f"case {c.name} ({c.element} {c.nx}x{c.ny}, KS = {run.size}), {resp.load} step load, "
+             f"{resp.scheme}: {step}, {resp.seconds * 1e3:.2f} ms",
+             f"{'quantity':<13} {'peak':>10} {'exact peak':>11} {'error %':>9} {'+ peak %':>9} "
+             f"{'- peak %':>9}" + (f" {'halving h %':>12}" if run.halving_pct else "")]
+    for q in ("displacement", "velocity", "acceleration"):
+        a, e = getattr(resp, q), getattr(run.exact, q)
+        k = int(np.argmax(np.abs(e)))
+        peak = float(np.max(a)) if e[k] > 0 else float(np.min(a))
+        err = run.errors_pct[q]
+        exact_shown = "n/a" if math.isnan(err) else f"{e[k]:.4f}"
+        line = (f"{q:<13} {peak:>10.4f} {exact_shown:>11} {_pct(err, 9)} {_pct(run.signed_pct[q + '+'], 9)}"
+                f" {_pct(run.signed_pct[q + '-'], 9)}")
+        if run.halving_pct:
+            line += f" {run.halving_pct[q]:>12.3f}"
+        lines.append(line)
+    lines.append(exact_note(run.exact))
+    lines += list(run.warnings)
+    return "\n".join(lines)
+
+
+def case_run_dict(run: CaseRun) -> dict[str, Any]:
+    resp = run.response
+    rk4 = resp.scheme == "rk4"
+    return {
+        "case": run.case.name, "KS": run.size, "load": resp.load, "scheme": resp.scheme,
+        "omega_max_h": run.omega_max_h if rk4 else None, "steps": resp.steps,
+        "step_s": resp.step if rk4 else None, "seconds": resp.seconds,
+        "time_unit": "t/T (exact fundamental period)", "window_periods": float(resp.tau[-1]),
+        "peak_errors_pct": _nan_none(run.errors_pct),
+        "signed_peak_errors_pct": _nan_none(run.signed_pct),
+        "halving_change_pct": run.halving_pct, "exact_modes": run.exact.n_modes,
+        "exact_peak_change_pct": run.exact.change_pct,
+        "exact_acceleration_converged": run.exact.acceleration_converged,
+        "warnings": list(run.warnings),
+    }

@@ -27,7 +27,11 @@ from vtool.assessments.plate.assembly import Plate
 from vtool.assessments.plate.elements import ELEMENTS
 from vtool.assessments.plate.model import Case, MasterSelection, ReducedModel, build_model
 from vtool.assessments.plate.transient import (
+    LOADS,
+    MIN_OMEGA_MAX_H,
     QUANTITIES,
+    RK4_LIMIT_THESIS,
+    SCHEMES,
     ExactHistories,
     Response,
     exact_histories,
@@ -311,3 +315,64 @@ def run_study(study: Study, *, transient: bool = True, cancel: Cancel | None = N
     opt = optima(rows, settings, full.name) if rows else []
     return StudyResult(study, free, conv, orders, exponent, rows, exact, opt,
                        time.perf_counter() - start, exact_4n, tuple(warnings))
+
+
+@dataclass(frozen=True)
+class CaseRun:
+    """One case under one step load by one scheme, against the exact reference.
+
+    What ``vtool plate transient`` prints and the TUI's Transient tab draws.
+    """
+
+    case: Case
+    size: int
+    response: Response
+    exact: ExactHistories
+    errors_pct: dict[str, float]
+    signed_pct: dict[str, float]
+    halving_pct: dict[str, float]
+    omega_max_h: float
+    warnings: tuple[str, ...] = ()
+
+
+def check_run_options(load: str, scheme: str, omega_max_h: float, periods: float,
+                      exact_modes: int, prefix: str = "") -> None:
+    """The ranges of a single-case run (the CLI's options and the TUI's run fields)."""
+    if load not in LOADS:
+        raise InputError(f"{prefix}load", load, f"one of: {', '.join(LOADS)}")
+    if scheme not in SCHEMES:
+        raise InputError(f"{prefix}scheme", scheme, f"one of: {', '.join(SCHEMES)}")
+    if isinstance(omega_max_h, bool) or not isinstance(omega_max_h, int | float) or not (
+            MIN_OMEGA_MAX_H <= omega_max_h <= RK4_LIMIT_THESIS):
+        raise InputError(f"{prefix}omega_max_h", omega_max_h,
+                         f">= {MIN_OMEGA_MAX_H:g} and <= {RK4_LIMIT_THESIS} (omega_max*h, RK4 "
+                         "stability limit, thesis eq. 44)")
+    if isinstance(periods, bool) or not isinstance(periods, int | float) or not 0.5 <= periods <= 20.0:
+        raise InputError(f"{prefix}periods", periods, ">= 0.5 and <= 20 (exact fundamental periods)")
+    if isinstance(exact_modes, bool) or not isinstance(exact_modes, int) or not (
+            2 <= exact_modes <= MAX_EXACT_MODES):
+        raise InputError(f"{prefix}exact_modes", exact_modes, f"an integer >= 2 and <= {MAX_EXACT_MODES}")
+
+
+def run_case(plate: Plate, case: Case, load: str, scheme: str = "rk4", omega_max_h: float = 1.0,
+             periods: float = DEFAULT_PERIODS, exact_modes: int = 200, *, halving: bool = True,
+             cancel: Cancel | None = None) -> CaseRun:
+    """Build ``case``, run it (RK4 at ``omega_max_h`` or modal) and compare with exact."""
+    check_run_options(load, scheme, omega_max_h, periods, exact_modes)
+    check_mesh_size(case.element, case.nx, case.ny)
+    check_exact_cost(plate, TransientSettings(cases=(case.name,), periods=periods,
+                                              exact_modes=exact_modes, truncation_check=False))
+    model = build_model(plate, case)
+    check(cancel)
+    exact = exact_histories(plate, load, periods, exact_modes)
+    check(cancel)
+    if scheme == "rk4":
+        resp = run_rk4(plate, model, load, omega_max_h, periods, cancel)
+        change = halving_change_pct(plate, model, load, omega_max_h, periods, cancel) if halving else {}
+    else:
+        resp = run_modal(plate, model, load, exact.tau)
+        change = {}
+    return CaseRun(case, model.size, resp, exact, peak_errors(resp, exact),
+                   signed_peak_errors(resp, exact), change,
+                   omega_max_h if scheme == "rk4" else float("nan"),
+                   tuple(window_warnings({load: exact}, periods)))
