@@ -77,3 +77,21 @@ def test_cli_bad_values_are_one_line() -> None:
     result = runner.invoke(cli, ["plate", "modes", "plate-table2", "--case", "A11", "--csv", "/missing/x.csv"])
     assert result.exit_code == 2 and "error: --csv: got '/missing/x.csv'" in result.output
     assert "Traceback" not in result.output
+
+
+def test_cancel_stops_a_study() -> None:
+    from vtool.assessments.cancel import Cancelled
+    from vtool.assessments.plate.study import run_study
+    from vtool.presets import load_preset
+
+    study = load_preset("plate-table2").study
+    polls = []
+
+    def cancel() -> bool:
+        polls.append(1)
+        return len(polls) > 2
+
+    start = time.perf_counter()
+    with pytest.raises(Cancelled):
+        run_study(study, cancel=cancel)
+    assert time.perf_counter() - start < 10.0
