@@ -10,6 +10,7 @@ name their versions.
 
 from __future__ import annotations
 
+import functools
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -142,11 +143,21 @@ def plate_frequency_table(name: str = "plate-table2", cases: tuple[str, ...] | N
     return header, rows
 
 
+@functools.cache
+def _exact(load: str, modes: int, on: int | None = None) -> object:
+    """Exact references of plate-table2 (cached: two tables share them); ``on``: the grid of ``on`` modes."""
+    from vtool.assessments.plate.transient import exact_histories
+    from vtool.presets import load_preset
+
+    spec = load_preset("plate-table2")
+    tau = None if on is None else _exact(load, on).tau  # type: ignore[attr-defined]
+    return exact_histories(spec.study.plate, load, spec.study.transient.periods, modes, tau=tau)
+
+
 def plate_transient_table() -> Table:
     """Full model A1 at omega_max h = 1 and modal: peak errors against 200 and 800 exact modes."""
     from vtool.assessments.plate.model import build_model
     from vtool.assessments.plate.study import TransientSettings, run_transient_case
-    from vtool.assessments.plate.transient import exact_histories
     from vtool.presets import load_preset
 
     spec = load_preset("plate-table2")
@@ -154,9 +165,8 @@ def plate_transient_table() -> Table:
     settings = spec.study.transient
     run = TransientSettings(cases=("A1",), loads=("uniform", "point"), omega_max_h=(1.0,),
                             periods=settings.periods, exact_modes=200)
-    exact = {load: exact_histories(plate, load, run.periods, 200) for load in run.loads}
-    fine = {load: exact_histories(plate, load, run.periods, 800, tau=exact[load].tau)
-            for load in run.loads}
+    exact = {load: _exact(load, 200) for load in run.loads}
+    fine = {load: _exact(load, 800, 200) for load in run.loads}
     model = build_model(plate, spec.study.case("A1"))
     rows_out = run_transient_case(plate, model, run, exact, fine)
     header = ["load", "A1 run", "quantity", "peak error %, 200 modes (thesis)", "+ peak %", "- peak %",
@@ -175,17 +185,17 @@ def plate_transient_table() -> Table:
 
 def plate_truncation_table() -> Table:
     from vtool.assessments.plate.report import truncation_pct
-    from vtool.assessments.plate.transient import exact_histories, peak_at_end
+    from vtool.assessments.plate.transient import peak_at_end
     from vtool.presets import load_preset
 
     spec = load_preset("plate-table2")
-    plate, periods = spec.study.plate, spec.study.transient.periods
+    periods = spec.study.transient.periods
     header = ["load", "quantity", "exact peak, 200 modes", "at t/T", "800 modes", "200-mode change %",
               f"peak at the end of the {periods:g}-period window"]
     rows = []
     for load in ("uniform", "point"):
-        coarse = exact_histories(plate, load, periods, 200)
-        fine = exact_histories(plate, load, periods, 800, tau=coarse.tau)
+        coarse = _exact(load, 200)
+        fine = _exact(load, 800, 200)
         change = truncation_pct(coarse, fine)
         for q in ("displacement", "velocity", "acceleration"):
             h, g = getattr(coarse, q), getattr(fine, q)

@@ -106,8 +106,25 @@ def load(doc: dict[str, Any], base: str | Path | None = None) -> BoomWallSpec | 
     """Validate a parsed boom preset and return its frozen spec.
 
     ``base`` is the preset's folder: a relative pulse CSV path resolves
-    against it (not against the working directory).
+    against it (not against the working directory). An echoed bad value is
+    cut to a readable length.
     """
+    try:
+        return _load(doc, base)
+    except InputError as exc:
+        raise short_error(exc) from None
+
+
+def short_error(exc: InputError, limit: int = 80) -> InputError:
+    """``exc`` with its echoed value (and field) cut to ``limit`` characters."""
+    text = repr(exc.value)
+    if len(text) <= limit and len(exc.field) <= limit:
+        return exc
+    value = exc.value if len(text) <= limit else text[: limit - 3] + "..."
+    return InputError(exc.field[:limit], value, exc.expected[: 4 * limit], exc.unit)
+
+
+def _load(doc: dict[str, Any], base: str | Path | None) -> BoomWallSpec | BoomFloorSpec:
     top = Table(doc, "")
     kind = top.string("kind", choices=KINDS)
     title = top.string("title", default="")

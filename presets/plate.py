@@ -28,6 +28,7 @@ from vtool.assessments.plate.study import (
 )
 from vtool.assessments.plate.transient import LOADS, MIN_OMEGA_MAX_H, RK4_LIMIT_THESIS
 from vtool.errors import InputError
+from vtool.presets.boom import short_error
 from vtool.presets.fields import Table
 
 __all__ = ["UNIT_SYSTEMS", "PlateSpec", "PlateUnits", "dump", "load"]  # specs live in assessments.plate.spec
@@ -174,7 +175,14 @@ def _transient(t: Table | None, cases: tuple[Case, ...], plate: Plate) -> Transi
 
 
 def load(doc: dict[str, Any]) -> PlateSpec:
-    """Validate a parsed plate preset and return its frozen spec."""
+    """Validate a parsed plate preset and return its frozen spec (echoed values cut short)."""
+    try:
+        return _load(doc)
+    except InputError as exc:
+        raise short_error(exc) from None
+
+
+def _load(doc: dict[str, Any]) -> PlateSpec:
     top = Table(doc, "")
     top.string("kind", choices=("plate",))
     title = top.string("title", default="")

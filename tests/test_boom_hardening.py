@@ -167,3 +167,24 @@ def test_relative_pulse_csv_resolves_against_the_preset_folder(tmp_path: Path, m
     result = _run("boom", "wall", str(preset))
     assert result.exit_code == 0, result.output
     assert "csv:boom.csv" in result.output
+
+
+def test_an_echoed_value_is_cut_to_a_readable_length() -> None:
+    from vtool.presets import plate
+
+    with pytest.raises(InputError) as err:
+        boom.load(_edit(WALL, ("boom", "pulse"), "x" * 100_000))
+    assert str(err.value).startswith("boom.pulse: got ") and len(str(err.value)) < 200
+    doc = read_document(PRESET_DIR / "plate-table2.toml")
+    doc["study"]["element"] = "y" * 100_000
+    with pytest.raises(InputError) as err:
+        plate.load(doc)
+    assert len(str(err.value)) < 200
+
+
+def test_huge_pulse_parameters_are_refused() -> None:
+    from vtool.assessments.sonic_boom.pulses import PulseParams, validate
+
+    with pytest.raises(InputError, match=r"s: got 1e\+308"):
+        validate(PulseParams("N", s=1e308))
+    assert samples_estimate(idealized("N", s=100.0), [1e4]) > MAX_SAMPLES

@@ -55,6 +55,7 @@ from vtool.errors import InputError
 #: pulse types in the thesis' order (VELDAF's KOM = 1..5).
 PULSE_TYPES: tuple[str, ...] = ("N", "P", "Q", "R", "T")
 _NARROWEST = 1e-9  # segments shorter than this (units of tau) are treated as jumps
+MAX_PARAMETER = 100.0  # largest s, r2, alpha, |beta|: a pulse 100 tau long is no boom
 
 
 @dataclass(frozen=True)
@@ -185,6 +186,10 @@ def validate(params: PulseParams, prefix: str = "") -> PulseParams:
     p = params.resolved()
     if not (math.isfinite(p.s) and p.s >= 1.0):
         raise InputError(name("s"), p.s, ">= 1 (total / positive duration)")
+    for key in ("s", "r2", "alpha", "beta"):
+        value = getattr(p, key)
+        if value is not None and math.isfinite(value) and abs(value) > MAX_PARAMETER:
+            raise InputError(name(key), value, f"|{key}| <= {MAX_PARAMETER:g}")
     if not (math.isfinite(p.r1) and 0.0 <= p.r1 < 1.0):
         raise InputError(name("r1"), p.r1, "in [0, 1) (rise time / positive duration)")
     if p.kind == "N" and p.r1 != 0.0:

@@ -369,7 +369,10 @@ def samples_estimate(pulse: Pulse, ratio: np.ndarray | float) -> int:
     top = 2.0 * math.pi * float(np.max(ratio))
     cells = 0.0
     for seg in pulse.segments:
-        cells += math.ceil(max(top * seg.length, seg.length * seg.freq, 2.0 * _GRID) / _GRID) + 1
+        span = max(top * seg.length, seg.length * seg.freq, 2.0 * _GRID) / _GRID
+        if not span < 1e18:  # inf or absurd: the guard refuses it
+            return 2**62
+        cells += math.ceil(span) + 1
     return int(min(cells * ratio.size, 2**62))
 
 
