@@ -113,3 +113,27 @@ def test_a_burst_shifted_as_a_whole_keeps_its_order_within_the_resolution() -> N
     assert pair_events(ref, late).unmatched == 4
     pairing = pair_events(ref, late, resolution=1e-5)
     assert pairing.pairs == ((0, 0), (1, 1), (2, 2), (3, 3))
+
+
+def test_cli_prints_the_table_and_writes_csv(tmp_path) -> None:  # noqa: ANN001
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    out = tmp_path / "acc.csv"
+    result = CliRunner().invoke(cli, ["accuracy", "gnilka-1d", "--degrees", "30", "--csv", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "unmatched" in result.output and "refused" in result.output
+    lines = out.read_text().splitlines()
+    assert lines[0].startswith("backend,setting,wall time (s),steps,events,unmatched")
+    assert len(lines) == 1 + 1 + 14 + 1 + 6  # header, exact, Newmark 7 steps x 2 betas, plain, scipy 6 rtols
+
+
+def test_cli_refuses_a_non_valvetrain_preset() -> None:
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    result = CliRunner().invoke(cli, ["accuracy", "plate-table2"])
+    assert result.exit_code == 2
+    assert "valvetrain" in result.output
