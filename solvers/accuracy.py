@@ -170,8 +170,13 @@ def table_text(rows: list[AccuracyRow], length_unit: str = "in") -> str:
     return "\n".join(line.rstrip() for line in lines)
 
 
+def markdown_header(length_unit: str = "in") -> list[str]:
+    """The header with its pipes escaped for a Markdown table."""
+    return [c.replace("|", "\\|") for c in header(length_unit)]
+
+
 def table_markdown(rows: list[AccuracyRow], length_unit: str = "in") -> str:
-    return markdown_table(header(length_unit), [cells(row) for row in rows]).rstrip("\n")
+    return markdown_table(markdown_header(length_unit), [cells(row) for row in rows]).rstrip("\n")
 
 
 def write_table_csv(path: str, rows: list[AccuracyRow], length_unit: str = "in") -> None:
