@@ -14,9 +14,9 @@ error against the exact back end in
 * valve lift: the largest absolute difference of the valve coordinate over
   the output angles.
 
-Newmark runs use its default refinement after events (steps of dt/10 for two
-periods of the highest mode); one extra row shows the plain thesis scheme at
-1 µs. Settings a back end refuses (a Newmark step beyond its stability
+Newmark runs use its default refinement after events (steps of
+dt / ``NewmarkOptions.refine`` for ``refine_periods`` periods of the highest
+mode); one extra row shows the plain thesis scheme at 1 µs. Settings a back end refuses (a Newmark step beyond its stability
 limit) are listed with the reason instead of figures. scipy rows depend on
 the scipy and numpy versions, which :func:`library_versions` names.
 """

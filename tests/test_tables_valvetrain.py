@@ -10,7 +10,6 @@ numpy versions the committed rows name. After a change to the solver,
 
 from __future__ import annotations
 
-import contextlib
 import importlib.util
 import os
 import sys
@@ -39,14 +38,7 @@ SCIPY_PRESETS = tables.PRESETS if os.environ.get("VTOOL_FULL_TABLES") else ("gni
 
 @pytest.fixture(scope="module")
 def studies() -> dict:
-    try:  # one BLAS thread when available: the exact back end's small matrices only contend for threads
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        limits = contextlib.nullcontext()
-    else:
-        limits = threadpool_limits(1)
-    with limits:
-        return {name: tables.study(name, scipy=name in SCIPY_PRESETS) for name in tables.PRESETS}
+    return {name: tables.study(name, scipy=name in SCIPY_PRESETS) for name in tables.PRESETS}
 
 
 def committed(path: Path, name: str) -> list[list[str]]:
