@@ -507,3 +507,50 @@ def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan
             low = mid
     return SpeedResult(criterion, high, tuple(history),
                        f"{words} from {high:g} rev/min (not at {low:g})")
+
+
+# ----- reports -----
+
+def report_columns(spec: MechanismSpec, timing: bool = True) -> list[tuple[str, str]]:
+    return [(n, u) for n, u in metric_columns(spec) if timing or n not in TIMING_METRICS]
+
+
+def results_table(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], spec: MechanismSpec) -> str:
+    """A plain text table: one row per point, units on a second header line."""
+    columns = [(f, u) for f, u in fields] + report_columns(spec)
+    header = [name for name, _ in columns] + ["status"]
+    units = [f"({u})" if u else "" for _, u in columns] + [""]
+    rows = []
+    for r in results:
+        cells = [format_value(v) for _, v in r.values]
+        for name, _ in report_columns(spec):
+            value = r.metrics[name]
+            cells.append("-" if isinstance(value, float) and math.isnan(value)
+                         else f"{value:.4g}" if isinstance(value, float) else str(value))
+        rows.append(cells + [r.status])
+    widths = [max(len(h), len(u), *(len(row[i]) for row in rows)) for i, (h, u) in enumerate(zip(header, units,
+                                                                                                 strict=True))]
+    lines = ["  ".join(h.rjust(w) for h, w in zip(header, widths, strict=True)).rstrip(),
+             "  ".join(u.rjust(w) for u, w in zip(units, widths, strict=True)).rstrip()]
+    lines += ["  ".join(c.rjust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows]
+    return "\n".join(lines)
+
+
+def _json_value(value: Any) -> Any:
+    return None if isinstance(value, float) and math.isnan(value) else value
+
+
+def results_json(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], spec: MechanismSpec,
+                 preset: str) -> dict:
+    """The sweep as a JSON-ready dict: units as ``*_unit`` keys, NaN as null."""
+    columns = report_columns(spec)
+    units = {f"{f}_unit": u for f, u in fields} | {f"{n}_unit": u for n, u in columns}
+    return {
+        "preset": preset,
+        "title": spec.title,
+        "fields": [f for f, _ in fields],
+        "metrics": [n for n, _ in columns],
+        "units": units,
+        "points": [dict(r.values) | {"status": r.status} | {n: _json_value(r.metrics[n]) for n, _ in columns}
+                   for r in results],
+    }
