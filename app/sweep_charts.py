@@ -1,4 +1,8 @@
-"""Charts of a sweep: a metric against the first swept field, and a character map for two fields."""
+"""Charts of a sweep: a metric against the first swept field, and a character map for two fields.
+
+``fields`` are the chart's axes, (path, unit) of the swept fields that take
+more than one value (fields set to a single value are fixed settings).
+"""
 
 from __future__ import annotations
 
@@ -11,28 +15,33 @@ from vtool.solvers.sweep import PointResult, format_value
 SHADES = " .:-=+*#%@"
 
 
-def _axes(results: Sequence[PointResult]) -> tuple[list, list]:
-    """Distinct values of the first and second swept fields, in grid order."""
+def _key(result: PointResult, fields: Sequence[tuple[str, str]]) -> tuple:
+    values = dict(result.values)
+    return tuple(values[path] for path, _ in fields[:2])
+
+
+def _axes(results: Sequence[PointResult], fields: Sequence[tuple[str, str]]) -> tuple[list, list]:
+    """Distinct values of the first and second chart fields, in grid order."""
     first: list = []
     second: list = []
     for r in results:
-        values = [v for _, v in r.values]
-        if values and values[0] not in first:
+        values = _key(r, fields)
+        if values[0] not in first:
             first.append(values[0])
         if len(values) > 1 and values[1] not in second:
             second.append(values[1])
     return first, second
 
 
-def _lookup(results: Sequence[PointResult], metric: str) -> dict[tuple, float]:
-    return {tuple(v for _, v in r.values[:2]): float(r.metrics[metric]) for r in results}
+def _lookup(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], metric: str) -> dict[tuple, float]:
+    return {_key(r, fields): float(r.metrics[metric]) for r in results}
 
 
 def metric_chart(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], metric: str, unit: str,
                  *, width: int = 100, height: int = 22, color: bool = True) -> str:
     """``metric`` against the first swept field, one line per value of the second (NaN: gaps)."""
-    first, second = _axes(results)
-    table = _lookup(results, metric)
+    first, second = _axes(results, fields)
+    table = _lookup(results, fields, metric)
     x_path, x_unit = fields[0]
     series = {}
     for value in second or [None]:
@@ -52,8 +61,8 @@ def metric_map(results: Sequence[PointResult], fields: Sequence[tuple[str, str]]
     """
     if len(fields) < 2:
         raise ValueError("a map needs two swept fields")
-    first, second = _axes(results)
-    table = _lookup(results, metric)
+    first, second = _axes(results, fields)
+    table = _lookup(results, fields, metric)
     finite = [v for v in table.values() if math.isfinite(v)]
     low, high = (min(finite), max(finite)) if finite else (0.0, 0.0)
     label_width = max(len(format_value(v)) for v in second)

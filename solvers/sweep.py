@@ -171,7 +171,7 @@ def parse_scheduler(text: str) -> tuple[str, int]:
 class DaskRunner:
     """A Dask client (to an existing scheduler or a LocalCluster it starts); connect before any output."""
 
-    def __init__(self, scheduler: str, timeout: float = 5.0) -> None:
+    def __init__(self, scheduler: str, timeout: float = 3.0) -> None:
         kind, count = parse_scheduler(scheduler)
         from distributed import Client, LocalCluster
 

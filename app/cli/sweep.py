@@ -87,8 +87,11 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     names = {name: unit for name, unit in metric_columns(plan.spec)}
     if metric not in names:
         raise InputError("--metric", metric, f"one of: {', '.join(names)}")
-    if as_map and len(plan.fields) != 2:
-        raise InputError("--map", len(plan.fields), "exactly two swept fields")
+    axes = [f for f in plan.fields if len({dict(p.values)[f[0]] for p in plan.points}) > 1]
+    if as_map and len(axes) != 2:
+        raise InputError("--map", len(axes), "exactly two swept fields with more than one value")
+    if plot and not axes:
+        raise InputError("--plot", plan.fields[0][0] if plan.fields else None, "a swept field with two or more values")
     runner = make_runner(workers, scheduler)  # a Dask scheduler is reached here, before any file is written
     try:
         if find is not None:
@@ -124,9 +127,9 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         from vtool.app.sweep_charts import metric_chart, metric_map
 
         if plot:
-            click.echo(metric_chart(results, plan.fields, metric, names[metric]))
+            click.echo(metric_chart(results, axes, metric, names[metric]))
         if as_map:
-            click.echo(metric_map(results, plan.fields, metric, names[metric]))
+            click.echo(metric_map(results, axes, metric, names[metric]))
 
 
 def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # type: ignore[no-untyped-def]
