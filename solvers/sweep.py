@@ -350,6 +350,30 @@ def column_title(name: str, unit: str) -> str:
     return f"{name} ({unit})" if unit else name
 
 
+def csv_header(fields: Sequence[tuple[str, str]], spec: MechanismSpec, timing: bool = False) -> list[str]:
+    """Swept fields (with units), ``status``, then every metric (with units)."""
+    return ([column_title(f, u) for f, u in fields] + ["status"]
+            + [column_title(n, u) for n, u in report_columns(spec, timing)])
+
+
+def csv_row(result: PointResult, metrics: Sequence[tuple[str, str]]) -> list[str]:
+    return ([format_value(v) for _, v in result.values] + [result.status]
+            + [format_value(result.metrics[n]) for n, _ in metrics])
+
+
+def csv_lines(rows: Iterable[list[str]]) -> str:
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="\n").writerows(rows)
+    return buffer.getvalue()
+
+
+def results_csv(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], spec: MechanismSpec,
+                timing: bool = False) -> str:
+    """The whole sweep as CSV text (the same bytes as a finished :class:`SweepFile`)."""
+    metrics = report_columns(spec, timing)
+    return csv_lines([csv_header(fields, spec, timing)] + [csv_row(r, metrics) for r in results])
+
+
 class SweepFile:
     """A CSV written as points finish, kept valid and resumable; see the module doc.
 
@@ -362,9 +386,8 @@ class SweepFile:
                  *, resume: bool = False, timing: bool = False) -> None:
         self.path = Path(path)
         self.fields = [f for f, _ in fields]
-        self.metrics = [(n, u) for n, u in metric_columns(spec) if timing or n not in TIMING_METRICS]
-        self.header = [column_title(f, u) for f, u in fields] + ["status"] + [column_title(n, u)
-                                                                            for n, u in self.metrics]
+        self.metrics = report_columns(spec, timing)
+        self.header = csv_header(fields, spec, timing)
         self.keys: dict[tuple[str, ...], int] = {}
         self.rows: list[list[str]] = []
         if resume and self.path.exists():
@@ -399,14 +422,11 @@ class SweepFile:
         self.handle = self.path.open("a", encoding="utf-8", newline="")
 
     def row(self, result: PointResult) -> list[str]:
-        return ([format_value(v) for _, v in result.values] + [result.status]
-                + [format_value(result.metrics[n]) for n, _ in self.metrics])
+        return csv_row(result, self.metrics)
 
     @staticmethod
     def _text(rows: Iterable[list[str]]) -> str:
-        buffer = io.StringIO()
-        csv.writer(buffer, lineterminator="\n").writerows(rows)
-        return buffer.getvalue()
+        return csv_lines(rows)
 
     def append(self, result: PointResult) -> None:
         assert self.handle is not None
