@@ -17,7 +17,7 @@ from vtool.markdown import replace_block, table
 from vtool.presets import load_preset
 from vtool.presets.paths import plan_sweep
 from vtool.presets.valvetrain import with_run_overrides
-from vtool.solvers.metrics import metric_columns
+from vtool.solvers.metrics import metric_columns, seat_index
 from vtool.solvers.sweep import CRITERIA, SerialRunner, find_speed, make_runner, run_points
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "sweep.md"
@@ -25,7 +25,7 @@ PRESETS = (("gnilka-1a", "1A: three clearances, valve seat"),
            ("gnilka-1b", "1B: three clearances, no valve seat"),
            ("gnilka-1c", "1C: two clearances (rocker pinned), valve seat"),
            ("gnilka-2", "example 2 (and 3): three clearances, valve seat"))
-SCAN = list(range(4000, 16001, 1000))  # rev/min
+SCAN = list(range(4000, 16001, 2000))  # rev/min
 CHART_RPM = "run.rpm=6000:14000:250"
 SPRING = "members.valve_spring.stiffness=150:350:50"
 MAP_RPM = "run.rpm=8000:14000:250"
@@ -37,7 +37,7 @@ def speeds_table(runner) -> str:  # type: ignore[no-untyped-def]
         spec = load_preset(name)
         cells = [f"`{name}`", words]
         for criterion in CRITERIA:
-            if criterion == "bounce-speed" and spec.seat is None:
+            if criterion == "bounce-speed" and seat_index(spec) is None:
                 cells.append("no seat")
                 continue
             result = find_speed(criterion, lambda rpm, spec=spec: with_run_overrides(spec, rpm=rpm), SCAN, runner)

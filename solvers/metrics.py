@@ -18,7 +18,7 @@ and units for a spec. ``vtool sweep`` reports them per point, and a single
     none).
 ``cam_separation_duration`` (deg)
     The longest such separation: cam angle from the separation to the next
-    cam impact (or to the end of the run).
+    cam impact (or to the end of the run); 0 when there is none.
 ``lift_loss`` (length)
     max over output rows after the first revolution of L_kin - L, where
     L = max(q_v - s, 0) is the valve's lift off its seat (q_v the seat
@@ -113,7 +113,7 @@ def _cam_separation(trace: Trace, name: str) -> tuple[int, float, float]:
     end = float(trace.cam_angle[-1]) if len(trace.cam_angle) else 0.0
     per_revolution: dict[int, int] = {}
     first = NAN
-    longest = NAN
+    longest = 0.0
     events = [e for e in trace.events if e.clearance == name]
     for k, e in enumerate(events):
         if e.kind not in (OPENED, RELEASED) or e.cam_angle < REVOLUTION or not _above_mid_stroke(e.cam_angle):
@@ -123,7 +123,7 @@ def _cam_separation(trace: Trace, name: str) -> tuple[int, float, float]:
         closing = next((f.cam_angle for f in events[k + 1:] if f.kind == CLOSED), end)
         first = min(first, e.cam_angle % REVOLUTION) if not math.isnan(first) else e.cam_angle % REVOLUTION
         duration = closing - e.cam_angle
-        longest = max(longest, duration) if not math.isnan(longest) else duration
+        longest = max(longest, duration)
     return max(per_revolution.values(), default=0), first, longest
 
 

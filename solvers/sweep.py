@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import copy
 import csv
+import functools
 import io
 import math
 import os
@@ -104,6 +105,12 @@ def _mechanism(spec: MechanismSpec, previous: Mechanism | None) -> Mechanism:
     return mechanism
 
 
+@functools.cache
+def _backend_class(name: str) -> Any:
+    """The back-end class, looked up once per process (an entry-point scan costs tens of ms)."""
+    return backends.get(name)
+
+
 def evaluate_point(spec: MechanismSpec, *, every_step: bool = False, previous: Mechanism | None = None,
                    cancel: Callable[[], bool] | None = None) -> tuple[dict[str, float], str, Mechanism | None]:
     """Run one point and return (metrics, status, mechanism for reuse by the next point).
@@ -116,7 +123,7 @@ def evaluate_point(spec: MechanismSpec, *, every_step: bool = False, previous: M
     mechanism = None
     try:
         mechanism = _mechanism(spec, previous)
-        backend = backends.get(spec.run.backend)()
+        backend = _backend_class(spec.run.backend)()
         options = backend.options_from_run(spec.run, every_step)
         trace = backend.simulate(mechanism, options, progress=None,
                                  cancel=cancel if backend.supports_cancel else None)

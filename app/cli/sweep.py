@@ -71,7 +71,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     """
     from vtool.errors import InputError, RunError
     from vtool.presets.paths import plan_sweep
-    from vtool.solvers.metrics import metric_columns
+    from vtool.solvers.metrics import metric_columns, seat_index
     from vtool.solvers.sweep import SweepFile, make_runner, results_json, results_table, run_points
 
     if resume and csv_path is None:
@@ -84,6 +84,8 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     elif not sets:
         raise InputError("--set", None, "at least one FIELD=VALUES (or --find jump-speed)")
     plan = plan_sweep(preset, list(sets))
+    if find == "bounce-speed" and seat_index(plan.spec) is None:
+        raise InputError("--find", find, "a preset with a valve seat (this one has none)")
     names = {name: unit for name, unit in metric_columns(plan.spec)}
     if metric not in names:
         raise InputError("--metric", metric, f"one of: {', '.join(names)}")
