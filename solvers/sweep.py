@@ -32,6 +32,7 @@ import copy
 import csv
 import functools
 import io
+import logging
 import math
 import os
 import signal
@@ -188,7 +189,7 @@ class DaskRunner:
                 self.client = Client(scheduler, timeout=timeout)
             else:
                 self.cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=kind == "local",
-                                            dashboard_address=None)
+                                            dashboard_address=None, silence_logs=logging.ERROR)
                 self.client = Client(self.cluster)
         except (OSError, TimeoutError) as exc:
             raise InputError("--scheduler", scheduler,
