@@ -335,6 +335,8 @@ def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False
     finally:
         if sink is not None:
             sink.finish()
+    if sink is not None:
+        results = sink.finished_results(points) | results
     ordered = [results[i] for i in sorted(results)]
     return SweepOutcome(ordered, complete, time.perf_counter() - started, len(points) - len(todo), len(points))
 
@@ -352,6 +354,13 @@ def format_value(value: Any) -> str:
             return ""
         return f"{value:.10g}"
     return str(value)
+
+
+def _parse_cell(text: str) -> float:
+    """Inverse of :func:`format_value` for metrics: empty is NaN, integers stay integers."""
+    if not text:
+        return math.nan
+    return int(text) if text.lstrip("-").isdigit() else float(text)
 
 
 def column_title(name: str, unit: str) -> str:
@@ -428,6 +437,19 @@ class SweepFile:
         self.index_of = index_of
         write_atomic(self.path, self._text([self.header] + kept))
         self.handle = self.path.open("a", encoding="utf-8", newline="")
+
+    def finished_results(self, points: Sequence[Point]) -> dict[int, PointResult]:
+        """The points read back from a resumed file (numbers parsed; empty cells NaN)."""
+        by_index = {p.index: p for p in points}
+        results = {}
+        for row in self.rows:
+            index = self.index_of.get(tuple(row[: len(self.fields)]))
+            if index is None or index not in self.finished:
+                continue
+            cells = row[len(self.fields) + 1:]
+            metrics = {name: _parse_cell(cell) for (name, _), cell in zip(self.metrics, cells, strict=True)}
+            results[index] = PointResult(index, by_index[index].values, metrics, row[len(self.fields)])
+        return results
 
     def row(self, result: PointResult) -> list[str]:
         return csv_row(result, self.metrics)

@@ -157,7 +157,8 @@ def test_resume_of_a_cut_file_gives_the_uninterrupted_file(tmp_path: Path) -> No
     cut.write_text(lines[0] + lines[3] + lines[1] + lines[4][:20])  # out of order, last line cut by a kill
     sink = SweepFile(cut, plan.fields, plan.spec, resume=True)
     outcome = run_points(plan.points, SerialRunner(), sink=sink)
-    assert outcome.skipped == 2 and len(outcome.results) == 3
+    assert outcome.skipped == 2 and len(outcome.results) == 5
+    assert [r.index for r in outcome.results] == [0, 1, 2, 3, 4]
     assert cut.read_bytes() == full
 
 
