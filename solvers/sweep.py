@@ -404,6 +404,7 @@ class SweepFile:
         self.path = Path(path)
         self.fields = [f for f, _ in fields]
         self.metrics = report_columns(spec, timing)
+        self.spec = spec
         self.header = csv_header(fields, spec, timing)
         self.keys: dict[tuple[str, ...], int] = {}
         self.rows: list[list[str]] = []
@@ -447,7 +448,8 @@ class SweepFile:
             if index is None or index not in self.finished:
                 continue
             cells = row[len(self.fields) + 1:]
-            metrics = {name: _parse_cell(cell) for (name, _), cell in zip(self.metrics, cells, strict=True)}
+            metrics = failed_metrics(self.spec)  # NaN for the columns the file leaves out (wall time)
+            metrics.update({name: _parse_cell(cell) for (name, _), cell in zip(self.metrics, cells, strict=True)})
             results[index] = PointResult(index, by_index[index].values, metrics, row[len(self.fields)])
         return results
 
