@@ -28,7 +28,6 @@ assignments). This module evaluates them and keeps the results:
 
 from __future__ import annotations
 
-import copy
 import csv
 import functools
 import io
@@ -100,10 +99,7 @@ def _mechanism(spec: MechanismSpec, previous: Mechanism | None) -> Mechanism:
     """An assembled mechanism for ``spec``, reusing ``previous``'s matrices and layers when only [run] differs."""
     if previous is None or _model_key(previous.spec) != _model_key(spec):
         return assemble(spec)
-    mechanism = copy.copy(previous)  # shares M, K and the built contact layers
-    mechanism.__dict__.pop("start", None)  # the static start depends on the cam speed
-    mechanism.spec = spec
-    return mechanism
+    return previous.with_run(spec.run)  # shares M, K, the contact layers and configuration tables
 
 
 @functools.cache

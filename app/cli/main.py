@@ -29,6 +29,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "plate": ("vtool.app.cli.plate", "plate"),
     "accuracy": ("vtool.app.cli.accuracy", "accuracy"),
     "sweep": ("vtool.app.cli.sweep", "sweep"),
+    "compare": ("vtool.app.cli.compare", "compare"),
     "tui": ("vtool.app.cli.tui", "tui"),
 }
 
