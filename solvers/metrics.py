@@ -9,10 +9,11 @@ and units for a spec. ``vtool sweep`` reports them per point, and a single
 
 ``cam_separations``
     Largest number, over the revolutions after the first, of cam-clearance
-    separations (``opened`` or ``released`` events) that start above
-    mid-stroke: cam angle mod 360 in (0, 180) deg, where the harmonic cam
-    q_cam = A sin(theta) + offset is above its offset and decelerating the
-    follower. One or more means the follower leaves the cam (jump).
+    separation episodes (``Trace.episodes``: a burst of events that leaves
+    the clearance open) that start above mid-stroke: cam angle mod 360 in
+    (0, 180) deg, where the harmonic cam q_cam = A sin(theta) + offset is
+    above its offset and decelerating the follower. One or more means the
+    follower leaves the cam (jump).
 ``cam_separation_angle`` (deg)
     The earliest such separation, as an angle within its revolution (NaN if
     none).
@@ -30,17 +31,17 @@ and units for a spec. ``vtool sweep`` reports them per point, and a single
     Approach speed (-d gap/dt before the impact) of the valve's impacts on the
     seat after the first revolution: largest and mean (NaN without impacts).
 ``seat_bounces``
-    Largest number, over the revolutions after the first, of seat impacts
-    beyond the first one (the seating) in that revolution.
+    Largest number, over the revolutions after the first, of seat bounces
+    (``Trace.seat_bounces``: a re-opening after an impact that closes again
+    within ``BOUNCE_WINDOW_DEG``), counted in the revolution of the landing.
 ``bounce_height`` (length)
-    Largest seat gap q_v - s on the output rows between a bounce's lift-off
-    and its impact (0 when a bounce falls between two rows; NaN without a
-    seat).
+    Largest bounce height of those (the largest seat gap on the output rows
+    between lift-off and landing; 0 without bounces, NaN without a seat).
 ``peak_F<i>`` (force)
-    Largest contact force at each clearance on the output rows after the
-    first revolution (NaN for a removed clearance). ``Trace.peak_force`` is
-    over every step of the whole run; these are over the output rows (set
-    ``run.output_interval`` or ``every_step`` for finer sampling).
+    Largest contact force at each clearance after the first revolution, over
+    every step (``Trace.peak_force_after_first_revolution``; on the output
+    rows for a back end that does not record it; NaN for a removed
+    clearance).
 ``spring_margin`` (force)
     Smallest cam contact force on the output rows after the first revolution
     over the nose (cam angle mod 360 in (0, 180) deg) while the cam clearance
@@ -61,7 +62,7 @@ import numpy as np
 
 from vtool.solvers.configurations import clearance_bit
 from vtool.solvers.spec import EXTERNAL, REMOVED, MechanismSpec
-from vtool.solvers.trace import CLOSED, OPENED, RELEASED, Trace
+from vtool.solvers.trace import CLOSED, SEPARATION, Trace
 
 REVOLUTION = 360.0
 NAN = float("nan")
@@ -111,19 +112,19 @@ def _above_mid_stroke(angle: float) -> bool:
 
 def _cam_separation(trace: Trace, name: str) -> tuple[int, float, float]:
     end = float(trace.cam_angle[-1]) if len(trace.cam_angle) else 0.0
+    impacts = [e.cam_angle for e in trace.events if e.clearance == name and e.kind == CLOSED]
     per_revolution: dict[int, int] = {}
     first = NAN
     longest = 0.0
-    events = [e for e in trace.events if e.clearance == name]
-    for k, e in enumerate(events):
-        if e.kind not in (OPENED, RELEASED) or e.cam_angle < REVOLUTION or not _above_mid_stroke(e.cam_angle):
+    for episode in trace.episodes(name):
+        start = episode.first_angle
+        if episode.kind != SEPARATION or start < REVOLUTION or not _above_mid_stroke(start):
             continue
-        revolution = int(e.cam_angle // REVOLUTION)
+        revolution = int(start // REVOLUTION)
         per_revolution[revolution] = per_revolution.get(revolution, 0) + 1
-        closing = next((f.cam_angle for f in events[k + 1:] if f.kind == CLOSED), end)
-        first = min(first, e.cam_angle % REVOLUTION) if not math.isnan(first) else e.cam_angle % REVOLUTION
-        duration = closing - e.cam_angle
-        longest = max(longest, duration)
+        closing = next((a for a in impacts if a > episode.last_angle), end)
+        first = start % REVOLUTION if math.isnan(first) else min(first, start % REVOLUTION)
+        longest = max(longest, closing - start)
     return max(per_revolution.values(), default=0), first, longest
 
 
@@ -142,26 +143,28 @@ def _seat_metrics(trace: Trace, index: int | None, after: np.ndarray) -> dict[st
         lift = np.maximum(valve - s, 0.0)
         kinematic = np.maximum(ratio * cam - s, 0.0)
         result["lift_loss"] = float(np.max((kinematic - lift)[after]))
-    events = [e for e in trace.events if e.clearance == clearance.name]
-    impacts = [e for e in events if e.kind == CLOSED and e.cam_angle >= REVOLUTION]
+    impacts = [e for e in trace.events if e.clearance == clearance.name and e.kind == CLOSED
+               and e.cam_angle >= REVOLUTION]
     if impacts:
         speeds = np.array([-e.relative_velocity for e in impacts])
         result["seating_velocity_max"] = float(speeds.max())
         result["seating_velocity_mean"] = float(speeds.mean())
-    by_revolution: dict[int, list[float]] = {}
-    for e in impacts:
-        by_revolution.setdefault(int(e.cam_angle // REVOLUTION), []).append(e.cam_angle)
-    result["seat_bounces"] = max((len(v) - 1 for v in by_revolution.values()), default=0)
-    height = 0.0
-    for angles in by_revolution.values():
-        for landing in angles[1:]:
-            lift_off = max((e.cam_angle for e in events if e.kind in (OPENED, RELEASED) and e.cam_angle < landing),
-                           default=landing)
-            inside = (trace.cam_angle > lift_off) & (trace.cam_angle < landing)
-            if inside.any():
-                height = max(height, float(np.max(valve[inside] - s)))
-    result["bounce_height"] = height
+    bounces = [b for b in trace.seat_bounces(clearance.name) if b[1] >= REVOLUTION]
+    per_revolution: dict[int, int] = {}
+    for _, landing, _ in bounces:
+        per_revolution[int(landing // REVOLUTION)] = per_revolution.get(int(landing // REVOLUTION), 0) + 1
+    result["seat_bounces"] = max(per_revolution.values(), default=0)
+    result["bounce_height"] = max((height for _, _, height in bounces), default=0.0)
     return result
+
+
+def _peak(trace: Trace, index: int, after: np.ndarray) -> float:
+    if trace.spec.clearances[index].state == REMOVED:
+        return NAN
+    if trace.peak_force_after_first_revolution is not None:
+        return float(trace.peak_force_after_first_revolution[index])
+    values = trace.contact_force[after, index]
+    return float(values.max()) if values.size else NAN
 
 
 def run_metrics(trace: Trace) -> dict[str, float]:
@@ -175,10 +178,8 @@ def run_metrics(trace: Trace) -> dict[str, float]:
     metrics["cam_separation_angle"] = angle
     metrics["cam_separation_duration"] = duration
     metrics.update(_seat_metrics(trace, seat_index(spec), after))
-    for i, c in enumerate(spec.clearances):
-        values = trace.contact_force[after, i]
-        peak = float(values.max()) if values.size and c.state != REMOVED else NAN
-        metrics[f"peak_{force_label(spec, i)}"] = peak
+    for i in range(len(spec.clearances)):
+        metrics[f"peak_{force_label(spec, i)}"] = _peak(trace, i, after)
     nose = after & (np.mod(trace.cam_angle, REVOLUTION) > 0.0) & (np.mod(trace.cam_angle, REVOLUTION) < 180.0)
     in_contact = nose & ((trace.configuration & clearance_bit(spec, cam)) != 0)
     metrics["spring_margin"] = float(trace.contact_force[in_contact, cam].min()) if in_contact.any() else NAN

@@ -20,8 +20,8 @@ RATIO = 1.5  # valve motion per cam motion at the start
 SEAT = 0.7  # in: 1A's seat position
 
 
-def _event(angle: float, clearance: str, kind: str, velocity: float = 0.0) -> Event:
-    return Event(angle / 66000.0, angle, clearance, kind, velocity, 0, 0)
+def _event(angle: float, clearance: str, kind: str, before: int, after: int, velocity: float = 0.0) -> Event:
+    return Event(angle / 66000.0, angle, clearance, kind, velocity, before, after)
 
 
 def hand_built_trace() -> Trace:
@@ -46,15 +46,21 @@ def hand_built_trace() -> Trace:
     open_rows = (angle > 450.5) & (angle < 470.5)
     configuration[open_rows] &= ~CAM_BIT
     force[open_rows, 0] = 0.0
+    # masks: cam 0b100, rocker 0b010, seat 0b001
     events = (
-        _event(100.0, "cam", OPENED), _event(110.0, "cam", CLOSED, -3.0),  # first revolution: not counted
-        _event(450.5, "cam", OPENED), _event(470.5, "cam", CLOSED, -5.0),  # the jump: 90.5 deg, 20 deg long
-        _event(560.0, "seat", CLOSED, -400.0), _event(565.0, "seat", OPENED), _event(568.0, "seat", CLOSED, -100.0),
-        _event(600.0, "cam", RELEASED, 1.0),  # below mid-stroke: not a jump
+        _event(100.0, "cam", OPENED, 0b110, 0b010),  # first revolution: not counted
+        _event(110.0, "cam", CLOSED, 0b010, 0b110, -3.0),
+        _event(450.5, "cam", OPENED, 0b110, 0b010),  # the jump: 90.5 deg, 20 deg long
+        _event(470.5, "cam", CLOSED, 0b010, 0b110, -5.0),
+        _event(560.0, "seat", CLOSED, 0b110, 0b111, -400.0),  # the seating ...
+        _event(565.0, "seat", OPENED, 0b111, 0b110),  # ... a bounce ...
+        _event(568.0, "seat", CLOSED, 0b110, 0b111, -100.0),  # ... and its landing
+        _event(600.0, "cam", RELEASED, 0b111, 0b011, 1.0),  # below mid-stroke: not a jump
     )
     statistics = RunStatistics("hand", len(angle), len(events), 0.25, ())
+    after = angle >= 360.0
     return Trace(spec, angle / 66000.0, angle, tuple(range(1, 11)), q, q * 0, q * 0, force, configuration, events,
-                 force.max(axis=0), statistics)
+                 force.max(axis=0), statistics, peak_force_after_first_revolution=force[after].max(axis=0))
 
 
 def test_hand_built_trace_gives_the_constructed_answers() -> None:

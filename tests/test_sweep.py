@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -219,11 +220,16 @@ def test_jump_speed_agrees_with_a_one_rpm_grid() -> None:
 
 
 def test_find_prints_the_bracket_history() -> None:
-    result = run("sweep", "gnilka-1a", "--find", "jump-speed", "--set", "run.rpm=10800,10900", "--workers", "1")
+    """Scan the thesis' two speeds (in contact at 10,000, thrown off at 11,000) and bisect to 1 rev/min."""
+    result = run("sweep", "gnilka-1a", "--find", "jump-speed", "--set", "run.rpm=10000,11000", "--workers", "1")
     assert result.exit_code == 0, result.output
-    assert "scan" in result.output and "bisect" in result.output
-    assert "jump-speed: the follower leaves the cam above mid-stroke from 10868 rev/min (not at 10867)" \
-        in result.output
+    lines = result.stdout.splitlines()
+    assert lines[0].split()[:4] == ["scan", "10000", "rev/min", "no"]
+    assert lines[1].split()[:4] == ["scan", "11000", "rev/min", "holds"]
+    assert all(line.split()[0] == "bisect" for line in lines[2:-1]) and 9 <= len(lines) - 3 <= 10
+    match = re.fullmatch(r"jump-speed: the follower leaves the cam above mid-stroke from (\d+) rev/min "
+                         r"\(not at (\d+)\)", lines[-1])
+    assert match is not None and int(match[1]) - int(match[2]) == 1
 
 
 def test_cli_table_csv_json_plot_and_map(tmp_path: Path) -> None:
