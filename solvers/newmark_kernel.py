@@ -86,6 +86,21 @@ F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
 F_SIZE = 4
 
 
+ENTRY_POINTS = ("run_chunk", "impact", "settle", "fill_sources")  # what the back ends call from Python
+
+
+def is_cached(names: tuple[str, ...] = ENTRY_POINTS) -> bool:
+    """True when these entry points' compiled code is in the numba cache (no compile needed).
+
+    Reads the cache's index (numba keeps one per function, stamped with this
+    file's modification time and size); any doubt counts as not cached.
+    """
+    try:
+        return all(globals()[name]._cache._cache_file._load_index() for name in names)
+    except Exception:  # noqa: BLE001 (numba internals: a missing or unreadable index means "compile")
+        return False
+
+
 # ----- sources -----
 @jit
 def fill_sources(ns, nh, omega, sc, sa, sb, t, src):

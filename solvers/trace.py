@@ -76,6 +76,7 @@ class RunStatistics:
     configurations_built: tuple[int, ...]
     settings: dict = field(default_factory=dict)
     error_estimate: float | None = None
+    compile_time: float = 0.0  # s spent compiling (or loading) the kernel, not in wall_time
 
 
 @dataclass(frozen=True)
@@ -282,6 +283,7 @@ class Trace:
             "steps": stats.steps,
             "events": stats.events,
             "wall_time_s": stats.wall_time,
+            "compile_time_s": stats.compile_time,
             "episode_window_deg": EPISODE_WINDOW_DEG,
             "configurations_built": [configuration_label(self.spec, m) for m in stats.configurations_built],
             "events_list": [
@@ -297,8 +299,10 @@ class Trace:
         s = self.summary()
         units = self.spec.unit_system
         lines = [s["title"], f"back end {s['backend']}: " + ", ".join(f"{k} = {v}" for k, v in s["settings"].items())]
+        compiling = (f" (+ {s['compile_time_s']:.1f} s compiling or loading the solver)"
+                     if s["compile_time_s"] >= 0.5 else "")
         lines.append(
-            f"steps {s['steps']}, events {s['events']}, wall time {s['wall_time_s']:.3f} s, "
+            f"steps {s['steps']}, events {s['events']}, wall time {s['wall_time_s']:.3f} s{compiling}, "
             f"configurations built: {', '.join(s['configurations_built'])}"
         )
         lines.append("")
