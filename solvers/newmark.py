@@ -224,8 +224,8 @@ class KernelRun:
 
     def compile(self) -> None:
         """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""
-        if kernel.run_chunk.signatures:
-            return
+        if not hasattr(kernel.run_chunk, "signatures") or kernel.run_chunk.signatures:
+            return  # NUMBA_DISABLE_JIT (the plain reference), or compiled already
         import numba
 
         started = wallclock.perf_counter()
