@@ -28,6 +28,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "boom": ("vtool.app.cli.boom", "boom"),
     "plate": ("vtool.app.cli.plate", "plate"),
     "accuracy": ("vtool.app.cli.accuracy", "accuracy"),
+    "sweep": ("vtool.app.cli.sweep", "sweep"),
     "compare": ("vtool.app.cli.compare", "compare"),
     "tui": ("vtool.app.cli.tui", "tui"),
 }

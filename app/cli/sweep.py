@@ -1,0 +1,180 @@
+"""``vtool sweep PRESET --set FIELD=VALUES ...``: grids of valve-train runs and derived speeds."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+
+DEFAULT_SCAN = "1000:20000:1000"
+
+
+class CountProgress:
+    """A click progress bar with ETA on stderr, fed (done, total)."""
+
+    def __init__(self, label: str) -> None:
+        self.label = label
+        self.bar = None
+        self.shown = 0
+
+    def __call__(self, done: int, total: int) -> None:
+        if self.bar is None:
+            self.bar = click.progressbar(length=total, label=self.label, show_eta=True, show_pos=True,
+                                         file=click.get_text_stream("stderr"))
+            self.bar.__enter__()
+        self.bar.update(done - self.shown)
+        self.shown = done
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.__exit__(None, None, None)
+            self.bar = None
+
+
+@click.command()
+@click.argument("preset")
+@click.option("--set", "sets", multiple=True, metavar="FIELD=VALUES",
+              help="Swept field (dotted preset path, e.g. run.rpm, members.valve_spring.stiffness, "
+                   "clearances[2].restitution) and its values: start:stop:step (stop included) or a,b,c. "
+                   "Several --set make a grid.")
+@click.option("--find", "find", type=click.Choice(["jump-speed", "bounce-speed"]),
+              help="Bracket and bisect the cam speed (to 1 rev/min) where the follower first leaves the cam "
+                   f"(jump-speed) or the valve first bounces on its seat (bounce-speed); --set run.rpm gives "
+                   f"the scan (default {DEFAULT_SCAN}), other --set fields a grid of searches.")
+@click.option("--workers", type=int, help="Local worker processes (default: all cores; 1 = in this process).")
+@click.option("--scheduler", help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
+                                  "processes) or local-threads:N.")
+@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="Write one row per point (swept fields, status, metrics; units in the header), appended as "
+                   "points finish.")
+@click.option("--resume", is_flag=True, help="Continue the sweep in the --csv file, skipping finished points.")
+@click.option("--timing", is_flag=True, help="Also write each point's wall time to the CSV (not reproducible).")
+@click.option("--json", "as_json", is_flag=True, help="Print the results as JSON instead of a table.")
+@click.option("--plot", is_flag=True, help="Chart --metric against the first swept field.")
+@click.option("--map", "as_map", is_flag=True, help="Character heat map of --metric over two swept fields.")
+@click.option("--metric", default="spring_margin", show_default=True, help="Metric for --plot and --map.")
+@click.option("--every-step", is_flag=True, help="Metrics from every time step instead of the output rows.")
+def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | None, scheduler: str | None,
+          csv_path: Path | None, resume: bool, timing: bool, as_json: bool, plot: bool, as_map: bool,
+          metric: str, every_step: bool) -> None:
+    """Run a valve-train preset over a grid of field values and report per-point metrics.
+
+    \b
+    Examples:
+      vtool sweep gnilka-1a --set run.rpm=8000:12000:250 --plot --metric peak_F1
+      vtool sweep gnilka-1a --set run.rpm=9000:12000:500 --set members.valve_spring.stiffness=200,254,300 --map
+      vtool sweep gnilka-1a --find jump-speed
+
+    Every point is validated like a preset before any run starts. Metrics
+    and their definitions: docs/sweep.md.
+    """
+    from vtool.errors import InputError, RunError
+    from vtool.presets.paths import plan_sweep
+    from vtool.solvers.metrics import metric_columns, seat_index
+    from vtool.solvers.sweep import SweepFile, make_runner, results_json, results_table, run_points
+
+    if resume and csv_path is None:
+        raise InputError("--resume", True, "a --csv file to resume")
+    if find is not None:
+        if not any(s.partition("=")[0].strip() == "run.rpm" for s in sets):
+            sets = (f"run.rpm={DEFAULT_SCAN}",) + sets
+        if resume or plot or as_map:
+            raise InputError("--find", find, "no --resume, --plot or --map (a search prints its bracket history)")
+    elif not sets:
+        raise InputError("--set", None, "at least one FIELD=VALUES (or --find jump-speed)")
+    plan = plan_sweep(preset, list(sets))
+    if find == "bounce-speed" and seat_index(plan.spec) is None:
+        raise InputError("--find", find, "a preset with a valve seat (this one has none)")
+    names = {name: unit for name, unit in metric_columns(plan.spec)}
+    if metric not in names:
+        raise InputError("--metric", metric, f"one of: {', '.join(names)}")
+    axes = [f for f in plan.fields if len({dict(p.values)[f[0]] for p in plan.points}) > 1]
+    if as_map and len(axes) != 2:
+        raise InputError("--map", len(axes), "exactly two swept fields with more than one value")
+    if plot and not axes:
+        raise InputError("--plot", plan.fields[0][0] if plan.fields else None, "a swept field with two or more values")
+    runner = make_runner(workers, scheduler)  # a Dask scheduler is reached here, before any file is written
+    try:
+        if find is not None:
+            _find(find, plan, runner, csv_path, as_json, every_step)
+            return
+        sink = SweepFile(csv_path, plan.fields, plan.spec, resume=resume, timing=timing) if csv_path else None
+        progress = CountProgress(f"{len(plan.points)} points")
+        try:
+            outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress)
+        except KeyboardInterrupt:
+            progress.close()
+            where = (f"the finished points are in {csv_path}; run again with --resume to finish"
+                     if csv_path else "nothing was kept (use --csv to keep finished points)")
+            raise RunError(f"interrupted: {where}") from None
+        finally:
+            progress.close()
+    finally:
+        runner.close()
+    results = outcome.results
+    if sink is not None and outcome.skipped:
+        click.echo(f"resumed: {outcome.skipped} of {outcome.total} points were already in {csv_path}", err=True)
+    if as_json:
+        click.echo(json.dumps(results_json(results, plan.fields, plan.spec, preset), indent=2))
+    else:
+        if results:
+            click.echo(results_table(results, plan.fields, plan.spec))
+        n = len(results)
+        click.echo(f"{n} points in {outcome.wall_time:.2f} s ({1000 * outcome.wall_time / max(n, 1):.1f} ms per "
+                   f"point, {runner.workers} worker{'s' if runner.workers > 1 else ''})")
+        if csv_path is not None:
+            click.echo(f"wrote {outcome.total} rows to {csv_path}")
+    if results and (plot or as_map):
+        from vtool.app.sweep_charts import metric_chart, metric_map
+
+        if plot:
+            click.echo(metric_chart(results, axes, metric, names[metric]))
+        if as_map:
+            click.echo(metric_map(results, axes, metric, names[metric]))
+
+
+def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # type: ignore[no-untyped-def]
+    """One speed search per grid point of the fields other than run.rpm."""
+    from vtool.files import write_atomic
+    from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.sweep import find_speed, format_value
+
+    scan = sorted({dict(p.values)["run.rpm"] for p in plan.points})
+    others = [f for f in plan.fields if f[0] != "run.rpm"]
+    searches: dict[tuple, object] = {}
+    for point in plan.points:
+        key = tuple((k, v) for k, v in point.values if k != "run.rpm")
+        searches.setdefault(key, point.spec)
+    rows = []
+    found = []
+    for key, spec in searches.items():
+        if key and not as_json:
+            click.echo(", ".join(f"{k} = {format_value(v)}" for k, v in key))
+
+        def report(b):  # type: ignore[no-untyped-def]
+            if not as_json:
+                click.echo(f"  {b.stage:<6} {b.rpm:>9g} rev/min  {'holds' if b.holds else 'no':<5}  "
+                           f"({format_value(b.value)})")
+
+        result = find_speed(criterion, lambda rpm, spec=spec: with_run_overrides(spec, rpm=rpm), scan, runner,
+                            every_step=every_step, report=report)
+        if not as_json:
+            click.echo(f"{criterion}: {result.message}")
+        rows.append([format_value(v) for _, v in key] + [format_value(result.speed) if result.speed else "",
+                                                         result.message])
+        found.append(dict(key) | {criterion.replace("-", "_"): result.speed,
+                                  f"{criterion.replace('-', '_')}_unit": "rev/min", "message": result.message,
+                                  "history": [{"rpm": b.rpm, "holds": b.holds, "value": b.value, "stage": b.stage}
+                                              for b in result.history]})
+    if as_json:
+        click.echo(json.dumps({"preset": plan.spec.title, "criterion": criterion, "searches": found}, indent=2))
+    if csv_path is not None:
+        header = [f"{f} ({u})" if u else f for f, u in others] + [f"{criterion.replace('-', '_')} (rev/min)",
+                                                                  "message"]
+        import csv
+        import io
+
+        buffer = io.StringIO()
+        csv.writer(buffer, lineterminator="\n").writerows([header] + rows)
+        write_atomic(csv_path, buffer.getvalue())

@@ -1,0 +1,240 @@
+"""The sweep pane: a self-contained widget to sweep one preset field and chart a metric.
+
+``SweepPane(preset)`` is mounted as a tab on the valve-train screen (or in any
+App). The user picks a field (dotted preset path), its values
+(``start:stop:step`` or ``a,b,c``) and a metric, and presses *Run*: the
+points are validated like a preset (an error is shown on the status line and
+nothing runs), then evaluated in a thread worker that posts
+:class:`SweepProgressed` (collapsing) and :class:`SweepFinished`. *Cancel*
+stops between points and keeps what finished; *Export CSV* writes the
+results atomically (same bytes as ``vtool sweep --csv``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from textual import on, work
+from textual.app import ComposeResult
+from textual.containers import Horizontal, Vertical
+from textual.message import Message
+from textual.widget import Widget
+from textual.widgets import Button, Input, ProgressBar, Select, Static
+from textual.worker import Worker, WorkerState, get_current_worker
+
+from vtool.app.tui.widgets import ChartView, TextPanel
+
+DEFAULT_METRICS = ("spring_margin", "cam_separation_duration", "cam_separations", "lift_loss",
+                   "seating_velocity_max", "seat_bounces", "bounce_height", "peak_F1", "peak_F2", "peak_F7",
+                   "events", "wall_time")
+
+
+class SweepProgressed(Message):
+    """``done`` of ``total`` points are finished."""
+
+    def __init__(self, done: int, total: int) -> None:
+        super().__init__()
+        self.done = done
+        self.total = total
+
+    def can_replace(self, message: Message) -> bool:
+        return isinstance(message, SweepProgressed)
+
+
+class SweepFinished(Message):
+    """The worker ended: ``outcome.complete`` is False when it was cancelled."""
+
+    def __init__(self, plan: Any, outcome: Any) -> None:
+        super().__init__()
+        self.plan = plan
+        self.outcome = outcome
+
+
+class SweepPane(Widget):
+    """Field, range and metric inputs; run/cancel/export; progress, chart and table (see module doc)."""
+
+    DEFAULT_CSS = """
+    SweepPane { height: 1fr; }
+    SweepPane Horizontal { height: auto; }
+    SweepPane Input { width: 1fr; }
+    SweepPane #sweep-metric { width: 30; }
+    SweepPane Button { min-width: 10; }
+    SweepPane #sweep-status { height: auto; }
+    SweepPane ChartView { height: 2fr; }
+    SweepPane TextPanel { height: 1fr; }
+    """
+
+    def __init__(self, preset: str | Path = "gnilka-1a", *, workers: int | None = 1, field: str = "run.rpm",
+                 values: str = "9000:12000:250", fixed: str = "", metric: str = "spring_margin",
+                 id: str | None = None) -> None:
+        super().__init__(id=id)
+        self.preset = str(preset)
+        self.sweep_workers = workers
+        self._initial = (field, values, fixed, metric)
+        self.plan: Any = None
+        self.outcome: Any = None
+        self.worker: Worker[Any] | None = None
+
+    def compose(self) -> ComposeResult:
+        field, values, fixed, metric = self._initial
+        with Vertical():
+            with Horizontal():
+                yield Input(field, placeholder="field, e.g. run.rpm", id="sweep-field")
+                yield Input(values, placeholder="start:stop:step or a,b,c", id="sweep-values")
+                yield Input(fixed, placeholder="fixed settings, e.g. run.degrees=460", id="sweep-fixed")
+                names = self._metric_names()
+                yield Select([(m, m) for m in names], value=metric if metric in names else names[0],
+                             allow_blank=False, id="sweep-metric")
+            with Horizontal():
+                yield Button("Run", id="sweep-run", variant="primary")
+                yield Button("Cancel", id="sweep-cancel")
+                yield Input("sweep.csv", placeholder="CSV file", id="sweep-csv")
+                yield Button("Export CSV", id="sweep-export")
+            yield ProgressBar(total=1, show_eta=True, id="sweep-progress")
+            yield Static("", id="sweep-status", markup=False)
+            yield ChartView("run a sweep to see the chart", id="sweep-chart")
+            yield TextPanel("", id="sweep-table")
+
+    def _metric_names(self) -> tuple[str, ...]:
+        """The preset's metrics (its own force labels), or a default list if it does not load."""
+        from vtool.errors import InputError
+        from vtool.presets import load_preset
+        from vtool.solvers.metrics import metric_columns
+
+        try:
+            return tuple(name for name, _ in metric_columns(load_preset(self.preset)))
+        except (InputError, AttributeError, StopIteration):
+            return DEFAULT_METRICS
+
+    # ----- small typed accessors -----
+    def _input(self, name: str) -> Input:
+        return self.query_one(f"#sweep-{name}", Input)
+
+    @property
+    def status(self) -> Static:
+        return self.query_one("#sweep-status", Static)
+
+    @property
+    def status_text(self) -> str:
+        return str(self.status.content)
+
+    @property
+    def chart(self) -> ChartView:
+        return self.query_one("#sweep-chart", ChartView)
+
+    @property
+    def table(self) -> TextPanel:
+        return self.query_one("#sweep-table", TextPanel)
+
+    @property
+    def metric(self) -> str:
+        return str(self.query_one("#sweep-metric", Select).value)
+
+    @property
+    def running(self) -> bool:
+        return self.worker is not None and self.worker.state in (WorkerState.PENDING, WorkerState.RUNNING)
+
+    # ----- actions -----
+    def run_sweep(self) -> None:
+        """Validate the inputs (errors on the status line) and start the worker."""
+        from vtool.errors import InputError
+        from vtool.presets.paths import plan_sweep
+
+        sets = [f"{self._input('field').value.strip()}={self._input('values').value.strip()}"]
+        sets += [s.strip() for s in self._input("fixed").value.split(";") if s.strip()]
+        try:
+            plan = plan_sweep(self.preset, sets)
+        except InputError as exc:
+            self.status.update(f"error: {exc.one_line()}")
+            return
+        self.plan = plan
+        self.query_one("#sweep-progress", ProgressBar).update(total=len(plan.points), progress=0)
+        self.status.update(f"running {len(plan.points)} points ...")
+        self.worker = self._work(plan)
+
+    @work(thread=True, exclusive=True, exit_on_error=False, group="sweep")
+    def _work(self, plan: Any) -> None:
+        from vtool.solvers.sweep import make_runner, run_points
+
+        worker = get_current_worker()
+        runner = make_runner(self.sweep_workers)
+        try:
+            outcome = run_points(plan.points, runner, progress=lambda d, t: self.post_message(SweepProgressed(d, t)),
+                                 cancel=lambda: worker.is_cancelled)
+        finally:
+            runner.close()
+        self.post_message(SweepFinished(plan, outcome))
+
+    def cancel(self) -> None:
+        if self.running and self.worker is not None:
+            self.worker.cancel()
+            self.status.update("stopping ...")
+
+    def export_csv(self, path: str | Path | None = None) -> None:
+        from vtool.files import write_atomic
+        from vtool.solvers.sweep import results_csv
+
+        if self.outcome is None or not self.outcome.results:
+            self.status.update("error: nothing to export (run a sweep first)")
+            return
+        target = Path(path or self._input("csv").value.strip() or "sweep.csv")
+        try:
+            write_atomic(target, results_csv(self.outcome.results, self.plan.fields, self.plan.spec))
+        except OSError as exc:
+            self.status.update(f"error: {target}: {exc.strerror}")
+            return
+        self.status.update(f"wrote {len(self.outcome.results)} rows to {target}")
+
+    # ----- handlers -----
+    @on(Button.Pressed, "#sweep-run")
+    def _run_pressed(self) -> None:
+        if not self.running:
+            self.run_sweep()
+
+    @on(Button.Pressed, "#sweep-cancel")
+    def _cancel_pressed(self) -> None:
+        self.cancel()
+
+    @on(Button.Pressed, "#sweep-export")
+    def _export_pressed(self) -> None:
+        self.export_csv()
+
+    @on(Select.Changed, "#sweep-metric")
+    def _metric_changed(self) -> None:
+        self._draw()
+
+    def on_sweep_progressed(self, message: SweepProgressed) -> None:
+        self.query_one("#sweep-progress", ProgressBar).update(total=message.total, progress=message.done)
+
+    def on_sweep_finished(self, message: SweepFinished) -> None:
+        self.outcome = message.outcome
+        done = len(message.outcome.results)
+        state = "finished" if message.outcome.complete else "stopped"
+        self.status.update(f"{state}: {done} of {message.outcome.total} points in {message.outcome.wall_time:.2f} s")
+        self._draw()
+
+    def on_worker_state_changed(self, event: Worker.StateChanged) -> None:
+        if event.worker is self.worker and event.state == WorkerState.ERROR:
+            self.status.update(f"error: {event.worker.error}")
+
+    def _draw(self) -> None:
+        from vtool.solvers.metrics import metric_columns
+        from vtool.solvers.sweep import results_table
+
+        if self.outcome is None or not self.outcome.results or self.plan is None:
+            return
+        results, plan, metric = self.outcome.results, self.plan, self.metric
+        units = dict(metric_columns(plan.spec))
+        self.table.set_text(results_table(results, plan.fields, plan.spec))
+        if metric not in units:
+            self.chart.plot(None)
+            return
+        axes = [f for f in plan.fields if len({dict(r.values)[f[0]] for r in results}) > 1]
+        if not axes:
+            self.chart.plot(None)
+            return
+        from vtool.app.sweep_charts import metric_chart
+
+        self.chart.plot(lambda width, height, color: metric_chart(results, axes, metric, units[metric], width=width,
+                                                                  height=height, color=color))

@@ -1,0 +1,99 @@
+"""Regenerate the figures of docs/sweep.md: jump and bounce speeds, sweep charts, the spring-rate map.
+
+Run: ``python3 benchmarks/sweep_docs.py`` (all local cores; about a minute on
+two). Every number in docs/sweep.md's generated blocks comes from here; the
+solver's numbers change when its impact law or kernel changes, and this one
+command brings the page up to date. ``tests/test_sweep_docs.py`` regenerates
+the deterministic tables and compares them with the committed page.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+from vtool.markdown import replace_block, table
+from vtool.presets import load_preset
+from vtool.presets.paths import plan_sweep
+from vtool.presets.valvetrain import with_run_overrides
+from vtool.solvers.metrics import metric_columns, seat_index
+from vtool.solvers.sweep import CRITERIA, SerialRunner, find_speed, make_runner, run_points
+
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "sweep.md"
+PRESETS = (("gnilka-1a", "1A: three clearances, valve seat"),
+           ("gnilka-1b", "1B: three clearances, no valve seat"),
+           ("gnilka-1c", "1C: two clearances (rocker pinned), valve seat"),
+           ("gnilka-2", "example 2 (and 3): three clearances, valve seat"))
+SCAN = list(range(4000, 16001, 2000))  # rev/min
+CHART_RPM = "run.rpm=6000:14000:250"
+SPRING = "members.valve_spring.stiffness=150:350:50"
+MAP_RPM = "run.rpm=8000:14000:250"
+
+
+def speeds_table(runner) -> str:  # type: ignore[no-untyped-def]
+    rows = []
+    for name, words in PRESETS:
+        spec = load_preset(name)
+        cells = [f"`{name}`", words]
+        for criterion in CRITERIA:
+            if criterion == "bounce-speed" and seat_index(spec) is None:
+                cells.append("no seat")
+                continue
+            result = find_speed(criterion, lambda rpm, spec=spec: with_run_overrides(spec, rpm=rpm), SCAN, runner)
+            steps = len(result.history)
+            cells.append(f"{result.speed:,.0f} ({steps} runs)" if result.speed else result.message)
+        rows.append(cells)
+    return table(["preset", "mechanism", "jump speed (rev/min)", "bounce speed (rev/min)"], rows)
+
+
+def spring_table(runner) -> str:  # type: ignore[no-untyped-def]
+    base = load_preset("gnilka-1a")
+    unit = base.unit_system.stiffness
+    rows = []
+    for point in plan_sweep("gnilka-1a", [SPRING]).points:
+        stiffness = dict(point.values)["members.valve_spring.stiffness"]
+        result = find_speed("jump-speed", lambda rpm, spec=point.spec: with_run_overrides(spec, rpm=rpm), SCAN,
+                            runner)
+        rows.append([f"{stiffness:g}", f"{result.speed:,.0f}" if result.speed else result.message])
+    return table([f"valve-spring rate ({unit})", "1A jump speed (rev/min)"], rows)
+
+
+def chart_blocks(runner) -> dict[str, str]:  # type: ignore[no-untyped-def]
+    from vtool.app.sweep_charts import metric_chart, metric_map
+
+    blocks = {}
+    for name, _ in PRESETS:
+        plan = plan_sweep(name, [CHART_RPM])
+        results = run_points(plan.points, runner).results
+        units = dict(metric_columns(plan.spec))
+        charts = [metric_chart(results, plan.fields, metric, units[metric], width=90, height=18, color=False)
+                  for metric in ("spring_margin", "cam_separation_duration")]
+        blocks[f"sweep-chart-{name}"] = "```text\n" + "\n".join(charts) + "\n```\n"
+    plan = plan_sweep("gnilka-1a", [MAP_RPM, SPRING])
+    results = run_points(plan.points, runner).results
+    units = dict(metric_columns(plan.spec))
+    blocks["sweep-spring-map"] = ("```text\n" + metric_map(results, plan.fields, "cam_separation_duration",
+                                                           units["cam_separation_duration"]) + "\n```\n")
+    return blocks
+
+
+def deterministic_blocks(runner=None) -> dict[str, str]:  # type: ignore[no-untyped-def]
+    """The tables a test regenerates (no wall times in them)."""
+    runner = runner or SerialRunner()
+    return {"sweep-speeds": speeds_table(runner), "sweep-spring": spring_table(runner)}
+
+
+def main() -> None:
+    runner = make_runner(os.cpu_count() or 1)
+    try:
+        blocks = deterministic_blocks(runner) | chart_blocks(runner)
+    finally:
+        runner.close()
+    for name, text in blocks.items():
+        changed = replace_block(DOCS, name, text)
+        print(f"{name}: {'updated' if changed else 'unchanged'}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,96 @@
+"""Per-run metrics (solvers/metrics.py) on a hand-built trace whose answers follow from its construction,
+and on real runs where only the definitions' structure is checked."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from vtool.presets import load_preset
+from vtool.presets.valvetrain import with_run_overrides
+from vtool.solvers.metrics import failed_metrics, metric_columns, run_metrics
+from vtool.solvers.run import simulate
+from vtool.solvers.trace import CLOSED, OPENED, RELEASED, Event, RunStatistics, Trace
+
+CAM_BIT = 0b100  # 1A: cam, rocker, seat; the cam clearance is the leading bit
+OFFSET = 0.6  # in: cam offset of the hand-built trace
+RATIO = 1.5  # valve motion per cam motion at the start
+SEAT = 0.7  # in: 1A's seat position
+
+
+def _event(angle: float, clearance: str, kind: str, before: int, after: int, velocity: float = 0.0) -> Event:
+    return Event(angle / 66000.0, angle, clearance, kind, velocity, before, after)
+
+
+def hand_built_trace() -> Trace:
+    """Two and a bit revolutions, 1 deg rows, with one jump, one seat bounce and known dips and spikes."""
+    spec = load_preset("gnilka-1a")
+    angle = np.arange(0.0, 801.0)
+    theta = np.radians(angle)
+    cam = 0.5 * np.sin(theta) + OFFSET
+    valve = np.maximum(RATIO * cam, SEAT)  # follows the cam kinematically, seated below the seat position
+    rows = {int(a): i for i, a in enumerate(angle)}
+    valve[rows[450]] -= 0.01  # lift loss 0.01 in at the second revolution's nose
+    valve[rows[566]], valve[rows[567]] = SEAT + 0.02, SEAT + 0.03  # a bounce 0.03 in high
+    q = np.zeros((len(angle), 10))
+    q[:, 8], q[:, 6], q[:, 9] = cam, valve, SEAT
+    force = np.zeros((len(angle), 3))
+    force[:, 0] = 100.0 + 50.0 * np.sin(theta)
+    force[:, 1] = 80.0
+    force[rows[400], 0] = 900.0
+    force[rows[50], 0] = 5000.0  # first revolution: not counted
+    force[rows[561], 2] = 300.0
+    configuration = np.full(len(angle), CAM_BIT | 0b010)
+    open_rows = (angle > 450.5) & (angle < 470.5)
+    configuration[open_rows] &= ~CAM_BIT
+    force[open_rows, 0] = 0.0
+    # masks: cam 0b100, rocker 0b010, seat 0b001
+    events = (
+        _event(100.0, "cam", OPENED, 0b110, 0b010),  # first revolution: not counted
+        _event(110.0, "cam", CLOSED, 0b010, 0b110, -3.0),
+        _event(450.5, "cam", OPENED, 0b110, 0b010),  # the jump: 90.5 deg, 20 deg long
+        _event(470.5, "cam", CLOSED, 0b010, 0b110, -5.0),
+        _event(560.0, "seat", CLOSED, 0b110, 0b111, -400.0),  # the seating ...
+        _event(565.0, "seat", OPENED, 0b111, 0b110),  # ... a bounce ...
+        _event(568.0, "seat", CLOSED, 0b110, 0b111, -100.0),  # ... and its landing
+        _event(600.0, "cam", RELEASED, 0b111, 0b011, 1.0),  # below mid-stroke: not a jump
+    )
+    statistics = RunStatistics("hand", len(angle), len(events), 0.25, ())
+    after = angle >= 360.0
+    return Trace(spec, angle / 66000.0, angle, tuple(range(1, 11)), q, q * 0, q * 0, force, configuration, events,
+                 force.max(axis=0), statistics, peak_force_after_first_revolution=force[after].max(axis=0))
+
+
+def test_hand_built_trace_gives_the_constructed_answers() -> None:
+    m = run_metrics(hand_built_trace())
+    assert list(m) == [name for name, _ in metric_columns(load_preset("gnilka-1a"))]
+    assert m["cam_separations"] == 1
+    assert m["cam_separation_angle"] == pytest.approx(90.5)
+    assert m["cam_separation_duration"] == pytest.approx(20.0)
+    assert m["lift_loss"] == pytest.approx(0.01, abs=1e-12)
+    assert m["seating_velocity_max"] == 400.0 and m["seating_velocity_mean"] == 250.0
+    assert m["seat_bounces"] == 1 and m["bounce_height"] == pytest.approx(0.03)
+    assert (m["peak_F1"], m["peak_F2"], m["peak_F7"]) == (900.0, 80.0, 300.0)
+    assert m["spring_margin"] == pytest.approx(100.0 + 50.0 * math.sin(math.radians(1.0)))
+    assert m["events"] == 8 and m["wall_time"] == 0.25
+
+
+def test_units_follow_the_preset() -> None:
+    units = dict(metric_columns(load_preset("gnilka-1a")))
+    assert units["lift_loss"] == "in" and units["seating_velocity_max"] == "in/s" and units["peak_F7"] == "lbf"
+    assert units["cam_separation_angle"] == "deg" and units["cam_separations"] == "" and units["wall_time"] == "s"
+
+
+def test_failed_point_has_every_metric_as_nan() -> None:
+    spec = load_preset("gnilka-1a")
+    assert all(math.isnan(v) for v in failed_metrics(spec).values())
+    assert list(failed_metrics(spec)) == [n for n, _ in metric_columns(spec)]
+
+
+def test_without_a_seat_the_seat_metrics_are_undefined() -> None:
+    spec = with_run_overrides(load_preset("gnilka-1b"), degrees=400.0)
+    m = run_metrics(simulate(spec))
+    assert math.isnan(m["lift_loss"]) and math.isnan(m["seating_velocity_max"]) and m["seat_bounces"] == 0
+    assert set(m) == {n for n, _ in metric_columns(spec)}
