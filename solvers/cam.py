@@ -1,0 +1,234 @@
+"""The cam's lift as a periodic Fourier series: harmonic cams, lift tables, fit reports.
+
+The cam coordinate moves as q_cam(t) = base + L(θ), θ = ωt in rad from the
+preset's angle zero, with the lift
+
+    L(θ) = c0 + Σ_{k=1..K} ( a_k cos kθ + b_k sin kθ )
+
+(:mod:`vtool.solvers.sources`). The thesis' harmonic cam is L = A + A sin θ
+(c0 = A, b_1 = A). A lift table (θ_i, L_i), any spacing over one revolution,
+is fitted by linear least squares on the samples:
+
+    min ‖ Φ x - L ‖₂,   Φ_i = [1, cos θ_i, sin θ_i, ..., cos Kθ_i, sin Kθ_i]
+
+On a table sampled at N equal steps this is the truncated discrete Fourier
+series; a table that is itself a trigonometric polynomial of degree <= K
+comes back exactly. One QR factorization Φ = QR of the widest basis gives the
+fit of every K at once (the leading columns of Q span the basis of the first
+K harmonics), so ``tolerance`` picks the fewest harmonics whose largest
+residual at the samples is within it.
+
+Derivatives with respect to θ (length/rad^n) follow term by term; at a cam
+speed ω they are velocity, acceleration and jerk times ω, ω², ω³. Junctions
+where the table's acceleration jumps (a ramp meeting a flank) are found from
+the table itself, not the fit: the second divided differences
+a_i = 2 [ (L_{i+1} - L_i)/h_+ - (L_i - L_{i-1})/h_- ] / (h_+ + h_-) of a
+smooth table change by O(h) from sample to sample; a jump J changes them by
+about J within one or two samples, standing out against its neighbours.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from vtool.errors import InputError
+from vtool.solvers.spec import CamSpec
+
+HARMONIC = "harmonic"
+TABLE = "table"
+MAX_HARMONICS = 400
+JUMP_FRACTION = 0.02  # a jump must exceed this share of the table's acceleration range ...
+JUMP_ISOLATION = 3.0  # ... and this many times the change two samples either side
+
+
+@dataclass(frozen=True)
+class LiftFit:
+    """A lift table's Fourier fit: coefficients and its error at the samples (length units)."""
+
+    c0: float
+    a: np.ndarray
+    b: np.ndarray
+    max_error: float
+    rms_error: float
+
+    @property
+    def harmonics(self) -> int:
+        return len(self.a)
+
+
+@dataclass(frozen=True)
+class Junction:
+    """A place where the table's acceleration d²L/dθ² jumps (length/rad²)."""
+
+    angle_deg: float
+    jump: float
+    before: float
+    after: float
+
+
+def normalize_table(angles_deg: list[float], lifts: list[float], field: str, unit: str) -> tuple[np.ndarray, np.ndarray]:
+    """Validate a lift table: >= 3 points, angles strictly increasing within one revolution.
+
+    A closing point at first angle + 360 deg repeating the first lift is dropped.
+    """
+    theta = np.asarray(angles_deg, dtype=float)
+    lift = np.asarray(lifts, dtype=float)
+    if theta.shape != lift.shape:
+        raise InputError(f"{field}.lifts", f"{lift.size} values", f"as many lifts as angles ({theta.size})", unit)
+    if theta.size >= 2 and abs(theta[-1] - theta[0] - 360.0) < 1e-9:
+        if abs(lift[-1] - lift[0]) > 1e-9 * max(1.0, float(np.abs(lift).max())):
+            raise InputError(f"{field}.lifts", float(lift[-1]),
+                             f"the lift at {theta[0]:g} deg ({lift[0]:g}): a cam is periodic", unit)
+        theta, lift = theta[:-1], lift[:-1]
+    if theta.size < 3:
+        raise InputError(f"{field}.angles", theta.size, "at least 3 points over one revolution", "deg")
+    if not (np.all(np.isfinite(theta)) and np.all(np.isfinite(lift))):
+        raise InputError(f"{field}.angles", "non-finite values", "finite angles and lifts", "deg")
+    if np.any(np.diff(theta) <= 0.0) or theta[-1] - theta[0] >= 360.0:
+        raise InputError(f"{field}.angles", f"{theta[0]:g}..{theta[-1]:g}",
+                         "strictly increasing angles spanning less than 360", "deg")
+    return theta, lift
+
+
+def _basis(theta_rad: np.ndarray, harmonics: int) -> np.ndarray:
+    """Φ with columns 1, cos θ, sin θ, cos 2θ, sin 2θ, ..."""
+    columns = [np.ones_like(theta_rad)]
+    for k in range(1, harmonics + 1):
+        columns += [np.cos(k * theta_rad), np.sin(k * theta_rad)]
+    return np.column_stack(columns)
+
+
+def max_harmonics(n_points: int) -> int:
+    """The most harmonics a table of n points can determine (2K + 1 <= n)."""
+    return min((n_points - 1) // 2, MAX_HARMONICS)
+
+
+def fit_table(angles_deg: np.ndarray, lifts: np.ndarray, harmonics: int | None = None,
+              tolerance: float | None = None, field: str = "cam", unit: str = "") -> LiftFit:
+    """Least-squares Fourier fit of a lift table (see module doc).
+
+    Give ``harmonics`` (K) or ``tolerance`` (the largest residual allowed at
+    the samples, length units; the fewest K that meet it are used).
+    """
+    theta = np.radians(np.asarray(angles_deg, dtype=float))
+    lift = np.asarray(lifts, dtype=float)
+    top = max_harmonics(theta.size)
+    if harmonics is not None and not 1 <= harmonics <= top:
+        raise InputError(f"{field}.harmonics", harmonics,
+                         f"an integer in 1..{top} (a table of {theta.size} points fixes at most {top})")
+    widest = harmonics if harmonics is not None else top
+    Q, R = np.linalg.qr(_basis(theta, widest))
+    diagonal = np.abs(np.diag(R))
+    if diagonal.min() < 1e-10 * diagonal.max():
+        raise InputError(f"{field}.harmonics", widest,
+                         "fewer harmonics: the table's spacing cannot tell them apart (ill-conditioned fit)")
+    projection = Q.T @ lift
+    if harmonics is None:
+        for K in range(1, widest + 1):
+            residual = lift - Q[:, : 2 * K + 1] @ projection[: 2 * K + 1]
+            if np.abs(residual).max() <= tolerance:  # type: ignore[operator]
+                break
+        else:
+            raise InputError(f"{field}.tolerance", tolerance,
+                             f">= {np.abs(residual).max():.3g} (the best fit with {widest} harmonics; "
+                             f"or give more points)", unit)
+    else:
+        K = harmonics
+    p = 2 * K + 1
+    x = np.linalg.solve(R[:p, :p], projection[:p])
+    residual = lift - Q[:, :p] @ projection[:p]
+    return LiftFit(float(x[0]), x[1::2].copy(), x[2::2].copy(),
+                   float(np.abs(residual).max()), float(np.sqrt(np.mean(residual**2))))
+
+
+@lru_cache(maxsize=64)
+def cam_fit(cam: CamSpec) -> LiftFit:
+    """The fit of a cam (harmonic: exact, one term)."""
+    if cam.profile == HARMONIC:
+        return LiftFit(cam.amplitude, np.zeros(1), np.array([cam.amplitude]), 0.0, 0.0)
+    return fit_table(np.asarray(cam.angles), np.asarray(cam.lifts), cam.harmonics, cam.tolerance)
+
+
+def lift_series(cam: CamSpec) -> tuple[float, np.ndarray, np.ndarray]:
+    """(c0, a[K], b[K]) of the cam's lift L(θ) = c0 + Σ a_k cos kθ + b_k sin kθ, for every profile."""
+    fit = cam_fit(cam)
+    return fit.c0, fit.a.copy(), fit.b.copy()
+
+
+def derivatives(c0: float, a: np.ndarray, b: np.ndarray, theta_rad: np.ndarray) -> np.ndarray:
+    """Rows: L, dL/dθ, d²L/dθ², d³L/dθ³ at θ (length/rad^n)."""
+    theta = np.asarray(theta_rad, dtype=float)
+    out = np.zeros((4, theta.size))
+    out[0] = c0
+    for k in range(1, len(a) + 1):
+        c, s = np.cos(k * theta), np.sin(k * theta)
+        ak, bk = a[k - 1], b[k - 1]
+        out[0] += ak * c + bk * s
+        out[1] += k * (-ak * s + bk * c)
+        out[2] += -(k**2) * (ak * c + bk * s)
+        out[3] += k**3 * (ak * s - bk * c)
+    return out
+
+
+def spectrum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per harmonic k = 1..K: lift amplitude |c_k| and acceleration amplitude k²|c_k| (length/rad²)."""
+    amplitude = np.hypot(a, b)
+    k = np.arange(1, len(a) + 1)
+    return amplitude, k**2 * amplitude
+
+
+def highest_harmonic(a: np.ndarray, b: np.ndarray, fraction: float) -> int:
+    """The highest k whose acceleration amplitude is at least ``fraction`` of the largest one."""
+    _, acc = spectrum(a, b)
+    if acc.max() == 0.0:
+        return 0
+    return int(np.nonzero(acc >= fraction * acc.max())[0].max()) + 1
+
+
+def table_acceleration(angles_deg: np.ndarray, lifts: np.ndarray) -> np.ndarray:
+    """Second divided differences of a periodic table at its samples (length/rad²)."""
+    theta = np.radians(np.asarray(angles_deg, dtype=float))
+    L = np.asarray(lifts, dtype=float)
+    h_next = np.diff(np.append(theta, theta[0] + 2 * math.pi))
+    h_prev = np.roll(h_next, 1)
+    slope_next = (np.roll(L, -1) - L) / h_next
+    slope_prev = (L - np.roll(L, 1)) / h_prev
+    return 2.0 * (slope_next - slope_prev) / (h_next + h_prev)
+
+
+def acceleration_jumps(angles_deg: np.ndarray, lifts: np.ndarray) -> list[Junction]:
+    """Junctions where the table's acceleration jumps (see module doc), in table order."""
+    theta = np.asarray(angles_deg, dtype=float)
+    acc = table_acceleration(theta, lifts)
+    n = acc.size
+    if n < 6:
+        return []
+    change = np.roll(acc, -1) - acc  # change[i]: from sample i to i + 1
+    size = np.abs(change)
+    span = acc.max() - acc.min()
+    if span == 0.0:
+        return []
+    neighbours = np.maximum(np.roll(size, 2), np.roll(size, -2))
+    flagged = (size > JUMP_FRACTION * span) & (size > JUMP_ISOLATION * neighbours)
+    junctions = []
+    done: set[int] = set()
+    for i in np.nonzero(flagged)[0]:
+        if i in done:
+            continue
+        group = [int(i)]
+        if flagged[(i + 1) % n] and np.sign(change[(i + 1) % n]) == np.sign(change[i]):
+            group.append(int((i + 1) % n))
+        done.update(group)
+        first, last = group[0], (group[-1] + 1) % n
+        step = theta[(first + 1) % n] - theta[first]
+        if len(group) == 2:
+            angle = theta[(first + 1) % n]  # the junction sits on the shared sample
+        else:
+            angle = theta[first] + 0.5 * (step if step > 0 else step + 360.0)
+        junctions.append(Junction(float(angle % 360.0), float(change[group].sum()),
+                                  float(acc[first]), float(acc[last])))
+    return sorted(junctions, key=lambda j: j.angle_deg)
