@@ -24,7 +24,11 @@ where the table's acceleration jumps (a ramp meeting a flank) are found from
 the table itself, not the fit: the second divided differences
 a_i = 2 [ (L_{i+1} - L_i)/h_+ - (L_i - L_{i-1})/h_- ] / (h_+ + h_-) of a
 smooth table change by O(h) from sample to sample; a jump J changes them by
-about J within one or two samples, standing out against its neighbours.
+about J within one or two samples, standing out against its neighbours (a
+jump is flagged above 2 % of the table's 90th-percentile |acceleration| and
+3 times the change two samples either side). A kink in the lift (a velocity
+jump) shows as a spike: up then down at one sample. Tables are assumed
+smooth between junctions: lifts rounded to few digits can raise false flags.
 """
 
 from __future__ import annotations
@@ -41,7 +45,7 @@ from vtool.solvers.spec import CamSpec
 HARMONIC = "harmonic"
 TABLE = "table"
 MAX_HARMONICS = 400
-JUMP_FRACTION = 0.02  # a jump must exceed this share of the table's acceleration range ...
+JUMP_FRACTION = 0.02  # a jump must exceed this share of the table's typical acceleration (90th pct) ...
 JUMP_ISOLATION = 3.0  # ... and this many times the change two samples either side
 
 
@@ -62,12 +66,13 @@ class LiftFit:
 
 @dataclass(frozen=True)
 class Junction:
-    """A place where the table's acceleration d²L/dθ² jumps (length/rad²)."""
+    """A place where the table's acceleration d²L/dθ² jumps (length/rad²), or its velocity does."""
 
     angle_deg: float
     jump: float
     before: float
     after: float
+    kind: str = "acceleration"  # or "velocity": a kink in the lift (an acceleration spike)
 
 
 def normalize_table(angles_deg: list[float], lifts: list[float], field: str, unit: str) -> tuple[np.ndarray, np.ndarray]:
@@ -209,26 +214,31 @@ def acceleration_jumps(angles_deg: np.ndarray, lifts: np.ndarray) -> list[Juncti
         return []
     change = np.roll(acc, -1) - acc  # change[i]: from sample i to i + 1
     size = np.abs(change)
-    span = acc.max() - acc.min()
-    if span == 0.0:
+    scale = float(np.percentile(np.abs(acc), 90))  # robust: kinks (spikes) do not set the scale
+    if scale == 0.0:
+        scale = float(np.abs(acc).max())
+    if scale == 0.0:
         return []
     neighbours = np.maximum(np.roll(size, 2), np.roll(size, -2))
-    flagged = (size > JUMP_FRACTION * span) & (size > JUMP_ISOLATION * neighbours)
+    flagged = (size > JUMP_FRACTION * scale) & (size > JUMP_ISOLATION * neighbours)
     junctions = []
     done: set[int] = set()
     for i in np.nonzero(flagged)[0]:
         if i in done:
             continue
         group = [int(i)]
-        if flagged[(i + 1) % n] and np.sign(change[(i + 1) % n]) == np.sign(change[i]):
+        kind = "acceleration"
+        if flagged[(i + 1) % n]:
             group.append(int((i + 1) % n))
+            if np.sign(change[(i + 1) % n]) != np.sign(change[i]):
+                kind = "velocity"  # an isolated spike: the slope itself jumps at the shared sample
         done.update(group)
-        first, last = group[0], (group[-1] + 1) % n
+        first = group[0]
+        before, after = acc[(first - 1) % n], acc[(group[-1] + 2) % n]  # just outside the stencils
         step = theta[(first + 1) % n] - theta[first]
         if len(group) == 2:
             angle = theta[(first + 1) % n]  # the junction sits on the shared sample
         else:
             angle = theta[first] + 0.5 * (step if step > 0 else step + 360.0)
-        junctions.append(Junction(float(angle % 360.0), float(change[group].sum()),
-                                  float(acc[first]), float(acc[last])))
+        junctions.append(Junction(float(angle % 360.0), float(after - before), float(before), float(after), kind))
     return sorted(junctions, key=lambda j: j.angle_deg)
