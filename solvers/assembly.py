@@ -174,3 +174,40 @@ def _shift_prescribed(spec: MechanismSpec, first: int, shift: int, coordinates: 
     quantities = tuple(renumber_quantity(q, first, shift) for q in spec.run.quantities)
     return replace(spec, coordinates=coordinates, members=members, cam=cam, seat=seat, clearances=clearances,
                    run=replace(spec.run, quantities=quantities))
+
+
+SURGE_SHARE = 0.5
+
+
+def kinetic_shares(spec: MechanismSpec, shapes: np.ndarray) -> dict[str, np.ndarray]:
+    """Each member's share of every mode's kinetic energy, φ_eᵀ M_e φ_e / φᵀ M φ.
+
+    ``shapes`` are mode shapes over the full coordinates (columns), e.g. T φ_L.
+    """
+    n = spec.n_coordinates
+    total = np.zeros(shapes.shape[1])
+    shares = {}
+    for member in spec.members:
+        energy = np.zeros(shapes.shape[1])
+        for element in sub_elements(member):
+            _, M_e = element_matrices(member_properties(element, spec.gravity))
+            u = beta_matrix(element.coordinates, n) @ shapes
+            energy += np.einsum("im,ij,jm->m", u, M_e, u)
+        shares[member.name] = energy
+        total += energy
+    return {name: energy / np.where(total > 0, total, 1.0) for name, energy in shares.items()}
+
+
+def surge_labels(spec: MechanismSpec, shapes: np.ndarray) -> list[str]:
+    """'<member> surge' for modes carried mostly (> 50 % of kinetic energy) by a split member, else ''.
+
+    A member of one element has no modes of its own; split into n it has n - 1
+    (bars) internal ones: for the valve spring, its surge modes.
+    """
+    labels = [""] * shapes.shape[1]
+    for name, share in kinetic_shares(spec, shapes).items():
+        member = next(m for m in spec.members if m.name == name)
+        if member.elements > 1:
+            for mode in np.nonzero(share > SURGE_SHARE)[0]:
+                labels[mode] = f"{name} surge"
+    return labels
