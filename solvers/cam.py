@@ -242,3 +242,75 @@ def acceleration_jumps(angles_deg: np.ndarray, lifts: np.ndarray) -> list[Juncti
             angle = theta[first] + 0.5 * (step if step > 0 else step + 360.0)
         junctions.append(Junction(float(angle % 360.0), float(after - before), float(before), float(after), kind))
     return sorted(junctions, key=lambda j: j.angle_deg)
+
+
+MATTERS = 0.01  # a harmonic matters when its acceleration amplitude is >= 1 % of the largest
+
+
+def cam_report(spec, points: int = 3600, top: int = 8) -> dict:  # type: ignore[no-untyped-def]
+    """What ``vtool cam show`` prints: fit, extremes at the preset's speed, spectrum, junctions.
+
+    Derivatives are of the fitted series (what the solver sees); at the run's
+    ω they are scaled by ω, ω², ω³ to velocity, acceleration and jerk.
+    """
+    units = spec.unit_system
+    cam = spec.cam
+    fit = cam_fit(cam)
+    omega = spec.run.rpm * math.pi / 30.0
+    theta = np.linspace(0.0, 2 * math.pi, points, endpoint=False)
+    L, v, acc, jerk = derivatives(fit.c0, fit.a, fit.b, theta)
+    lift_amplitude, acc_amplitude = spectrum(fit.a, fit.b)
+    order = np.argsort(acc_amplitude)[::-1][:top]
+    per_s = {"velocity": units.velocity, "acceleration": units.acceleration,
+             "jerk": f"{units.length}/s^3"}
+    report: dict = {
+        "title": spec.title, "profile": cam.profile, "harmonics": fit.harmonics,
+        "length_unit": units.length, "rpm": spec.run.rpm,
+        "fit_max_error": fit.max_error, "fit_rms_error": fit.rms_error,
+        "table_points": len(cam.angles),
+        "lift_max": float(L.max()), "lift_min": float(L.min()),
+        "extremes": {}, "spectrum": [], "junctions": [],
+        "highest_harmonic": highest_harmonic(fit.a, fit.b, MATTERS),
+    }
+    for name, values, power in (("velocity", v, 1), ("acceleration", acc, 2), ("jerk", jerk, 3)):
+        report["extremes"][name] = {
+            "min": float(values.min() * omega**power), "max": float(values.max() * omega**power),
+            "unit": per_s[name], "per_rad_unit": f"{units.length}/rad^{power}",
+            "min_per_rad": float(values.min()), "max_per_rad": float(values.max())}
+    for k in sorted(order + 1):
+        report["spectrum"].append({
+            "harmonic": int(k), "frequency_hz": k * spec.run.rpm / 60.0,
+            "lift_amplitude": float(lift_amplitude[k - 1]),
+            "acceleration_amplitude": float(acc_amplitude[k - 1] * omega**2)})
+    if cam.profile != HARMONIC:
+        for j in acceleration_jumps(np.asarray(cam.angles), np.asarray(cam.lifts)):
+            report["junctions"].append({"angle_deg": j.angle_deg, "kind": j.kind, "jump_per_rad2": j.jump,
+                                        "jump": j.jump * omega**2, "unit": units.acceleration})
+    return report
+
+
+def report_text(report: dict) -> str:
+    """The report as the lines ``vtool cam show`` prints."""
+    u = report["length_unit"]
+    lines = [report["title"],
+             f"cam: {report['profile']}, {report['harmonics']} harmonic(s)"
+             + (f" fitted to {report['table_points']} table points: largest error "
+                f"{report['fit_max_error']:.3g} {u}, rms {report['fit_rms_error']:.3g} {u}"
+                if report["profile"] != HARMONIC else " (exact)"),
+             f"lift {report['lift_min']:.6g} .. {report['lift_max']:.6g} {u}"
+             f"   at {report['rpm']:g} rpm:"]
+    for name, e in report["extremes"].items():
+        lines.append(f"  {name:<12} {e['min']:>13.5g} .. {e['max']:<13.5g} {e['unit']:<10}"
+                     f" ({e['min_per_rad']:.4g} .. {e['max_per_rad']:.4g} {e['per_rad_unit']})")
+    lines.append(f"highest harmonic that matters (acceleration >= {MATTERS:.0%} of the largest): "
+                 f"{report['highest_harmonic']}")
+    lines.append(f"  {'k':>4} {'f (Hz)':>10} {'lift amp (' + u + ')':>16} {'accel amp (' + u + '/s^2)':>22}")
+    for row in report["spectrum"]:
+        lines.append(f"  {row['harmonic']:>4} {row['frequency_hz']:>10.5g} {row['lift_amplitude']:>16.5g}"
+                     f" {row['acceleration_amplitude']:>22.5g}")
+    for j in report["junctions"]:
+        what = "acceleration jumps by" if j["kind"] == "acceleration" else "velocity jumps (a kink)"
+        size = f" {j['jump']:.4g} {j['unit']}" if j["kind"] == "acceleration" else ""
+        lines.append(f"warning: the table's {what}{size} at {j['angle_deg']:g} deg (a ramp/flank "
+                     f"junction?): its Fourier series rings there")
+    return "\n".join(lines)

@@ -28,6 +28,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "boom": ("vtool.app.cli.boom", "boom"),
     "plate": ("vtool.app.cli.plate", "plate"),
     "accuracy": ("vtool.app.cli.accuracy", "accuracy"),
+    "cam": ("vtool.app.cli.cam", "cam"),
+    "size": ("vtool.app.cli.size", "size"),
     "tui": ("vtool.app.cli.tui", "tui"),
 }
 
