@@ -36,7 +36,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from vtool.solvers.assembly import split_members, unsplit_members
-from vtool.solvers.cam import HARMONIC, MATTERS, cam_fit, fit_table, highest_harmonic, max_harmonics
+from vtool.solvers.cam import HARMONIC, MATTERS, fit_table, highest_harmonic, max_harmonics
 from vtool.solvers.model import assemble
 from vtool.solvers.spec import EXTERNAL, MechanismSpec
 

@@ -131,3 +131,12 @@ def test_modes_command_names_the_surge_modes(tmp_path) -> None:  # type: ignore[
     assert layer.count("valve_spring surge") == 3
     fundamental = layer.splitlines()[2]
     assert "surge" not in fundamental
+
+
+def test_per_mode_damping_follows_the_one_element_mode() -> None:
+    """gnilka-1a gives 0.5 to mode 2 (25.9e3 rad/s) of the rocker-closed layer; split springs add
+    surge modes below it, and the override stays with the 25.9e3 rad/s mode."""
+    layer = assemble(split_1a(valve_spring=8)).layer({"rocker"})
+    heavy = np.nonzero(layer.damping_ratios == 0.5)[0]
+    assert len(heavy) == 1
+    assert layer.modes.omega[heavy[0]] == pytest.approx(25.9e3, rel=0.03)
