@@ -194,6 +194,22 @@ def highest_harmonic(a: np.ndarray, b: np.ndarray, fraction: float) -> int:
     return int(np.nonzero(acc >= fraction * acc.max())[0].max()) + 1
 
 
+WIDE_FIT = 128
+
+
+def harmonic_that_matters(cam: CamSpec) -> int:
+    """The highest harmonic whose acceleration amplitude is >= 1 % of the largest.
+
+    A table cam is judged on its widest fit (up to 128 harmonics), not on the
+    preset's truncated one.
+    """
+    if cam.profile == HARMONIC:
+        return 1
+    angles, lifts = np.asarray(cam.angles), np.asarray(cam.lifts)
+    wide = fit_table(angles, lifts, min(max_harmonics(len(angles)), WIDE_FIT))
+    return highest_harmonic(wide.a, wide.b, MATTERS)
+
+
 def table_acceleration(angles_deg: np.ndarray, lifts: np.ndarray) -> np.ndarray:
     """Second divided differences of a periodic table at its samples (length/rad²)."""
     theta = np.radians(np.asarray(angles_deg, dtype=float))
@@ -270,7 +286,7 @@ def cam_report(spec, points: int = 3600, top: int = 8) -> dict:  # type: ignore[
         "table_points": len(cam.angles),
         "lift_max": float(L.max()), "lift_min": float(L.min()),
         "extremes": {}, "spectrum": [], "junctions": [],
-        "highest_harmonic": highest_harmonic(fit.a, fit.b, MATTERS),
+        "highest_harmonic": harmonic_that_matters(cam),
     }
     for name, values, power in (("velocity", v, 1), ("acceleration", acc, 2), ("jerk", jerk, 3)):
         report["extremes"][name] = {

@@ -36,11 +36,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from vtool.solvers.assembly import split_members, unsplit_members
-from vtool.solvers.cam import HARMONIC, MATTERS, fit_table, highest_harmonic, max_harmonics
+from vtool.solvers.cam import HARMONIC, MATTERS, WIDE_FIT, harmonic_that_matters, max_harmonics
 from vtool.solvers.model import assemble
 from vtool.solvers.spec import EXTERNAL, MechanismSpec
-
-MAX_FIT_HARMONICS = 128
 
 
 @dataclass(frozen=True)
@@ -107,13 +105,12 @@ def relative_change(new: dict[str, float], old: dict[str, float]) -> float:
 
 def stable_time_step(spec: MechanismSpec) -> float:
     """The preset's step, cut to 0.9 of Newmark's stability limit for the model's highest mode."""
-    dt = spec.run.time_step
-    beta, gamma = spec.run.beta, spec.run.gamma
-    if beta >= 0.25 or spec.run.backend != "newmark":
-        return dt
-    omega_max = max(float(layer.modes.omega.max()) for layer in assemble(spec).all_layers())
-    limit = 0.9 / math.sqrt(gamma / 2.0 - beta) / omega_max
-    return min(dt, limit)
+    if spec.run.backend != "newmark":
+        return spec.run.time_step
+    from vtool.solvers.newmark import highest_frequency, stability_limit
+
+    limit = stability_limit(spec.run.beta, spec.run.gamma, highest_frequency(assemble(spec)))
+    return min(spec.run.time_step, 0.9 * limit)
 
 
 def with_elements(spec: MechanismSpec, member: str, n: int) -> MechanismSpec:
@@ -126,13 +123,7 @@ def cam_reach(spec: MechanismSpec, rpm_max: float) -> tuple[int, float, list[tup
     """(highest harmonic that matters, its frequency in Hz, reachable starting-layer modes)."""
     from vtool.solvers.assembly import surge_labels
 
-    cam = spec.cam
-    if cam.profile == HARMONIC:
-        k_max = 1
-    else:
-        angles, lifts = np.asarray(cam.angles), np.asarray(cam.lifts)
-        wide = fit_table(angles, lifts, min(max_harmonics(len(angles)), MAX_FIT_HARMONICS))
-        k_max = highest_harmonic(wide.a, wide.b, MATTERS)
+    k_max = harmonic_that_matters(spec.cam)
     omega = rpm_max * math.pi / 30.0
     layer = assemble(spec).start_layer
     labels = surge_labels(spec, layer.T @ layer.modes.shapes)
@@ -172,7 +163,7 @@ def size_study(spec: MechanismSpec, rpm_max: float, tolerance: float = 0.01, max
         elements[member.name] = (n, converged)
     harmonics = None
     if spec.cam.profile != HARMONIC:
-        top = min(max_harmonics(len(spec.cam.angles)), MAX_FIT_HARMONICS)
+        top = min(max_harmonics(len(spec.cam.angles)), WIDE_FIT)
 
         def with_harmonics(K: int) -> MechanismSpec:
             return replace(base, cam=replace(base.cam, harmonics=K, tolerance=None))
