@@ -58,3 +58,21 @@ def test_position_or_lash_not_both(seat: dict) -> None:
 def test_ramped_preset_is_set_by_lash() -> None:
     spec = load_preset("ramped-cam")
     assert spec.seat.lash == 0.008 and lash_of(spec) == pytest.approx(0.008, rel=1e-12)
+
+
+@pytest.mark.asyncio
+async def test_tui_edits_the_lash_and_the_fit_of_a_table_cam() -> None:
+    from tests.tui_helpers import put
+    from vtool.app.tui.app import create_app
+
+    app = create_app("ramped-cam", remember=False, chart_color=False)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        assert screen.form.value("seat.lash") == "0.008" and screen.form.value("cam.tolerance") == "0.0001"
+        assert not screen.form.has_field("cam.amplitude") and not screen.form.has_field("seat.position")
+        await put(pilot, screen, "seat.lash", "0.01")
+        await put(pilot, screen, "cam.tolerance", "0.001")
+        spec = screen.validate()
+        assert spec.seat.lash == 0.01 and lash_of(spec) == pytest.approx(0.01, rel=1e-12)
+        assert spec.cam.tolerance == 0.001 and len(spec.cam.angles) == 360
