@@ -45,6 +45,8 @@ from vtool.solvers.spec import CamSpec
 HARMONIC = "harmonic"
 TABLE = "table"
 MAX_HARMONICS = 400
+MAX_POINTS = 10_000
+QR_ENTRIES = 2_000_000  # the least-squares matrix of an unequally spaced table, at most
 JUMP_FRACTION = 0.02  # a jump must exceed this share of the table's typical acceleration (90th pct) ...
 JUMP_ISOLATION = 3.0  # ... and this many times the change two samples either side
 
@@ -89,8 +91,9 @@ def normalize_table(angles_deg: list[float], lifts: list[float], field: str, uni
             raise InputError(f"{field}.lifts", float(lift[-1]),
                              f"the lift at {theta[0]:g} deg ({lift[0]:g}): a cam is periodic", unit)
         theta, lift = theta[:-1], lift[:-1]
-    if theta.size < 3:
-        raise InputError(f"{field}.angles", theta.size, "at least 3 points over one revolution", "deg")
+    if not 3 <= theta.size <= MAX_POINTS:
+        raise InputError(f"{field}.angles", f"{theta.size} points", f"3..{MAX_POINTS} points over one revolution",
+                         "deg")
     if not (np.all(np.isfinite(theta)) and np.all(np.isfinite(lift))):
         raise InputError(f"{field}.angles", "non-finite values", "finite angles and lifts", "deg")
     if np.any(np.diff(theta) <= 0.0) or theta[-1] - theta[0] >= 360.0:
@@ -112,42 +115,73 @@ def max_harmonics(n_points: int) -> int:
     return min((n_points - 1) // 2, MAX_HARMONICS)
 
 
+def _uniform_fit(theta: np.ndarray, lift: np.ndarray, K: int) -> tuple[float, np.ndarray, np.ndarray]:
+    """The least-squares fit on N equal steps: the truncated DFT, shifted to start at θ_0."""
+    N = theta.size
+    C = 2.0 * np.fft.rfft(lift)[: K + 1] / N
+    D = C[1:] * np.exp(-1j * np.arange(1, K + 1) * theta[0])
+    return float(C[0].real / 2.0), D.real.copy(), -D.imag.copy()
+
+
+def _residual(theta: np.ndarray, lift: np.ndarray, c0: float, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return lift - derivatives(c0, a, b, theta)[0]
+
+
 def fit_table(angles_deg: np.ndarray, lifts: np.ndarray, harmonics: int | None = None,
               tolerance: float | None = None, field: str = "cam", unit: str = "") -> LiftFit:
     """Least-squares Fourier fit of a lift table (see module doc).
 
     Give ``harmonics`` (K) or ``tolerance`` (the largest residual allowed at
-    the samples, length units; the fewest K that meet it are used).
+    the samples, length units; the fewest K that meet it are used). Equal
+    steps use the FFT; other spacings a QR factorization whose size is
+    bounded (at most :data:`QR_ENTRIES` matrix entries), so any table fits in
+    seconds.
     """
     theta = np.radians(np.asarray(angles_deg, dtype=float))
     lift = np.asarray(lifts, dtype=float)
-    top = max_harmonics(theta.size)
+    N = theta.size
+    uniform = bool(np.allclose(np.diff(theta), 2 * math.pi / N, rtol=0.0, atol=1e-9))
+    top = max_harmonics(N) if uniform else min(max_harmonics(N), max(1, (QR_ENTRIES // N - 1) // 2))
     if harmonics is not None and not 1 <= harmonics <= top:
         raise InputError(f"{field}.harmonics", harmonics,
-                         f"an integer in 1..{top} (a table of {theta.size} points fixes at most {top})")
+                         f"an integer in 1..{top} (what a table of {N} points with this spacing fixes)")
     widest = harmonics if harmonics is not None else top
-    Q, R = np.linalg.qr(_basis(theta, widest))
-    diagonal = np.abs(np.diag(R))
-    if diagonal.min() < 1e-10 * diagonal.max():
-        raise InputError(f"{field}.harmonics", widest,
-                         "fewer harmonics: the table's spacing cannot tell them apart (ill-conditioned fit)")
-    projection = Q.T @ lift
+    if uniform:
+        c0, a, b = _uniform_fit(theta, lift, widest)
+    else:
+        Q, R = np.linalg.qr(_basis(theta, widest))
+        diagonal = np.abs(np.diag(R))
+        bad = np.nonzero(diagonal < 1e-10 * diagonal.max())[0]
+        usable = widest if bad.size == 0 else (int(bad[0]) - 1) // 2
+        if harmonics is not None and usable < harmonics:
+            raise InputError(f"{field}.harmonics", harmonics,
+                             f"<= {max(usable, 1)}: the table's spacing cannot tell more apart (ill-conditioned)")
+        widest = max(usable, 1)
+        x = np.linalg.solve(R[: 2 * widest + 1, : 2 * widest + 1], (Q.T @ lift)[: 2 * widest + 1])
+        c0, a, b = float(x[0]), x[1::2].copy(), x[2::2].copy()
     if harmonics is None:
+        # nested least squares: the fit of K harmonics is the widest one's first terms only on equal
+        # steps; otherwise refit each K (cheap: K is small where most tables stop)
+        fitted = np.full(N, c0)
+        projection = None if uniform else Q.T @ lift
         for K in range(1, widest + 1):
-            residual = lift - Q[:, : 2 * K + 1] @ projection[: 2 * K + 1]
-            if np.abs(residual).max() <= tolerance:  # type: ignore[operator]
+            if uniform:
+                fitted += a[K - 1] * np.cos(K * theta) + b[K - 1] * np.sin(K * theta)
+                error = np.abs(lift - fitted).max()
+            else:
+                x = np.linalg.solve(R[: 2 * K + 1, : 2 * K + 1], projection[: 2 * K + 1])
+                error = np.abs(lift - Q[:, : 2 * K + 1] @ projection[: 2 * K + 1]).max()
+            if error <= tolerance:  # type: ignore[operator]
+                if uniform:
+                    a, b = a[:K].copy(), b[:K].copy()
+                else:
+                    c0, a, b = float(x[0]), x[1::2].copy(), x[2::2].copy()
                 break
         else:
             raise InputError(f"{field}.tolerance", tolerance,
-                             f">= {np.abs(residual).max():.3g} (the best fit with {widest} harmonics; "
-                             f"or give more points)", unit)
-    else:
-        K = harmonics
-    p = 2 * K + 1
-    x = np.linalg.solve(R[:p, :p], projection[:p])
-    residual = lift - Q[:, :p] @ projection[:p]
-    return LiftFit(float(x[0]), x[1::2].copy(), x[2::2].copy(),
-                   float(np.abs(residual).max()), float(np.sqrt(np.mean(residual**2))))
+                             f">= {error:.3g} (the best fit with {widest} harmonics; or give more points)", unit)
+    residual = _residual(theta, lift, c0, a, b)
+    return LiftFit(c0, a, b, float(np.abs(residual).max()), float(np.sqrt(np.mean(residual**2))))
 
 
 @lru_cache(maxsize=64)
