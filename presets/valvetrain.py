@@ -26,8 +26,11 @@ from vtool.solvers.spec import (
     INTERNAL,
     PINNED,
     REMOVED,
+    IMPACT_LAWS,
+    START_VELOCITIES,
     CamSpec,
     ClearanceSpec,
+    ContactSpec,
     CoordinateSpec,
     DampingSpec,
     InitialSpec,
@@ -69,6 +72,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     cam_name = next(c.name for c in clearances if c.behind == cam.coordinate)
     initial = _initial(top.table("initial"), names, cam_name, units)  # type: ignore[arg-type]
     damping = _damping(top.table("damping", required=False), names)
+    contact = _contact(top.table("contact", required=False))
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances))  # type: ignore[arg-type]
     top.finish()
     spec = MechanismSpec(
@@ -84,6 +88,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         damping=damping,
         run=run,
         notes=notes,
+        contact=contact,
     )
     spec = split_members(spec)
     if seat is not None and seat.lash is not None:
@@ -91,6 +96,16 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
 
         spec = replace(spec, seat=replace(spec.seat, position=float(seat_position(spec, seat.lash))))
     return spec
+
+
+def _contact(t: Table | None) -> ContactSpec:
+    """[contact]: the default impact law and the thesis' SCALE (eq. 3.54)."""
+    if t is None:
+        return ContactSpec()
+    impact = t.string("impact", default=ContactSpec.impact, choices=IMPACT_LAWS)
+    scale = t.number("rocker_scale", default=1.0, min_value=0.1, max_value=10.0)
+    t.finish()
+    return ContactSpec(impact, scale)
 
 
 def _coordinates(top: Table) -> tuple[CoordinateSpec, ...]:
@@ -249,8 +264,9 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int) -
         if state == PINNED and kind == EXTERNAL:
             raise InputError(t.field("state"), state, "enabled or removed for an external clearance")
         restitution = t.number("restitution", default=0.0, min_value=0.0, max_value=1.0)
+        impact = t.string("impact", choices=IMPACT_LAWS) if t.raw("impact") is not None else None
         t.finish()
-        result.append(ClearanceSpec(name, ahead, behind, kind, state, restitution))
+        result.append(ClearanceSpec(name, ahead, behind, kind, state, restitution, impact))
     if sum(c.behind == cam_coordinate for c in result) != 1:
         raise InputError("clearances", [c.name for c in result], f"exactly one clearance with behind = {cam_coordinate} (the cam)")
     return tuple(result)
@@ -266,8 +282,9 @@ def _initial(t: Table, names: dict[str, ClearanceSpec], cam_name: str, units: Un
             raise InputError(t.field("closed"), name, f"only the cam clearance ('{cam_name}') and internal clearances")
     preload = t.number("spring_preload", unit=units.force, min_value=0.0)
     ratio = t.number("lever_ratio", min_exclusive=0.0)
+    velocities = t.string("velocities", default=InitialSpec.velocities, choices=START_VELOCITIES)
     t.finish()
-    return InitialSpec(closed, preload, ratio)
+    return InitialSpec(closed, preload, ratio, velocities)
 
 
 def _names(t: Table, key: str, names: dict[str, ClearanceSpec], kinds: tuple[str, ...] = (EXTERNAL, INTERNAL)) -> tuple[str, ...]:
@@ -387,14 +404,16 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         doc["seat"].update({"position": seat.position} if seat.lash is None else {"lash": seat.lash})
     doc["clearances"] = [
         {"name": c.name, "ahead": c.ahead, "behind": c.behind, "kind": c.kind,
-         "state": c.state, "restitution": c.restitution}
+         "state": c.state, "restitution": c.restitution} | ({"impact": c.impact} if c.impact else {})
         for c in spec.clearances
     ]
     doc["initial"] = {
         "closed": list(spec.initial.closed),
         "spring_preload": spec.initial.spring_preload,
         "lever_ratio": spec.initial.lever_ratio,
+        "velocities": spec.initial.velocities,
     }
+    doc["contact"] = {"impact": spec.contact.impact, "rocker_scale": spec.contact.rocker_scale}
     damping: dict[str, Any] = {"factor": spec.damping.factor, "default_ratio": spec.damping.default_ratio}
     layers = []
     for layer in spec.damping.layers:

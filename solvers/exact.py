@@ -30,10 +30,11 @@ import scipy.linalg
 from scipy.optimize import brentq
 
 from vtool.errors import InputError
+from vtool.solvers.contact import ContactProblem
 from vtool.solvers.model import Mechanism
-from vtool.solvers.piecewise import Cancel, PiecewiseRun, Progress, StateSpace, timed
+from vtool.solvers.piecewise import PiecewiseBackend, PiecewiseRun, StateSpace
 from vtool.solvers.spec import RunSpec
-from vtool.solvers.trace import Trace
+from vtool.solvers.trace import TraceBuilder
 
 SCAN_FRACTION = 1.0 / 16.0  # scan grid as a fraction of the shortest period
 BLOCK = 256  # samples evaluated together
@@ -51,25 +52,21 @@ class ExactOptions:
         return cls(run.output_interval, every_step)
 
 
-class ExactBackend:
+class ExactBackend(PiecewiseBackend):
     """Piecewise-exact back end (see module doc). Registered as ``exact``."""
 
     name = "exact"
-    supports_cancel = True
-    supports_progress = True
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> ExactOptions:
         return ExactOptions.from_run(run, every_step)
 
-    def simulate(self, mechanism: Mechanism, options: ExactOptions | None = None,
-                 progress: Progress | None = None, cancel: Cancel | None = None) -> Trace:
-        options = options or ExactOptions.from_run(mechanism.spec.run)
+    def check(self, mechanism: Mechanism, options: ExactOptions) -> None:
         if not 0.0 < options.time_tolerance < 1e-3:
             raise InputError("time_tolerance", options.time_tolerance, "> 0 and < 1e-3", "s")
-        run = _ExactRun(mechanism, options)
-        return timed(run, progress, cancel, {"time_tolerance_s": options.time_tolerance,
-                                             "rpm": mechanism.spec.run.rpm, "degrees": mechanism.spec.run.degrees})
+
+    def settings(self, options: ExactOptions) -> dict:
+        return {"time_tolerance_s": options.time_tolerance}
 
 
 def parabolic_peak(v0: np.ndarray, v1: np.ndarray, v2: np.ndarray) -> np.ndarray:
@@ -92,8 +89,8 @@ def parabolic_peak(v0: np.ndarray, v1: np.ndarray, v2: np.ndarray) -> np.ndarray
 class _ExactRun(PiecewiseRun):
     backend = "exact"
 
-    def __init__(self, mechanism: Mechanism, options: ExactOptions) -> None:
-        super().__init__(mechanism, options.output_interval, options.every_step)
+    def __init__(self, problem: ContactProblem, options: ExactOptions, builder: TraceBuilder) -> None:
+        super().__init__(problem, options.output_interval, options.every_step, builder)
         self.options = options
         self._grid: dict[int, tuple[float, np.ndarray]] = {}
 
@@ -134,7 +131,8 @@ class _ExactRun(PiecewiseRun):
             if last:
                 window = np.concatenate([recent, values[:, :last]], axis=1)
                 self.track_peaks(ss, np.maximum(window[:, 2:].max(axis=1),
-                                                parabolic_peak(window[:, :-2], window[:, 1:-1], window[:, 2:]).max(axis=1)))
+                                                parabolic_peak(window[:, :-2], window[:, 1:-1], window[:, 2:]).max(axis=1)),
+                                 float(times[last - 1]))
                 recent = window[:, -2:]
             start_t, start_yh = (times[last - 1], samples[:, last - 1]) if last else (t, yh)
             self.outputs(ss, t, yh, start_t - t)
@@ -150,7 +148,7 @@ class _ExactRun(PiecewiseRun):
                 self.outputs(ss, float(start_t), start_yh, tau)
                 self.steps += 1
                 y_event = self.exact(ss, float(start_t), start_yh, tau)
-                self.track_peaks(ss, self.monitors(ss, start_t + tau, y_event))
+                self.track_peaks(ss, self.monitors(ss, start_t + tau, y_event), float(start_t + tau))
                 return float(start_t) + tau, y_event, [k for k, r in roots.items() if r <= tau + tol]
             t, yh = float(times[-1]), samples[:, -1]
         return t, yh + ss.particular(t), []
@@ -169,3 +167,6 @@ class _ExactRun(PiecewiseRun):
     def outputs(self, ss: StateSpace, t: float, yh: np.ndarray, tau: float) -> None:
         for t_out in self.output_times(t, t + tau):
             self.emit(ss, t_out, self.exact(ss, t, yh, t_out - t))
+
+
+ExactBackend.run_class = _ExactRun

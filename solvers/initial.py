@@ -21,11 +21,19 @@ rate 254 lbf/in) this gives XZERO = 0.88245022 in and FZERO = 501.85073 lbf,
 the values of the thesis' sample printout for the 11,000 RPM run.
 
 The initial displacements are the static deflection under FZERO at the
-follower, q_L = K_L⁻¹ e_f FZERO (so q_f = XZERO). Choice where the thesis is
-silent: the initial velocities and accelerations are the quasi-static ones,
-the same deflection shape moving with the cam (q̇ = q/XZERO · q̇_cam(0),
-q̈ = q/XZERO · q̈_cam(0)), so the follower moves with the cam and no member
-starts with a spurious velocity jump.
+follower, q_L = K_L⁻¹ e_f FZERO (so q_f = XZERO). The initial velocities are
+a preset choice (``initial.velocities``):
+
+* ``thesis`` (subroutine INITAL): the follower's values are set equal to the
+  cam's, the left rocker's to the pushrod's (ADJUST: a tied pair shares its
+  values), and every other velocity starts at zero: q̇_f = q̇_cam(0), the rest
+  0. The members then catch up with the cam: the start shock of the thesis'
+  run.
+* ``quasi-static``: the same deflection shape moving with the cam
+  (q̇ = q/XZERO · q̇_cam(0)), so no member starts with a velocity jump.
+
+The accelerations are the consistent ones of the starting configuration
+(computed by the back end before the first step).
 """
 
 from __future__ import annotations
@@ -36,7 +44,7 @@ import numpy as np
 
 from vtool.errors import InputError
 from vtool.solvers.layers import Layer
-from vtool.solvers.spec import ENABLED, MechanismSpec
+from vtool.solvers.spec import ENABLED, QUASI_STATIC_START, MechanismSpec
 
 
 @dataclass(frozen=True)
@@ -97,11 +105,16 @@ def static_start(spec: MechanismSpec, layer: Layer, omega: float) -> StaticStart
     cam_velocity = amplitude * omega  # d/dt (A sin wt) at t = 0
     cam_acceleration = 0.0  # -A w² sin(0)
     check_open_gaps(spec, shape * cam_offset)
+    if spec.initial.velocities == QUASI_STATIC_START:
+        qd, qdd = shape * cam_velocity, shape * cam_acceleration
+    else:  # the thesis' INITAL: the follower moves with the cam, everything else at rest
+        qd, qdd = np.zeros_like(shape), np.zeros_like(shape)
+        qd[follower - 1], qdd[follower - 1] = cam_velocity, cam_acceleration
     return StaticStart(
         cam_offset=cam_offset,
         follower_force=follower_force,
         follower_stiffness=follower_stiffness,
         q=shape * cam_offset,
-        qd=shape * cam_velocity,
-        qdd=shape * cam_acceleration,
+        qd=qd,
+        qdd=qdd,
     )

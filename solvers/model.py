@@ -8,24 +8,49 @@ pinned clearance never produces a layer in which it is open.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from functools import cached_property
 
 import numpy as np
 
 from vtool.solvers.assembly import assemble_full
+from vtool.solvers.damping import undamped_modes
 from vtool.solvers.initial import StaticStart, static_start
 from vtool.solvers.layers import Layer, build_layer, internal_layer_names, possible_layers
-from vtool.solvers.spec import INTERNAL, MechanismSpec
+from vtool.solvers.spec import INTERNAL, MechanismSpec, RunSpec
 
 
 class Mechanism:
     """A valve train ready to solve: see the module docstring."""
 
-    def __init__(self, spec: MechanismSpec) -> None:
+    def __init__(self, spec: MechanismSpec, _shared: Mechanism | None = None) -> None:
         self.spec = spec
-        self.M, self.K = assemble_full(spec)
-        self._layers: dict[frozenset[str], Layer] = {}
+        if _shared is None:
+            self.M, self.K = assemble_full(spec)
+            self._layers: dict[frozenset[str], Layer] = {}
+            self._tables: list = []  # the speed-independent configuration tables, made on demand
+        else:  # the same mechanism run with other run settings: share what does not depend on them
+            self.M, self.K, self._layers, self._tables = _shared.M, _shared.K, _shared._layers, _shared._tables
+            if "highest_frequency" in _shared.__dict__:
+                self.__dict__["highest_frequency"] = _shared.highest_frequency
+
+    def with_run(self, run: RunSpec) -> Mechanism:
+        """This mechanism with other run settings (cam speed, step, ...), sharing its layers and tables."""
+        return Mechanism(dataclasses.replace(self.spec, run=run), _shared=self)
+
+    def configuration_tables(self):  # type: ignore[no-untyped-def]
+        """The configuration tables of :mod:`vtool.solvers.contact`, shared by every run of this mechanism."""
+        if not self._tables:
+            from vtool.solvers.contact import ConfigurationTables
+
+            self._tables.append(ConfigurationTables(self))
+        return self._tables[0]
+
+    @cached_property
+    def highest_frequency(self) -> float:
+        """omega_max of the unconstrained system (rad/s): no configuration is stiffer."""
+        return float(undamped_modes(self.M, self.K).omega.max())
 
     @property
     def omega(self) -> float:

@@ -3,300 +3,597 @@
 Everything the run loop touches lives in this one module (the numba cache
 misses edits in other files). The same source, run with
 ``NUMBA_DISABLE_JIT=1``, is the plain-NumPy reference the tests compare the
-compiled kernel with.
+compiled kernel with. The arrays are built by :mod:`vtool.solvers.contact`
+(the contact problem every back end shares); their layout is given by the
+``IP_*``, ``FP_*``, ``CL_*``, ``CI_*``, ``CM_*`` and ``MK_*`` slot numbers
+below.
 
 Conventions
 -----------
 Full coordinates: the n elastic system coordinates q_1..q_n (0-based here).
-Sources: prescribed motions (0: harmonic cam ``p0 sin(p1 t) + p2``; 1: fixed
-seat at ``p0``). A configuration ``c`` is a bit mask over the clearances
-(contact = 1). In configuration c the layer coordinates x_L (size m) are the
-full ones with every closed internal pair tied; ``group[c, i]`` is the layer
-column of full coordinate i and ``kept[c, j]`` a full coordinate of layer
-column j. Layer columns tied to a source (closed external clearance) are
-prescribed (P); the others are free (F).
+Sources: prescribed motions as Fourier series (:mod:`vtool.solvers.sources`)
+x_s(t) = c_s + Σ_k a_sk cos kωt + b_sk sin kωt. A configuration ``c`` is a
+bit mask over the clearances (contact = 1). In configuration c the layer
+vector z (size m) holds the full coordinates with every closed internal pair
+tied, ordered **free first**: z[0:nf] are integrated, z[nf:m] are prescribed
+(tied to a source through a closed external clearance). ``group`` maps a full
+coordinate to its z index, ``kept`` a z index to one full coordinate.
 
 Newmark step of length h in configuration c (general beta, gamma):
 
-    x̃ = x + h v + h²(1/2 - beta) a,   ṽ = v + h(1 - gamma) a
-    S a_F = -C_FF ṽ_F - K_FF x̃_F - (M_FP a_P + C_FP v_P + K_FP x_P)     (ΔP)
+    z̃ = z + h ż + h²(1/2 - beta) z̈,   ż̃ = ż + h(1 - gamma) z̈
+    S z̈_F = -C_FF ż̃_F - K_FF z̃_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P)     (ΔP)
     S = M_FF + gamma h C_FF + beta h² K_FF          (thesis BMIV = S⁻¹)
-    x_F = x̃_F + beta h² a_F,   v_F = ṽ_F + gamma h a_F
+    z_F = z̃_F + beta h² z̈_F,   ż_F = ż̃_F + gamma h z̈_F
 
-with the prescribed values (x_P, v_P, a_P) taken from the sources at t + h.
+with the prescribed values (z_P, ż_P, z̈_P) taken from the sources at t + h.
+Standard and refined steps use the stored S⁻¹; other step lengths (event
+location, the return to the step grid) factor S by Cholesky in place.
 
-Contact forces: one row of coefficients per (configuration, clearance) on
-the full state and the sources (see :mod:`vtool.solvers.configurations`),
-positive in compression.
+Monitors: a closed clearance's contact force (a row of coefficients on
+(z, ż, z̈, sources) per configuration, positive in compression), an open
+one's gap q[ahead] - q[behind] (+ the round-off allowance). A sign change
+is an event.
 
-Status codes returned by :func:`run_chunk` are the ``STATUS_*`` values in
-:mod:`vtool.solvers.newmark`, passed in as plain integers.
+Impact laws (per clearance, ``CL_LAW``): ``LAW_MOMENTUM`` one linear
+complementarity problem on the consistent mass matrix; ``LAW_LOCAL`` only the
+impacting coordinate's velocity changes (external), or the two tied
+coordinates take their common, momentum-conserving velocity computed with the
+two diagonal masses (internal); ``LAW_THESIS`` as local but an internal
+closing gives the tied pair SCALE times the ahead coordinate's velocity
+(Gnilka eq. 3.54). See :func:`impact`.
+
+After every transition :func:`settle` computes the consistent accelerations
+of the new configuration and releases at once any contact whose force would
+pull (an impact so released is a bounce: two events at one instant).
 """
 
 from __future__ import annotations
 
-from collections import namedtuple
-
 import numpy as np
 from numba import njit
 
-jit = njit(cache=True, nogil=True)
-leaf = njit(cache=True, nogil=True, inline="always")
+jit = njit(cache=True, nogil=True, error_model="numpy")
 
-Problem = namedtuple(
-    "Problem",
-    [
-        "n",  # number of full (elastic) coordinates
-        "beta",
-        "gamma",
-        "dt",  # standard time step, s
-        "t_end",  # end of the run, s
-        "out_dt",  # output interval, s (ignored when every_step)
-        "every_step",  # 1: record every accepted (sub)step
-        "cl_ahead",  # int[ncl]: full index of the coordinate ahead when open
-        "cl_behind",  # int[ncl]: full index behind (internal) or -1
-        "cl_src",  # int[ncl]: source index behind (external) or -1
-        "cl_monitored",  # int[ncl]: 1 for enabled clearances (pinned/removed: 0)
-        "cl_pinned",  # int[ncl]: 1 for pinned clearances
-        "cl_e",  # float[ncl]: restitution coefficient
-        "cl_bit",  # int[ncl]: bit of the clearance in the configuration mask
-        "src_kind",  # int[ns]
-        "src_par",  # float[ns, 3]
-        "Minv",  # float[n, n]: inverse of the full mass matrix (impacts)
-        "time_tol",  # event location tolerance in time, s
-        "zeno_window",  # events closer than this count as rapid, s
-        "zeno_stick",  # rapid events before contacts are made to stick
-        "zeno_stop",  # rapid events before the run stops
-        "x_limit",  # |q| beyond this is divergence
-        "rest_velocity",  # slower separations and impacts are resting contacts
-        "gap_noise",  # gaps within this of zero are round-off (length)
-        "refine",  # after an event, steps are dt / refine ...
-        "refine_window",  # ... for this long (s)
-    ],
-)
-
-Configs = namedtuple(
-    "Configs",
-    ["built", "m", "kept", "group", "nf", "free", "npres", "pres", "pres_src",
-     "ML", "CL", "KL", "Sinv", "SinvFine", "MinvFF", "Frow"],
-)
-
-Output = namedtuple(
-    "Output",
-    ["t", "x", "v", "a", "F", "cfg", "ev_t", "ev_k", "ev_kind", "ev_u", "ev_from", "ev_to", "F_peak"],
-)
-
-Work = namedtuple(
-    "Work",
-    ["xl", "vl", "al", "rhs", "S", "Sinv", "x0", "v0", "a0", "x1", "v1", "a1",
-     "phi", "tau", "xo", "vo", "ao", "src"],
-)
-
-# istate / fstate slots (documented in vtool.solvers.newmark)
-I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_ACCEL, I_WANT_CFG = range(9)
+# ----- slots of the integer and float parameter vectors -----
+IP_N, IP_NCL, IP_NS, IP_NH, IP_EVERY, IP_ZSTICK, IP_ZSTOP = range(7)
+IP_SIZE = 8
+(FP_BETA, FP_GAMMA, FP_DT, FP_TEND, FP_OUTDT, FP_OMEGA, FP_TTOL, FP_ZWIN, FP_XLIM, FP_VREST,
+ FP_GAPNOISE, FP_REFINE, FP_REFWIN, FP_FTOL, FP_TREV) = range(15)
+FP_SIZE = 16
+# clearance table columns (int) and float columns
+CL_AHEAD, CL_BEHIND, CL_SRC, CL_MON, CL_PIN, CL_BIT, CL_LAW = range(7)
+CL_SIZE = 7
+CLF_E, CLF_SCALE = range(2)
+# impact laws
+LAW_MOMENTUM, LAW_LOCAL, LAW_THESIS = range(3)
+# event kinds
+EV_OPENED, EV_CLOSED, EV_RELEASED = range(3)
+# configuration integer table: built, m, nf, then kept[n], group[n], source of each z index[n]
+CI_BUILT, CI_M, CI_NF = range(3)
+CI_HEAD = 3
+# configuration matrices
+CM_MFF, CM_CFF, CM_KFF, CM_SINV, CM_SINVF, CM_MINVFF = range(6)
+CM_SIZE = 6
+# monitor kind per (configuration, clearance): (type, ahead z index, behind z index or -1 - source)
+MK_NONE, MK_GAP, MK_FORCE = range(3)
+# run status
+FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED, CHATTER = range(1, 7)
+# integer and float state slots
+I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_SETTLE, I_WANT_CFG, I_STARTED = range(10)
+I_SIZE = 10
 F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
+F_SIZE = 4
 
 
-@leaf
-def source_state(src_kind, src_par, s, t):
-    """Displacement, velocity and acceleration of prescribed source s at time t."""
-    if src_kind[s] == 0:
-        amp = src_par[s, 0]
-        w = src_par[s, 1]
-        sw = np.sin(w * t)
-        return amp * sw + src_par[s, 2], amp * w * np.cos(w * t), -amp * w * w * sw
-    return src_par[s, 0], 0.0, 0.0
+# ----- sources -----
+@jit
+def fill_sources(ns, nh, omega, sc, sa, sb, t, src):
+    """src[3s : 3s + 3] = (x, v, a) of every source s at t (harmonics by angle addition)."""
+    c1 = np.cos(omega * t)
+    s1 = np.sin(omega * t)
+    for s in range(ns):
+        src[3 * s] = sc[s]
+        src[3 * s + 1] = 0.0
+        src[3 * s + 2] = 0.0
+    ck = 1.0
+    sk = 0.0
+    for k in range(nh):
+        ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1  # cos, sin of (k + 1) omega t
+        wk = (k + 1) * omega
+        for s in range(ns):
+            a = sa[s, k]
+            b = sb[s, k]
+            src[3 * s] += a * ck + b * sk
+            src[3 * s + 1] += wk * (b * ck - a * sk)
+            src[3 * s + 2] -= wk * wk * (a * ck + b * sk)
 
 
-@leaf
-def gather(cfg, c, x, v, a, xl, vl, al):
-    """Layer values of configuration c from full arrays (tied coordinates are equal)."""
-    for j in range(cfg.m[c]):
-        i = cfg.kept[c, j]
-        xl[j] = x[i]
-        vl[j] = v[i]
-        al[j] = a[i]
+# ----- layer values of a configuration -----
+@jit
+def gather(ci, c, n, x, v, a, z, zd, zdd):
+    for j in range(ci[c, CI_M]):
+        i = ci[c, CI_HEAD + j]
+        z[j] = x[i]
+        zd[j] = v[i]
+        zdd[j] = a[i]
 
 
-@leaf
-def scatter(prob, cfg, c, xl, vl, al, x, v, a):
-    for i in range(prob.n):
-        j = cfg.group[c, i]
-        x[i] = xl[j]
-        v[i] = vl[j]
-        a[i] = al[j]
+@jit
+def scatter(ci, c, n, z, zd, zdd, x, v, a):
+    for i in range(n):
+        j = ci[c, CI_HEAD + n + i]
+        x[i] = z[j]
+        v[i] = zd[j]
+        a[i] = zdd[j]
 
 
-@leaf
-def set_prescribed(prob, cfg, c, t, xl, vl, al):
-    for p in range(cfg.npres[c]):
-        j = cfg.pres[c, p]
-        xl[j], vl[j], al[j] = source_state(prob.src_kind, prob.src_par, cfg.pres_src[c, p], t)
+@jit
+def set_prescribed(ci, c, n, src, z, zd, zdd):
+    for j in range(ci[c, CI_NF], ci[c, CI_M]):
+        s = ci[c, CI_HEAD + 2 * n + j]
+        z[j] = src[3 * s]
+        zd[j] = src[3 * s + 1]
+        zdd[j] = src[3 * s + 2]
 
 
-@leaf
-def free_rhs(cfg, c, xl, vl, al, rhs):
-    """rhs_F = -C_FF v_F - K_FF x_F - (M_FP a_P + C_FP v_P + K_FP x_P): the thesis' ΔP on the right."""
-    nf, npres = cfg.nf[c], cfg.npres[c]
+@jit
+def free_rhs(ci, cm, cp, c, z, zd, zdd, rhs):
+    """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P): the thesis' ΔP on the right."""
+    nf = ci[c, CI_NF]
+    m = ci[c, CI_M]
     for f in range(nf):
-        jf = cfg.free[c, f]
         s = 0.0
         for g in range(nf):
-            jg = cfg.free[c, g]
-            s -= cfg.CL[c, jf, jg] * vl[jg] + cfg.KL[c, jf, jg] * xl[jg]
-        for p in range(npres):
-            jp = cfg.pres[c, p]
-            s -= cfg.ML[c, jf, jp] * al[jp] + cfg.CL[c, jf, jp] * vl[jp] + cfg.KL[c, jf, jp] * xl[jp]
+            s -= cm[c, CM_CFF, f, g] * zd[g] + cm[c, CM_KFF, f, g] * z[g]
+        for p in range(m - nf):
+            j = nf + p
+            s -= cp[c, f, 3 * p] * zdd[j] + cp[c, f, 3 * p + 1] * zd[j] + cp[c, f, 3 * p + 2] * z[j]
         rhs[f] = s
 
 
 @jit
-def effective_inverse(prob, cfg, c, h, S, Sinv):
-    """Sinv = (M_FF + gamma h C_FF + beta h² K_FF)⁻¹ for a non-standard step h."""
-    nf = cfg.nf[c]
+def factor_effective(ci, cm, c, beta, gamma, h, L):
+    """Cholesky factor (lower, in place in L) of S = M_FF + gamma h C_FF + beta h² K_FF."""
+    nf = ci[c, CI_NF]
     for f in range(nf):
-        jf = cfg.free[c, f]
-        for g in range(nf):
-            jg = cfg.free[c, g]
-            S[f, g] = (cfg.ML[c, jf, jg] + prob.gamma * h * cfg.CL[c, jf, jg]
-                       + prob.beta * h * h * cfg.KL[c, jf, jg])
-    Sinv[:nf, :nf] = np.linalg.inv(S[:nf, :nf])
-
-
-@leaf
-def newmark_step(prob, cfg, c, t, h, Sinv, x, v, a, w, x1, v1, a1):
-    """One Newmark step of length h in configuration c from full (x, v, a) at t.
-
-    Writes the full state at t + h into (x1, v1, a1) and leaves the layer
-    state at t + h in (w.xl, w.vl, w.al) for the contact forces.
-    """
-    beta, gamma = prob.beta, prob.gamma
-    m, nf = cfg.m[c], cfg.nf[c]
-    xl, vl, al = w.xl, w.vl, w.al
-    gather(cfg, c, x, v, a, xl, vl, al)
-    for j in range(m):  # predictors x̃, ṽ (overwritten for prescribed columns)
-        xl[j] += h * vl[j] + h * h * (0.5 - beta) * al[j]
-        vl[j] += h * (1.0 - gamma) * al[j]
-    set_prescribed(prob, cfg, c, t + h, xl, vl, al)
-    free_rhs(cfg, c, xl, vl, al, w.rhs)
-    for f in range(nf):
-        s = 0.0
-        for g in range(nf):
-            s += Sinv[f, g] * w.rhs[g]
-        jf = cfg.free[c, f]
-        al[jf] = s
-        xl[jf] += beta * h * h * s
-        vl[jf] += gamma * h * s
-    scatter(prob, cfg, c, xl, vl, al, x1, v1, a1)
-
-
-@leaf
-def fill_sources(prob, t, src):
-    """src[3s : 3s + 3] = (x, v, a) of every prescribed source s at time t."""
-    for s in range(prob.src_kind.shape[0]):
-        src[3 * s], src[3 * s + 1], src[3 * s + 2] = source_state(prob.src_kind, prob.src_par, s, t)
-
-
-@leaf
-def gap(prob, k, x, src):
-    """q[ahead] - q[behind] of clearance k (positive while open); src from :func:`fill_sources`."""
-    if prob.cl_behind[k] >= 0:
-        return x[prob.cl_ahead[k]] - x[prob.cl_behind[k]]
-    return x[prob.cl_ahead[k]] - src[3 * prob.cl_src[k]]
-
-
-@leaf
-def consistent_acceleration(prob, cfg, c, t, x, v, a, xl, vl, al, rhs):
-    """Accelerations (into a) from the equations of motion of configuration c at t.
-
-    Uses the layer scratch arrays (xl, vl, al, rhs) given, so a caller can
-    keep another layer state alive.
-    """
-    gather(cfg, c, x, v, a, xl, vl, al)
-    set_prescribed(prob, cfg, c, t, xl, vl, al)
-    nf = cfg.nf[c]
-    free_rhs(cfg, c, xl, vl, al, rhs)
-    for f in range(nf):
-        s = 0.0
-        for g in range(nf):
-            s += cfg.MinvFF[c, f, g] * rhs[g]
-        al[cfg.free[c, f]] = s
-    for i in range(prob.n):
-        a[i] = al[cfg.group[c, i]]
-
-
-@leaf
-def contact_force(prob, cfg, c, k, x, v, a, src):
-    """Contact force of clearance k in configuration c, positive in compression.
-
-    A row of coefficients per (configuration, clearance) on the full state
-    and the sources (see :mod:`vtool.solvers.configurations`); zero when open.
-    ``src`` holds the sources at the same instant (:func:`fill_sources`).
-    """
-    n = prob.n
-    f = 0.0
-    for i in range(n):
-        f += cfg.Frow[c, k, i] * x[i] + cfg.Frow[c, k, n + i] * v[i] + cfg.Frow[c, k, 2 * n + i] * a[i]
-    for j in range(src.shape[0]):
-        f += cfg.Frow[c, k, 3 * n + j] * src[j]
-    return f
-
-
-@leaf
-def monitor(prob, cfg, c, k, x, v, a, src):
-    """The value whose sign change flips clearance k: its contact force if closed, its gap if open.
-
-    A gap counts as closed when it is below -gap_noise (1e-13 of the
-    mechanism's size): a gap that starts at zero (a contact just released,
-    or separating tangentially) has a round-off sign until it has moved.
-    """
-    if c & prob.cl_bit[k]:
-        return contact_force(prob, cfg, c, k, x, v, a, src)
-    return gap(prob, k, x, src) + prob.gap_noise
-
-
-@leaf
-def step_to(prob, cfg, c, t, h, x, v, a, w, x1, v1, a1):
-    """A Newmark step of any length h (standard steps reuse the stored inverse)."""
-    if h == prob.dt:
-        newmark_step(prob, cfg, c, t, h, cfg.Sinv[c], x, v, a, w, x1, v1, a1)
-    elif h == prob.dt / prob.refine:
-        newmark_step(prob, cfg, c, t, h, cfg.SinvFine[c], x, v, a, w, x1, v1, a1)
-    else:
-        effective_inverse(prob, cfg, c, h, w.S, w.Sinv)
-        newmark_step(prob, cfg, c, t, h, w.Sinv, x, v, a, w, x1, v1, a1)
+        for g in range(f + 1):
+            s = cm[c, CM_MFF, f, g] + gamma * h * cm[c, CM_CFF, f, g] + beta * h * h * cm[c, CM_KFF, f, g]
+            for k in range(g):
+                s -= L[f, k] * L[g, k]
+            if f == g:
+                L[f, f] = np.sqrt(s) if s > 0.0 else 1e-300
+            else:
+                L[f, g] = s / L[g, g]
 
 
 @jit
-def locate_event(prob, cfg, c, k, t, lo, h, phi_lo, phi_hi, x, v, a, w):
-    """Earliest tau in (lo, h] where monitor k crosses zero, re-stepping from t.
+def cholesky_solve(nf, L, rhs, out):
+    for f in range(nf):
+        s = rhs[f]
+        for k in range(f):
+            s -= L[f, k] * out[k]
+        out[f] = s / L[f, f]
+    for f in range(nf - 1, -1, -1):
+        s = out[f]
+        for k in range(f + 1, nf):
+            s -= L[k, f] * out[k]
+        out[f] = s / L[f, f]
+
+
+@jit
+def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol):
+    """One Newmark step of length h from layer state (z, ż, z̈) into (z1, ż1, z̈1).
+
+    ``which``: 0 the stored S⁻¹ of the standard step, 1 of the refined step,
+    2 a Cholesky factor already in ``L``. ``src1`` holds the sources at t + h.
+    """
+    m = ci[c, CI_M]
+    nf = ci[c, CI_NF]
+    for j in range(m):
+        z1[j] = z[j] + h * zd[j] + h * h * (0.5 - beta) * zdd[j]
+        zd1[j] = zd[j] + h * (1.0 - gamma) * zdd[j]
+    set_prescribed(ci, c, n, src1, z1, zd1, zdd1)
+    free_rhs(ci, cm, cp, c, z1, zd1, zdd1, rhs)
+    if which == 2:
+        cholesky_solve(nf, L, rhs, sol)
+    else:
+        slot = CM_SINV if which == 0 else CM_SINVF
+        for f in range(nf):
+            s = 0.0
+            for g in range(nf):
+                s += cm[c, slot, f, g] * rhs[g]
+            sol[f] = s
+    for f in range(nf):
+        zdd1[f] = sol[f]
+        z1[f] += beta * h * h * sol[f]
+        zd1[f] += gamma * h * sol[f]
+
+
+@jit
+def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
+    """Free accelerations of configuration c from its equations of motion (prescribed set from src)."""
+    set_prescribed(ci, c, n, src, z, zd, zdd)
+    free_rhs(ci, cm, cp, c, z, zd, zdd, rhs)
+    nf = ci[c, CI_NF]
+    for f in range(nf):
+        s = 0.0
+        for g in range(nf):
+            s += cm[c, CM_MINVFF, f, g] * rhs[g]
+        zdd[f] = s
+
+
+@jit
+def monitor_value(mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src):
+    """Contact force (closed) or gap + allowance (open) of clearance k; 0 when not monitored."""
+    kind = mk[c, k, 0]
+    if kind == MK_GAP:
+        behind = mk[c, k, 2]
+        other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
+        return z[mk[c, k, 1]] - other + gap_noise
+    if kind == MK_FORCE:
+        f = mon[c, k, 3 * n + 3 * ns]
+        for j in range(mk[c, k, 1]):  # mk[c, k, 1] holds m for force rows
+            f += mon[c, k, j] * z[j] + mon[c, k, n + j] * zd[j] + mon[c, k, 2 * n + j] * zdd[j]
+        for j in range(3 * ns):
+            f += mon[c, k, 3 * n + j] * src[j]
+        return f
+    return 0.0
+
+
+# ----- output -----
+@jit
+def record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src, out_t, out_q, out_F, out_c, row):
+    out_t[row] = t
+    out_c[row] = c
+    for i in range(n):
+        j = ci[c, CI_HEAD + n + i]
+        out_q[row, 0, i] = z[j]
+        out_q[row, 1, i] = zd[j]
+        out_q[row, 2, i] = zdd[j]
+    for s in range(ns):
+        out_q[row, 0, n + s] = src[3 * s]
+        out_q[row, 1, n + s] = src[3 * s + 1]
+        out_q[row, 2, n + s] = src[3 * s + 2]
+    for k in range(ncl):
+        if mk[c, k, 0] == MK_FORCE:
+            out_F[row, k] = monitor_value(mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src)
+        else:
+            out_F[row, k] = 0.0
+
+
+# ----- impacts -----
+@jit
+def add_event(ev_f, ev_i, ist, t, k, kind, u, c_from, c_to):
+    row = ist[I_NEV]
+    if row < ev_f.shape[0]:
+        ev_f[row, 0] = t
+        ev_f[row, 1] = u
+        ev_i[row, 0] = k
+        ev_i[row, 1] = kind
+        ev_i[row, 2] = c_from
+        ev_i[row, 3] = c_to
+    ist[I_NEV] = row + 1
+
+
+@jit
+def solve_dense(A, b, out, na):
+    """out[:na] = A[:na, :na]⁻¹ b[:na] by Gaussian elimination with partial pivoting (A, b overwritten)."""
+    for col in range(na):
+        pivot = col
+        for r in range(col + 1, na):
+            if abs(A[r, col]) > abs(A[pivot, col]):
+                pivot = r
+        if pivot != col:
+            for q in range(na):
+                A[col, q], A[pivot, q] = A[pivot, q], A[col, q]
+            b[col], b[pivot] = b[pivot], b[col]
+        d = A[col, col] if A[col, col] != 0.0 else 1e-300
+        for r in range(col + 1, na):
+            f = A[r, col] / d
+            for q in range(col, na):
+                A[r, q] -= f * A[col, q]
+            b[r] -= f * b[col]
+    for r in range(na - 1, -1, -1):
+        s = b[r]
+        for q in range(r + 1, na):
+            s -= A[r, q] * out[q]
+        d = A[r, r] if A[r, r] != 0.0 else 1e-300
+        out[r] = s / d
+
+
+@jit
+def solve_impulse_lcp(W, u, b, eq, scale, P, uplus):
+    """Impulses P >= 0 with u + W P - b >= 0 and complementarity (equalities: = b).
+
+    Enumerates active sets, most contacts first; W is positive definite, so
+    exactly one set satisfies the conditions (to the tolerance ``scale``).
+    Writes P and u⁺ = u + W P.
+    """
+    nc = u.shape[0]
+    active = np.zeros(nc, dtype=np.int64)
+    Wa = np.zeros((nc, nc))
+    ra = np.zeros(nc)
+    sol = np.zeros(nc)
+    for pattern in range(2**nc - 1, -1, -1):
+        na = 0
+        for r in range(nc):
+            P[r] = 0.0
+            if eq[r] or (pattern >> r) & 1:
+                active[na] = r
+                na += 1
+        for p in range(na):
+            ra[p] = b[active[p]] - u[active[p]]
+            for q in range(na):
+                Wa[p, q] = W[active[p], active[q]]
+        solve_dense(Wa, ra, sol, na)
+        for p in range(na):
+            P[active[p]] = sol[p]
+        ok = True
+        for r in range(nc):
+            s = u[r]
+            for q in range(nc):
+                s += W[r, q] * P[q]
+            uplus[r] = s
+            if not eq[r] and (P[r] * W[r, r] < -10.0 * scale or s - b[r] < -10.0 * scale):
+                ok = False
+        if ok:
+            return
+    for r in range(nc):
+        P[r] = 0.0
+        uplus[r] = u[r]
+
+
+@jit
+def impact_momentum(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t):
+    """Newton impact with restitution, impulses of all contacts together on the consistent mass matrix.
+
+    Contacts taking part: every clearance closed in c (persistent) and the
+    closing ones with the ``momentum`` law. With G their velocity-constraint
+    rows (internal: e_ahead - e_behind; external: e_ahead), relative
+    velocities u = G v - w (w: source velocity) and the Delassus matrix
+    W = G M⁻¹ Gᵀ, the impulses P solve the linear complementarity problem
+
+        u⁺ = u⁻ + W P,   P >= 0,   u⁺ - b >= 0,   P · (u⁺ - b) = 0
+
+    with b = -e u⁻ for a closing contact (Newton's law) and b = 0 for a
+    persistent one (it may separate, but not penetrate); pinned clearances are
+    equalities. Then v⁺ = v⁻ + M⁻¹ Gᵀ P conserves generalised momentum. A
+    contact is closed afterwards when it leaves with no separating relative
+    velocity; a persistent one that the impulse pulls apart is released.
+    Separations slower than the resting velocity are resting contacts (held
+    as equalities); in ``stick`` mode (chattering) every contact involved is.
+    """
+    n = ip[IP_N]
+    ncl = ip[IP_NCL]
+    idx = np.empty(ncl, dtype=np.int64)
+    nc = 0
+    for k in range(ncl):
+        if (c & cl[k, CL_BIT]) or closing[k]:
+            idx[nc] = k
+            nc += 1
+    G = np.zeros((nc, n))
+    u = np.zeros(nc)
+    b = np.zeros(nc)
+    eq = np.zeros(nc, dtype=np.int64)
+    for r in range(nc):
+        k = idx[r]
+        G[r, cl[k, CL_AHEAD]] = 1.0
+        wsrc = 0.0
+        if cl[k, CL_BEHIND] >= 0:
+            G[r, cl[k, CL_BEHIND]] -= 1.0
+        else:
+            wsrc = src[3 * cl[k, CL_SRC] + 1]
+        for i in range(n):
+            u[r] += G[r, i] * v[i]
+        u[r] -= wsrc
+        if closing[k]:
+            e = 0.0 if (stick or abs(u[r]) < fp[FP_VREST]) else clf[k, CLF_E]
+            b[r] = -e * u[r]
+        eq[r] = cl[k, CL_PIN] or stick
+    MG = np.zeros((n, nc))  # M⁻¹ Gᵀ
+    for i in range(n):
+        for r in range(nc):
+            s = 0.0
+            for j in range(n):
+                s += mass[1, i, j] * G[r, j]
+            MG[i, r] = s
+    W = np.zeros((nc, nc))
+    for r in range(nc):
+        for q in range(nc):
+            s = 0.0
+            for i in range(n):
+                s += G[r, i] * MG[i, q]
+            W[r, q] = s
+    umax = 0.0
+    for r in range(nc):
+        umax = max(umax, abs(u[r]))
+    scale = 1e-12 + 1e-9 * umax
+    P = np.zeros(nc)
+    uplus = np.zeros(nc)
+    for _ in range(nc + 1):
+        solve_impulse_lcp(W, u, b, eq, scale, P, uplus)
+        resting = False
+        for r in range(nc):
+            if not eq[r] and 10.0 * scale < uplus[r] < fp[FP_VREST]:
+                eq[r] = 1
+                b[r] = 0.0
+                resting = True
+        if not resting:
+            break
+    for i in range(n):
+        for r in range(nc):
+            v[i] += MG[i, r] * P[r]
+    mask = c
+    for r in range(nc):
+        k = idx[r]
+        stays = eq[r] or uplus[r] <= 10.0 * scale
+        if stays:
+            mask |= cl[k, CL_BIT]
+        else:
+            mask &= ~cl[k, CL_BIT]
+    for r in range(nc):
+        k = idx[r]
+        if closing[k]:
+            add_event(ev_f, ev_i, ist, t, k, EV_CLOSED, u[r], c, mask)
+        elif not (mask & cl[k, CL_BIT]):
+            add_event(ev_f, ev_i, ist, t, k, EV_RELEASED, uplus[r], c, mask)
+    return mask
+
+
+@jit
+def prescribed_velocity(cl, c, ncl, coordinate, src):
+    """Velocity of the source a coordinate is tied to in configuration c, or nan if it is free."""
+    for k in range(ncl):
+        if (c & cl[k, CL_BIT]) and cl[k, CL_BEHIND] < 0 and cl[k, CL_AHEAD] == coordinate:
+            return src[3 * cl[k, CL_SRC] + 1]
+    return np.nan
+
+
+@jit
+def impact_local(ip, fp, cl, clf, mass, c, k, src, v, stick, ev_f, ev_i, ist, t):
+    """The thesis' local law at one closing clearance k (see the module doc); returns the new mask.
+
+    External: the impacting coordinate a takes the source velocity w with
+    restitution, v_a⁺ = w - e (v_a⁻ - w); nothing else changes. Internal
+    (a ahead, b behind, relative velocity u⁻ = v_a - v_b): with diagonal
+    masses m_a, m_b the common velocity U = (m_a v_a + m_b v_b)/(m_a + m_b)
+    (law ``thesis``: U = SCALE v_a, Gnilka eq. 3.54), and
+    v_a⁺ = U + m_b/(m_a + m_b) u⁺, v_b⁺ = U - m_a/(m_a + m_b) u⁺ with
+    u⁺ = -e u⁻. A coordinate of the pair that is tied to a source counts as
+    infinitely heavy. A contact that leaves with a separating velocity
+    (e > 0, above the resting velocity) stays open.
+    """
+    ncl = ip[IP_NCL]
+    a = cl[k, CL_AHEAD]
+    behind = cl[k, CL_BEHIND]
+    if behind < 0:
+        w = src[3 * cl[k, CL_SRC] + 1]
+        u = v[a] - w
+        e = 0.0 if (stick or abs(u) < fp[FP_VREST]) else clf[k, CLF_E]
+        v[a] = w - e * u
+    else:
+        u = v[a] - v[behind]
+        e = 0.0 if (stick or abs(u) < fp[FP_VREST]) else clf[k, CLF_E]
+        wa = prescribed_velocity(cl, c, ncl, a, src)
+        wb = prescribed_velocity(cl, c, ncl, behind, src)
+        if not np.isnan(wa):  # a follows a source: b alone changes
+            v[behind] = wa + e * u
+        elif not np.isnan(wb):
+            v[a] = wb - e * u
+        else:
+            ma = mass[0, a, a]
+            mb = mass[0, behind, behind]
+            if cl[k, CL_LAW] == LAW_THESIS:
+                common = clf[k, CLF_SCALE] * v[a]
+            else:
+                common = (ma * v[a] + mb * v[behind]) / (ma + mb)
+            uplus = -e * u
+            v[a] = common + mb / (ma + mb) * uplus
+            v[behind] = common - ma / (ma + mb) * uplus
+    mask = c
+    if e * abs(u) <= 0.0:
+        mask |= cl[k, CL_BIT]
+    add_event(ev_f, ev_i, ist, t, k, EV_CLOSED, u, c, mask)
+    return mask
+
+
+@jit
+def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t):
+    """Apply the impact law of every closing clearance at t; returns the new configuration mask.
+
+    Local-law closings are applied one after the other (each changes only its
+    own coordinates); momentum-law closings are solved together with every
+    closed contact (:func:`impact_momentum`). Gaps are snapped shut (they are
+    within the time tolerance).
+    """
+    ncl = ip[IP_NCL]
+    mask = c
+    momentum = np.zeros(ncl, dtype=np.int64)
+    any_momentum = False
+    for k in range(ncl):
+        if not closing[k]:
+            continue
+        a = cl[k, CL_AHEAD]
+        x[a] = x[cl[k, CL_BEHIND]] if cl[k, CL_BEHIND] >= 0 else src[3 * cl[k, CL_SRC]]
+        if cl[k, CL_LAW] == LAW_MOMENTUM:
+            momentum[k] = 1
+            any_momentum = True
+        else:
+            mask = impact_local(ip, fp, cl, clf, mass, mask, k, src, v, stick, ev_f, ev_i, ist, t)
+    if any_momentum:
+        mask = impact_momentum(ip, fp, cl, clf, mass, mask, momentum, src, x, v, stick, ev_f, ev_i, ist, t)
+    return mask
+
+
+@jit
+def settle(ip, fp, cl, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist, rhs, z, zd, zdd):
+    """Consistent accelerations of configuration c; release at once every contact that would pull.
+
+    Returns the settled configuration, or -1 - c2 when configuration c2 must
+    be built first (call again after building it). The most pulling contact
+    is released first and the accelerations recomputed, until every closed
+    contact pushes (at most one release per clearance).
+    """
+    n = ip[IP_N]
+    ns = ip[IP_NS]
+    ncl = ip[IP_NCL]
+    for _ in range(ncl + 1):
+        if not ci[c, CI_BUILT]:
+            return -1 - c
+        gather(ci, c, n, x, v, a, z, zd, zdd)
+        consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs)
+        scatter(ci, c, n, z, zd, zdd, x, v, a)
+        worst = -1
+        worst_f = -fp[FP_FTOL]
+        for k in range(ncl):
+            if mk[c, k, 0] == MK_FORCE and cl[k, CL_MON]:
+                f = monitor_value(mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z, zd, zdd, src)
+                if f < worst_f:
+                    worst = k
+                    worst_f = f
+        if worst < 0:
+            return c
+        new_c = c & ~cl[worst, CL_BIT]
+        add_event(ev_f, ev_i, ist, t, worst, EV_OPENED, 0.0, c, new_c)
+        c = new_c
+    return c
+
+
+# ----- event location -----
+@jit
+def locate_event(ci, cm, cp, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi_lo, phi_hi,
+                 z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L):
+    """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from (z, ż, z̈) at t.
 
     Illinois (modified regula falsi) on phi(tau) = monitor after a Newmark
-    step of length tau, bracketed by phi(lo) >= 0 > phi(h), with a bisection
+    step of length tau, bracketed by phi(0) >= 0 > phi(h), with a bisection
     whenever two iterations have not halved the bracket; returns the left end
-    of the final bracket (the monitor still non-negative), within
-    prob.time_tol of the crossing.
+    of the final bracket (the monitor still non-negative), within the time
+    tolerance of the crossing. Each trial factors S(tau) by Cholesky.
     """
-    hi = h
+    beta, gamma, tol = fp[FP_BETA], fp[FP_GAMMA], fp[FP_TTOL]
+    lo, hi = 0.0, h
     flo, fhi = phi_lo, phi_hi
     side = 0
     width_before = 2.0 * h
     for iteration in range(200):
         width = hi - lo
-        if width <= prob.time_tol:
+        if width <= tol:
             break
         if iteration % 2 == 0:
             if width > 0.5 * width_before:
-                tau = 0.5 * (lo + hi)  # slow progress: bisect
+                tau = 0.5 * (lo + hi)
             else:
                 tau = (lo * fhi - hi * flo) / (fhi - flo)
             width_before = width
         else:
             tau = (lo * fhi - hi * flo) / (fhi - flo)
-        tau = min(max(tau, lo + 0.25 * prob.time_tol), hi - 0.25 * prob.time_tol)
-        step_to(prob, cfg, c, t, tau, x, v, a, w, w.x1, w.v1, w.a1)
-        fill_sources(prob, t + tau, w.src)
-        f = monitor(prob, cfg, c, k, w.x1, w.v1, w.a1, w.src)
+        tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
+        fill_sources(ns, nh, fp[FP_OMEGA], sc, sa, sb, t + tau, src1)
+        factor_effective(ci, cm, c, beta, gamma, tau, L)
+        layer_step(ci, cm, cp, c, beta, gamma, tau, 2, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol)
+        f = monitor_value(mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z1, zd1, zdd1, src1)
         if f < 0.0:
             hi, fhi = tau, f
             if side == -1:
@@ -310,413 +607,232 @@ def locate_event(prob, cfg, c, k, t, lo, h, phi_lo, phi_hi, x, v, a, w):
     return lo
 
 
+# ----- the run loop -----
 @jit
-def record(prob, cfg, c, t, x, v, a, w, out, row):
-    """Write one output row at t: coordinates, sources and contact forces.
+def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
+              out_t, out_q, out_F, out_c, ev_f, ev_i, peak, x, v, a, ist, fst):
+    """Integrate from fst[F_T] until t_end, the chunk end, or something Python must do.
 
-    The prescribed coordinates of configuration c are first set exactly from
-    their sources (an interpolated state only approximates them).
+    Returns a status (FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED,
+    CHATTER). (x, v, a) is the full state at fst[F_T] in configuration
+    ist[I_CFG]; everything needed to resume is in the arguments, so Python may
+    build a configuration or empty a buffer and call again. Output rows at the
+    output instants are interpolated inside the step by the linear-acceleration
+    interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); ``peak[0]`` holds
+    the peak contact forces over every step, ``peak[1]`` those after the first
+    cam revolution.
     """
-    n = prob.n
-    gather(cfg, c, x, v, a, w.xl, w.vl, w.al)
-    set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
-    scatter(prob, cfg, c, w.xl, w.vl, w.al, x, v, a)
-    out.t[row] = t
-    out.cfg[row] = c
-    for i in range(n):
-        out.x[row, i] = x[i]
-        out.v[row, i] = v[i]
-        out.a[row, i] = a[i]
-    fill_sources(prob, t, w.src)
-    for s in range(prob.src_kind.shape[0]):
-        out.x[row, n + s] = w.src[3 * s]
-        out.v[row, n + s] = w.src[3 * s + 1]
-        out.a[row, n + s] = w.src[3 * s + 2]
-    for k in range(prob.cl_ahead.shape[0]):
-        out.F[row, k] = contact_force(prob, cfg, c, k, x, v, a, w.src) if c & prob.cl_bit[k] else 0.0
-
-
-@jit
-def record_outputs(prob, cfg, c, t0, h, istate, out, w):
-    """Record every output instant in (t0, t0 + h] by the linear-acceleration interpolant.
-
-    Within a step the acceleration is taken linear (exact for beta = 1/6),
-    so v and x are its quadratic and cubic integrals (thesis eqs. B.3–B.5).
-    Returns False when the output buffer is full.
-    """
-    n = prob.n
-    t1 = t0 + h
-    if prob.every_step:
-        row = istate[I_NOUT]
-        if row >= out.t.shape[0]:
-            return False
-        record(prob, cfg, c, t1, w.x1, w.v1, w.a1, w, out, row)
-        istate[I_NOUT] = row + 1
-        return True
-    while True:
-        j = istate[I_NEXT_OUT]
-        t_out = j * prob.out_dt
-        if t_out > t1 + 1e-9 * prob.dt or t_out > prob.t_end + 1e-9 * prob.dt:
-            return True
-        row = istate[I_NOUT]
-        if row >= out.t.shape[0]:
-            return False
-        tau = t_out - t0
-        r = tau / h if h > 0 else 0.0
-        for i in range(n):
-            da = w.a1[i] - w.a0[i]
-            w.ao[i] = w.a0[i] + da * r
-            w.vo[i] = w.v0[i] + w.a0[i] * tau + da * tau * r / 2.0
-            w.xo[i] = w.x0[i] + w.v0[i] * tau + w.a0[i] * tau * tau / 2.0 + da * tau * tau * r / 6.0
-        record(prob, cfg, c, t_out, w.xo, w.vo, w.ao, w, out, row)
-        istate[I_NOUT] = row + 1
-        istate[I_NEXT_OUT] = j + 1
-
-
-@jit
-def add_event(out, istate, t, k, kind, u, c_from, c_to):
-    row = istate[I_NEV]
-    if row < out.ev_t.shape[0]:
-        out.ev_t[row] = t
-        out.ev_k[row] = k
-        out.ev_kind[row] = kind
-        out.ev_u[row] = u
-        out.ev_from[row] = c_from
-        out.ev_to[row] = c_to
-    istate[I_NEV] = row + 1
-
-
-@jit
-def impact(prob, c, closing, t, x, v, stick, out, istate):
-    """Newton impact with restitution at the closing clearances; returns the new mask.
-
-    Contacts taking part: every clearance closed in c (persistent) and the
-    closing ones. With G their velocity-constraint rows (internal:
-    e_ahead - e_behind; external: e_ahead), relative velocities u = G v - w
-    (w: source velocity) and the Delassus matrix W = G M⁻¹ Gᵀ, the impulses P
-    solve the linear complementarity problem
-
-        u⁺ = u⁻ + W P,   P >= 0,   u⁺ - b >= 0,   P · (u⁺ - b) = 0
-
-    with b = -e u⁻ for a closing contact (Newton's law) and b = 0 for a
-    persistent one (it may separate, but not penetrate); pinned clearances are
-    equalities. Then v⁺ = v⁻ + M⁻¹ Gᵀ P conserves generalised momentum. The
-    LCP (W positive definite) has one solution, found by enumerating the
-    active sets. A contact is closed afterwards when it leaves with no
-    separating relative velocity (plastic or grazing); a closing contact that bounces
-    (e > 0) and a persistent one that the impulse pulls apart are open, and
-    the latter is recorded as released.
-
-    Resting contacts: with consistent mass matrices an impulse at one end of a
-    bar moves the other end backwards (M⁻¹ has negative off-diagonal terms),
-    so a cam impact on a pushrod squeezed against the rocker "releases" the
-    rocker at a tiny speed, the rocker re-impacts within picoseconds, releases
-    the cam, and so on without end. Any separation (or bounce) slower than
-    ``prob.rest_velocity`` is therefore a resting contact: it becomes an
-    equality with zero relative velocity (plastic), and whether it really
-    separates is then decided smoothly by its contact force at the next
-    step. The kinetic energy this can change is at most of order
-    m v_rest², and none is created (an equality row with u⁻ = u⁺ = 0 does no
-    work). In ``stick`` mode (chattering) restitution is taken as zero and
-    every contact involved is held shut (equality), so the chattering ends in
-    sticking contact whose forces then decide any separation.
-    """
-    n = prob.n
-    ncl = prob.cl_ahead.shape[0]
-    idx = np.empty(ncl, dtype=np.int64)
-    nc = 0
-    for k in range(ncl):
-        if (c & prob.cl_bit[k]) or closing[k]:
-            idx[nc] = k
-            nc += 1
-    G = np.zeros((nc, n))
-    u = np.zeros(nc)
-    b = np.zeros(nc)
-    eq = np.zeros(nc, dtype=np.int64)
-    for r in range(nc):
-        k = idx[r]
-        G[r, prob.cl_ahead[k]] = 1.0
-        wsrc = 0.0
-        if prob.cl_behind[k] >= 0:
-            G[r, prob.cl_behind[k]] -= 1.0
-        else:
-            wsrc = source_state(prob.src_kind, prob.src_par, prob.cl_src[k], t)[1]
-        for i in range(n):
-            u[r] += G[r, i] * v[i]
-        u[r] -= wsrc
-        if closing[k]:
-            e = 0.0 if (stick or abs(u[r]) < prob.rest_velocity) else prob.cl_e[k]
-            b[r] = -e * u[r]
-        eq[r] = prob.cl_pinned[k] or stick  # chattering: every contact involved sticks
-    MG = prob.Minv @ G.T
-    W = G @ MG
-    scale = 1e-12 + 1e-9 * np.max(np.abs(u)) if nc > 0 else 1e-12
-    P = np.zeros(nc)
-    uplus = u.copy()
-    for _ in range(nc + 1):
-        P, uplus = solve_impulse_lcp(W, u, b, eq, scale)
-        resting = False
-        for r in range(nc):  # slow separations are resting contacts: they stay closed
-            if not eq[r] and 10.0 * scale < uplus[r] < prob.rest_velocity:
-                eq[r] = 1
-                b[r] = 0.0
-                resting = True
-        if not resting:
-            break
-    dv = MG @ P
-    for i in range(n):
-        v[i] += dv[i]
-    mask = c
-    for r in range(nc):
-        k = idx[r]
-        if closing[k]:  # snap the gap shut at the event (it is within the time tolerance)
-            if prob.cl_behind[k] >= 0:
-                x[prob.cl_ahead[k]] = x[prob.cl_behind[k]]
-            else:
-                x[prob.cl_ahead[k]] = source_state(prob.src_kind, prob.src_par, prob.cl_src[k], t)[0]
-        stays = eq[r] or uplus[r] <= 10.0 * scale  # no separating velocity: in contact
-        if stays:
-            mask |= prob.cl_bit[k]
-        else:
-            mask &= ~prob.cl_bit[k]
-    for r in range(nc):
-        k = idx[r]
-        if closing[k]:
-            add_event(out, istate, t, k, 1, u[r], c, mask)
-        elif not (mask & prob.cl_bit[k]):
-            add_event(out, istate, t, k, 2, uplus[r], c, mask)
-    return mask
-
-
-@jit
-def advance(prob, cfg, c, x, v, a, w, istate, fstate, out):
-    """Standard (or, after an event, refined) steps in configuration c while nothing happens: the hot loop.
-
-    Stops, without taking it, at the first step that would reach the next grid
-    point from off the grid, end past the chunk, cross an output instant,
-    change a monitor's sign or leave the divergence limit; :func:`run_chunk` then takes that step with
-    full handling. Kept small so numba can prune its reference counting.
-    """
-    ncl = prob.cl_ahead.shape[0]
-    dt = prob.dt
-    fine = dt / prob.refine
-    while True:
-        t = fstate[F_T]
-        k_grid = istate[I_GRID]
-        on_grid = t == k_grid * dt
-        if t < fstate[F_FINE_UNTIL]:  # refined steps after an event, up to the next grid point
-            h = fine
-            if t + h >= (k_grid + 1) * dt:
-                return
-        elif on_grid:
-            h = dt
-        else:
-            return
-        if t + h > prob.t_end or t >= fstate[F_CHUNK_END]:
-            return
-        if prob.every_step or istate[I_NEXT_OUT] * prob.out_dt <= t + h + 1e-9 * dt:
-            return
-        newmark_step(prob, cfg, c, t, h, cfg.Sinv[c] if h == dt else cfg.SinvFine[c], x, v, a, w,
-                     w.x1, w.v1, w.a1)
-        fill_sources(prob, t + h, w.src)  # once per step
-        for k in range(ncl):  # monitor() written out: numba runs this loop four times faster so
-            if c & prob.cl_bit[k]:
-                w.phi[k] = contact_force(prob, cfg, c, k, w.x1, w.v1, w.a1, w.src)
-            elif prob.cl_monitored[k]:
-                w.phi[k] = gap(prob, k, w.x1, w.src) + prob.gap_noise
-            if prob.cl_monitored[k] and w.phi[k] < 0.0:
-                return
-        for i in range(prob.n):
-            if not (abs(w.x1[i]) <= prob.x_limit):
-                return
-        for k in range(ncl):
-            if c & prob.cl_bit[k] and w.phi[k] > out.F_peak[k]:
-                out.F_peak[k] = w.phi[k]
-        for i in range(prob.n):
-            x[i] = w.x1[i]
-            v[i] = w.v1[i]
-            a[i] = w.a1[i]
-        istate[I_STEPS] += 1
-        if h == dt:
-            istate[I_GRID] = k_grid + 1
-            fstate[F_T] = (k_grid + 1) * dt
-        else:
-            fstate[F_T] = t + h
-
-
-@jit
-def run_chunk(prob, cfg, out, w, x, v, a, istate, fstate, codes):
-    """Integrate from fstate[F_T] until t_end, the chunk end, or something Python must do.
-
-    ``codes`` = (FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED,
-    CHATTER): the status returned. (x, v, a) is the full state at fstate[F_T]
-    in configuration istate[I_CFG]; everything needed to resume is in the
-    arguments, so Python may build a configuration or grow a buffer and
-    call again.
-    """
-    FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED, CHATTER = codes
-    ncl = prob.cl_ahead.shape[0]
-    n = prob.n
+    n, ncl, ns, nh = ip[IP_N], ip[IP_NCL], ip[IP_NS], ip[IP_NH]
+    every = ip[IP_EVERY]
+    beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
+    omega, tol, gap_noise, x_limit = fp[FP_OMEGA], fp[FP_TTOL], fp[FP_GAPNOISE], fp[FP_XLIM]
+    fine = dt / fp[FP_REFINE]
+    t_rev = fp[FP_TREV]
+    z = np.zeros(n)
+    zd = np.zeros(n)
+    zdd = np.zeros(n)
+    z1 = np.zeros(n)
+    zd1 = np.zeros(n)
+    zdd1 = np.zeros(n)
+    zo = np.zeros(n)
+    zdo = np.zeros(n)
+    zddo = np.zeros(n)
+    rhs = np.zeros(n)
+    sol = np.zeros(n)
+    L = np.zeros((n, n))
+    src0 = np.zeros(3 * ns)
+    src1 = np.zeros(3 * ns)
+    srco = np.zeros(3 * ns)
+    phi = np.zeros(ncl)
+    tau = np.zeros(ncl)
     closing = np.zeros(ncl, dtype=np.int64)
+    rows = out_t.shape[0]
     while True:
-        t = fstate[F_T]
-        c = istate[I_CFG]
-        if not cfg.built[c]:
-            istate[I_WANT_CFG] = c
+        t = fst[F_T]
+        c = ist[I_CFG]
+        if not ci[c, CI_BUILT]:
+            ist[I_WANT_CFG] = c
             return NEED_CONFIG
-        if istate[I_NEED_ACCEL]:
-            consistent_acceleration(prob, cfg, c, t, x, v, a, w.xl, w.vl, w.al, w.rhs)
-            istate[I_NEED_ACCEL] = 0
-            if istate[I_NOUT] == 0 and istate[I_NEXT_OUT] == 0:
-                record(prob, cfg, c, t, x, v, a, w, out, 0)
-                for k in range(ncl):  # the start counts for the peaks too
-                    out.F_peak[k] = max(out.F_peak[k], out.F[0, k])
-                istate[I_NOUT] = 1
-                istate[I_NEXT_OUT] = 1
-        if t >= prob.t_end - 1e-9 * prob.dt:
-            return FINISHED
-        if t >= fstate[F_CHUNK_END]:
-            return CHUNK_END
-        if istate[I_NEV] + 2 * ncl >= out.ev_t.shape[0]:  # room for the events of one step
+        if ist[I_NEV] + 3 * ncl + 2 >= ev_f.shape[0]:
             return OUTPUT_FULL
-        advance(prob, cfg, c, x, v, a, w, istate, fstate, out)
-        t = fstate[F_T]
-        if t >= prob.t_end - 1e-9 * prob.dt:
-            return FINISHED
-        if t >= fstate[F_CHUNK_END]:
-            return CHUNK_END
-        grid_next = (istate[I_GRID] + 1) * prob.dt
-        if t == istate[I_GRID] * prob.dt:  # on the grid: a standard step (exactly dt)
-            h = min(prob.dt, prob.t_end - t)
-        else:  # after an event: the rest of the step, back onto the grid
-            h = min(grid_next, prob.t_end) - t
-        if t < fstate[F_FINE_UNTIL]:  # just after an event: refined steps
-            h = min(h, prob.dt / prob.refine)
-        if h <= 1e-9 * prob.dt:  # already on the grid point
-            istate[I_GRID] += 1
-            fstate[F_T] = istate[I_GRID] * prob.dt
-            continue
-        step_to(prob, cfg, c, t, h, x, v, a, w, w.x1, w.v1, w.a1)
-        fill_sources(prob, t + h, w.src)
-        fired = False
-        for k in range(ncl):
-            w.tau[k] = 2.0 * h
-            if prob.cl_monitored[k]:
-                w.phi[k] = monitor(prob, cfg, c, k, w.x1, w.v1, w.a1, w.src)
-                if w.phi[k] < 0.0:
-                    fired = True
-        if fired:  # locate every sign change; the earliest is taken
-            tau_min = 2.0 * h
-            for k in range(ncl):
-                if prob.cl_monitored[k] and w.phi[k] < 0.0:
-                    gather(cfg, c, x, v, a, w.xl, w.vl, w.al)
-                    set_prescribed(prob, cfg, c, t, w.xl, w.vl, w.al)
-                    fill_sources(prob, t, w.src)
-                    phi0 = monitor(prob, cfg, c, k, x, v, a, w.src)
-                    lo = 0.0
-                    if phi0 < 0.0:
-                        w.tau[k] = lo
-                    else:
-                        w.tau[k] = locate_event(prob, cfg, c, k, t, lo, h, phi0, w.phi[k], x, v, a, w)
-                    tau_min = min(tau_min, w.tau[k])
-            h = tau_min
-            if h > 0.0:
-                step_to(prob, cfg, c, t, h, x, v, a, w, w.x1, w.v1, w.a1)
+        fill_sources(ns, nh, omega, sc, sa, sb, t, src0)
+        if ist[I_NEED_SETTLE]:
+            settled = settle(ip, fp, cl, ci, cm, cp, mk, mon, c, t, x, v, a, src0, ev_f, ev_i, ist,
+                             rhs, z, zd, zdd)
+            if settled < 0:
+                ist[I_CFG] = -1 - settled
+                ist[I_WANT_CFG] = -1 - settled
+                return NEED_CONFIG
+            c = settled
+            ist[I_CFG] = c
+            ist[I_NEED_SETTLE] = 0
+            if not ist[I_STARTED]:  # the start is an output row and counts for the peaks
+                if ist[I_NOUT] >= rows:
+                    return OUTPUT_FULL
+                gather(ci, c, n, x, v, a, z, zd, zdd)
+                record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src0,
+                           out_t, out_q, out_F, out_c, ist[I_NOUT])
+                for k in range(ncl):
+                    peak[0, k] = max(peak[0, k], out_F[ist[I_NOUT], k])
+                ist[I_NOUT] += 1
+                ist[I_NEXT_OUT] = 1
+                ist[I_STARTED] = 1
+        gather(ci, c, n, x, v, a, z, zd, zdd)
+        # ---- steps in configuration c until an event, the chunk end or a full buffer ----
+        status = 0
+        event = False
+        while True:
+            if t >= t_end - 1e-9 * dt:
+                status = FINISHED
+                break
+            if t >= fst[F_CHUNK_END]:
+                status = CHUNK_END
+                break
+            k_grid = ist[I_GRID]
+            grid_next = (k_grid + 1) * dt
+            if t == k_grid * dt:
+                h = min(dt, t_end - t)
             else:
-                w.x1[:] = x
-                w.v1[:] = v
-                w.a1[:] = a
-        # accept the (sub)step: peak forces at its end, outputs inside it
-        if h > 0.0:
+                h = min(grid_next, t_end) - t
+            if t < fst[F_FINE_UNTIL]:
+                h = min(h, fine)
+            if h <= 1e-9 * dt:
+                ist[I_GRID] = k_grid + 1
+                t = grid_next
+                fst[F_T] = t
+                continue
+            fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
+            if h == dt:
+                layer_step(ci, cm, cp, c, beta, gamma, h, 0, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol)
+            elif h == fine:
+                layer_step(ci, cm, cp, c, beta, gamma, h, 1, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol)
+            else:
+                factor_effective(ci, cm, c, beta, gamma, h, L)
+                layer_step(ci, cm, cp, c, beta, gamma, h, 2, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol)
+            fired = False
             for k in range(ncl):
-                if c & prob.cl_bit[k]:
-                    f = w.phi[k]  # the monitor already holds it (unless an event moved the step end)
-                    if fired or not prob.cl_monitored[k]:
-                        fill_sources(prob, t + h, w.src)
-                        f = contact_force(prob, cfg, c, k, w.x1, w.v1, w.a1, w.src)
-                    if f > out.F_peak[k]:
-                        out.F_peak[k] = f
-        w.x0[:] = x
-        w.v0[:] = v
-        w.a0[:] = a
-        if h > 0.0:
-            due = prob.every_step or istate[I_NEXT_OUT] * prob.out_dt <= t + h + 1e-9 * prob.dt
-            if due and not record_outputs(prob, cfg, c, t, h, istate, out, w):
-                return OUTPUT_FULL
-            istate[I_STEPS] += 1
-        x[:] = w.x1
-        v[:] = w.v1
-        a[:] = w.a1
-        t = t + h
-        fstate[F_T] = t
-        if abs(t - grid_next) <= 1e-9 * prob.dt:
-            istate[I_GRID] += 1
-            fstate[F_T] = grid_next
-            t = grid_next
-        for i in range(n):
-            if not (abs(x[i]) <= prob.x_limit):
-                return DIVERGED
-        if not fired:
-            continue
-        # the events at the earliest time (within the tolerance)
+                phi[k] = monitor_value(mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1)
+                if cl[k, CL_MON] and phi[k] < 0.0:
+                    fired = True
+            if fired:  # locate every sign change; the earliest is taken
+                tau_min = 2.0 * h
+                for k in range(ncl):
+                    tau[k] = 2.0 * h
+                    if cl[k, CL_MON] and phi[k] < 0.0:
+                        phi0 = monitor_value(mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src0)
+                        if phi0 < 0.0:
+                            tau[k] = 0.0
+                        else:
+                            tau[k] = locate_event(ci, cm, cp, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h,
+                                                  phi0, phi[k], z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L)
+                        tau_min = min(tau_min, tau[k])
+                h = tau_min
+                if h > 0.0:
+                    fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
+                    factor_effective(ci, cm, c, beta, gamma, h, L)
+                    layer_step(ci, cm, cp, c, beta, gamma, h, 2, L, n, src1, z, zd, zdd,
+                               z1, zd1, zdd1, rhs, sol)
+                    for k in range(ncl):
+                        if mk[c, k, 0] == MK_FORCE:
+                            phi[k] = monitor_value(mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1)
+                else:
+                    for j in range(n):
+                        z1[j] = z[j]
+                        zd1[j] = zd[j]
+                        zdd1[j] = zdd[j]
+                    for j in range(3 * ns):
+                        src1[j] = src0[j]
+            if h > 0.0:
+                diverged = False
+                for j in range(ci[c, CI_NF]):
+                    if not (abs(z1[j]) <= x_limit):
+                        diverged = True
+                if diverged:
+                    scatter(ci, c, n, z1, zd1, zdd1, x, v, a)
+                    fst[F_T] = t + h
+                    return DIVERGED
+                # outputs inside (t, t + h]
+                if every:
+                    if ist[I_NOUT] >= rows:
+                        status = OUTPUT_FULL
+                        break
+                    record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t + h, z1, zd1, zdd1, src1,
+                               out_t, out_q, out_F, out_c, ist[I_NOUT])
+                    ist[I_NOUT] += 1
+                else:
+                    full = False
+                    while True:
+                        j_out = ist[I_NEXT_OUT]
+                        t_out = j_out * out_dt
+                        if t_out > t + h + 1e-9 * dt or t_out > t_end + 1e-9 * dt:
+                            break
+                        if ist[I_NOUT] >= rows:
+                            full = True
+                            break
+                        s_out = t_out - t
+                        r = s_out / h
+                        for j in range(ci[c, CI_NF]):
+                            da = zdd1[j] - zdd[j]
+                            zddo[j] = zdd[j] + da * r
+                            zdo[j] = zd[j] + zdd[j] * s_out + da * s_out * r / 2.0
+                            zo[j] = z[j] + zd[j] * s_out + zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
+                        fill_sources(ns, nh, omega, sc, sa, sb, t_out, srco)
+                        set_prescribed(ci, c, n, srco, zo, zdo, zddo)
+                        record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t_out, zo, zdo, zddo, srco,
+                                   out_t, out_q, out_F, out_c, ist[I_NOUT])
+                        ist[I_NOUT] += 1
+                        ist[I_NEXT_OUT] = j_out + 1
+                    if full:
+                        status = OUTPUT_FULL
+                        break
+                # peaks at the step's end
+                after = t + h >= t_rev
+                for k in range(ncl):
+                    if mk[c, k, 0] == MK_FORCE:
+                        if phi[k] > peak[0, k]:
+                            peak[0, k] = phi[k]
+                        if after and phi[k] > peak[1, k]:
+                            peak[1, k] = phi[k]
+                ist[I_STEPS] += 1
+                for j in range(n):
+                    z[j] = z1[j]
+                    zd[j] = zd1[j]
+                    zdd[j] = zdd1[j]
+                for j in range(3 * ns):
+                    src0[j] = src1[j]
+                t = t + h
+                if abs(t - grid_next) <= 1e-9 * dt:
+                    ist[I_GRID] = k_grid + 1
+                    t = grid_next
+                fst[F_T] = t
+            if fired:
+                event = True
+                break
+        scatter(ci, c, n, z, zd, zdd, x, v, a)
+        if not event:
+            return status
+        # ---- the events at t (within the tolerance) ----
         new_c = c
         any_closing = False
         for k in range(ncl):
             closing[k] = 0
-            if prob.cl_monitored[k] and w.tau[k] <= h + prob.time_tol:
-                if c & prob.cl_bit[k]:
-                    new_c &= ~prob.cl_bit[k]
+            if cl[k, CL_MON] and tau[k] <= h + tol:
+                if c & cl[k, CL_BIT]:
+                    new_c &= ~cl[k, CL_BIT]
                 else:
                     closing[k] = 1
                     any_closing = True
-        rapid = t - fstate[F_LAST_EVENT] <= prob.zeno_window
-        istate[I_RAPID] = istate[I_RAPID] + 1 if rapid else 0
-        fstate[F_LAST_EVENT] = t
-        if istate[I_RAPID] >= prob.zeno_stop:
+        rapid = t - fst[F_LAST_EVENT] <= fp[FP_ZWIN]
+        ist[I_RAPID] = ist[I_RAPID] + 1 if rapid else 0
+        fst[F_LAST_EVENT] = t
+        if ist[I_RAPID] >= ip[IP_ZSTOP]:
             return CHATTER
-        stick = istate[I_RAPID] >= prob.zeno_stick
+        stick = ist[I_RAPID] >= ip[IP_ZSTICK]
         for k in range(ncl):
-            if (c & prob.cl_bit[k]) and not (new_c & prob.cl_bit[k]):
-                add_event(out, istate, t, k, 0, 0.0, c, new_c)
+            if (c & cl[k, CL_BIT]) and not (new_c & cl[k, CL_BIT]):
+                add_event(ev_f, ev_i, ist, t, k, EV_OPENED, 0.0, c, new_c)
         if any_closing:
-            new_c = impact(prob, new_c, closing, t, x, v, stick, out, istate)
-        istate[I_CFG] = new_c
-        istate[I_NEED_ACCEL] = 1
-        fstate[F_FINE_UNTIL] = t + prob.refine_window
-
-
-@jit
-def solve_impulse_lcp(W, u, b, eq, scale):
-    """Impulses P >= 0 with u + W P - b >= 0 and complementarity (equalities: = b).
-
-    Enumerates active sets, most contacts first; W is positive definite, so
-    exactly one set satisfies the conditions (to the tolerance ``scale``).
-    Returns (P, u⁺).
-    """
-    nc = u.shape[0]
-    for pattern in range(2**nc - 1, -1, -1):
-        Pt = np.zeros(nc)
-        active = np.zeros(nc, dtype=np.int64)
-        na = 0
-        for r in range(nc):
-            if eq[r] or (pattern >> r) & 1:
-                active[na] = r
-                na += 1
-        if na > 0:
-            Wa = np.empty((na, na))
-            ra = np.empty(na)
-            for p in range(na):
-                ra[p] = b[active[p]] - u[active[p]]
-                for q in range(na):
-                    Wa[p, q] = W[active[p], active[q]]
-            sol = np.linalg.solve(Wa, ra)
-            for p in range(na):
-                Pt[active[p]] = sol[p]
-        ut = u + W @ Pt
-        ok = True
-        for r in range(nc):
-            if not eq[r] and (Pt[r] * W[r, r] < -10.0 * scale or ut[r] - b[r] < -10.0 * scale):
-                ok = False
-        if ok:
-            return Pt, ut
-    return np.zeros(nc), u.copy()
+            new_c = impact(ip, fp, cl, clf, mass, new_c, closing, src0, x, v, stick, ev_f, ev_i, ist, t)
+        ist[I_CFG] = new_c
+        ist[I_NEED_SETTLE] = 1
+        fst[F_FINE_UNTIL] = t + fp[FP_REFWIN]

@@ -22,10 +22,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from vtool.errors import InputError, RunError
+from vtool.solvers.contact import ContactProblem
 from vtool.solvers.model import Mechanism
-from vtool.solvers.piecewise import Cancel, PiecewiseRun, Progress, StateSpace, timed
+from vtool.solvers.piecewise import PiecewiseBackend, PiecewiseRun, StateSpace
 from vtool.solvers.spec import RunSpec
-from vtool.solvers.trace import Trace
+from vtool.solvers.trace import TraceBuilder
 
 METHODS = ("DOP853", "Radau", "RK45", "LSODA")
 GUARD = 1e-12  # s after a restart during which no event is taken
@@ -44,39 +45,34 @@ class ScipyOptions:
         return cls(output_interval=run.output_interval, every_step=every_step)
 
 
-class ScipyBackend:
+class ScipyBackend(PiecewiseBackend):
     """solve_ivp back end (see module doc). Registered as ``scipy``."""
 
     name = "scipy"
-    supports_cancel = True
-    supports_progress = True
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> ScipyOptions:
         return ScipyOptions.from_run(run, every_step)
 
-    def simulate(self, mechanism: Mechanism, options: ScipyOptions | None = None,
-                 progress: Progress | None = None, cancel: Cancel | None = None) -> Trace:
-        options = options or ScipyOptions.from_run(mechanism.spec.run)
+    def check(self, mechanism: Mechanism, options: ScipyOptions) -> None:
         if not 1e-14 <= options.rtol <= 1e-2:
             raise InputError("rtol", options.rtol, ">= 1e-14 and <= 1e-2")
         if options.method not in METHODS:
             raise InputError("method", options.method, f"one of: {', '.join(METHODS)}")
-        run = _ScipyRun(mechanism, options)
-        settings = {"method": options.method, "rtol": options.rtol, "rpm": mechanism.spec.run.rpm,
-                    "degrees": mechanism.spec.run.degrees}
-        return timed(run, progress, cancel, settings)
+
+    def settings(self, options: ScipyOptions) -> dict:
+        return {"method": options.method, "rtol": options.rtol}
 
 
 class _ScipyRun(PiecewiseRun):
     backend = "scipy"
 
-    def __init__(self, mechanism: Mechanism, options: ScipyOptions) -> None:
-        super().__init__(mechanism, options.output_interval, options.every_step)
+    def __init__(self, problem: ContactProblem, options: ScipyOptions, builder: TraceBuilder) -> None:
+        super().__init__(problem, options.output_interval, options.every_step, builder)
         self.options = options
-        start = mechanism.start
+        start = problem.mechanism.start
         self.x_scale = max(float(np.abs(start.q).max()), 1e-12)
-        self.v_scale = max(float(np.abs(start.qd).max()), self.x_scale * mechanism.omega, 1e-12)
+        self.v_scale = max(float(np.abs(start.qd).max()), self.x_scale * problem.omega, 1e-12)
 
     def advance(self, ss: StateSpace, t0: float, y0: np.ndarray, t_stop: float) -> tuple[float, np.ndarray, list[int]]:
         nf = ss.size // 2
@@ -119,5 +115,8 @@ class _ScipyRun(PiecewiseRun):
         for t_sample in samples:
             self.emit(ss, float(t_sample), solution.sol(t_sample))
         for t_sample in solution.t[1:]:
-            self.track_peaks(ss, self.monitors(ss, float(t_sample), solution.sol(t_sample)))
+            self.track_peaks(ss, self.monitors(ss, float(t_sample), solution.sol(t_sample)), float(t_sample))
         return t_end, solution.y[:, -1], fired
+
+
+ScipyBackend.run_class = _ScipyRun

@@ -29,6 +29,18 @@ ENABLED = "enabled"
 PINNED = "pinned"
 REMOVED = "removed"
 
+#: Impact laws (see :mod:`vtool.solvers.newmark_kernel`): the thesis' local law (eq. 3.53),
+#: the thesis' SCALE at internal clearances (eq. 3.54), one LCP on the consistent mass matrix.
+LOCAL = "local"
+THESIS = "thesis"
+MOMENTUM = "momentum"
+IMPACT_LAWS = (LOCAL, THESIS, MOMENTUM)
+
+#: Start velocities (see :mod:`vtool.solvers.initial`).
+THESIS_START = "thesis"
+QUASI_STATIC_START = "quasi-static"
+START_VELOCITIES = (THESIS_START, QUASI_STATIC_START)
+
 
 @dataclass(frozen=True)
 class CoordinateSpec:
@@ -93,6 +105,7 @@ class ClearanceSpec:
     kind: str
     state: str = ENABLED
     restitution: float = 0.0
+    impact: str | None = None  # impact law; None: the mechanism's default (ContactSpec.impact)
 
 
 @dataclass(frozen=True)
@@ -144,6 +157,20 @@ class InitialSpec:
     closed: tuple[str, ...]
     spring_preload: float
     lever_ratio: float
+    velocities: str = THESIS_START
+
+
+@dataclass(frozen=True)
+class ContactSpec:
+    """The impact law every clearance uses unless it names its own, and the thesis' SCALE.
+
+    ``rocker_scale`` is SCALE of Gnilka eq. 3.54 (the ``thesis`` law at an
+    internal clearance: the tied pair takes SCALE times the ahead coordinate's
+    velocity; the thesis chose it "from 1.0 to 2.0").
+    """
+
+    impact: str = LOCAL
+    rocker_scale: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -205,7 +232,12 @@ class MechanismSpec:
     damping: DampingSpec
     run: RunSpec
     notes: str = ""
+    contact: ContactSpec = field(default_factory=ContactSpec)
     kind: str = field(default="valvetrain", init=False)
+
+    def impact_law(self, clearance: ClearanceSpec) -> str:
+        """The impact law of a clearance: its own, or the mechanism's default."""
+        return clearance.impact or self.contact.impact
 
     @property
     def unit_system(self) -> UnitSystem:

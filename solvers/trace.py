@@ -24,6 +24,31 @@ OPENED = "opened"
 CLOSED = "closed"
 RELEASED = "released"  # a persistent contact pulled apart by another contact's impact
 
+#: Events at one clearance closer than this (degrees of cam rotation) form one physical episode.
+EPISODE_WINDOW_DEG = 0.1
+#: A seat re-opening that closes again within this (degrees) is a bounce, not the cam lifting the valve.
+BOUNCE_WINDOW_DEG = 90.0
+
+#: Episode kinds by the clearance's state before and after the burst of events.
+SEPARATION, IMPACT, BOUNCE, FLICKER = "separation", "impact", "bounce", "flicker"
+
+
+@dataclass(frozen=True)
+class Episode:
+    """A burst of events at one clearance (each within EPISODE_WINDOW_DEG of the previous).
+
+    ``kind`` by the state before and after: closed -> open ``separation``,
+    open -> closed ``impact``, open -> open ``bounce`` (touched and left),
+    closed -> closed ``flicker`` (a momentary separation).
+    """
+
+    clearance: str
+    kind: str
+    first_angle: float  # degrees
+    last_angle: float
+    events: int
+    impact_velocity: float | None  # relative velocity of the first impact in it (length/s), if any
+
 
 @dataclass(frozen=True)
 class Event:
@@ -71,6 +96,7 @@ class Trace:
     statistics: RunStatistics
     success: bool = True
     message: str = ""
+    peak_force_after_first_revolution: np.ndarray | None = None  # per clearance, over every step
 
     # ----- columns by the engineer's names -----
     def coordinate(self, number: int) -> np.ndarray:
@@ -154,25 +180,97 @@ class Trace:
                 counts[index] += 1
         return counts
 
+    def episodes(self, clearance: str, window_deg: float = EPISODE_WINDOW_DEG) -> list[Episode]:
+        """The physical episodes at a clearance (see :class:`Episode`)."""
+        index = next(i for i, c in enumerate(self.spec.clearances) if c.name == clearance)
+        bit = 1 << (len(self.spec.clearances) - 1 - index)
+        events = [e for e in self.events if e.clearance == clearance]
+        groups: list[list[Event]] = []
+        for e in events:
+            if groups and e.cam_angle - groups[-1][-1].cam_angle <= window_deg:
+                groups[-1].append(e)
+            else:
+                groups.append([e])
+        result = []
+        for group in groups:
+            was, now = bool(group[0].before & bit), bool(group[-1].after & bit)
+            kind = {(True, False): SEPARATION, (False, True): IMPACT, (False, False): BOUNCE,
+                    (True, True): FLICKER}[(was, now)]
+            impacts = [e.relative_velocity for e in group if e.kind == CLOSED]
+            result.append(Episode(clearance, kind, group[0].cam_angle, group[-1].cam_angle, len(group),
+                                  impacts[0] if impacts else None))
+        return result
+
+    def seat_bounces(self, clearance: str) -> list[tuple[float, float, float]]:
+        """(opening angle, closing angle, largest gap) of each bounce at a seat-like clearance.
+
+        A bounce is a re-opening after an impact that closes again within
+        BOUNCE_WINDOW_DEG; its height is the largest gap over the output rows in
+        between (at the output interval: use --every-step for the true peak).
+        """
+        c = next(c for c in self.spec.clearances if c.name == clearance)
+        gap = self.coordinate(c.ahead) - self.coordinate(c.behind)
+        result = []
+        last_closed = None
+        opened_at = None
+        for e in self.events:
+            if e.clearance != clearance:
+                continue
+            if e.kind == CLOSED:
+                if opened_at is not None and last_closed is not None and e.cam_angle - opened_at <= BOUNCE_WINDOW_DEG:
+                    inside = (self.cam_angle >= opened_at) & (self.cam_angle <= e.cam_angle)
+                    height = float(gap[inside].max()) if inside.any() else 0.0
+                    result.append((opened_at, e.cam_angle, max(height, 0.0)))
+                last_closed, opened_at = e.cam_angle, None
+                continue
+            opened_at = e.cam_angle
+        return result
+
+    def per_revolution(self, angles: list[float]) -> list[int]:
+        """Counts of the given angles in each whole cam revolution after the first."""
+        revolutions = int(self.cam_angle[-1] // 360.0) if len(self.cam_angle) else 0
+        counts = [0] * max(revolutions - 1, 0)
+        for angle in angles:
+            index = int(angle // 360.0) - 1
+            if 0 <= index < len(counts):
+                counts[index] += 1
+        return counts
+
     def summary(self) -> dict:
         """Counts, peaks and seating velocities per clearance, and the run statistics."""
         units = self.spec.unit_system
         clearances = []
+        late = self.peak_force_after_first_revolution
         for i, c in enumerate(self.spec.clearances):
             impacts = self.events_at(c.name, (CLOSED,))
+            episodes = self.episodes(c.name)
             entry = {
                 "clearance": c.name,
                 "force": self.force_label(i),
                 "state": c.state,
+                "impact_law": self.spec.impact_law(c),
+                "events": sum(e.clearance == c.name for e in self.events),
                 "separations": len(self.events_at(c.name, (OPENED, RELEASED))),
                 "impacts": len(impacts),
+                "episodes": {kind: sum(e.kind == kind for e in episodes)
+                             for kind in (SEPARATION, IMPACT, BOUNCE, FLICKER)},
                 "peak_force": float(self.peak_force[i]),
+                "peak_force_after_first_revolution": None if late is None else float(late[i]),
                 "peak_force_unit": units.force,
             }
             if c.kind == EXTERNAL and c.behind != self.spec.cam.coordinate:
                 entry["seating_velocities"] = [-e.relative_velocity for e in impacts]
                 entry["seating_velocity_unit"] = units.velocity
                 entry["bounces_per_revolution"] = self.bounces_per_revolution(c.name)
+                seatings = [(e.first_angle, -e.impact_velocity) for e in episodes if e.impact_velocity is not None]
+                entry["seating_velocities_per_revolution"] = [
+                    [v for angle, v in seatings if int(angle // 360.0) == r + 1]
+                    for r in range(len(entry["bounces_per_revolution"]))]
+                bounces = self.seat_bounces(c.name)
+                entry["bounce_heights_per_revolution"] = [
+                    [h for opened, _, h in bounces if int(opened // 360.0) == r + 1]
+                    for r in range(len(entry["bounces_per_revolution"]))]
+                entry["bounce_height_unit"] = units.length
             clearances.append(entry)
         stats = self.statistics
         return {
@@ -184,6 +282,7 @@ class Trace:
             "steps": stats.steps,
             "events": stats.events,
             "wall_time_s": stats.wall_time,
+            "episode_window_deg": EPISODE_WINDOW_DEG,
             "configurations_built": [configuration_label(self.spec, m) for m in stats.configurations_built],
             "events_list": [
                 {"time_s": e.time, "cam_angle_deg": e.cam_angle, "clearance": e.clearance, "kind": e.kind,
@@ -203,11 +302,17 @@ class Trace:
             f"configurations built: {', '.join(s['configurations_built'])}"
         )
         lines.append("")
-        lines.append(f"{'clearance':<10} {'force':<6} {'state':<8} {'separations':>11} {'impacts':>8} "
+        lines.append(f"{'clearance':<10} {'force':<6} {'state':<8} {'law':<8} {'separations':>11} {'impacts':>8} "
                      f"{'peak force (' + units.force + ')':>18}")
         for c in s["clearances"]:
-            lines.append(f"{c['clearance']:<10} {c['force']:<6} {c['state']:<8} {c['separations']:>11} "
-                         f"{c['impacts']:>8} {c['peak_force']:>18.6g}")
+            lines.append(f"{c['clearance']:<10} {c['force']:<6} {c['state']:<8} {c['impact_law']:<8} "
+                         f"{c['separations']:>11} {c['impacts']:>8} {c['peak_force']:>18.6g}")
+        lines.append("")
+        lines.append(f"episodes (events at one clearance within {s['episode_window_deg']:g} deg are one):")
+        for c in s["clearances"]:
+            ep = c["episodes"]
+            lines.append(f"  {c['clearance']:<10} {c['events']:>4} events: {ep[SEPARATION]} separations, "
+                         f"{ep[IMPACT]} impacts, {ep[BOUNCE]} bounces, {ep[FLICKER]} flickers")
         for c in s["clearances"]:
             if "seating_velocities" in c and c["seating_velocities"]:
                 v = np.array(c["seating_velocities"])
@@ -217,6 +322,10 @@ class Trace:
                 )
                 lines.append(f"{c['clearance']} bounces per revolution (after the first): "
                              f"{c['bounces_per_revolution']}")
+                heights = [max(h) if h else 0.0 for h in c["bounce_heights_per_revolution"]]
+                if any(heights):
+                    lines.append(f"{c['clearance']} largest bounce height per revolution ({c['bounce_height_unit']}, "
+                                 f"at the output interval): " + ", ".join(f"{h:.4g}" for h in heights))
         if not s["success"]:
             lines.append(f"run stopped: {s['message']}")
         return "\n".join(lines)
@@ -234,5 +343,52 @@ class Trace:
         return "\n".join(lines)
 
 
-def cam_angle_deg(time: np.ndarray, omega: float) -> np.ndarray:
+def cam_angle_deg(time: np.ndarray | float, omega: float) -> np.ndarray:
+    """Cam angle in degrees at time(s) t (s) for a cam speed omega (rad/s)."""
     return np.asarray(time) * omega * 180.0 / math.pi
+
+
+class TraceBuilder:
+    """Collects a run's output rows and events as a back end produces them, then builds the Trace.
+
+    Rows arrive in blocks (arrays): time, the (x, v, a) of every coordinate
+    and source ``q3[rows, 3, n + ns]``, contact forces and configuration
+    masks. Every back end builds its trace here, so they share one format.
+    """
+
+    def __init__(self, spec: MechanismSpec, source_numbers: tuple[int, ...], omega: float) -> None:
+        self.spec = spec
+        self.source_numbers = tuple(source_numbers)
+        self.omega = omega
+        self.blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self.events: list[Event] = []
+
+    def add_rows(self, t: np.ndarray, q3: np.ndarray, F: np.ndarray, cfg: np.ndarray) -> None:
+        if len(t):
+            self.blocks.append((np.array(t, dtype=float), np.array(q3, dtype=float),
+                                np.array(F, dtype=float), np.array(cfg, dtype=np.int64)))
+
+    def add_event(self, t: float, clearance: int, kind: str, relative_velocity: float, before: int,
+                  after: int) -> None:
+        self.events.append(Event(float(t), float(cam_angle_deg(t, self.omega)),
+                                 self.spec.clearances[clearance].name, kind, float(relative_velocity),
+                                 int(before), int(after)))
+
+    def build(self, peak: np.ndarray, statistics: RunStatistics, peak_late: np.ndarray | None = None,
+              sort: bool = False) -> Trace:
+        n = self.spec.n_coordinates + len(self.source_numbers)
+        ncl = len(self.spec.clearances)
+        if self.blocks:
+            t = np.concatenate([b[0] for b in self.blocks])
+            q3 = np.concatenate([b[1] for b in self.blocks])
+            F = np.concatenate([b[2] for b in self.blocks])
+            cfg = np.concatenate([b[3] for b in self.blocks])
+        else:
+            t, q3, F, cfg = np.zeros(0), np.zeros((0, 3, n)), np.zeros((0, ncl)), np.zeros(0, dtype=np.int64)
+        if sort:
+            order = np.argsort(t, kind="stable")
+            t, q3, F, cfg = t[order], q3[order], F[order], cfg[order]
+        numbers = tuple(range(1, self.spec.n_coordinates + 1)) + self.source_numbers
+        return Trace(self.spec, t, cam_angle_deg(t, self.omega), numbers, q3[:, 0], q3[:, 1], q3[:, 2], F, cfg,
+                     tuple(self.events), np.array(peak, dtype=float), statistics,
+                     peak_force_after_first_revolution=None if peak_late is None else np.array(peak_late))

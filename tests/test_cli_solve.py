@@ -59,7 +59,23 @@ def test_overrides_change_the_run() -> None:
     result = run("solve", "gnilka-1a", "--rpm", "9000", "--degrees", "90", "--dt", "2e-6", "--json")
     settings = json.loads(result.output)["settings"]
     assert settings == {"time_step_s": 2e-6, "beta": 1 / 6, "gamma": 0.5, "refine_after_events": 10,
-                        "rpm": 9000.0, "degrees": 90.0}
+                        "rpm": 9000.0, "degrees": 90.0, "impact": ["local"], "rocker_scale": 1.0,
+                        "start_velocities": "thesis"}
+
+
+def test_impact_law_and_start_overrides_are_in_the_settings_and_the_events() -> None:
+    """`--impact` and `--start` change the model; `--events --json` carries every event's angle,
+    clearance, kind, relative velocity and the configurations before and after, and the law."""
+    result = run("solve", "gnilka-1a", "--degrees", "400", "--impact", "momentum", "--start", "quasi-static",
+                 "--events", "--json")
+    summary = json.loads(result.output)
+    assert summary["settings"]["impact"] == ["momentum"]
+    assert summary["settings"]["start_velocities"] == "quasi-static"
+    assert {c["impact_law"] for c in summary["clearances"]} == {"momentum"}
+    event = summary["events_list"][0]
+    assert set(event) >= {"cam_angle_deg", "clearance", "kind", "relative_velocity", "before", "after"}
+    bad = run("solve", "gnilka-1a", "--impact", "elastic")
+    assert bad.exit_code == 2 and "--impact: got 'elastic', expected one of: local, thesis, momentum" in bad.output
 
 
 @pytest.mark.parametrize(

@@ -14,7 +14,10 @@ it. Each case adds the physics it is about: the quasi-static answer at
 100 rpm, separation at 30,000 rpm, no seat bounce at critical damping, ...
 
 The variants start from the thesis' example 1A (``gnilka-1a``: 11,000 rpm,
-seat at 0.7 in, spring 254 lbf/in, cam amplitude 0.5 in, Δt = 1 µs). The
+seat at 0.7 in, spring 254 lbf/in, cam amplitude 0.5 in, Δt = 1 µs, the
+local impact law), from the quasi-static start: the thesis' start shock
+would otherwise throw the follower off at about 15 degrees whatever the
+extreme, and the first revolution should show the extreme's own physics. The
 figures measured at each extreme and the list of enforced limits are in
 docs/limits.md.
 """
@@ -55,14 +58,16 @@ WALL_TIME_BUDGET = 60.0
 
 def variant(name: str = "gnilka-1a", *, seat: float | str | None = None, spring: float = 1.0,
             amplitude: float | None = None, damping: float | None = None,
-            restitution: dict[str, float] | None = None, **run_settings: float) -> dict:
+            restitution: dict[str, float] | None = None, law: str | None = None, **run_settings: float) -> dict:
     """A thesis preset with one input pushed to an extreme.
 
+    ``law``: the impact law of every clearance (default: the preset's, local).
     ``seat``: seat position (in) or ``"removed"``; ``spring``: factor on the
     valve-spring rate; ``damping``: one modal damping ratio for every mode of
     every layer; ``restitution``: per clearance name; ``run_settings``: [run] keys.
     """
     doc = thesis_doc(name)
+    doc["initial"]["velocities"] = "quasi-static"
     clearances = {c["name"]: c for c in doc["clearances"]}
     if seat == "removed":
         clearances["seat"]["state"] = "removed"
@@ -75,6 +80,8 @@ def variant(name: str = "gnilka-1a", *, seat: float | str | None = None, spring:
         doc["damping"] = {"factor": 1.0, "default_ratio": damping}
     for name_, e in (restitution or {}).items():
         clearances[name_]["restitution"] = e
+    if law is not None:
+        doc["contact"]["impact"] = law
     doc["run"].update(run_settings)
     return doc
 
@@ -327,15 +334,15 @@ def test_the_seat_cannot_be_closed_at_the_static_start() -> None:
 # ----- damping -----
 
 def test_damping_extremes_make_a_restless_or_a_quiet_valve_train() -> None:
-    """Undamped, the contacts keep separating and re-closing (the exact back end: 1,060 events in
-    850 degrees); critically damped, the valve seats once per revolution and little else happens
-    (53 events). (A plain 1 µs Newmark run showed six seat bounces per revolution undamped: its
+    """Undamped, the contacts keep separating and re-closing; critically damped, the valve seats at
+    most once per revolution (with the local law and the quasi-static start it floats clear of the seat:
+    the follower leaves the cam at 90 degrees and lands at 305) and little else happens. (A plain 1 µs Newmark run showed six seat bounces per revolution undamped: its
     high-mode error after impacts, which the refinement after events removes.)"""
     undamped, mechanism = run(variant(damping=0.0))
     assert_sane(undamped, mechanism)
     damped, mechanism = run(variant(damping=1.0))
     assert_sane(damped, mechanism)
-    assert damped.bounces_per_revolution("seat") == [1]  # the revolution 360-720 deg
+    assert all(count <= 1 for count in damped.bounces_per_revolution("seat"))  # the revolution 360-720 deg
     assert undamped.bounces_per_revolution("seat")[0] >= 1
     assert len(undamped.events) > 5 * len(damped.events)
 
@@ -504,8 +511,10 @@ def test_twenty_revolutions_keep_closed_contacts_shut_and_do_not_drift(name: str
 
 @pytest.mark.parametrize("bouncy", [("seat",), ("cam",), ("seat", "cam")], ids="+".join)
 def test_bouncing_contacts_make_finite_trains_decaying_at_the_restitution(bouncy: tuple[str, ...]) -> None:
-    """Restitution 0.9: each bounce train slows geometrically, about 0.8-0.9 per impact, and ends."""
-    trace, mechanism = run(variant(restitution={name: 0.9 for name in bouncy}))
+    """Restitution 0.9 with the momentum law (the impulse acts on the whole train): each bounce train
+    slows geometrically, about 0.8-0.9 per impact, and ends. (With the local law the rebounding valve
+    or follower is driven back at once by the train behind it: four impacts a train, not decaying.)"""
+    trace, mechanism = run(variant(restitution={name: 0.9 for name in bouncy}, law="momentum"))
     assert_sane(trace, mechanism)
     assert len(trace.events) < 5000
     for name in bouncy:
@@ -533,9 +542,9 @@ def test_restitution_on_every_clearance_runs_sane_or_stops_clearly() -> None:
 
 @pytest.mark.slow
 def test_many_events_are_all_recorded() -> None:
-    """Restitution 0.9 on the cam for ten revolutions: about 7,000 events. The event list is
+    """Restitution 0.9 on the cam for ten revolutions (momentum law): thousands of events. The event list is
     the same whether the back end hands back control every 100 steps or once at the end."""
-    spec = spec_from(variant(restitution={"cam": 0.9}, degrees=3600.0))
+    spec = spec_from(variant(restitution={"cam": 0.9}, degrees=3600.0, law="momentum"))
     counts = {}
     for chunk_steps in (100, 10**6):
         trace = NewmarkBackend().simulate(assemble(spec), NewmarkOptions(1e-6, chunk_steps=chunk_steps))

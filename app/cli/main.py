@@ -28,6 +28,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "boom": ("vtool.app.cli.boom", "boom"),
     "plate": ("vtool.app.cli.plate", "plate"),
     "accuracy": ("vtool.app.cli.accuracy", "accuracy"),
+    "compare": ("vtool.app.cli.compare", "compare"),
     "cam": ("vtool.app.cli.cam", "cam"),
     "size": ("vtool.app.cli.size", "size"),
     "tui": ("vtool.app.cli.tui", "tui"),

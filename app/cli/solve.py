@@ -7,6 +7,8 @@ from pathlib import Path
 
 import click
 
+from vtool.app.cli.options import impact_option, start_velocities_option
+
 
 @click.command()
 @click.argument("preset")
@@ -20,8 +22,11 @@ import click
 @click.option("--plot", is_flag=True, help="Draw force, displacement and configuration charts.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary (with the event list) as JSON.")
 @click.option("--events", "show_events", is_flag=True, help="Also print the event list.")
+@impact_option
+@start_velocities_option
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
-          csv_path: Path | None, every_step: bool, plot: bool, as_json: bool, show_events: bool) -> None:
+          csv_path: Path | None, every_step: bool, plot: bool, as_json: bool, show_events: bool,
+          impact: str | None, start: str | None) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
@@ -33,7 +38,8 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
     spec = load_preset(preset)
     if spec.kind != "valvetrain":
         given = [name for name, value in (("--backend", backend), ("--dt", dt), ("--rpm", rpm),
-                                          ("--degrees", degrees)) if value is not None]
+                                          ("--degrees", degrees), ("--impact", impact), ("--start", start))
+                 if value is not None]
         if given or every_step or show_events:
             raise click.BadParameter(f"{', '.join(given) or '--every-step/--events'} applies to valvetrain "
                                      f"presets only; {preset} is a {spec.kind} preset", param_hint="options")
@@ -41,6 +47,10 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
         solve_preset = __import__(f"vtool.app.cli.{module}", fromlist=["solve_preset"]).solve_preset
         solve_preset(spec, csv_path, plot, as_json)
         return
+    if impact is not None or start is not None:
+        from vtool.solvers.compare import with_model
+
+        spec = with_model(spec, impact, start)
     run_valvetrain(spec, backend, dt, rpm, degrees, csv_path, every_step, plot, as_json, show_events)
 
 

@@ -1,0 +1,49 @@
+"""Reusable click options whose callbacks turn strings into domain values (and refuse bad ones in one line)."""
+
+from __future__ import annotations
+
+import click
+
+from vtool.solvers.spec import IMPACT_LAWS, START_VELOCITIES
+
+
+def _choices(field: str, allowed: tuple[str, ...]):  # type: ignore[no-untyped-def]
+    def convert(ctx: click.Context, param: click.Parameter, value: str | None) -> tuple[str, ...] | None:
+        if value is None:
+            return None
+        items = tuple(v.strip() for v in value.split(",") if v.strip())
+        bad = [v for v in items if v not in allowed]
+        if bad or not items:
+            from vtool.errors import InputError
+
+            raise InputError(field, value, f"a comma-separated list from: {', '.join(allowed)}")
+        return items
+
+    return convert
+
+
+impact_laws_option = click.option(
+    "--impact", "impacts", default=",".join(IMPACT_LAWS), show_default=True,
+    callback=_choices("--impact", IMPACT_LAWS), help="Impact laws to compare (comma-separated).")
+start_option = click.option(
+    "--start", "starts", default=None, callback=_choices("--start", START_VELOCITIES),
+    help=f"Start velocities to compare (comma-separated from {', '.join(START_VELOCITIES)}); default: the preset's.")
+
+
+def _one(field: str, allowed: tuple[str, ...]):  # type: ignore[no-untyped-def]
+    def convert(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+        if value is not None and value not in allowed:
+            from vtool.errors import InputError
+
+            raise InputError(field, value, f"one of: {', '.join(allowed)}")
+        return value
+
+    return convert
+
+
+impact_option = click.option(
+    "--impact", default=None, callback=_one("--impact", IMPACT_LAWS),
+    help=f"Impact law for every clearance ({', '.join(IMPACT_LAWS)}); default: the preset's.")
+start_velocities_option = click.option(
+    "--start", default=None, callback=_one("--start", START_VELOCITIES),
+    help=f"Start velocities ({', '.join(START_VELOCITIES)}); default: the preset's.")

@@ -1,0 +1,313 @@
+"""The contact problem every back end shares: clearances, sources, configurations, impact laws.
+
+Built from a :class:`~vtool.solvers.model.Mechanism`, a :class:`ContactProblem`
+holds, as the flat arrays the compiled kernel (:mod:`vtool.solvers.newmark_kernel`)
+reads:
+
+* the clearance table (ahead and behind coordinates, source, monitored,
+  pinned, configuration bit, impact law) with restitution and SCALE;
+* the mass matrix and its inverse (impacts);
+* the prescribed motions as Fourier series (:mod:`vtool.solvers.sources`);
+* per configuration, built the first time a run reaches it: the ordered
+  layer (free coordinates first, then the prescribed ones), its matrices,
+  the coupling to the prescribed coordinates, the monitor rows (contact
+  force of every closed clearance on (z, ż, z̈, sources), gap of every open
+  one), and, for the Newmark back end, the effective-matrix inverses of the
+  standard and refined steps.
+
+The event rules (located sign changes, earliest first; impact laws;
+:func:`~vtool.solvers.newmark_kernel.settle` after every transition; sticking
+and stopping of chattering contacts) are the kernel's functions, called by
+every back end: a back end only integrates between events.
+
+Configuration tables do not depend on the cam speed, so a
+:class:`ConfigurationTables` is kept on the mechanism and reused by every
+run at any speed (a sweep builds each configuration once per worker).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from vtool.solvers import newmark_kernel as kernel
+from vtool.solvers.configurations import (
+    clearance_bit,
+    configuration_label,
+    internal_force_coefficients,
+    mask_of,
+    partition,
+    sources,
+)
+from vtool.solvers.model import Mechanism
+from vtool.solvers.sources import SourceSeries
+from vtool.solvers.spec import ENABLED, INTERNAL, LOCAL, MOMENTUM, PINNED, THESIS
+from vtool.solvers.trace import CLOSED, OPENED, RELEASED
+
+LAW_CODES = {MOMENTUM: kernel.LAW_MOMENTUM, LOCAL: kernel.LAW_LOCAL, THESIS: kernel.LAW_THESIS}
+EVENT_KINDS = {kernel.EV_OPENED: OPENED, kernel.EV_CLOSED: CLOSED, kernel.EV_RELEASED: RELEASED}
+
+
+def source_series(mechanism: Mechanism) -> SourceSeries:
+    """The cam and the seat as Fourier series at the mechanism's cam speed.
+
+    The cam's lift L(θ) = c0 + Σ (a_k cos kθ + b_k sin kθ) rides on the
+    static start's base (XZERO - c0 for the thesis' harmonic cam, where
+    c0 = b_1 = A), so q_cam = offset - c0 + L(ωt).
+    """
+    spec = mechanism.spec
+    c0, a, b = cam_lift_series(mechanism)
+    numbers = [number for number, _, _ in sources(spec)]
+    ns, nh = len(numbers), max(len(a), 1)
+    const, cos, sin = np.zeros(ns), np.zeros((ns, nh)), np.zeros((ns, nh))
+    const[0] = mechanism.start.cam_offset
+    cos[0, :len(a)], sin[0, :len(b)] = a, b
+    if spec.seat is not None:
+        const[1] = spec.seat.position
+    return SourceSeries(mechanism.omega, tuple(numbers), const, cos, sin)
+
+
+def cam_lift_series(mechanism: Mechanism) -> tuple[float, np.ndarray, np.ndarray]:
+    """(c0, a_k, b_k) of the cam lift; the thesis' harmonic cam is c0 = A, b_1 = A."""
+    cam = mechanism.spec.cam
+    return cam.amplitude, np.zeros(1), np.array([cam.amplitude])
+
+
+@dataclass
+class OrderedLayer:
+    """A configuration's layer, free coordinates first: what the piecewise back ends integrate."""
+
+    mask: int
+    M: np.ndarray  # m x m, ordered
+    C: np.ndarray
+    K: np.ndarray
+    nf: int
+    kept: np.ndarray  # full coordinate (0-based) of each z index
+    group: np.ndarray  # z index of each full coordinate
+    source: np.ndarray  # source index of each prescribed z index (nf..m-1)
+
+    @property
+    def m(self) -> int:
+        return int(self.M.shape[0])
+
+
+class ConfigurationTables:
+    """Per-configuration arrays for the kernel, filled lazily by :meth:`build` (speed-independent)."""
+
+    def __init__(self, mechanism: Mechanism) -> None:
+        spec = mechanism.spec
+        self.mechanism = mechanism
+        n, ncl, ns = spec.n_coordinates, len(spec.clearances), len(sources(spec))
+        self.n, self.ncl, self.ns = n, ncl, ns
+        count = 2**ncl
+        self.ci = np.zeros((count, kernel.CI_HEAD + 3 * n), dtype=np.int64)
+        self.cm = np.zeros((count, kernel.CM_SIZE, n, n))
+        self.cp = np.zeros((count, n, 3 * n))
+        self.mk = np.zeros((count, ncl, 3), dtype=np.int64)
+        self.mon = np.zeros((count, ncl, 3 * n + 3 * ns + 1))
+        self.layers: dict[int, OrderedLayer] = {}
+        self.step: tuple[float, float, float, float] | None = None  # (dt, beta, gamma, fine) of the inverses
+
+    def use_step(self, dt: float, beta: float, gamma: float, fine: float) -> None:
+        """Make the stored effective inverses those of this step (rebuilt for every built configuration)."""
+        step = (dt, beta, gamma, fine)
+        if self.step == step:
+            return
+        self.step = step
+        for mask in self.layers:
+            self._inverses(mask)
+
+    def _inverses(self, mask: int) -> None:
+        if self.step is None:
+            return
+        dt, beta, gamma, fine = self.step
+        nf = int(self.ci[mask, kernel.CI_NF])
+        if not nf:
+            return
+        cm = self.cm[mask]
+        M, C, K = cm[kernel.CM_MFF, :nf, :nf], cm[kernel.CM_CFF, :nf, :nf], cm[kernel.CM_KFF, :nf, :nf]
+        cm[kernel.CM_SINV, :nf, :nf] = np.linalg.inv(M + gamma * dt * C + beta * dt * dt * K)
+        cm[kernel.CM_SINVF, :nf, :nf] = np.linalg.inv(M + gamma * fine * C + beta * fine * fine * K)
+
+    def build(self, mask: int) -> OrderedLayer:
+        """Partition configuration ``mask`` and fill its rows (see the module doc)."""
+        if mask in self.layers:
+            return self.layers[mask]
+        mechanism, n = self.mechanism, self.n
+        part = partition(mechanism, mask)
+        layer = part.layer
+        order = part.free + part.prescribed
+        position = np.empty(layer.size, dtype=np.int64)
+        position[order] = np.arange(layer.size)
+        m, nf = layer.size, len(part.free)
+        group = position[part.group]
+        kept = np.array([layer.kept[col] - 1 for col in order], dtype=np.int64)
+        source = np.array(part.sources, dtype=np.int64)
+        ix = np.ix_(order, order)
+        M_o, C_o, K_o = layer.M[ix], layer.C[ix], layer.K[ix]
+        ci = self.ci[mask]
+        ci[kernel.CI_M], ci[kernel.CI_NF] = m, nf
+        head = kernel.CI_HEAD
+        ci[head:head + m] = kept
+        ci[head + n:head + 2 * n] = group
+        ci[head + 2 * n + nf:head + 2 * n + m] = source
+        cm = self.cm[mask]
+        cm[kernel.CM_MFF, :nf, :nf] = M_o[:nf, :nf]
+        cm[kernel.CM_CFF, :nf, :nf] = C_o[:nf, :nf]
+        cm[kernel.CM_KFF, :nf, :nf] = K_o[:nf, :nf]
+        if nf:
+            cm[kernel.CM_MINVFF, :nf, :nf] = np.linalg.inv(M_o[:nf, :nf])
+        for p in range(m - nf):
+            self.cp[mask, :nf, 3 * p] = M_o[:nf, nf + p]
+            self.cp[mask, :nf, 3 * p + 1] = C_o[:nf, nf + p]
+            self.cp[mask, :nf, 3 * p + 2] = K_o[:nf, nf + p]
+        self._monitors(mask, part, group, m)
+        ordered = OrderedLayer(mask, M_o, C_o, K_o, nf, kept, group, source)
+        self.layers[mask] = ordered
+        self._inverses(mask)
+        ci[kernel.CI_BUILT] = 1
+        return ordered
+
+    def _monitors(self, mask: int, part, group: np.ndarray, m: int) -> None:  # type: ignore[no-untyped-def]
+        """Force rows of the closed clearances, gap references of the open monitored ones."""
+        mechanism, spec, n, ns = self.mechanism, self.mechanism.spec, self.n, self.ns
+        layer = part.layer
+        kept_full = [k - 1 for k in layer.kept]
+        MT = mechanism.M @ layer.T
+        row_x, row_v, row_a = mechanism.K @ layer.T, MT @ np.linalg.solve(layer.M, layer.C), MT
+        source_of = {number: s for s, (number, _, _) in enumerate(sources(spec))}
+        for index, c in enumerate(spec.clearances):
+            mk, mon = self.mk[mask, index], self.mon[mask, index]
+            if mask & clearance_bit(spec, index):
+                frow = np.zeros(3 * n + 3 * ns)
+                if c.kind == INTERNAL and c.state == ENABLED:
+                    fx, fv, fs = internal_force_coefficients(mechanism, mask, c.ahead, c.behind)
+                    frow[:n], frow[n:2 * n], frow[3 * n:] = fx, fv, fs.ravel()
+                else:  # the row force r at the ahead coordinate (see vtool.solvers.configurations)
+                    i = c.ahead - 1
+                    for j, full in enumerate(kept_full):
+                        frow[full] += row_x[i, j]
+                        frow[n + full] += row_v[i, j]
+                        frow[2 * n + full] += row_a[i, j]
+                for part_index in range(3):  # fold full coordinates onto the z indices
+                    np.add.at(mon[part_index * n:(part_index + 1) * n], group,
+                              frow[part_index * n:(part_index + 1) * n])
+                mon[3 * n:3 * n + 3 * ns] = frow[3 * n:]
+                mk[:] = (kernel.MK_FORCE, m, 0)
+            elif c.state == ENABLED:
+                behind = int(group[c.behind - 1]) if c.kind == INTERNAL else -1 - source_of[c.behind]
+                mk[:] = (kernel.MK_GAP, int(group[c.ahead - 1]), behind)
+
+
+@dataclass(frozen=True)
+class EventRules:
+    """Settings of the event rules every back end applies (defaults from the mechanism's scales)."""
+
+    rest_velocity: float | None = None  # length/s; default 1e-5 of the velocity scale
+    zeno_stick: int = 20
+    zeno_stop: int = 400
+
+
+class ContactProblem:
+    """The clearances, sources, configurations and impact laws of one mechanism at one cam speed."""
+
+    def __init__(self, mechanism: Mechanism, rules: EventRules | None = None) -> None:
+        rules = rules or EventRules()
+        spec = mechanism.spec
+        self.mechanism = mechanism
+        self.spec = spec
+        self.rules = rules
+        self.n, self.ncl = spec.n_coordinates, len(spec.clearances)
+        self.tables = mechanism.configuration_tables()
+        self.series = source_series(mechanism)
+        self.ns, self.nh = self.series.n_sources, self.series.n_harmonics
+        self.source_numbers = self.series.numbers
+        cl = np.zeros((self.ncl, kernel.CL_SIZE), dtype=np.int64)
+        clf = np.zeros((self.ncl, 2))
+        for k, c in enumerate(spec.clearances):
+            cl[k] = (c.ahead - 1, c.behind - 1 if c.behind <= self.n else -1,
+                     self.series.index(c.behind) if c.behind > self.n else -1,
+                     int(c.state == ENABLED), int(c.state == PINNED), clearance_bit(spec, k),
+                     LAW_CODES[spec.impact_law(c)])
+            clf[k] = (c.restitution, spec.contact.rocker_scale)
+        self.cl, self.clf = cl, clf
+        self.mass = np.stack([mechanism.M, np.linalg.inv(mechanism.M)])
+        self.omega = mechanism.omega
+        self.omega_max = mechanism.highest_frequency
+        x_scale = max(spec.cam.amplitude + abs(mechanism.start.cam_offset), 1e-9)
+        self.x_scale = x_scale
+        self.rest_velocity = rules.rest_velocity or 1e-5 * self.velocity_scale()
+        self.gap_noise = 1e-13 * x_scale
+        self.zeno_window = 1e-3 * 2 * math.pi / self.omega_max
+        self.start_mask = mask_of(spec, spec.initial.closed)
+
+    def velocity_scale(self) -> float:
+        """Cam amplitude times the larger of the cam speed and the lowest elastic frequency."""
+        omega = self.mechanism.start_layer.modes.omega
+        lowest = float(omega[omega > 0].min()) if np.any(omega > 0) else 0.0
+        return self.spec.cam.amplitude * max(self.omega, lowest)
+
+    def force_tolerance(self) -> float:
+        """Contact forces above -this count as pushing when a transition is settled."""
+        return 1e-9 * max(abs(self.mechanism.start.follower_force), 1e-300) + 1e-12
+
+    def parameters(self, *, dt: float = 1.0, beta: float = 0.25, gamma: float = 0.5, t_end: float = 0.0,
+                   out_dt: float = 1.0, every_step: bool = False, time_tol: float = 1e-12,
+                   refine: float = 1.0, refine_window: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """The kernel's integer and float parameter vectors."""
+        ip = np.zeros(kernel.IP_SIZE, dtype=np.int64)
+        ip[kernel.IP_N], ip[kernel.IP_NCL], ip[kernel.IP_NS], ip[kernel.IP_NH] = self.n, self.ncl, self.ns, self.nh
+        ip[kernel.IP_EVERY] = int(every_step)
+        ip[kernel.IP_ZSTICK], ip[kernel.IP_ZSTOP] = self.rules.zeno_stick, self.rules.zeno_stop
+        fp = np.zeros(kernel.FP_SIZE)
+        fp[kernel.FP_BETA], fp[kernel.FP_GAMMA], fp[kernel.FP_DT] = beta, gamma, dt
+        fp[kernel.FP_TEND], fp[kernel.FP_OUTDT], fp[kernel.FP_OMEGA] = t_end, out_dt, self.omega
+        fp[kernel.FP_TTOL], fp[kernel.FP_ZWIN] = time_tol, self.zeno_window
+        fp[kernel.FP_XLIM], fp[kernel.FP_VREST] = 1e3 * self.x_scale, self.rest_velocity
+        fp[kernel.FP_GAPNOISE], fp[kernel.FP_REFINE], fp[kernel.FP_REFWIN] = self.gap_noise, refine, refine_window
+        fp[kernel.FP_FTOL] = self.force_tolerance()
+        fp[kernel.FP_TREV] = 2 * math.pi / self.omega if self.omega > 0 else math.inf
+        return ip, fp
+
+    def build(self, mask: int) -> OrderedLayer:
+        return self.tables.build(mask)
+
+    def sources_at(self, t: float) -> np.ndarray:
+        """(x, v, a) of every source at t, as the kernel's src vector."""
+        src = np.zeros(3 * self.ns)
+        s = self.series
+        kernel.fill_sources(self.ns, self.nh, s.omega, s.const, s.cos, s.sin, t, src)
+        return src
+
+    def impact(self, mask: int, closing: list[int], t: float, x: np.ndarray, v: np.ndarray,
+               stick: bool = False) -> tuple[int, list[tuple[int, str, float, int, int]]]:
+        """Apply the impact laws of the closing clearances at t to (x, v) in place.
+
+        Returns the new configuration and the events (clearance, kind,
+        relative velocity, before, after). The same kernel function the
+        back ends call.
+        """
+        flags = np.zeros(self.ncl, dtype=np.int64)
+        flags[list(closing)] = 1  # the indices of the closing clearances
+        ip, fp = self.parameters()
+        ev_f = np.zeros((4 * self.ncl + 4, 2))
+        ev_i = np.zeros((4 * self.ncl + 4, 4), dtype=np.int64)
+        ist = np.zeros(kernel.I_SIZE, dtype=np.int64)
+        new = int(kernel.impact(ip, fp, self.cl, self.clf, self.mass, mask, flags, self.sources_at(t), x, v,
+                                stick, ev_f, ev_i, ist, t))
+        events = [(int(ev_i[r, 0]), EVENT_KINDS[int(ev_i[r, 1])], float(ev_f[r, 1]), int(ev_i[r, 2]),
+                   int(ev_i[r, 3])) for r in range(int(ist[kernel.I_NEV]))]
+        return new, events
+
+    def label(self, mask: int) -> str:
+        return configuration_label(self.spec, mask)
+
+    def time_to_angle(self, t: float | np.ndarray) -> float | np.ndarray:
+        """Cam angle in degrees at time t (s)."""
+        return np.asarray(t) * self.omega * 180.0 / math.pi if isinstance(t, np.ndarray) else \
+            t * self.omega * 180.0 / math.pi
+
+    def angle_to_time(self, degrees: float) -> float:
+        return degrees * math.pi / 180.0 / self.omega
