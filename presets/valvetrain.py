@@ -23,10 +23,10 @@ from vtool.solvers.spec import (
     ELEMENT_SIZE,
     ENABLED,
     EXTERNAL,
+    IMPACT_LAWS,
     INTERNAL,
     PINNED,
     REMOVED,
-    IMPACT_LAWS,
     START_VELOCITIES,
     CamSpec,
     ClearanceSpec,
@@ -147,6 +147,9 @@ def _cam(t: Table, n: int, units: UnitSystem, folder: Path | None = None) -> Cam
         offset = t.number("offset", unit=units.length, min_value=0.0)
     else:
         raise InputError(t.field("offset"), raw_offset, f'"{STATIC_START}" or a number', units.length)
+    if table and offset is not None:
+        raise InputError(t.field("offset"), offset, f'"{STATIC_START}" for a table cam (its base circle carries '
+                         f"the spring preload)", units.length)
     t.finish()
     return CamSpec(coordinate, amplitude, offset, name, profile, **table)
 

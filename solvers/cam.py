@@ -364,3 +364,32 @@ def report_text(report: dict) -> str:
         lines.append(f"warning: the table's {what}{size} at {j['angle_deg']:g} deg (a ramp/flank "
                      f"junction?): its Fourier series rings there")
     return "\n".join(lines)
+
+
+def table_start(spec, harmonic, omega: float):  # type: ignore[no-untyped-def]
+    """The static start of a table cam, from the harmonic rule's start ``harmonic``.
+
+    :func:`vtool.solvers.initial.static_start` places the harmonic cam at
+    XZERO = A + base; its deflection shape per unit follower displacement,
+    q / XZERO, and base = XZERO - A carry over. The table cam starts at
+    q_cam(0) = base + L(0), moving at L'(0) ω with acceleration L''(0) ω²;
+    the cam's series constant ("cam offset") is base + c0, so that
+    q_cam = base + L(ωt).
+    """
+    from vtool.solvers.initial import StaticStart, cam_clearance, check_open_gaps
+    from vtool.solvers.spec import QUASI_STATIC_START
+
+    base = harmonic.cam_offset - spec.cam.amplitude
+    c0, a, b = lift_series(spec.cam)
+    L, dL, ddL, _ = derivatives(c0, a, b, np.zeros(1))[:, 0]
+    shape = harmonic.q / harmonic.cam_offset
+    x0 = base + L
+    check_open_gaps(spec, shape * x0)
+    if spec.initial.velocities == QUASI_STATIC_START:
+        qd, qdd = shape * dL * omega, shape * ddL * omega**2
+    else:  # the thesis' INITAL: the follower moves with the cam, everything else at rest
+        follower = cam_clearance(spec).ahead
+        qd, qdd = np.zeros_like(shape), np.zeros_like(shape)
+        qd[follower - 1], qdd[follower - 1] = dL * omega, ddL * omega**2
+    return StaticStart(cam_offset=base + c0, follower_force=harmonic.follower_stiffness * x0,
+                       follower_stiffness=harmonic.follower_stiffness, q=shape * x0, qd=qd, qdd=qdd)

@@ -23,12 +23,6 @@ def simulate(
     options: object | None = None,
 ) -> Trace:
     """Run the preset's back end (``spec.run.backend``) on the assembled mechanism."""
-    if spec.cam.profile != "harmonic":
-        from vtool.errors import RunError
-
-        # until the back ends evaluate the cam as a Fourier series (vtool.solvers.sources)
-        raise RunError("a lift-table cam needs the Fourier-series cam in the back ends, not yet on this "
-                       "version; `vtool cam show` and `vtool modes` work")
     backend = backends.get(spec.run.backend)()
     mechanism = assemble(spec)
     if options is None:

@@ -151,3 +151,20 @@ def test_bad_tables_are_one_line_input_errors(cam: dict, message: str, tmp_path:
     with pytest.raises(InputError) as info:
         load(table_doc(**cam), folder=tmp_path)
     assert message in info.value.one_line()
+
+
+def test_table_of_the_harmonic_cam_reproduces_the_harmonic_run() -> None:
+    """Exact back end: the table cam fitted from 72 samples of A + A sin θ runs as the thesis' cam."""
+    from dataclasses import replace
+
+    from vtool.solvers.run import simulate
+
+    thesis = load_preset("gnilka-1a")
+    thesis = replace(thesis, run=replace(thesis.run, backend="exact", degrees=400.0))
+    angles = np.arange(0.0, 360.0, 5.0)
+    doc = table_doc(angles=angles.tolist(), lifts=harmonic_table(angles).tolist(), harmonics=4)
+    table = load(doc)
+    table = replace(table, run=thesis.run)
+    a, b = simulate(thesis), simulate(table)
+    assert [(e.clearance, e.kind) for e in a.events] == [(e.clearance, e.kind) for e in b.events]
+    assert max(abs(x.cam_angle - y.cam_angle) for x, y in zip(a.events, b.events, strict=True)) < 1e-6

@@ -105,3 +105,12 @@ def test_generated_size_block_for_the_thesis_mechanism_is_current() -> None:
     committed = read_block(bench_size.DOCS, "size-1a")
     assert deterministic(committed.split("\n\n")[0]) == deterministic(fresh.split("\n\n")[0])
     assert committed.splitlines()[-3:] == fresh.splitlines()[-3:]
+
+
+@pytest.mark.slow
+def test_generated_table_versus_harmonic_block_is_current() -> None:
+    from vtool.markdown import table
+
+    fresh = bench_size.table_vs_harmonic_rows()
+    assert read_block(bench_size.DOCS, "table-vs-harmonic") == table(*fresh)
+    assert all(row[2] == "yes" and float(row[3]) < 1e-5 for row in fresh[1])
