@@ -111,12 +111,14 @@ class Backend(ABC):
             problem = ContactProblem(mechanism, rules)
             builder = TraceBuilder(mechanism.spec, problem.source_numbers, problem.omega)
             stats = self.integrate(problem, options, builder, progress, cancel)
-            wall = wallclock.perf_counter() - started
+            compile_time = float(stats.get("compile_time", 0.0))
+            wall = wallclock.perf_counter() - started - compile_time
         spec = mechanism.spec
         settings = dict(stats.get("settings", {}))
         settings.update(rpm=spec.run.rpm, degrees=spec.run.degrees,
                         impact=sorted({spec.impact_law(c) for c in spec.clearances}),
                         rocker_scale=spec.contact.rocker_scale, start_velocities=spec.initial.velocities)
         statistics = RunStatistics(self.name, int(stats["steps"]), len(builder.events), wall,
-                                   tuple(sorted(stats.get("configurations", problem.tables.layers))), settings)
+                                   tuple(sorted(stats.get("configurations", problem.tables.layers))), settings,
+                                   compile_time=compile_time)
         return builder.build(stats["peak"], statistics, stats.get("peak_late"), sort=stats.get("sort", False))

@@ -53,6 +53,7 @@ Method (see the kernel's docstring for the equations):
 from __future__ import annotations
 
 import math
+import time as wallclock
 from dataclasses import dataclass
 from typing import Any
 
@@ -66,6 +67,7 @@ from vtool.solvers.model import Mechanism
 from vtool.solvers.spec import RunSpec
 from vtool.solvers.trace import TraceBuilder
 
+COMPILE_ESTIMATE_S = 30.0  # first compile of the kernel on a 2-core machine (benchmarks/bench_newmark.py)
 ROW_BUFFER = 4096  # output rows between flushes: memory stays bounded for any run length
 EVENT_BUFFER = 4096
 
@@ -91,6 +93,19 @@ class NewmarkOptions:
     @classmethod
     def from_run(cls, run: RunSpec, every_step: bool = False) -> NewmarkOptions:
         return cls(run.time_step, run.beta, run.gamma, run.output_interval, every_step)
+
+
+def compile_notice(backend: str = "newmark") -> str | None:
+    """The line to show before a run that must first compile the kernel, or None when it is cached.
+
+    The newmark back end runs ``run_chunk``; the piecewise back ends call the
+    event rules (``impact``, ``settle``, ``fill_sources``) from Python.
+    """
+    names = ("run_chunk",) if backend == "newmark" else ("impact", "settle", "fill_sources")
+    if kernel.is_cached(names):
+        return None
+    return (f"compiling the solver, once (about {COMPILE_ESTIMATE_S:.0f} s on two cores); "
+            "later runs load it from the cache")
 
 
 def stability_limit(beta: float, gamma: float, omega_max: float) -> float:
@@ -149,6 +164,7 @@ class NewmarkBackend(Backend):
         run.execute(progress, cancel)
         o = options
         return {"steps": int(run.ist[kernel.I_STEPS]), "peak": run.peak[0].copy(), "peak_late": run.peak[1].copy(),
+                "compile_time": run.compile_time,
                 "settings": {"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
                              "refine_after_events": o.refine}}
 
@@ -186,6 +202,7 @@ class KernelRun:
         self.ist[kernel.I_NEED_SETTLE] = 1
         self.fst = np.zeros(kernel.F_SIZE)
         self.fst[kernel.F_LAST_EVENT] = -1.0
+        self.compile_time = 0.0
 
     def flush(self) -> None:
         """Move the filled rows and events out of the kernel's buffers."""
@@ -198,16 +215,31 @@ class KernelRun:
         self.ist[kernel.I_NOUT] = 0
         self.ist[kernel.I_NEV] = 0
 
-    def execute(self, progress: Progress | None, cancel: Cancel | None) -> None:
+    def arguments(self) -> tuple:
         problem, tables = self.problem, self.problem.tables
-        chunk = self.options.chunk_steps * self.options.time_step
-        while True:
-            self.fst[kernel.F_CHUNK_END] = self.fst[kernel.F_T] + chunk
-            status = kernel.run_chunk(
-                self.ip, self.fp, problem.cl, problem.clf, problem.series.const, problem.series.cos,
+        return (self.ip, self.fp, problem.cl, problem.clf, problem.series.const, problem.series.cos,
                 problem.series.sin, problem.mass, tables.ci, tables.cm, tables.cp, tables.mk, tables.mon,
                 self.out_t, self.out_q, self.out_F, self.out_c, self.ev_f, self.ev_i, self.peak,
                 self.x, self.v, self.a, self.ist, self.fst)
+
+    def compile(self) -> None:
+        """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""
+        if not hasattr(kernel.run_chunk, "signatures") or kernel.run_chunk.signatures:
+            return  # NUMBA_DISABLE_JIT (the plain reference), or compiled already
+        import numba
+
+        started = wallclock.perf_counter()
+        kernel.run_chunk.compile(tuple(numba.typeof(value) for value in self.arguments()))
+        self.compile_time = wallclock.perf_counter() - started
+
+    def execute(self, progress: Progress | None, cancel: Cancel | None) -> None:
+        problem = self.problem
+        chunk = self.options.chunk_steps * self.options.time_step
+        self.compile()
+        args = self.arguments()
+        while True:
+            self.fst[kernel.F_CHUNK_END] = self.fst[kernel.F_T] + chunk
+            status = kernel.run_chunk(*args)
             t = float(self.fst[kernel.F_T])
             if status == kernel.NEED_CONFIG:
                 problem.build(int(self.ist[kernel.I_WANT_CFG]))

@@ -86,6 +86,21 @@ F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
 F_SIZE = 4
 
 
+ENTRY_POINTS = ("run_chunk", "impact", "settle", "fill_sources")  # what the back ends call from Python
+
+
+def is_cached(names: tuple[str, ...] = ENTRY_POINTS) -> bool:
+    """True when these entry points' compiled code is in the numba cache (no compile needed).
+
+    Reads the cache's index (numba keeps one per function, stamped with this
+    file's modification time and size); any doubt counts as not cached.
+    """
+    try:
+        return all(globals()[name]._cache._cache_file._load_index() for name in names)
+    except Exception:  # noqa: BLE001 (numba internals: a missing or unreadable index means "compile")
+        return False
+
+
 # ----- sources -----
 @jit
 def fill_sources(ns, nh, omega, sc, sa, sb, t, src):
@@ -607,6 +622,196 @@ def locate_event(ci, cm, cp, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi
     return lo
 
 
+# ----- the hot loop -----
+@jit
+def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist, fst, c,
+            z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi):
+    """Standard and refined steps in configuration c while nothing happens; returns the time reached.
+
+    Everything a quiet step does is written out here, with no call that
+    passes arrays (each such call costs a reference-count increment and
+    decrement per array, more than the step's arithmetic): the Newmark step
+    with the stored effective inverse, the sources, the monitors, the output
+    rows at the output instants, the peaks. It stops, without taking it, at
+    the first step that is neither a standard step on the grid nor a refined
+    one, that would end past the chunk or the run, change a monitor's sign,
+    leave the divergence limit or overflow the output buffer, and in
+    every-step mode at once; :func:`run_chunk` takes that step with full
+    handling.
+    """
+    n, ncl, ns, nh = ip[IP_N], ip[IP_NCL], ip[IP_NS], ip[IP_NH]
+    if ip[IP_EVERY]:
+        return fst[F_T]
+    beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
+    omega, gap_noise, x_limit, t_rev = fp[FP_OMEGA], fp[FP_GAPNOISE], fp[FP_XLIM], fp[FP_TREV]
+    fine = dt / fp[FP_REFINE]
+    m = ci[c, CI_M]
+    nf = ci[c, CI_NF]
+    rows = out_t.shape[0]
+    t = fst[F_T]
+    while True:
+        k_grid = ist[I_GRID]
+        if t < fst[F_FINE_UNTIL]:
+            h = fine
+            slot = CM_SINVF
+            if t + h >= (k_grid + 1) * dt:
+                return t
+        elif t == k_grid * dt:
+            h = dt
+            slot = CM_SINV
+        else:
+            return t
+        if t + h > t_end or t >= fst[F_CHUNK_END]:
+            return t
+        # the sources at t + h
+        t1 = t + h
+        c1 = np.cos(omega * t1)
+        s1 = np.sin(omega * t1)
+        for s in range(ns):
+            src1[3 * s] = sc[s]
+            src1[3 * s + 1] = 0.0
+            src1[3 * s + 2] = 0.0
+        ck = 1.0
+        sk = 0.0
+        for kh in range(nh):
+            ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
+            wk = (kh + 1) * omega
+            for s in range(ns):
+                ca = sa[s, kh]
+                cb = sb[s, kh]
+                src1[3 * s] += ca * ck + cb * sk
+                src1[3 * s + 1] += wk * (cb * ck - ca * sk)
+                src1[3 * s + 2] -= wk * wk * (ca * ck + cb * sk)
+        # the Newmark step (see layer_step)
+        for j in range(m):
+            z1[j] = z[j] + h * zd[j] + h * h * (0.5 - beta) * zdd[j]
+            zd1[j] = zd[j] + h * (1.0 - gamma) * zdd[j]
+        for j in range(nf, m):
+            sidx = ci[c, CI_HEAD + 2 * n + j]
+            z1[j] = src1[3 * sidx]
+            zd1[j] = src1[3 * sidx + 1]
+            zdd1[j] = src1[3 * sidx + 2]
+        for f in range(nf):
+            acc = 0.0
+            for g in range(nf):
+                acc -= cm[c, CM_CFF, f, g] * zd1[g] + cm[c, CM_KFF, f, g] * z1[g]
+            for p in range(m - nf):
+                j = nf + p
+                acc -= cp[c, f, 3 * p] * zdd1[j] + cp[c, f, 3 * p + 1] * zd1[j] + cp[c, f, 3 * p + 2] * z1[j]
+            rhs[f] = acc
+        for f in range(nf):
+            acc = 0.0
+            for g in range(nf):
+                acc += cm[c, slot, f, g] * rhs[g]
+            zdd1[f] = acc
+            z1[f] += beta * h * h * acc
+            zd1[f] += gamma * h * acc
+        # monitors (see monitor_value): stop before a sign change
+        for k in range(ncl):
+            kind = mk[c, k, 0]
+            value = 0.0
+            if kind == MK_GAP:
+                behind = mk[c, k, 2]
+                other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
+                value = z1[mk[c, k, 1]] - other + gap_noise
+                if value < 0.0:
+                    return t
+            elif kind == MK_FORCE:
+                value = mon[c, k, 3 * n + 3 * ns]
+                for j in range(m):
+                    value += mon[c, k, j] * z1[j] + mon[c, k, n + j] * zd1[j] + mon[c, k, 2 * n + j] * zdd1[j]
+                for j in range(3 * ns):
+                    value += mon[c, k, 3 * n + j] * src1[j]
+                if value < 0.0 and cl[k, CL_MON]:
+                    return t
+            phi[k] = value
+        for j in range(nf):
+            if not (abs(z1[j]) <= x_limit):
+                return t
+        # output rows inside (t, t + h] (see run_chunk)
+        while True:
+            j_out = ist[I_NEXT_OUT]
+            t_out = j_out * out_dt
+            if t_out > t1 + 1e-9 * dt or t_out > t_end + 1e-9 * dt:
+                break
+            row = ist[I_NOUT]
+            if row >= rows:
+                return t
+            s_out = t_out - t
+            r = s_out / h
+            for j in range(nf):
+                da = zdd1[j] - zdd[j]
+                zddo[j] = zdd[j] + da * r
+                zdo[j] = zd[j] + zdd[j] * s_out + da * s_out * r / 2.0
+                zo[j] = z[j] + zd[j] * s_out + zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
+            co = np.cos(omega * t_out)
+            so = np.sin(omega * t_out)
+            for s in range(ns):
+                srco[3 * s] = sc[s]
+                srco[3 * s + 1] = 0.0
+                srco[3 * s + 2] = 0.0
+            ck = 1.0
+            sk = 0.0
+            for kh in range(nh):
+                ck, sk = ck * co - sk * so, sk * co + ck * so
+                wk = (kh + 1) * omega
+                for s in range(ns):
+                    ca = sa[s, kh]
+                    cb = sb[s, kh]
+                    srco[3 * s] += ca * ck + cb * sk
+                    srco[3 * s + 1] += wk * (cb * ck - ca * sk)
+                    srco[3 * s + 2] -= wk * wk * (ca * ck + cb * sk)
+            for j in range(nf, m):
+                sidx = ci[c, CI_HEAD + 2 * n + j]
+                zo[j] = srco[3 * sidx]
+                zdo[j] = srco[3 * sidx + 1]
+                zddo[j] = srco[3 * sidx + 2]
+            out_t[row] = t_out
+            out_c[row] = c
+            for i in range(n):
+                j = ci[c, CI_HEAD + n + i]
+                out_q[row, 0, i] = zo[j]
+                out_q[row, 1, i] = zdo[j]
+                out_q[row, 2, i] = zddo[j]
+            for s in range(ns):
+                out_q[row, 0, n + s] = srco[3 * s]
+                out_q[row, 1, n + s] = srco[3 * s + 1]
+                out_q[row, 2, n + s] = srco[3 * s + 2]
+            for k in range(ncl):
+                force = 0.0
+                if mk[c, k, 0] == MK_FORCE:
+                    force = mon[c, k, 3 * n + 3 * ns]
+                    for j in range(m):
+                        force += mon[c, k, j] * zo[j] + mon[c, k, n + j] * zdo[j] + mon[c, k, 2 * n + j] * zddo[j]
+                    for j in range(3 * ns):
+                        force += mon[c, k, 3 * n + j] * srco[j]
+                out_F[row, k] = force
+            ist[I_NOUT] = row + 1
+            ist[I_NEXT_OUT] = j_out + 1
+        # accept: peaks, state, time
+        after = t1 >= t_rev
+        for k in range(ncl):
+            if mk[c, k, 0] == MK_FORCE:
+                if phi[k] > peak[0, k]:
+                    peak[0, k] = phi[k]
+                if after and phi[k] > peak[1, k]:
+                    peak[1, k] = phi[k]
+        for j in range(m):
+            z[j] = z1[j]
+            zd[j] = zd1[j]
+            zdd[j] = zdd1[j]
+        ist[I_STEPS] += 1
+        if h == dt:
+            ist[I_GRID] = k_grid + 1
+            t = (k_grid + 1) * dt
+        else:
+            t = t1
+            if abs(t - (k_grid + 1) * dt) <= 1e-9 * dt:
+                ist[I_GRID] = k_grid + 1
+                t = (k_grid + 1) * dt
+        fst[F_T] = t
+
+
 # ----- the run loop -----
 @jit
 def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
@@ -688,6 +893,12 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
             if t >= fst[F_CHUNK_END]:
                 status = CHUNK_END
                 break
+            t_quiet = advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist,
+                              fst, c, z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi)
+            if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
+                t = t_quiet
+                fill_sources(ns, nh, omega, sc, sa, sb, t, src0)
+                continue
             k_grid = ist[I_GRID]
             grid_next = (k_grid + 1) * dt
             if t == k_grid * dt:

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from vtool.files import write_atomic
+from vtool.files import open_atomic
 from vtool.solvers.configurations import closed_names, configuration_label, thesis_number
 from vtool.solvers.spec import EXTERNAL, MechanismSpec
 
@@ -76,6 +76,7 @@ class RunStatistics:
     configurations_built: tuple[int, ...]
     settings: dict = field(default_factory=dict)
     error_estimate: float | None = None
+    compile_time: float = 0.0  # s spent compiling (or loading) the kernel, not in wall_time
 
 
 @dataclass(frozen=True)
@@ -99,27 +100,27 @@ class Trace:
     peak_force_after_first_revolution: np.ndarray | None = None  # per clearance, over every step
 
     # ----- columns by the engineer's names -----
-    def coordinate(self, number: int) -> np.ndarray:
-        return self.q[:, self.coordinate_numbers.index(number)]
+    def coordinate(self, number: int, rows: slice = slice(None)) -> np.ndarray:
+        return self.q[rows, self.coordinate_numbers.index(number)]
 
     def force_label(self, index: int) -> str:
         return f"F{self.spec.clearances[index].ahead}"
 
-    def force(self, label_or_name: str) -> np.ndarray:
+    def force(self, label_or_name: str, rows: slice = slice(None)) -> np.ndarray:
         for i, c in enumerate(self.spec.clearances):
             if label_or_name in (c.name, self.force_label(i)):
-                return self.contact_force[:, i]
+                return self.contact_force[rows, i]
         raise KeyError(label_or_name)
 
-    def quantity(self, expression: str) -> np.ndarray:
-        """``q7``, ``q1-q9`` or ``F2`` (the force at the clearance ahead of q2)."""
+    def quantity(self, expression: str, rows: slice = slice(None)) -> np.ndarray:
+        """``q7``, ``q1-q9`` or ``F2`` (the force at the clearance ahead of q2), on a slice of rows."""
         text = expression.replace(" ", "")
         if match := re.fullmatch(r"q(\d+)-q(\d+)", text):
-            return self.coordinate(int(match[1])) - self.coordinate(int(match[2]))
+            return self.coordinate(int(match[1]), rows) - self.coordinate(int(match[2]), rows)
         if match := re.fullmatch(r"q(\d+)", text):
-            return self.coordinate(int(match[1]))
+            return self.coordinate(int(match[1]), rows)
         if re.fullmatch(r"F\d+", text):
-            return self.force(text)
+            return self.force(text, rows)
         raise KeyError(expression)
 
     def coordinate_unit(self, number: int) -> str:
@@ -135,36 +136,50 @@ class Trace:
         return self.coordinate_unit(int(re.findall(r"\d+", text)[0]))
 
     # ----- export -----
-    def csv_text(self, quantities: tuple[str, ...] = ()) -> str:
-        """CSV with one header row naming each quantity and its unit."""
+    def csv_columns(self, quantities: tuple[str, ...] = ()) -> tuple[list[str], list]:  # type: ignore[type-arg]
+        """The CSV header (quantity names with units) and one function per numeric column that gives
+        the column's values on a slice of rows (so a long run is written block by block)."""
         units = self.spec.unit_system
         header = ["time (s)", "cam_angle (deg)"]
-        columns: list[np.ndarray] = [self.time, self.cam_angle]
+        columns: list = [lambda rows: self.time[rows], lambda rows: self.cam_angle[rows]]
         for prefix, data, suffix in (("q", self.q, ""), ("qd", self.qd, f"/{units.time}"),
                                      ("qdd", self.qdd, f"/{units.time}^2")):
             for j, number in enumerate(self.coordinate_numbers):
                 header.append(f"{prefix}{number} ({self.coordinate_unit(number)}{suffix})")
-                columns.append(data[:, j])
+                columns.append(lambda rows, data=data, j=j: data[rows, j])
         for i in range(len(self.spec.clearances)):
             header.append(f"{self.force_label(i)} ({units.force})")
-            columns.append(self.contact_force[:, i])
+            columns.append(lambda rows, i=i: self.contact_force[rows, i])
         for expression in quantities:
             header.append(f"{expression} ({self.quantity_unit(expression)})")
-            columns.append(self.quantity(expression))
-        header += ["configuration", "closed"]
-        numbers = [thesis_number(self.spec, int(m)) for m in self.configuration]
-        closed = ["+".join(closed_names(self.spec, int(m))) or "none" for m in self.configuration]
+            columns.append(lambda rows, expression=expression: self.quantity(expression, rows))
+        return header + ["configuration", "closed"], columns
+
+    def write_csv_to(self, handle, quantities: tuple[str, ...] = (), chunk: int = 20_000) -> None:  # type: ignore[no-untyped-def]
+        """Write the CSV in blocks of ``chunk`` rows (memory stays bounded by the block, not the run)."""
+        header, columns = self.csv_columns(quantities)
+        handle.write(",".join(header) + "\n")
+        labels = {}
+        for mask in np.unique(self.configuration):
+            number = thesis_number(self.spec, int(mask))
+            labels[int(mask)] = f"{'' if number is None else number},{'+'.join(closed_names(self.spec, int(mask))) or 'none'}"
+        row_format = ",".join(["%.10g"] * len(columns)) + ",%s\n"
+        for start in range(0, len(self.time), chunk):
+            rows = slice(start, min(start + chunk, len(self.time)))
+            block = np.column_stack([column(rows) for column in columns]).tolist()
+            names = [labels[int(m)] for m in self.configuration[rows]]
+            handle.write("".join(row_format % (*row, name) for row, name in zip(block, names, strict=True)))
+
+    def csv_text(self, quantities: tuple[str, ...] = ()) -> str:
+        """CSV with one header row naming each quantity and its unit."""
         buffer = io.StringIO()
-        buffer.write(",".join(header) + "\n")
-        table = np.column_stack(columns)
-        for row, number, names in zip(table, numbers, closed, strict=True):
-            buffer.write(",".join(f"{value:.10g}" for value in row))
-            buffer.write(f",{'' if number is None else number},{names}\n")
+        self.write_csv_to(buffer, quantities)
         return buffer.getvalue()
 
     def write_csv(self, path: str, quantities: tuple[str, ...] | None = None) -> None:
-        """Write :meth:`csv_text` atomically (the preset's quantities by default)."""
-        write_atomic(path, self.csv_text(self.spec.run.quantities if quantities is None else quantities))
+        """Write the CSV atomically, block by block (the preset's quantities by default)."""
+        with open_atomic(path) as handle:
+            self.write_csv_to(handle, self.spec.run.quantities if quantities is None else quantities)
 
     # ----- summary -----
     def events_at(self, clearance: str, kinds: tuple[str, ...]) -> list[Event]:
@@ -282,6 +297,7 @@ class Trace:
             "steps": stats.steps,
             "events": stats.events,
             "wall_time_s": stats.wall_time,
+            "compile_time_s": stats.compile_time,
             "episode_window_deg": EPISODE_WINDOW_DEG,
             "configurations_built": [configuration_label(self.spec, m) for m in stats.configurations_built],
             "events_list": [
@@ -297,8 +313,10 @@ class Trace:
         s = self.summary()
         units = self.spec.unit_system
         lines = [s["title"], f"back end {s['backend']}: " + ", ".join(f"{k} = {v}" for k, v in s["settings"].items())]
+        compiling = (f" (+ {s['compile_time_s']:.1f} s compiling or loading the solver)"
+                     if s["compile_time_s"] >= 0.5 else "")
         lines.append(
-            f"steps {s['steps']}, events {s['events']}, wall time {s['wall_time_s']:.3f} s, "
+            f"steps {s['steps']}, events {s['events']}, wall time {s['wall_time_s']:.3f} s{compiling}, "
             f"configurations built: {', '.join(s['configurations_built'])}"
         )
         lines.append("")
@@ -378,17 +396,20 @@ class TraceBuilder:
               sort: bool = False) -> Trace:
         n = self.spec.n_coordinates + len(self.source_numbers)
         ncl = len(self.spec.clearances)
-        if self.blocks:
-            t = np.concatenate([b[0] for b in self.blocks])
-            q3 = np.concatenate([b[1] for b in self.blocks])
-            F = np.concatenate([b[2] for b in self.blocks])
-            cfg = np.concatenate([b[3] for b in self.blocks])
-        else:
-            t, q3, F, cfg = np.zeros(0), np.zeros((0, 3, n)), np.zeros((0, ncl)), np.zeros(0, dtype=np.int64)
+        rows = sum(len(b[0]) for b in self.blocks)
+        t, F, cfg = np.zeros(rows), np.zeros((rows, ncl)), np.zeros(rows, dtype=np.int64)
+        q, qd, qdd = np.zeros((rows, n)), np.zeros((rows, n)), np.zeros((rows, n))
+        start = 0
+        while self.blocks:  # copy block by block, freeing each: the peak is the result plus one block
+            bt, bq, bF, bc = self.blocks.pop(0)
+            stop = start + len(bt)
+            t[start:stop], F[start:stop], cfg[start:stop] = bt, bF, bc
+            q[start:stop], qd[start:stop], qdd[start:stop] = bq[:, 0], bq[:, 1], bq[:, 2]
+            start = stop
         if sort:
             order = np.argsort(t, kind="stable")
-            t, q3, F, cfg = t[order], q3[order], F[order], cfg[order]
+            t, q, qd, qdd, F, cfg = t[order], q[order], qd[order], qdd[order], F[order], cfg[order]
         numbers = tuple(range(1, self.spec.n_coordinates + 1)) + self.source_numbers
-        return Trace(self.spec, t, cam_angle_deg(t, self.omega), numbers, q3[:, 0], q3[:, 1], q3[:, 2], F, cfg,
+        return Trace(self.spec, t, cam_angle_deg(t, self.omega), numbers, q, qd, qdd, F, cfg,
                      tuple(self.events), np.array(peak, dtype=float), statistics,
                      peak_force_after_first_revolution=None if peak_late is None else np.array(peak_late))

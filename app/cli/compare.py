@@ -42,6 +42,9 @@ def compare(preset: str, impacts: tuple[str, ...], starts: tuple[str, ...] | Non
         if not 0.0 < degrees <= 36000.0:
             raise InputError("--degrees", degrees, "> 0 and <= 36000", "deg")
         spec = dataclasses.replace(spec, run=dataclasses.replace(spec.run, degrees=degrees))
+    from vtool.app.cli.solve import announce_compile
+
+    announce_compile(spec.run.backend)
     variants = run_compare(spec, impacts, starts)
     header, rows = table(variants)
     if as_json:

@@ -61,6 +61,7 @@ def run_valvetrain(spec, backend, dt, rpm, degrees, csv_path, every_step, plot, 
     from vtool.solvers.run import simulate
 
     spec = with_run_overrides(spec, backend=backend, time_step=dt, rpm=rpm, degrees=degrees)
+    announce_compile(spec.run.backend)
     progress = DelayedProgress(f"{spec.run.backend} {spec.run.degrees:g} deg")
     try:
         trace = simulate(spec, every_step=every_step, progress=progress)
@@ -81,3 +82,12 @@ def run_valvetrain(spec, backend, dt, rpm, degrees, csv_path, every_step, plot, 
         from vtool.app.valvetrain_charts import all_charts
 
         click.echo(all_charts(trace))
+
+
+def announce_compile(backend: str) -> None:
+    """One line on stderr before a run that must first compile the solver (a new install's first run)."""
+    from vtool.solvers.newmark import compile_notice
+
+    notice = compile_notice(backend)
+    if notice:
+        click.echo(notice, err=True)
