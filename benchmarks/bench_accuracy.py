@@ -1,8 +1,10 @@
-"""The speed/accuracy trade on example 1A, measured in one run (ratios, not absolute times).
+"""The speed/accuracy trade of one preset, measured in one run (ratios, not absolute times).
 
-Run: ``python3 benchmarks/bench_accuracy.py``. Prints figures, asserts nothing.
+Run: ``python3 benchmarks/bench_accuracy.py [PRESET]`` (default gnilka-1a).
+Prints figures, asserts nothing. The tables in README.md and
+docs/valvetrain.md are written by ``python3 benchmarks/tables_valvetrain.py``.
 
-1. The accuracy table of ``vtool accuracy gnilka-1a`` (every back end over its
+1. The accuracy table of ``vtool accuracy PRESET`` (every back end over its
    knob against the exact back end).
 2. Newmark at dt = 1e-6 s against scipy at equal event-angle accuracy: the
    cheapest scipy setting at least as accurate, and the time ratio.
@@ -12,14 +14,15 @@ Run: ``python3 benchmarks/bench_accuracy.py``. Prints figures, asserts nothing.
 
 from __future__ import annotations
 
+import sys
+
 from vtool.presets import load_preset
-from vtool.presets.valvetrain import with_run_overrides
-from vtool.solvers.accuracy import accuracy_study, compare, table_text
+from vtool.solvers.accuracy import accuracy_study, compare, table_text, with_run
 from vtool.solvers.run import simulate
 
 
-def main() -> None:
-    spec = load_preset("gnilka-1a")
+def main(name: str = "gnilka-1a") -> None:
+    spec = load_preset(name)
     simulate(spec)  # JIT warm-up
     reference, rows = accuracy_study(spec)
     print(table_text(rows))
@@ -35,8 +38,8 @@ def main() -> None:
               f"{cheapest.wall_time:.3f} s -> Newmark is {cheapest.wall_time / newmark.wall_time:.0f}x faster")
     for target in (0.1, 0.01):
         n = [r for r in rows if r.backend == "newmark" and r.event_angle_error is not None
-             and r.event_angle_error <= target and r.same_sequence]
-        s = [r for r in scipy_rows if r.event_angle_error <= target and r.same_sequence]
+             and r.event_angle_error <= target and r.unmatched_events == 0]
+        s = [r for r in scipy_rows if r.event_angle_error <= target and r.unmatched_events == 0]
         if n and s:
             best_n, best_s = min(n, key=lambda r: r.wall_time), min(s, key=lambda r: r.wall_time)
             print(f"  event angles within {target} deg: Newmark {best_n.setting} {best_n.wall_time:.3f} s, "
@@ -45,11 +48,11 @@ def main() -> None:
     print(f"exact back end: {exact_time:.3f} s ({reference.statistics.steps} scan samples, "
           f"{reference.statistics.events} events)")
     for dt in (5e-8, 2e-8, 1e-8):
-        trace = simulate(with_run_overrides(spec, time_step=dt))
+        trace = simulate(with_run(spec, time_step=dt))
         row = compare(trace, reference, "newmark", f"dt={dt:.0e}")
         print(f"  Newmark dt={dt:.0e} s: {row.wall_time:.3f} s = {row.wall_time / exact_time:.2f} x exact, "
               f"max event-angle error {row.event_angle_error:.2g} deg")
 
 
 if __name__ == "__main__":
-    main()
+    main(*sys.argv[1:2])

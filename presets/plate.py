@@ -10,7 +10,6 @@ round-trips. See ``presets/plate-table2.toml`` for a commented example.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 from vtool.assessments.plate.assembly import Mesh, Plate
@@ -18,47 +17,40 @@ from vtool.assessments.plate.constraints import free_dofs
 from vtool.assessments.plate.elements import ELEMENTS
 from vtool.assessments.plate.masters import NAMED_SETS, MasterSetError, labelled_set, named_set
 from vtool.assessments.plate.model import METHODS, Case, MasterSelection
-from vtool.assessments.plate.study import Study, TransientSettings
-from vtool.assessments.plate.transient import LOADS, RK4_LIMIT_THESIS
+from vtool.assessments.plate.spec import UNIT_SYSTEMS, PlateSpec, PlateUnits
+from vtool.assessments.plate.study import (
+    DEFAULT_PERIODS,
+    MAX_EXACT_MODES,
+    Study,
+    TransientSettings,
+    check_exact_cost,
+    check_mesh_size,
+)
+from vtool.assessments.plate.transient import LOADS, MIN_OMEGA_MAX_H, RK4_LIMIT_THESIS
 from vtool.errors import InputError
+from vtool.presets.boom import short_error
 from vtool.presets.fields import Table
 
-
-@dataclass(frozen=True)
-class PlateUnits:
-    """Unit names of one consistent system, as a plate preset uses them."""
-
-    length: str
-    pressure: str
-    density: str
-    force: str
-
-
-#: Same system names as the valve-train presets.
-UNIT_SYSTEMS: dict[str, PlateUnits] = {
-    "in-lbf-s": PlateUnits("in", "lbf/in^2", "lbf*s^2/in^4", "lbf"),
-    "SI": PlateUnits("m", "Pa", "kg/m^3", "N"),
-}
+__all__ = ["UNIT_SYSTEMS", "PlateSpec", "PlateUnits", "dump", "load"]  # specs live in assessments.plate.spec
 
 MAX_MESH = 64
+#: Physical bounds in SI, checked before any numerics (docs/plate.md, "Limits").
+PLATE_LIMITS_SI: dict[str, tuple[float, float]] = {
+    "a": (1e-3, 1e3),  # m
+    "b": (1e-3, 1e3),  # m
+    "thickness": (1e-6, 10.0),  # m
+    "youngs_modulus": (1e3, 1e13),  # Pa
+    "density": (1.0, 1e5),  # kg/m^3
+}
+POISSON_LIMITS = (-0.9, 0.499)
+MAX_ASPECT = 100.0  # a/b and b/a
+MAX_CASES = 50
 
 
-@dataclass(frozen=True)
-class PlateSpec:
-    """A validated plate preset: a study with its title and units."""
-
-    title: str
-    units: str
-    study: Study
-    element: str  # default element of the cases
-    nx: int  # default mesh of the cases
-    ny: int
-    notes: str = ""
-    kind: str = "plate"
-
-    @property
-    def unit_system(self) -> PlateUnits:
-        return UNIT_SYSTEMS[self.units]
+def _si_scale(units: PlateUnits, key: str) -> float:
+    """SI value per preset unit of ``key``."""
+    return {"a": units.metres, "b": units.metres, "thickness": units.metres,
+            "youngs_modulus": units.pascals, "density": units.kg_per_m3}[key]
 
 
 def _mesh(t: Table, key: str, default: tuple[int, int] | None) -> tuple[int, int]:
@@ -76,16 +68,23 @@ def _mesh(t: Table, key: str, default: tuple[int, int] | None) -> tuple[int, int
 
 
 def _plate(t: Table, units: PlateUnits) -> Plate:
-    plate = Plate(
-        a=t.number("a", unit=units.length, min_exclusive=0.0),
-        b=t.number("b", unit=units.length, min_exclusive=0.0),
-        thickness=t.number("thickness", unit=units.length, min_exclusive=0.0),
-        youngs_modulus=t.number("youngs_modulus", unit=units.pressure, min_exclusive=0.0),
-        poisson=t.number("poisson", min_exclusive=-1.0, max_exclusive=0.5),
-        density=t.number("density", unit=units.density, min_exclusive=0.0),
-    )
+    unit = {"a": units.length, "b": units.length, "thickness": units.length,
+            "youngs_modulus": units.pressure, "density": units.density}
+    values = {}
+    for key, (low, high) in PLATE_LIMITS_SI.items():
+        scale = _si_scale(units, key)
+        values[key] = t.number(key, unit=unit[key], min_value=float(f"{low / scale:.3g}"),
+                               max_value=float(f"{high / scale:.3g}"))
+    poisson = t.number("poisson", min_value=POISSON_LIMITS[0], max_value=POISSON_LIMITS[1])
+    a, b = values["a"], values["b"]
+    if not 1.0 / MAX_ASPECT <= a / b <= MAX_ASPECT:
+        raise InputError(t.field("b"), b, f"within a factor {MAX_ASPECT:g} of a = {a:g}", units.length)
+    if values["thickness"] > 0.5 * min(a, b):
+        raise InputError(t.field("thickness"), values["thickness"],
+                         f"<= half the shorter side, {0.5 * min(a, b):g} (a plate)", units.length)
     t.finish()
-    return plate
+    return Plate(a=a, b=b, thickness=values["thickness"], youngs_modulus=values["youngs_modulus"],
+                 poisson=poisson, density=values["density"])
 
 
 def _masters(t: Table, mesh: Mesh, field: str) -> MasterSelection:
@@ -117,6 +116,9 @@ def _masters(t: Table, mesh: Mesh, field: str) -> MasterSelection:
 
 
 def _cases(top: Table, plate: Plate, element: str, mesh: tuple[int, int]) -> tuple[Case, ...]:
+    raw = top.data.get("cases") if isinstance(top.data, dict) else None
+    if isinstance(raw, list) and len(raw) > MAX_CASES:
+        raise InputError("cases", f"{len(raw)} entries", f"at most {MAX_CASES}")
     tables = top.array_of_tables("cases")
     if not tables:
         raise InputError("cases", [], "at least one [[cases]] entry")
@@ -128,6 +130,7 @@ def _cases(top: Table, plate: Plate, element: str, mesh: tuple[int, int]) -> tup
         names.add(name)
         case_element = t.string("element", default=element, choices=tuple(ELEMENTS))
         nx, ny = _mesh(t, "mesh", mesh)
+        check_mesh_size(case_element, nx, ny, t.field("mesh"))
         grid = Mesh(plate, ELEMENTS[case_element], nx, ny)
         masters = _masters(t, grid, t.path)
         method = t.string("method", default="guyan", choices=METHODS)
@@ -137,7 +140,7 @@ def _cases(top: Table, plate: Plate, element: str, mesh: tuple[int, int]) -> tup
     return tuple(cases)
 
 
-def _transient(t: Table | None, cases: tuple[Case, ...]) -> TransientSettings:
+def _transient(t: Table | None, cases: tuple[Case, ...], plate: Plate) -> TransientSettings:
     if t is None:
         return TransientSettings()
     names = [c.name for c in cases]
@@ -147,27 +150,39 @@ def _transient(t: Table | None, cases: tuple[Case, ...]) -> TransientSettings:
     loads = t.raw("loads", list(LOADS))
     if not isinstance(loads, list) or not loads or any(v not in LOADS for v in loads):
         raise InputError(t.field("loads"), loads, f"a non-empty list of: {', '.join(LOADS)}")
+    raw = t.data.get("omega_max_h") if isinstance(t.data, dict) else None
+    if isinstance(raw, list) and len(raw) > 10:
+        raise InputError(t.field("omega_max_h"), f"a list of {len(raw)} values", "at most 10 values")
     steps = t.numbers("omega_max_h", default=[2.0, 1.0, 0.5])
     for v in steps:
-        if not 0.0 < v <= RK4_LIMIT_THESIS:
+        if not MIN_OMEGA_MAX_H <= v <= RK4_LIMIT_THESIS:
             raise InputError(t.field("omega_max_h"), v,
-                             f"> 0 and <= {RK4_LIMIT_THESIS} (RK4 stability limit, eq. 44)")
+                             f">= {MIN_OMEGA_MAX_H:g} and <= {RK4_LIMIT_THESIS} (RK4 stability limit, eq. 44)")
     if not steps:
         raise InputError(t.field("omega_max_h"), steps, "at least one value")
     settings = TransientSettings(
         cases=tuple(chosen),
         loads=tuple(loads),
         omega_max_h=tuple(steps),
-        periods=t.number("periods", default=1.5, min_exclusive=0.0, max_value=20.0),
-        exact_modes=t.integer("exact_modes", default=200, min_value=2, max_value=5000),
-        tolerance_pct=t.number("tolerance", unit="%", default=2.0, min_value=0.0),
+        periods=t.number("periods", default=DEFAULT_PERIODS, min_value=0.5, max_value=20.0),
+        exact_modes=t.integer("exact_modes", default=200, min_value=2, max_value=MAX_EXACT_MODES),
+        tolerance_pct=t.number("tolerance", unit="%", default=2.0, min_value=0.0, max_value=100.0),
+        truncation_check=t.boolean("truncation_check", default=True),
     )
     t.finish()
+    check_exact_cost(plate, settings, t.path)
     return settings
 
 
 def load(doc: dict[str, Any]) -> PlateSpec:
-    """Validate a parsed plate preset and return its frozen spec."""
+    """Validate a parsed plate preset and return its frozen spec (echoed values cut short)."""
+    try:
+        return _load(doc)
+    except InputError as exc:
+        raise short_error(exc) from None
+
+
+def _load(doc: dict[str, Any]) -> PlateSpec:
     top = Table(doc, "")
     top.string("kind", choices=("plate",))
     title = top.string("title", default="")
@@ -181,13 +196,19 @@ def load(doc: dict[str, Any]) -> PlateSpec:
     mesh = _mesh(s, "mesh", None)
     frequencies = s.integer("frequencies", default=6, min_value=1, max_value=100)
     conv = s.raw("convergence_meshes", [2, 4, 8])
-    if not isinstance(conv, list) or any(
+    if not isinstance(conv, list) or len(conv) > 8 or any(
         isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= 32 for v in conv
     ) or len(set(conv)) != len(conv):
-        raise InputError(s.field("convergence_meshes"), conv, "a list of distinct integers in 1..32 (n x n meshes)")
+        shown = conv if not isinstance(conv, list) or len(conv) <= 8 else f"a list of {len(conv)} values"
+        raise InputError(s.field("convergence_meshes"), shown,
+                         "a list of at most 8 distinct integers in 1..32 (n x n meshes)")
     s.finish()
+    check_mesh_size(element, mesh[0], mesh[1], s.field("mesh"))
     cases = _cases(top, plate, element, mesh)
-    transient = _transient(top.table("transient", required=False), cases)
+    for case_element in dict.fromkeys(c.element for c in cases):
+        for n in conv:
+            check_mesh_size(case_element, n, n, "study.convergence_meshes")
+    transient = _transient(top.table("transient", required=False), cases, plate)
     top.finish()
     study = Study(plate, cases, frequencies, tuple(conv), transient)
     return PlateSpec(title, units_name, study, element, mesh[0], mesh[1], notes)

@@ -3,23 +3,27 @@
 For each setting the study records wall time, steps and events, and the
 error against the exact back end in
 
-* event angles: the event sequences are aligned (same clearance, same kind,
-  in order); the largest |Δθ| over the aligned events, and how many events
-  are missing or extra;
+* event angles: the events are paired with the reference's by clearance,
+  kind and nearest time (:func:`vtool.solvers.pairing.pair_events`: a window
+  of half the spacing of that clearance's events of that kind in the
+  reference); the largest |Δθ| over the pairs, and how many events have no
+  partner (missing from the run or extra in it: *unmatched*);
 * peak contact forces: the largest relative error over the clearances;
-* valve seating velocity: relative error of the first seat impact;
+* valve seating velocity: relative error of the impact velocity at the first
+  seat impact of the reference that has a partner;
 * valve lift: the largest absolute difference of the valve coordinate over
   the output angles.
 
-Newmark runs use its default refinement after events (steps of dt/10 for two
-periods of the highest mode); one extra row shows the plain thesis scheme at
-1 µs. Settings a back end refuses (a Newmark step beyond its stability
-limit) are listed with the reason instead of figures.
+Newmark runs use its default refinement after events (steps of
+dt / ``NewmarkOptions.refine`` for ``refine_periods`` periods of the highest
+mode); one extra row shows the plain thesis scheme at 1 µs. Settings a back end refuses (a Newmark step beyond its stability
+limit) are listed with the reason instead of figures. scipy rows depend on
+the scipy and numpy versions, which :func:`library_versions` names.
 """
 
 from __future__ import annotations
 
-import difflib
+import dataclasses
 import io
 import math
 from dataclasses import dataclass
@@ -28,9 +32,10 @@ import numpy as np
 
 from vtool.errors import InputError, RunError
 from vtool.files import write_atomic
-from vtool.presets.valvetrain import with_run_overrides
+from vtool.markdown import table as markdown_table
 from vtool.solvers.model import assemble
 from vtool.solvers.newmark import NewmarkBackend, NewmarkOptions
+from vtool.solvers.pairing import pair_events
 from vtool.solvers.run import simulate
 from vtool.solvers.scipy_backend import ScipyBackend, ScipyOptions
 from vtool.solvers.spec import EXTERNAL, MechanismSpec
@@ -39,6 +44,8 @@ from vtool.solvers.trace import CLOSED, Trace
 NEWMARK_STEPS = (1e-4, 1e-5, 2e-6, 1e-6, 5e-7, 2e-7, 1e-7)
 NEWMARK_BETAS = (1 / 6, 1 / 4)
 SCIPY_RTOLS = (1e-4, 1e-6, 1e-8, 1e-9, 1e-10, 1e-11)
+RESOLUTION_DEG = 0.1  # smallest pairing window: bursts of contacts microseconds apart move as a whole
+PLAIN_SETTING = "dt=1e-06 beta=1/6, no refinement (the thesis' scheme)"
 
 
 @dataclass(frozen=True)
@@ -48,13 +55,25 @@ class AccuracyRow:
     wall_time: float | None = None  # s
     steps: int | None = None
     events: int | None = None
-    same_sequence: bool | None = None
     unmatched_events: int | None = None
-    event_angle_error: float | None = None  # deg
+    event_angle_error: float | None = None  # deg, over paired events
     peak_force_error: float | None = None  # relative
     seating_velocity_error: float | None = None  # relative
     lift_error: float | None = None  # length
     note: str = ""
+
+
+def library_versions() -> str:
+    """The numpy and scipy versions the scipy rows depend on, e.g. ``scipy 1.14.1, numpy 2.1.3``."""
+    import scipy
+
+    return f"scipy {scipy.__version__}, numpy {np.__version__}"
+
+
+def with_run(spec: MechanismSpec, **changes: object) -> MechanismSpec:
+    """``spec`` with some of its RunSpec fields replaced (``None`` values are ignored)."""
+    changes = {key: value for key, value in changes.items() if value is not None}
+    return dataclasses.replace(spec, run=dataclasses.replace(spec.run, **changes))
 
 
 def seat_clearance(spec: MechanismSpec) -> str | None:
@@ -64,34 +83,28 @@ def seat_clearance(spec: MechanismSpec) -> str | None:
     return None
 
 
-def compare(trace: Trace, reference: Trace, backend: str, setting: str) -> AccuracyRow:
+def compare(trace: Trace, reference: Trace, backend: str, setting: str, note: str = "") -> AccuracyRow:
     """Errors of ``trace`` against the exact ``reference`` (see module doc)."""
-    ours = [(e.clearance, e.kind) for e in trace.events]
-    truth = [(e.clearance, e.kind) for e in reference.events]
-    matcher = difflib.SequenceMatcher(a=truth, b=ours, autojunk=False)
-    deltas, unmatched = [], 0
-    for tag, i1, i2, j1, j2 in matcher.get_opcodes():
-        if tag == "equal":
-            deltas += [abs(reference.events[i].cam_angle - trace.events[j].cam_angle)
-                       for i, j in zip(range(i1, i2), range(j1, j2), strict=True)]
-        else:
-            unmatched += (i2 - i1) + (j2 - j1)
+    duration = float(reference.time[-1] - reference.time[0]) if reference.time.size else None
+    resolution = RESOLUTION_DEG / (6.0 * reference.spec.run.rpm)  # s; 6 rpm = deg/s
+    pairing = pair_events(reference.events, trace.events, duration, resolution)
+    deltas = [abs(reference.events[i].cam_angle - trace.events[j].cam_angle) for i, j in pairing.pairs]
     with np.errstate(divide="ignore", invalid="ignore"):
         peak = np.where(reference.peak_force > 0, np.abs(trace.peak_force / reference.peak_force - 1), 0.0)
     seat = seat_clearance(trace.spec)
     seating = None
-    if seat is not None:
-        ours_v = [e.relative_velocity for e in trace.events if e.clearance == seat and e.kind == CLOSED]
-        true_v = [e.relative_velocity for e in reference.events if e.clearance == seat and e.kind == CLOSED]
-        if ours_v and true_v:
-            seating = abs(ours_v[0] / true_v[0] - 1)
+    seat_pairs = [(i, j) for i, j in pairing.pairs
+                  if reference.events[i].clearance == seat and reference.events[i].kind == CLOSED]
+    if seat_pairs:
+        i, j = seat_pairs[0]
+        seating = abs(trace.events[j].relative_velocity / reference.events[i].relative_velocity - 1)
     valve = next(c.ahead for c in trace.spec.clearances if c.name == seat) if seat else None
     lift = None
     if valve is not None and trace.time.shape == reference.time.shape:
         lift = float(np.abs(trace.coordinate(valve) - reference.coordinate(valve)).max())
     stats = trace.statistics
-    return AccuracyRow(backend, setting, stats.wall_time, stats.steps, stats.events, ours == truth, unmatched,
-                       max(deltas) if deltas else None, float(peak.max()), seating, lift)
+    return AccuracyRow(backend, setting, stats.wall_time, stats.steps, stats.events, pairing.unmatched,
+                       max(deltas) if deltas else None, float(peak.max()), seating, lift, note)
 
 
 def accuracy_study(
@@ -101,14 +114,14 @@ def accuracy_study(
     scipy_rtols: tuple[float, ...] = SCIPY_RTOLS,
 ) -> tuple[Trace, list[AccuracyRow]]:
     """Run the exact reference, then every setting; return (reference, rows)."""
-    reference = simulate(with_run_overrides(spec, backend="exact"))
+    reference = simulate(with_run(spec, backend="exact"))
     rows = [AccuracyRow("exact", "reference", reference.statistics.wall_time, reference.statistics.steps,
-                        reference.statistics.events, True, 0, 0.0, 0.0, 0.0, 0.0)]
+                        reference.statistics.events, 0, 0.0, 0.0, 0.0, 0.0)]
     for beta in newmark_betas:
         for dt in newmark_steps:
             setting = f"dt={dt:.0e} beta={'1/6' if abs(beta - 1 / 6) < 1e-12 else '1/4'}"
             try:
-                trace = simulate(with_run_overrides(spec, backend="newmark", time_step=dt, beta=beta))
+                trace = simulate(with_run(spec, backend="newmark", time_step=dt, beta=beta))
             except InputError as error:
                 rows.append(AccuracyRow("newmark", setting, note=f"refused: {error.expected}"))
                 continue
@@ -118,50 +131,57 @@ def accuracy_study(
             rows.append(compare(trace, reference, "newmark", setting))
     mechanism = assemble(spec)
     plain = NewmarkBackend().simulate(mechanism, NewmarkOptions(1e-6, refine=1))
-    rows.append(compare(plain, reference, "newmark", "dt=1e-06 beta=1/6, no refinement (the thesis' scheme)"))
+    rows.append(compare(plain, reference, "newmark", PLAIN_SETTING))
+    versions = library_versions()
     for rtol in scipy_rtols:
         trace = ScipyBackend().simulate(mechanism, ScipyOptions(rtol=rtol))
-        rows.append(compare(trace, reference, "scipy", f"DOP853 rtol={rtol:.0e}"))
+        rows.append(compare(trace, reference, "scipy", f"DOP853 rtol={rtol:.0e}", versions))
     return reference, rows
 
 
-COLUMNS = ("backend", "setting", "wall time (s)", "steps", "events", "same sequence", "unmatched",
+COLUMNS = ("backend", "setting", "wall time (s)", "steps", "events", "unmatched",
            "max |dtheta| (deg)", "peak force err (%)", "seating vel err (%)", "lift err (in)", "note")
 
 
-def _cells(row: AccuracyRow, length_unit: str) -> list[str]:
-    def fmt(value: float | None, spec: str, scale: float = 1.0) -> str:
-        if value is None or (isinstance(value, float) and math.isnan(value)):
-            return ""
-        return format(value * scale if scale != 1.0 else value, spec)
+def header(length_unit: str = "in") -> list[str]:
+    return [c.replace("(in)", f"({length_unit})") for c in COLUMNS]
 
+
+def fmt(value: float | None, spec: str, scale: float = 1.0) -> str:
+    """``value * scale`` formatted; blank for None or NaN."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return ""
+    return format(value * scale if scale != 1.0 else value, spec)
+
+
+def cells(row: AccuracyRow) -> list[str]:
+    """One table row: errors to two significant digits, wall time to 1 ms."""
     return [row.backend, row.setting, fmt(row.wall_time, ".3f"), fmt(row.steps, "d"), fmt(row.events, "d"),
-            "" if row.same_sequence is None else ("yes" if row.same_sequence else "no"),
             fmt(row.unmatched_events, "d"), fmt(row.event_angle_error, ".2g"), fmt(row.peak_force_error, ".2g", 100),
             fmt(row.seating_velocity_error, ".2g", 100), fmt(row.lift_error, ".2g"), row.note]
 
 
 def table_text(rows: list[AccuracyRow], length_unit: str = "in") -> str:
-    header = [c.replace("(in)", f"({length_unit})") for c in COLUMNS]
-    body = [_cells(row, length_unit) for row in rows]
-    widths = [max(len(r[i]) for r in [header, *body]) for i in range(len(header) - 1)]
+    body = [cells(row) for row in rows]
+    widths = [max(len(r[i]) for r in [header(length_unit), *body]) for i in range(len(COLUMNS) - 1)]
     lines = []
-    for r in [header, *body]:
+    for r in [header(length_unit), *body]:
         lines.append("  ".join(cell.ljust(w) for cell, w in zip(r[:-1], widths, strict=True)) + "  " + r[-1])
     return "\n".join(line.rstrip() for line in lines)
 
 
+def markdown_header(length_unit: str = "in") -> list[str]:
+    """The header with its pipes escaped for a Markdown table."""
+    return [c.replace("|", "\\|") for c in header(length_unit)]
+
+
 def table_markdown(rows: list[AccuracyRow], length_unit: str = "in") -> str:
-    header = [c.replace("(in)", f"({length_unit})") for c in COLUMNS]
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(_cells(row, length_unit)) + " |" for row in rows]
-    return "\n".join(lines)
+    return markdown_table(markdown_header(length_unit), [cells(row) for row in rows]).rstrip("\n")
 
 
 def write_table_csv(path: str, rows: list[AccuracyRow], length_unit: str = "in") -> None:
     buffer = io.StringIO()
-    header = [c.replace("(in)", f"({length_unit})") for c in COLUMNS]
-    buffer.write(",".join(header) + "\n")
+    buffer.write(",".join(header(length_unit)) + "\n")
     for row in rows:
-        buffer.write(",".join(cell.replace(",", ";") for cell in _cells(row, length_unit)) + "\n")
+        buffer.write(",".join(cell.replace(",", ";") for cell in cells(row)) + "\n")
     write_atomic(path, buffer.getvalue())

@@ -1,23 +1,37 @@
 """The ``exact`` back end: piecewise-exact integration, no time-step error.
 
-Between events a configuration is linear with harmonic forcing
-(:mod:`vtool.solvers.piecewise`), so its response is exact:
+Between events a configuration is linear with Fourier forcing
+(:mod:`vtool.solvers.statespace`), so its response is exact:
 
-    y(t0 + τ) = e^{Aτ} (y(t0) - y_p(t0)) + y_p(t0 + τ)
+    y(t0 + τ) = e^{Aτ} (y(t0) - y_p(t0)) + y_p(t0 + τ),
 
-with the matrix exponential (scipy's Padé scaling and squaring) and the
-particular solution y_p of the cam forcing. The solution is sampled on a scan
-grid of π/(8 ω_max) (a sixteenth of the shortest period of the configuration;
-the homogeneous part advances by one stored exponential per sample, so the
-samples carry no error); a monitor (contact force or gap) that changes sign
-between two samples is bracketed and its root found by Brent's method on the
-exact solution to ``time_tolerance`` (default 1e-12 s). Outputs at the
-requested angles are computed from the exact solution, not interpolated.
-Impacts, contact forces and event rules are the ``newmark`` back end's.
+with the particular solution y_p(t) = Y u(t) from one direct solve per
+harmonic, and e^{Aτ} = V e^{Λτ} V⁻¹ from the eigendecomposition of A, done
+once per configuration (or scipy's expm of A times the scan interval, once
+per configuration, when V is ill-conditioned). The homogeneous state is
+carried in modal coordinates h = V⁻¹ y_h, so advancing it is a product of
+exponentials and a monitor (contact force if closed, gap if open) is
+
+    g(t0 + τ) = Re Σ_j (g V)_j e^{λ_j τ} h_j + (G Y + H) u(t0 + τ),
+
+a sum of exponentials and harmonics, cheap to evaluate anywhere.
+
+The solution is sampled on a scan grid of π/(8 ω_max) (a sixteenth of the
+shortest period of the configuration; samples carry no error, the
+exponentials advance by products); a monitor that changes sign between two
+samples is bracketed and its root found by Brent's method on the exact
+solution to ``time_tolerance`` (default 1e-12 s). A contact force's local
+maximum between samples is refined the same way, as the root of its exact
+rate g'(t), so peak forces are exact, not sampled. Outputs at the requested
+angles are computed from the exact solution, not interpolated. Impacts,
+contact forces and event rules are the ``newmark`` back end's.
 
 The scan grid is the only approximation: two sign changes of one monitor
 closer than a grid interval would be missed (the contact would have to open
 and close within 1/16 of the shortest natural period).
+
+Dense linear algebra runs single-threaded during a run
+(:func:`vtool.threads.limited`; ``VTOOL_THREADS`` overrides).
 """
 
 from __future__ import annotations
@@ -26,18 +40,19 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from scipy.optimize import brentq
 
-from vtool.errors import InputError
+from vtool.errors import InputError, RunError
 from vtool.solvers.contact import ContactProblem
 from vtool.solvers.model import Mechanism
-from vtool.solvers.piecewise import PiecewiseBackend, PiecewiseRun, StateSpace
+from vtool.solvers.piecewise import PiecewiseBackend, PiecewiseRun
 from vtool.solvers.spec import RunSpec
+from vtool.solvers.statespace import Propagator, StateSpace, shift_coefficients
 from vtool.solvers.trace import TraceBuilder
 
 SCAN_FRACTION = 1.0 / 16.0  # scan grid as a fraction of the shortest period
 BLOCK = 256  # samples evaluated together
+PEAK_MARGIN = 1e-2  # local maxima of sampled forces within this fraction of the peak are refined
 
 
 @dataclass(frozen=True)
@@ -69,21 +84,43 @@ class ExactBackend(PiecewiseBackend):
         return {"time_tolerance_s": options.time_tolerance}
 
 
-def parabolic_peak(v0: np.ndarray, v1: np.ndarray, v2: np.ndarray) -> np.ndarray:
-    """Vertex of the parabola through three equally spaced samples, where v1 is a local maximum.
+def peak_brackets(values: np.ndarray, closed: np.ndarray, peak: np.ndarray,
+                  margin: float = PEAK_MARGIN) -> list[tuple[int, int, int]]:
+    """Sample intervals that may hold a contact force's maximum: (clearance, first, last sample).
 
-    Peak forces between scan samples (1/16 of the shortest period apart) are
-    found to about 1e-4 relative this way instead of the 2 % the samples alone
-    could miss.
+    ``values`` (ncl, ns) are monitor samples in time order. A sample of a
+    closed clearance at least as large as its neighbours (a missing neighbour
+    counts as smaller) and within ``margin`` of the ``peak`` so far brackets a
+    maximum between its neighbours (a sample alone at an end: between it and
+    its one neighbour).
     """
-    curvature = (v0 + v2) / 2.0 - v1
-    slope = (v2 - v0) / 2.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        vertex = v1 - slope**2 / (4.0 * curvature)
-    is_peak = (v1 >= v0) & (v1 >= v2) & (curvature < 0)
-    if v1.ndim == 2 and v1.shape[1] == 0:
-        return np.full(v1.shape[0], -np.inf)[:, None]
-    return np.where(is_peak & np.isfinite(vertex), vertex, -np.inf)
+    count = values.shape[1]
+    threshold = peak - margin * np.abs(peak)
+    rows = np.flatnonzero(closed & (values.max(axis=1) >= threshold))
+    if count < 2 or not rows.size:
+        return []
+    values, threshold = values[rows], threshold[rows]
+    pad = np.full((values.shape[0], 1), -np.inf)
+    padded = np.concatenate([pad, values, pad], axis=1)
+    centre = padded[:, 1:-1]
+    local = (centre >= padded[:, :-2]) & (centre > padded[:, 2:])
+    local &= centre >= threshold[:, None]
+    return [(int(rows[k]), max(int(j) - 1, 0), min(int(j) + 1, count - 1)) for k, j in zip(*np.nonzero(local), strict=True)]
+
+
+@dataclass
+class _Config:
+    """What the exact back end derives once per configuration (see module doc)."""
+
+    delta: float  # scan interval
+    prop: Propagator
+    GV: np.ndarray  # monitors from h
+    GAV: np.ndarray  # monitor rates from h
+    Hm: np.ndarray  # monitors' forced part, on u(t)
+    PV: np.ndarray  # output rows (x, sources' x, v, sources' v, a, sources' a) from h
+    Qm: np.ndarray  # output rows' forced part, on u(t)
+    closed: np.ndarray  # bool per clearance
+    grid_basis: np.ndarray  # u(τ) at τ = delta * (1..BLOCK)
 
 
 class _ExactRun(PiecewiseRun):
@@ -92,81 +129,170 @@ class _ExactRun(PiecewiseRun):
     def __init__(self, problem: ContactProblem, options: ExactOptions, builder: TraceBuilder) -> None:
         super().__init__(problem, options.output_interval, options.every_step, builder)
         self.options = options
-        self._grid: dict[int, tuple[float, np.ndarray]] = {}
+        self.series = problem.series
+        self.monitored_index = np.flatnonzero(self.monitored)
+        self._carry: tuple | None = None  # (mask, t, h, y) where the last advance stopped without an event
 
-    def grid(self, ss: StateSpace) -> tuple[float, np.ndarray]:
-        """(scan interval, e^{A δ}) of a configuration."""
-        if ss.mask not in self._grid:
+    def config(self, ss: StateSpace) -> _Config:
+        if "exact" not in ss.cache:
             period = 2 * math.pi / ss.omega_max if ss.omega_max > 0 else self.t_end
             delta = min(self.options.scan_fraction * period, self.out_dt)
-            self._grid[ss.mask] = (delta, scipy.linalg.expm(ss.A * delta))
-        return self._grid[ss.mask]
+            prop = Propagator(ss.A, delta, ss.T, ss.Tinv)
+            GV = ss.G @ prop.V
+            closed = (ss.mask & self.closed_bit) != 0
+            PV, Qm = self.output_maps(ss, prop)
+            ss.cache["exact"] = _Config(delta, prop, GV, ss.G @ ss.A @ prop.V, ss.G @ ss.Y + ss.H, PV, Qm, closed,
+                                        ss.basis(delta * np.arange(1, BLOCK + 1)))
+        return ss.cache["exact"]
 
-    def exact(self, ss: StateSpace, t0: float, yh0: np.ndarray, tau: float) -> np.ndarray:
-        return scipy.linalg.expm(ss.A * tau) @ yh0 + ss.particular(t0 + tau)
+    def output_maps(self, ss: StateSpace, prop: Propagator) -> tuple[np.ndarray, np.ndarray]:
+        """Output rows z = Re(PV h) + Qm u(t): the coordinates' (x, v, a) and the sources' after them."""
+        n, series = self.n, self.series
+        harmonics = series.n_harmonics
+        if ss.n_harmonics != harmonics:
+            raise RunError("the sources and the configuration have different numbers of harmonics")
+        kw = series.omega * np.arange(1, harmonics + 1)
+        src_x = np.column_stack([series.const, series.cos, series.sin])
+        src_v = np.column_stack([np.zeros(series.n_sources), kw * series.sin, -kw * series.cos])
+        src_a = np.column_stack([np.zeros(series.n_sources), -kw**2 * series.cos, -kw**2 * series.sin])
+        forced = ss.P @ ss.Y + ss.Q
+        Qm = np.vstack([forced[:n], src_x, forced[n:2 * n], src_v, forced[2 * n:], src_a])
+        homogeneous = ss.P @ prop.V
+        none = np.zeros((series.n_sources, homogeneous.shape[1]), dtype=homogeneous.dtype)
+        PV = np.vstack([homogeneous[:n], none, homogeneous[n:2 * n], none, homogeneous[2 * n:], none])
+        return PV, Qm
 
     def advance(self, ss: StateSpace, t0: float, y0: np.ndarray, t_stop: float) -> tuple[float, np.ndarray, list[int]]:
         """Scan the exact solution in blocks of samples; stop at the first monitor sign change."""
-        delta, step = self.grid(ss)
-        t, yh = t0, y0 - ss.particular(t0)
+        cfg = self.config(ss)
+        prop, delta = cfg.prop, cfg.delta
+        carried = self._carry
+        if carried is not None and carried[0] == ss.mask and carried[1] == t0 and carried[3] is y0:
+            t, h = t0, carried[2]  # where the last call stopped (no event): keep the modal state
+        else:
+            t, h = t0, prop.to_h(y0 - ss.particular(t0))
+        self._carry = None
         tol = self.options.time_tolerance
-        recent = np.repeat(self.monitors(ss, t, y0)[:, None], 2, axis=1)  # last two samples (peaks)
-        monitored = np.flatnonzero(self.monitored)
+        monitored = self.monitored_index
+        base_v = (cfg.GV @ h).real + cfg.Hm @ ss.basis(t0)  # monitors at the block's start
+        self.raise_peaks(cfg.closed, base_v, t0)
         while t < t_stop * (1 - 1e-15):
             count = int(min(BLOCK, math.floor((t_stop - t) / delta)))
-            if count >= 1:  # whole scan intervals: one stored exponential each
-                times = t + delta * np.arange(1, count + 1)
-                propagate = [step] * count
+            if count >= 1:  # whole scan intervals: one product with the stored powers
+                taus = delta * np.arange(1, count + 1)
+                values, states = prop.grid(h, count, cfg.GV)
+                values += shift_coefficients(cfg.Hm, ss.omega, ss.n_harmonics, t) @ cfg.grid_basis[:, :count]
+            elif t > t0 and t_stop < self.t_end:  # stop on the grid; the next call continues it
+                break
             else:  # the remainder up to t_stop
-                count, times = 1, np.array([t_stop])
-                propagate = [scipy.linalg.expm(ss.A * (t_stop - t))]
-            samples = np.empty((yh.size, count))
-            current = yh
-            for i in range(count):
-                current = propagate[i] @ current
-                samples[:, i] = current
-            values = self.monitors(ss, times, samples + ss.particular(times))
-            crossed = (values[monitored] < 0.0).any(axis=0) if monitored.size else np.zeros(count, bool)
-            last = int(np.argmax(crossed)) if crossed.any() else count
-            if last:
-                window = np.concatenate([recent, values[:, :last]], axis=1)
-                self.track_peaks(ss, np.maximum(window[:, 2:].max(axis=1),
-                                                parabolic_peak(window[:, :-2], window[:, 1:-1], window[:, 2:]).max(axis=1)),
-                                 float(times[last - 1]))
-                recent = window[:, -2:]
-            start_t, start_yh = (times[last - 1], samples[:, last - 1]) if last else (t, yh)
-            self.outputs(ss, t, yh, start_t - t)
-            if self.every_step:
-                for i in range(last):
-                    self.emit(ss, float(times[i]), samples[:, i] + ss.particular(times[i]))
-            self.steps += last
-            if last < count:  # a sign change between start_t and times[last]
-                h = float(times[last] - start_t)
-                fired = [int(k) for k in monitored if values[k, last] < 0.0]
-                roots = {k: self.root(ss, float(start_t), start_yh, k, h, tol) for k in fired}
-                tau = min(roots.values())
-                self.outputs(ss, float(start_t), start_yh, tau)
-                self.steps += 1
-                y_event = self.exact(ss, float(start_t), start_yh, tau)
-                self.track_peaks(ss, self.monitors(ss, start_t + tau, y_event), float(start_t + tau))
-                return float(start_t) + tau, y_event, [k for k, r in roots.items() if r <= tau + tol]
-            t, yh = float(times[-1]), samples[:, -1]
-        return t, yh + ss.particular(t), []
+                count, taus = 1, np.array([t_stop - t])
+                hs = prop(h, taus)
+                values = (cfg.GV @ hs).real + cfg.Hm @ ss.basis(t + taus)
 
-    def root(self, ss: StateSpace, t: float, yh: np.ndarray, k: int, h: float, tol: float) -> float:
-        """First zero of monitor k in (0, h]: Brent on the exact solution."""
+                def states(index: int | slice, hs: np.ndarray = hs) -> np.ndarray:
+                    return hs[:, index]
+            times = t + taus
+            negative = values[monitored] < 0.0
+            last = int(np.argmax(negative.any(axis=0))) if negative.any() else count
+            if last:
+                self.peaks(ss, cfg, t, h, base_v, taus[:last], values[:, :last])
+            start_tau, start_h = (float(taus[last - 1]), states(last - 1)) if last else (0.0, h)
+            self.outputs(ss, cfg, t, h, self.output_times(t, t + start_tau))
+            if self.every_step and last:
+                self.emit_rows(ss, cfg, times[:last], states(slice(0, last)))
+            self.steps += last
+            if last < count:  # a sign change between t + start_tau and times[last]
+                start_t = t + start_tau
+                width = float(taus[last] - start_tau)
+                fired = [int(k) for k in monitored if values[k, last] < 0.0]
+                roots = {k: self.root(ss, cfg, start_t, start_h, k, width, tol) for k in fired}
+                tau = min(roots.values())
+                self.outputs(ss, cfg, start_t, start_h, self.output_times(start_t, start_t + tau))
+                self.steps += 1
+                h_event = prop.at(start_h, tau)
+                y_event = prop.real(h_event) + ss.particular(start_t + tau)
+                self.track_peaks(ss, (cfg.GV @ h_event).real + cfg.Hm @ ss.basis(start_t + tau), start_t + tau)
+                return start_t + tau, y_event, [k for k, r in roots.items() if r <= tau + tol]
+            t, h, base_v = float(times[-1]), states(count - 1), values[:, -1]
+        y = prop.real(h) + ss.particular(t)
+        self._carry = (ss.mask, t, h, y)
+        return t, y, []
+
+    def monitor(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, k: int):  # noqa: ANN202
+        """Monitor k at t + τ as a function of τ (and its rate), on the exact solution."""
+        forced, prop = cfg.Hm[k], cfg.prop
+        if prop.modal:  # Re Σ c_j e^{λ_j τ} (+ the rigid-body drift, linear in τ) + forced part
+            lam = prop.lam
+            c, c_rate = cfg.GV[k] * h, cfg.GAV[k] * h
+            drift = prop.drift * h[prop.drift_v]
+            slope = float((cfg.GV[k, prop.drift_x] @ drift).real) if drift.size else 0.0
+            slope_rate = float((cfg.GAV[k, prop.drift_x] @ drift).real) if drift.size else 0.0
+
+            def value(tau: float) -> float:
+                return float((c @ np.exp(lam * tau)).real + slope * tau + forced @ ss.basis(t + tau))
+
+            def rate(tau: float) -> float:
+                return float((c_rate @ np.exp(lam * tau)).real + slope_rate * tau
+                             + forced @ ss.basis_rate(t + tau))
+
+            return value, rate
 
         def value(tau: float) -> float:
-            return float(self.monitors(ss, t + tau, self.exact(ss, t, yh, tau))[k])
+            return float((cfg.GV[k] @ prop.at(h, tau)).real + forced @ ss.basis(t + tau))
 
-        low = min(0.5 * tol, 0.5 * h)
+        def rate(tau: float) -> float:
+            return float((cfg.GAV[k] @ prop.at(h, tau)).real + forced @ ss.basis_rate(t + tau))
+
+        return value, rate
+
+    def root(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, k: int, width: float,
+             tol: float) -> float:
+        """First zero of monitor k in (0, width]: Brent on the exact solution."""
+        value, _ = self.monitor(ss, cfg, t, h, k)
+        low = min(0.5 * tol, 0.5 * width)
         if value(low) < 0.0:  # already crossing at the start (a contact just released): now
             return low
-        return brentq(value, low, h, xtol=tol, rtol=4 * np.finfo(float).eps)
+        return brentq(value, low, width, xtol=tol, rtol=4 * np.finfo(float).eps)
 
-    def outputs(self, ss: StateSpace, t: float, yh: np.ndarray, tau: float) -> None:
-        for t_out in self.output_times(t, t + tau):
-            self.emit(ss, t_out, self.exact(ss, t, yh, t_out - t))
+    def peaks(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, base_v: np.ndarray,
+              taus: np.ndarray, values: np.ndarray) -> None:
+        """Peak forces from the samples at t (``base_v``) and t + taus, local maxima refined where g' = 0."""
+        top = np.maximum(values.max(axis=1), base_v)
+        self.raise_peaks(cfg.closed, top, t)
+        late = t + taus >= self.t_rev
+        if late.any():
+            self.raise_peaks(cfg.closed, values[:, late].max(axis=1), self.t_rev)
+        if not (cfg.closed & (top >= self.peak - PEAK_MARGIN * np.abs(self.peak))).any():
+            return
+        taus = np.concatenate([[0.0], taus])
+        values = np.concatenate([base_v[:, None], values], axis=1)
+        for k, first, last in peak_brackets(values, cfg.closed, self.peak):
+            value, rate = self.monitor(ss, cfg, t, h, k)
+            low, high = float(taus[first]), float(taus[last])
+            if rate(low) > 0.0 > rate(high):
+                tau = brentq(rate, low, high, xtol=self.options.time_tolerance, rtol=4 * np.finfo(float).eps)
+                self.peak[k] = max(self.peak[k], value(tau))
+                if t + tau >= self.t_rev:
+                    self.peak_late[k] = max(self.peak_late[k], value(tau))
+
+    def outputs(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, times: list[float]) -> None:
+        if times:
+            times = np.array(times)
+            self.emit_rows(ss, cfg, times, cfg.prop(h, times - t))
+
+    def emit_rows(self, ss: StateSpace, cfg: _Config, times: np.ndarray, hs: np.ndarray) -> None:
+        """Output rows at ``times`` from the homogeneous states ``hs`` (columns)."""
+        basis = ss.basis(times)
+        z = ((cfg.PV @ hs).real + cfg.Qm @ basis).T
+        forces = np.where(cfg.closed[:, None], (cfg.GV @ hs).real + cfg.Hm @ basis, 0.0)
+        self.peak = np.maximum(self.peak, forces.max(axis=1))
+        late = times >= self.t_rev
+        if late.any():
+            self.peak_late = np.maximum(self.peak_late, forces[:, late].max(axis=1))
+        width = self.n + self.series.n_sources
+        x, v, a, forces = z[:, :width], z[:, width:2 * width], z[:, 2 * width:], forces.T
+        self.rows.extend((float(t_out), np.stack([x[i], v[i], a[i]]), forces[i], ss.mask)
+                         for i, t_out in enumerate(times))
 
 
 ExactBackend.run_class = _ExactRun

@@ -11,14 +11,10 @@ prescribed P after) and y = (z_F, ż_F),
            ⎣ -M_FF⁻¹ (M_FP z̈_P + C_FP ż_P + K_FP z_P)(t)   ⎦
 
 The prescribed motions are Fourier series (:mod:`vtool.solvers.sources`), so
-with the basis φ(t) = (1, cos ωt, sin ωt, …, cos Kωt, sin Kωt), b(t) = B φ(t)
-and the particular solution y_p(t) = Y φ(t): the constant part from
-K_FF x₀ = -K_FP z_P,0 (a direct solve: v₀ = 0), and per harmonic k
-
-    ⎡ A     -kω I ⎤ ⎧Y_c⎫   ⎧-b_c⎫
-    ⎣ kω I   A    ⎦ ⎩Y_s⎭ = ⎩-b_s⎭ .
-
-Every output (coordinates, contact forces, gaps) is affine in y and φ(t).
+with the basis u(t) = (1, cos kωt…, sin kωt…), b(t) = B u(t) and the
+particular solution y_p(t) = Y u(t), one direct solve per harmonic
+(:mod:`vtool.solvers.statespace`). Every output (coordinates, contact
+forces, gaps) is affine in y and u(t): the maps P, Q, G, H built here.
 The configurations, contact forces, impact laws and event rules are the
 contact problem's (:mod:`vtool.solvers.contact`, the kernel's ``impact`` and
 ``settle``): only the integration differs. A back end subclasses
@@ -29,7 +25,6 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -39,117 +34,36 @@ from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.backends import Backend, Cancel, Progress
 from vtool.solvers.contact import EVENT_KINDS, ContactProblem, OrderedLayer
 from vtool.solvers.sources import SourceSeries
+from vtool.solvers.statespace import StateSpace, from_layer
 from vtool.solvers.trace import TraceBuilder
 
 
-def basis(omega: float, n_harmonics: int, t: float | np.ndarray) -> np.ndarray:
-    """φ(t) = (1, cos ωt, sin ωt, …, cos Kωt, sin Kωt): a vector, or columns for an array of t."""
-    t = np.asarray(t, dtype=float)
-    rows = [np.ones_like(t)]
-    for k in range(1, n_harmonics + 1):
-        rows += [np.cos(k * omega * t), np.sin(k * omega * t)]
-    return np.stack(rows)
-
-
 def source_coefficients(series: SourceSeries, s: int) -> np.ndarray:
-    """(3, 1 + 2K): x, v, a of source s as coefficients on the basis φ."""
+    """(3, 1 + 2K): x, v, a of source s as coefficients on the basis u = (1, cos kωt.., sin kωt..)."""
     K = series.n_harmonics
+    kw = series.omega * np.arange(1, K + 1)
+    a, b = series.cos[s], series.sin[s]
     out = np.zeros((3, 1 + 2 * K))
     out[0, 0] = series.const[s]
-    for k in range(1, K + 1):
-        a, b, wk = series.cos[s, k - 1], series.sin[s, k - 1], k * series.omega
-        out[0, 2 * k - 1], out[0, 2 * k] = a, b
-        out[1, 2 * k - 1], out[1, 2 * k] = wk * b, -wk * a
-        out[2, 2 * k - 1], out[2, 2 * k] = -wk * wk * a, -wk * wk * b
+    out[0, 1:K + 1], out[0, K + 1:] = a, b
+    out[1, 1:K + 1], out[1, K + 1:] = kw * b, -kw * a
+    out[2, 1:K + 1], out[2, K + 1:] = -kw * kw * a, -kw * kw * b
     return out
 
 
-@dataclass
-class StateSpace:
-    """y' = A y + B φ(t) of one configuration, its particular solution Y φ(t), and its affine outputs."""
-
-    mask: int
-    A: np.ndarray
-    B: np.ndarray  # (2nf, 1 + 2K)
-    Y: np.ndarray  # (2nf, 1 + 2K)
-    omega: float
-    n_harmonics: int
-    omega_max: float  # largest |eigenvalue| of A
-    P: np.ndarray  # (3n, 2nf): full (x, v, a) from y
-    Q: np.ndarray  # (3n, 1 + 2K): full (x, v, a) from φ
-    G: np.ndarray  # (ncl, 2nf): monitors from y
-    H: np.ndarray  # (ncl, 1 + 2K): monitors from φ
-
-    @property
-    def size(self) -> int:
-        return self.A.shape[0]
-
-    def basis(self, t: float | np.ndarray) -> np.ndarray:
-        return basis(self.omega, self.n_harmonics, t)
-
-    def forcing(self, t: float) -> np.ndarray:
-        return self.B @ self.basis(t)
-
-    def particular(self, t: float | np.ndarray) -> np.ndarray:
-        """y_p at t (a vector), or at every t of an array (columns)."""
-        return self.Y @ self.basis(t)
-
-    def harmonic(self, coefficients: np.ndarray, t: float | np.ndarray) -> np.ndarray:
-        return coefficients @ self.basis(t)
-
-
-def static_deflection(K: np.ndarray, f: np.ndarray, label: str) -> np.ndarray:
-    """x with K x = f. A free rigid-body motion (singular K) is allowed while f does not load it:
-    then the minimum-norm solution (least squares), checked to round-off."""
-    try:
-        x = np.linalg.solve(K, f)
-        if np.all(np.isfinite(x)) and np.allclose(K @ x, f, rtol=0, atol=1e-9 * np.abs(f).max()):
-            return x
-    except np.linalg.LinAlgError:
-        pass
-    x = np.linalg.lstsq(K, f, rcond=None)[0]
-    if not np.allclose(K @ x, f, rtol=0, atol=1e-9 * np.abs(f).max()):
-        raise RunError(f"configuration {label} has no steady solution under a constant load "
-                       "(a free rigid-body motion is loaded)")
-    return x
-
-
 def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
-    """The state-space form of a configuration, its particular solution and affine output maps."""
+    """The state-space form of a configuration (:func:`vtool.solvers.statespace.from_layer`: A, B, the
+    particular solution) and its affine output maps P, Q (coordinates) and G, H (monitors)."""
     series, tables = problem.series, problem.tables
     n, ncl, ns, K = problem.n, problem.ncl, problem.ns, series.n_harmonics
     nb = 1 + 2 * K
     m, nf, mask = layer.m, layer.nf, layer.mask
-    M, C, Kmat = layer.M, layer.C, layer.K
-    # prescribed z_P, ż_P, z̈_P as coefficients on φ: (3, m - nf, nb)
+    ss = from_layer(problem, layer)
+    A, B = ss.A, ss.B
+    n2 = 2 * nf
     zP = np.zeros((3, m - nf, nb))
     for p, s in enumerate(layer.source):
         zP[:, p, :] = source_coefficients(series, int(s))
-    Minv = np.linalg.inv(M[:nf, :nf]) if nf else np.zeros((0, 0))
-    A = np.zeros((2 * nf, 2 * nf))
-    A[:nf, nf:] = np.eye(nf)
-    A[nf:, :nf] = -Minv @ Kmat[:nf, :nf]
-    A[nf:, nf:] = -Minv @ C[:nf, :nf]
-    load = M[:nf, nf:] @ zP[2] + C[:nf, nf:] @ zP[1] + Kmat[:nf, nf:] @ zP[0]  # (nf, nb)
-    B = np.zeros((2 * nf, nb))
-    B[nf:] = -Minv @ load
-    Y = np.zeros((2 * nf, nb))
-    label = problem.label(mask)
-    if nf and np.any(load[:, 0]):
-        Y[:nf, 0] = static_deflection(Kmat[:nf, :nf], -(Kmat[:nf, nf:] @ zP[0, :, 0]), label)
-    n2 = 2 * nf
-    for k in range(1, K + 1):
-        bc, bs = B[:, 2 * k - 1], B[:, 2 * k]
-        if not (bc.any() or bs.any()):
-            continue
-        wk = k * series.omega
-        big = np.block([[A, -wk * np.eye(n2)], [wk * np.eye(n2), A]])
-        try:
-            sol = np.linalg.solve(big, -np.concatenate([bc, bs]))
-        except np.linalg.LinAlgError:
-            raise RunError(f"harmonic {k} of the cam speed is exactly a natural frequency of configuration "
-                           f"{label} (undamped resonance)") from None
-        Y[:, 2 * k - 1], Y[:, 2 * k] = sol[:n2], sol[n2:]
     # the layer vector (z, ż, z̈) as affine maps of y and φ
     Zy = np.zeros((3, m, n2))
     Zb = np.zeros((3, m, nb))
@@ -185,8 +99,8 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
                 H[k] += coefficients @ Zb[i]
             H[k] += row[3 * n:3 * n + 3 * ns] @ src
             H[k, 0] += row[3 * n + 3 * ns]
-    eig = np.linalg.eigvals(A) if n2 else np.zeros(0)
-    return StateSpace(mask, A, B, Y, series.omega, K, float(np.abs(eig).max()) if n2 else 0.0, P, Q, G, H)
+    ss.P, ss.Q, ss.G, ss.H = P, Q, G, H
+    return ss
 
 
 class PiecewiseRun(ABC):
@@ -258,6 +172,12 @@ class PiecewiseRun(ABC):
         self.peak = np.where(closed, np.maximum(self.peak, values), self.peak)
         if t >= self.t_rev:
             self.peak_late = np.where(closed, np.maximum(self.peak_late, values), self.peak_late)
+
+    def raise_peaks(self, closed: np.ndarray, values: np.ndarray, t: float) -> None:
+        """Raise the peaks of the closed clearances to ``values`` seen at (or, for a block, up to) t."""
+        self.peak = np.where(closed & (values > self.peak), values, self.peak)
+        if t >= self.t_rev:
+            self.peak_late = np.where(closed & (values > self.peak_late), values, self.peak_late)
 
     def emit(self, ss: StateSpace, t: float, y: np.ndarray) -> None:
         x, v, a = self.full_state(ss, t, y)

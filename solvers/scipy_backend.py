@@ -6,7 +6,11 @@ Radau with the user's tolerances; every monitored clearance is a terminal
 event function (contact force if closed, gap if open, direction negative).
 At an event the integration stops, the event rules and impact law of the
 other back ends are applied, and a new integration starts in the new
-configuration. Outputs at the requested angles come from ``t_eval``.
+configuration. Outputs at the requested angles come from the dense output.
+Peak contact forces are not only taken at the steps: every local maximum of
+a contact force among the steps (within 1 % of the peak so far) is refined on
+the dense output by a bounded Brent search between its neighbouring steps
+(steps alone read peaks 0.04-6.6 % low).
 
 This is what a Python user would reach for, and its known weakness shows:
 solve_ivp only looks for sign changes between its own steps, so a monitor
@@ -20,12 +24,15 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import minimize_scalar
 
 from vtool.errors import InputError, RunError
 from vtool.solvers.contact import ContactProblem
+from vtool.solvers.exact import peak_brackets
 from vtool.solvers.model import Mechanism
-from vtool.solvers.piecewise import PiecewiseBackend, PiecewiseRun, StateSpace
+from vtool.solvers.piecewise import PiecewiseBackend, PiecewiseRun
 from vtool.solvers.spec import RunSpec
+from vtool.solvers.statespace import StateSpace
 from vtool.solvers.trace import TraceBuilder
 
 METHODS = ("DOP853", "Radau", "RK45", "LSODA")
@@ -114,9 +121,29 @@ class _ScipyRun(PiecewiseRun):
         samples = solution.t[1:] if self.every_step else ()
         for t_sample in samples:
             self.emit(ss, float(t_sample), solution.sol(t_sample))
-        for t_sample in solution.t[1:]:
-            self.track_peaks(ss, self.monitors(ss, float(t_sample), solution.sol(t_sample)), float(t_sample))
+        self.refine_peaks(ss, solution)
         return t_end, solution.y[:, -1], fired
+
+    def refine_peaks(self, ss: StateSpace, solution) -> None:  # noqa: ANN001 (an OdeResult)
+        """Peak contact forces: at the steps, and each local maximum between steps refined on the
+        dense output (bounded Brent), so a peak between two steps is not missed."""
+        values = self.monitors(ss, solution.t, solution.y)
+        closed = (ss.mask & self.closed_bit) != 0
+        for i, t_sample in enumerate(solution.t):
+            self.raise_peaks(closed, values[:, i], float(t_sample))
+        for k, first, last in peak_brackets(values, closed, self.peak):
+            low, high = float(solution.t[first]), float(solution.t[last])
+            if high <= low:
+                continue
+
+            def force(t: float, k: int = k) -> float:
+                return -float(self.monitors(ss, t, solution.sol(t))[k])
+
+            best = minimize_scalar(force, bounds=(low, high), method="bounded",
+                                   options={"xatol": 1e-9 * (high - low)})
+            self.peak[k] = max(self.peak[k], -float(best.fun))
+            if best.x >= self.t_rev:
+                self.peak_late[k] = max(self.peak_late[k], -float(best.fun))
 
 
 ScipyBackend.run_class = _ScipyRun

@@ -10,7 +10,14 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from tests.valvetrain_cases import SDOF_MASS, SDOF_OMEGA, SDOF_STIFFNESS, sdof_doc, spec_from
+from tests.valvetrain_cases import (
+    SDOF_MASS,
+    SDOF_OMEGA,
+    SDOF_STIFFNESS,
+    base_excited_response,
+    sdof_doc,
+    spec_from,
+)
 from vtool.errors import InputError
 from vtool.presets import load_preset
 from vtool.presets.valvetrain import with_run_overrides
@@ -89,19 +96,7 @@ def test_harmonic_base_excitation_against_its_closed_form(backend: str) -> None:
     trace = run_with(backend, doc)
     assert not trace.events  # the follower stays on the cam
     mechanism = assemble(spec_from(doc))
-    M, K = mechanism.M, mechanism.K
-    omega_cam = mechanism.omega
-    amplitude, offset = 0.01, mechanism.start.cam_offset
-    w2 = K[1, 1] / M[1, 1]
-    forcing_0 = -K[1, 0] * offset / M[1, 1]
-    forcing_s = (-K[1, 0] + M[1, 0] * omega_cam**2) * amplitude / M[1, 1]
-    t = trace.time
-    x0, v0 = trace.coordinate(2)[0], trace.qd[0, 1]
-    steady_s = forcing_s / (w2 - omega_cam**2)
-    c1 = x0 - forcing_0 / w2
-    c2 = (v0 - steady_s * omega_cam) / math.sqrt(w2)
-    exact = (forcing_0 / w2 + steady_s * np.sin(omega_cam * t) + c1 * np.cos(math.sqrt(w2) * t)
-             + c2 * np.sin(math.sqrt(w2) * t))
+    exact, _ = base_excited_response(mechanism, trace.time, trace.coordinate(2)[0], trace.qd[0, 1])
     assert normalized_error(trace.coordinate(2), exact) < TOLERANCE[backend]
 
 

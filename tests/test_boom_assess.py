@@ -19,7 +19,7 @@ from vtool.assessments.sonic_boom.structures import (
     pseudo_height,
 )
 from vtool.errors import InputError
-from vtool.presets import load_preset
+from vtool.presets import PRESET_DIR, boom, load_preset, read_document
 
 # thesis section 1.5.1: a = 207 in, h = 4.5 in, E = 1.5e6 psi, nu = 0.15,
 # surface weight 0.2473 lb/in^2, g = 386.4 in/s^2
@@ -76,7 +76,7 @@ def test_brick_wall_preset_reproduces_the_worked_example():
     rows = {(r.structure, r.frequency_source, r.criterion): r for r in a.rows}
     measured = rows[("left", "measured", "damage-threshold")]
     assert measured.ratio == pytest.approx(1.75)
-    assert "envelope of types N,P,Q,R,T" in a.source
+    assert "envelope (thesis family) of types N,P,Q,R,T" in a.source
     env = envelope(THESIS_ENVELOPE, np.array([1.75]))
     assert measured.daf == pytest.approx(env.daf[0])
     m_omega = M_WALL * 2 * math.pi * 17.5
@@ -86,7 +86,27 @@ def test_brick_wall_preset_reproduces_the_worked_example():
     safe = rows[("left", "measured", "safe-limit")]
     assert safe.pressure / measured.pressure == pytest.approx(2.0 / 4.5)
     plate = rows[("left", "plate formula", "damage-threshold")]
-    assert plate.frequency == pytest.approx(14.0, abs=0.1)
+    # the thesis' pseudo-height: 31565/207 = 152.49 printed and used as 152 in
+    left = a.structures[0]
+    assert left.details["pseudo_height"] == 152.0
+    D = 1.5e6 * 4.5**3 / (12 * (1 - 0.15**2))
+    f_152 = math.pi / 2 * (1 / 207.0**2 + 1 / 152.0**2) * math.sqrt(D / M_WALL)
+    assert plate.frequency == pytest.approx(f_152, rel=1e-12)
+    assert plate.frequency == pytest.approx(14.0, abs=0.15)  # the thesis' "14 Hz"
+
+
+def test_brick_wall_exact_pseudo_height_is_an_option():
+    doc = read_document(PRESET_DIR / "boom-brick-wall.toml")
+    for wall in doc["walls"]:
+        wall["pseudo_height_rule"] = "exact"
+    a = assess(boom.load(doc))
+    left = a.structures[0]
+    assert left.details["pseudo_height"] == pytest.approx(31565.0 / 207.0)
+    D = 1.5e6 * 4.5**3 / (12 * (1 - 0.15**2))
+    b = 31565.0 / 207.0
+    f = math.pi / 2 * (1 / 207.0**2 + 1 / b**2) * math.sqrt(D / M_WALL)
+    assert left.frequencies["plate formula"] == pytest.approx(f, rel=1e-12)
+    assert boom.load(boom.dump(boom.load(doc))) == boom.load(doc)
 
 
 def test_floor_model():
@@ -101,6 +121,22 @@ def test_floor_model():
     # p+ l d / k * DAF_x = x_lim  (equations 11, 12, 14, 15)
     assert row.pressure * 144.0 * 1200.0 / k * row.daf == pytest.approx(float(x_lim))
     assert row.tentative
+
+
+def test_floor_criteria_are_labelled_with_the_quantity_they_limit():
+    """0.04 in/s is a velocity: the label says so, and how it becomes a displacement limit."""
+    crit = BUILTIN["reiher-meister-perceptible"]
+    assert crit.quantity == "velocity"
+    assert crit.rule() == ("steady-state velocity <= 0.04 in/s, applied as peak displacement "
+                           "<= 0.04 in/s / (2 pi f)")
+    g = BUILTIN["reiher-meister-unpleasant"]
+    assert g.rule().startswith("steady-state acceleration <= 0.1 g,")
+    assert g.rule().endswith("/ (2 pi f)^2")
+    assert BUILTIN["damage-threshold"].rule() == "peak velocity <= 4.5 in/s"
+    for c in BUILTIN.values():
+        assert "displacement <= 0.04 in/s" not in c.describe().split("applied as")[0]
+        # the value's unit always matches the quantity named before it
+        assert c.rule().split(" <= ")[0].endswith(c.quantity)
 
 
 def test_reiher_meister_velocity_line_becomes_displacement():

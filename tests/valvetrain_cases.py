@@ -41,3 +41,22 @@ def thesis_doc(name: str) -> dict:
 
 def spec_from(doc: dict) -> MechanismSpec:
     return load_document(doc)
+
+
+def base_excited_response(mechanism, t, x0: float, v0: float, amplitude: float = 0.01):  # noqa: ANN001, ANN201
+    """Closed form (x, a) of the mass q2 of the base-excited oscillator (test_backends.base_excited_doc),
+    the follower q1 riding the cam x1 = amplitude sin ωt + offset, from x2(0) = x0, x2'(0) = v0."""
+    import numpy as np
+
+    M, K = mechanism.M, mechanism.K
+    omega_cam, offset = mechanism.omega, mechanism.start.cam_offset
+    w2 = K[1, 1] / M[1, 1]
+    forcing_0 = -K[1, 0] * offset / M[1, 1]
+    forcing_s = (-K[1, 0] + M[1, 0] * omega_cam**2) * amplitude / M[1, 1]
+    steady_s = forcing_s / (w2 - omega_cam**2)
+    c1 = x0 - forcing_0 / w2
+    c2 = (v0 - steady_s * omega_cam) / math.sqrt(w2)
+    free = c1 * np.cos(math.sqrt(w2) * t) + c2 * np.sin(math.sqrt(w2) * t)
+    x = forcing_0 / w2 + steady_s * np.sin(omega_cam * t) + free
+    a = -omega_cam**2 * steady_s * np.sin(omega_cam * t) - w2 * free
+    return x, a

@@ -1,37 +1,66 @@
-"""Small dense linear algebra runs single-threaded: threads cost more than they give on 8x8 matrices.
+"""Thread limits for the small dense linear algebra of a run.
 
-The valve train's matrices are 8x8 to 64x64; a multi-threaded BLAS spends more
-time waking its threads than computing, and on a loaded machine much more
-(the plate study 5.6x slower, the exact back end 4.3x). Runs therefore limit
-BLAS/OpenMP to ``VTOOL_THREADS`` threads (default 1) while they compute;
-set ``VTOOL_THREADS=0`` to leave the libraries' own defaults.
+vtool's matrices are small (8x8 to 64x64). A multi-threaded BLAS (OpenBLAS,
+MKL) starts its thread pool for every product and solve, and on a loaded
+2-core machine the hand-offs cost more than the arithmetic: the plate study
+ran 5.6x slower and the exact back end 4.3x slower with the default threads.
+So a run limits the BLAS and OpenMP pools to one thread while it runs:
+
+    with vtool.threads.limited():
+        ...
+
+or as a decorator, ``@vtool.threads.limited()``. The pools are restored on
+exit (threadpoolctl).
+
+The environment variable ``VTOOL_THREADS`` overrides the default of 1: a
+positive integer is the thread count, ``0`` or ``default`` leaves the
+libraries' own settings untouched (e.g. for a large plate mesh on an idle
+many-core machine). Any other value is an input error naming the variable.
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
+
+from vtool.errors import InputError
+
+ENVIRONMENT = "VTOOL_THREADS"
+DEFAULT = 1
 
 
-def thread_limit() -> int | None:
-    """Threads a run may use for linear algebra: VTOOL_THREADS (default 1); None = no limit."""
-    text = os.environ.get("VTOOL_THREADS", "1").strip()
+def thread_limit(value: str | None = None) -> int | None:
+    """Threads allowed to BLAS/OpenMP: from ``value`` (default: $VTOOL_THREADS); None = no limit."""
+    if value is None:
+        value = os.environ.get(ENVIRONMENT)
+    if value is None or value.strip() == "":
+        return DEFAULT
+    text = value.strip().lower()
+    if text in ("0", "default"):
+        return None
     try:
-        value = int(text)
+        count = int(text)
     except ValueError:
-        return 1
-    return None if value <= 0 else value
+        count = -1
+    if count < 1 or count > 1024:
+        raise InputError(ENVIRONMENT, value, "1 to 1024 threads, or 0 / default for the libraries' "
+                         "own setting")
+    return count
 
 
 @contextmanager
-def limited() -> Iterator[None]:
-    """Limit BLAS/OpenMP threads to :func:`thread_limit` inside the block."""
-    limit = thread_limit()
-    if limit is None:
-        yield
-        return
-    with _controller().limit(limits=limit):
+def limited(threads: int | None = None) -> Iterator[None]:
+    """Limit BLAS/OpenMP pools to ``threads`` (default: :func:`thread_limit`) inside the block.
+
+    Usable as a context manager or a decorator (``@limited()``).
+    """
+    count = thread_limit() if threads is None else threads
+    if count is None:
+        context = nullcontext()
+    else:
+        context = _controller().limit(limits=count)
+    with context:
         yield
 
 
@@ -39,9 +68,12 @@ _CONTROLLERS: list = []
 
 
 def _controller():  # type: ignore[no-untyped-def]
-    """One ThreadpoolController per process (inspecting the loaded libraries costs about 30 ms)."""
+    """One ThreadpoolController per process: inspecting the loaded libraries costs about 30 ms,
+    limiting with it afterwards about 0.1 ms."""
     if not _CONTROLLERS:
-        from threadpoolctl import ThreadpoolController
+        from threadpoolctl import (
+            ThreadpoolController,  # imported lazily: a small import, but not free
+        )
 
         _CONTROLLERS.append(ThreadpoolController())
     return _CONTROLLERS[0]

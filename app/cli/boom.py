@@ -17,6 +17,7 @@ import click
 from vtool.errors import InputError
 
 PULSE_CHOICES = ("N", "P", "Q", "R", "T")
+FAMILIES = ("thesis", "equal-rise")  # assessments.sonic_boom.spectra.FAMILIES, kept import-free
 
 
 def _parse_range(ctx: click.Context, param: click.Parameter, value: str) -> tuple[float, float, float]:
@@ -35,10 +36,6 @@ def _parse_range(ctx: click.Context, param: click.Parameter, value: str) -> tupl
 @click.group()
 def boom() -> None:
     """Sonic-boom response of walls and floors (thesis 001, Part I)."""
-
-
-def _fmt(value: float, digits: int = 4) -> str:
-    return f"{value:.{digits}g}" if math.isfinite(value) else "inf"
 
 
 def _summary_lines(res: Any, quantity: str) -> list[str]:
@@ -66,36 +63,39 @@ def _summary_lines(res: Any, quantity: str) -> list[str]:
 @click.option("--pulse-csv", type=click.Path(path_type=Path), default=None,
               help="Tabulated pressure history (time [s], pressure) instead of --type.")
 @click.option("--envelope", is_flag=True, help="Envelope over the thesis' family (s 1.6-2.2, r1 0-0.5).")
+@click.option("--family", type=click.Choice(FAMILIES), default="thesis", show_default=True,
+              help="Envelope family: thesis (P r2=(s-1)r1) or equal-rise (P r2=r1).")
 @click.option("--damping", type=float, default=0.0, show_default=True, help="Damping ratio zeta, [0, 1).")
 @click.option("--range", "grid", default="0:2.5:0.01", show_default=True, callback=_parse_range,
               help="tau/T values start:stop:step (inclusive).")
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Write the DAF curves to this CSV file.")
+@click.option("--json", "as_json", is_flag=True, help="Print the DAF curves as JSON (units named).")
 @click.option("--plot", is_flag=True, help="Draw the DAF curves in the terminal.")
 def daf_command(kind: str, s: float, r1: float, r2: float | None, alpha: float | None,
-                beta: float | None, pulse_csv: Path | None, envelope: bool, damping: float,
-                grid: tuple[float, float, float], csv_path: Path | None, plot: bool) -> None:
+                beta: float | None, pulse_csv: Path | None, envelope: bool, family: str,
+                damping: float, grid: tuple[float, float, float], csv_path: Path | None,
+                as_json: bool, plot: bool) -> None:
     """DAF against tau/T (forced, free and overall) for one pulse, or an envelope."""
     import numpy as np
 
-    from vtool.assessments.sonic_boom import fourier, pulses, response, spectra
+    from vtool.assessments.sonic_boom import fourier, pulses, report, response, spectra
 
     response.check_damping(damping)
     ratio = spectra.ratio_grid(*grid)
+    lines: list[str] = []
     if envelope:
-        env_v = spectra.envelope(spectra.THESIS_ENVELOPE, ratio, "velocity", damping)
-        env_x = spectra.envelope(spectra.THESIS_ENVELOPE, ratio, "displacement", damping)
-        click.echo(f"source: {env_v.statement}")
-        for env in (env_v, env_x):
+        spec = spectra.EnvelopeSpec(family=family)
+        envs = [spectra.envelope(spec, ratio, q, damping) for q in ("velocity", "displacement")]
+        lines.append(f"source: {envs[0].statement}")
+        for env in envs:
             i = int(np.argmax(env.daf))
-            click.echo(f"{env.quantity} DAF envelope: max {env.daf[i]:.6f} at tau/T = {ratio[i]:.4g} "
-                       f"({env.governing[i]})")
-        header = ["tau/T [-]", "velocity DAF envelope [-]", "velocity governing pulse",
-                  "displacement DAF envelope [-]", "displacement governing pulse"]
-        rows = [[f"{r:.6g}", f"{v:.10g}", gv, f"{x:.10g}", gx] for r, v, gv, x, gx in
-                zip(ratio, env_v.daf, env_v.governing, env_x.daf, env_x.governing, strict=True)]
-        series = {"velocity envelope": env_v.daf, "displacement envelope": env_x.daf}
-        title = "DAF envelope (thesis family)"
+            lines.append(f"{env.quantity} DAF envelope: max {env.daf[i]:.6f} at tau/T = {ratio[i]:.4g} "
+                         f"({env.governing[i]})")
+        header, rows = report.envelope_daf_table(envs)
+        document = report.envelope_daf_dict(envs)
+        series = {f"{env.quantity} envelope": env.daf for env in envs}
+        title = f"DAF envelope ({family} family)"
     else:
         if pulse_csv is not None:
             pulse = pulses.read_pulse_csv(pulse_csv)
@@ -103,62 +103,60 @@ def daf_command(kind: str, s: float, r1: float, r2: float | None, alpha: float |
             pulse = pulses.make_pulse(pulses.PulseParams(kind, s, r1, r2, alpha, beta))
         res = response.peak_response(pulse, ratio, damping)
         damped = "undamped" if damping == 0.0 else f"damping ratio {damping:g}"
-        click.echo(f"pulse: {pulse.label}, {damped}")
+        lines.append(f"pulse: {pulse.label}, {damped}")
         if pulse.tau_seconds is not None:
-            click.echo(f"  tabulated: tau = {pulse.tau_seconds:.6g} s (positive phase), "
-                       f"p+ = {pulse.peak_pressure:.6g} (file units)")
+            lines.append(f"  tabulated: tau = {pulse.tau_seconds:.6g} s (positive phase), "
+                         f"p+ = {pulse.peak_pressure:.6g} (file units)")
         for quantity in response.QUANTITIES:
-            click.echo(f"{quantity} DAF:")
-            for line in _summary_lines(res, quantity):
-                click.echo(line)
+            lines.append(f"{quantity} DAF:")
+            lines += _summary_lines(res, quantity)
         fourier_free = fourier.free_amplitude(pulse, ratio) if damping == 0.0 else None
+        gap = None
         if fourier_free is not None:
             gap = float(np.max(np.abs(fourier_free - res.velocity.free)))
-            click.echo(f"free-motion amplitude by Fourier transform (appendix A): "
-                       f"max |difference| = {gap:.2e}")
-        header = ["tau/T [-]"]
-        columns = []
-        for quantity in response.QUANTITIES:
-            pk = res.peaks[quantity]
-            for phase, values in (("forced", pk.forced), ("free", pk.free), ("overall", pk.overall)):
-                header.append(f"{quantity} DAF {phase} [-]")
-                columns.append(values)
-            header.append(f"{quantity} peak instant [t/tau]")
-            columns.append(pk.overall_at)
-        if fourier_free is not None:
-            header.append("free amplitude Fourier [-]")
-            columns.append(fourier_free)
-        rows = [[f"{r:.6g}"] + [f"{c[i]:.10g}" for c in columns] for i, r in enumerate(ratio)]
+            lines.append(f"free-motion amplitude by Fourier transform (appendix A): "
+                         f"max |difference| = {gap:.2e}")
+        header, rows = report.pulse_daf_table(res, fourier_free)
+        document = report.pulse_daf_dict(res, pulse.tau_seconds, pulse.peak_pressure, gap)
         series = {"velocity overall": res.velocity.overall, "velocity forced": res.velocity.forced,
                   "displacement overall": res.displacement.overall}
         title = f"DAF of {pulse.label}"
     if csv_path is not None:
-        _write_csv(csv_path, header, rows)
-        click.echo(f"wrote {csv_path}")
+        _write(csv_path, report.csv_text(header, rows))
+        lines.append(f"wrote {csv_path}")
+    if as_json:
+        click.echo(json.dumps(document, indent=2))
+    else:
+        click.echo("\n".join(lines))
     if plot:
         from vtool.app.plots import line_chart
 
         click.echo(line_chart(ratio, series, title=title, xlabel="tau/T", ylabel="DAF"))
 
 
-def _write_csv(path: Path, header: list[str], rows: list[list[str]]) -> None:
-    import csv
-    import io
-
+def _write(path: Path, text: str) -> None:
+    """Write ``text`` atomically; a folder that cannot be written is an input error, not a traceback."""
+    from vtool.assessments.sonic_boom.pulses import shorten
     from vtool.files import write_atomic
 
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(header)
-    writer.writerows(rows)
-    write_atomic(path, buffer.getvalue())
+    try:
+        write_atomic(path, text)
+    except OSError as exc:
+        raise InputError("--csv", shorten(str(path), 80),
+                         f"a file in an existing, writable folder ({exc.strerror})") from None
 
 
 def _preset_command(expected: str, name: str, preset: str, csv_path: Path | None, plot: bool,
                     as_json: bool) -> None:
-    from vtool.presets import load_preset
+    from vtool.presets import boom as boom_presets
+    from vtool.presets import find_preset, kind_of, load_document, read_document
 
-    spec = load_preset(preset)
+    path = find_preset(preset)
+    doc = read_document(path)
+    if kind_of(doc) in boom_presets.KINDS:
+        spec = boom_presets.load(doc, base=path.parent)  # pulse CSVs beside the preset
+    else:
+        spec = load_document(doc)
     if spec.kind != expected:
         raise InputError("preset", preset, f"a {expected} preset for `vtool boom {name}` (got {spec.kind})")
     solve_preset(spec, csv_path, plot, as_json)
@@ -193,129 +191,26 @@ def floor_command(preset: str, csv_path: Path | None, plot: bool, as_json: bool)
     _preset_command("boom_floor", "floor", preset, csv_path, plot, as_json)
 
 
-# ----------------------------------------------------------------------------
-# shared by `vtool boom wall|floor` and `vtool solve`
-
-_ROW_HEADER = ("structure", "frequency source", "f [Hz]", "tau [s]", "tau/T [-]", "criterion",
-               "response", "DAF [-]")
-
-
-def _report(assessment: Any) -> dict[str, Any]:
-    u = assessment.units
-    return {
-        "kind": assessment.kind,
-        "title": assessment.title,
-        "units": u.name,
-        "daf_source": assessment.source,
-        "criteria": [c.describe() for c in assessment.criteria],
-        "structures": [
-            {"name": s.name, "frequencies_hz": s.frequencies, **s.details} for s in assessment.structures
-        ],
-        "limits": [
-            {"structure": r.structure, "frequency_source": r.frequency_source, "frequency_hz": r.frequency,
-             "tau_s": r.tau, "tau_over_T": r.ratio, "criterion": r.criterion, "response": r.response,
-             "daf": r.daf, "limit_over_daf": r.normalized, f"pressure_{u.pressure}": r.pressure,
-             f"pressure_{u.alt_pressure}": r.pressure_alt, "criterion_frequency_range_ok": r.in_range,
-             "tentative": r.tentative}
-            for r in assessment.rows
-        ],
-    }
-
-
-def _structure_line(s: Any, u: Any) -> str:
-    d = s.details
-    parts = []
-    if "pseudo_height" in d:
-        parts.append(f"pseudo-height {d['pseudo_height']:.1f} {u.length}")
-    if "flexural_rigidity" in d:
-        parts.append(f"D {d['flexural_rigidity']:.4g} {u.force} {u.length}")
-    if "mass_per_area" in d:
-        parts.append(f"mass {d['mass_per_area']:.4g} {u.mass} per {u.length}^2")
-    if "stiffness" in d:
-        parts.append(f"k {d['stiffness']:.4g} {u.force}/{u.length}, mass {d['mass']:.4g} {u.mass}, "
-                     f"loaded area {d['loaded_area']:.4g} {u.length}^2")
-    freqs = ", ".join(f"{k} {v:.3f} Hz" for k, v in s.frequencies.items())
-    return f"  {s.name}: {'; '.join(parts)}; f: {freqs}"
-
-
 def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool) -> None:
-    """Run a boom_wall / boom_floor preset: table (or JSON), optional CSV and charts."""
+    """Run a boom_wall / boom_floor preset: table (or JSON), optional CSV and charts.
+
+    Shared by ``vtool boom wall|floor`` and ``vtool solve``.
+    """
+    from vtool.assessments.sonic_boom import report
     from vtool.assessments.sonic_boom.assess import assess
 
     a = assess(spec)
-    u = a.units
-    p_cols = (f"limit/DAF [{u.length}/s | {u.length}]", f"p+ [{u.pressure}]", f"p+ [{u.alt_pressure}]")
-    if as_json:
-        click.echo(json.dumps(_report(a), indent=2))
-    else:
-        click.echo(a.title)
-        click.echo(f"DAF source: {a.source}")
-        click.echo(f"units: {u.name} (pressure {u.pressure}, also {u.alt_pressure}; g = {u.gravity:g} "
-                   f"{u.length}/s^2)")
-        click.echo("criteria:")
-        for c in a.criteria:
-            click.echo(f"  {c.describe()}")
-        click.echo("structures:")
-        for s in a.structures:
-            click.echo(_structure_line(s, u))
-        click.echo("allowable peak overpressure:")
-        header = (*_ROW_HEADER, *p_cols, "note")
-        table = [header]
-        for r in a.rows:
-            note = []
-            if r.tentative:
-                note.append("tentative")
-            if not r.in_range:
-                note.append("f outside criterion range")
-            table.append((r.structure, r.frequency_source, f"{r.frequency:.3f}", f"{r.tau:g}",
-                          f"{r.ratio:.4f}", r.criterion, r.response, f"{r.daf:.4f}",
-                          _fmt(r.normalized), _fmt(r.pressure), _fmt(r.pressure_alt), ", ".join(note)))
-        widths = [max(len(str(row[i])) for row in table) for i in range(len(header))]
-        for row in table:
-            click.echo("  " + "  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
     if csv_path is not None:
-        _write_csv(csv_path, *limits_csv_rows(a))
-        if not as_json:
+        _write(csv_path, report.limits_csv(a))
+    if as_json:
+        click.echo(json.dumps(report.limits_dict(a), indent=2))
+    else:
+        click.echo(report.limits_text(a))
+        if csv_path is not None:
             click.echo(f"wrote {csv_path}")
     if plot:
-        _plot(a)
+        from vtool.app.plots import line_chart
 
-
-def limits_csv_rows(a: Any) -> tuple[list[str], list[list[str]]]:
-    """Header and rows of the allowable-pressure CSV (``vtool solve BOOM_PRESET --csv``, the TUI export)."""
-    u = a.units
-    p_cols = [f"limit/DAF [{u.length}/s | {u.length}]", f"p+ [{u.pressure}]", f"p+ [{u.alt_pressure}]"]
-    rows = [[r.structure, r.frequency_source, f"{r.frequency:.10g}", f"{r.tau:.10g}", f"{r.ratio:.10g}",
-             r.criterion, r.response, f"{r.daf:.10g}", f"{r.normalized:.10g}", f"{r.pressure:.10g}",
-             f"{r.pressure_alt:.10g}"] for r in a.rows]
-    return [*_ROW_HEADER, *p_cols], rows
-
-
-def design_series(a: Any) -> list[tuple[str, Any, dict[str, Any]]]:
-    """(structure, frequencies, {label: p+ in the alternative unit}) per distinct set of design curves.
-
-    Structures with the same mass have identical curves; each distinct set is listed once.
-    """
-    u = a.units
-    by_structure: dict[str, dict[str, Any]] = {}
-    for curve in a.curves:
-        by_structure.setdefault(curve.structure, {})[f"{curve.criterion}, tau={curve.tau:g}s"] = curve
-    shown: set[tuple[float, ...]] = set()
-    out = []
-    for name, curves in by_structure.items():
-        key = tuple(round(float(v), 12) for c in curves.values() for v in c.pressure[::20])
-        if key in shown:
-            continue
-        shown.add(key)
-        first = next(iter(curves.values()))
-        out.append((name, first.frequency, {label: c.pressure * u.alt_per_pressure for label, c in curves.items()}))
-    return out
-
-
-def _plot(a: Any) -> None:
-    """Design curves (thesis Figures 4 and 7): allowable p+ against frequency, per structure."""
-    from vtool.app.plots import line_chart
-
-    for name, frequency, series in design_series(a):
-        click.echo(line_chart(frequency, series, title=f"{name}: allowable p+ against frequency",
-                              xlabel="f [Hz]", ylabel=f"p+ [{a.units.alt_pressure}]"))
+        for name, frequency, series in report.design_series(a):
+            click.echo(line_chart(frequency, series, title=f"{name}: allowable p+ against frequency",
+                                  xlabel="f [Hz]", ylabel=f"p+ [{a.units.alt_pressure}]"))

@@ -40,8 +40,9 @@ def _cases(spec: Any, case_name: str | None) -> list[Any]:
 
 
 def _wh(ctx: click.Context, param: click.Parameter, value: float) -> float:
-    if not 0.0 < value <= RK4_LIMIT:
-        raise InputError("--wh", value, f"> 0 and <= {RK4_LIMIT} (omega_max*h, RK4 stability limit, thesis eq. 44)")
+    if not 0.01 <= value <= RK4_LIMIT:
+        raise InputError("--wh", value, f">= 0.01 and <= {RK4_LIMIT} (omega_max*h, RK4 stability limit, "
+                         "thesis eq. 44)")
     return value
 
 
@@ -71,7 +72,6 @@ def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path 
     from vtool.assessments.plate.model import build_model
     from vtool.assessments.plate.report import modes_csv, modes_text
     from vtool.assessments.plate.vibration import free_vibration
-    from vtool.files import write_atomic
 
     spec = _load_plate_spec(preset)
     plate_ = spec.study.plate
@@ -89,7 +89,7 @@ def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path 
         text = "case,KS," + modes_csv(results[0][1]).splitlines()[0] + "\n"
         for c, f in results:
             text += "".join(f"{c.name},{f.size},{line}\n" for line in modes_csv(f).splitlines()[1:])
-        write_atomic(csv_path, text)
+        _write(csv_path, text)
         click.echo(f"wrote {csv_path}", err=True)
 
 
@@ -117,9 +117,9 @@ LABELS = {"displacement": "w / (p0/(m w11^2))", "velocity": "v / (p0/(m w11))", 
               help="RK4 at --wh, or exact modal integration of the reduced model.")
 @click.option("--wh", type=float, default=1.0, show_default=True, callback=_wh,
               help="omega_max*h, the RK4 step parameter (stable up to 2.8; adequate at 1).")
-@click.option("--periods", type=click.FloatRange(0.0, 20.0, min_open=True), default=None,
+@click.option("--periods", type=click.FloatRange(0.5, 20.0), default=None,
               help="Duration in exact fundamental periods (default: the preset's).")
-@click.option("--modes", "exact_modes", type=click.IntRange(2, 5000), default=None,
+@click.option("--modes", "exact_modes", type=click.IntRange(2, 1000), default=None,
               help="Modes of the exact reference (default: the preset's).")
 @click.option("--plot/--no-plot", default=True, show_default=True, help="Draw the histories.")
 @csv_option
@@ -128,68 +128,36 @@ def transient(preset: str, case_name: str | None, load: str, scheme: str, wh: fl
               periods: float | None, exact_modes: int | None, plot: bool, csv_path: Path | None,
               as_json: bool) -> None:
     """Centre displacement, velocity and acceleration under a step load, against exact."""
-    from vtool.assessments.plate.model import build_model
-    from vtool.assessments.plate.report import exact_note, response_csv
-    from vtool.assessments.plate.transient import (
-        exact_histories,
-        halving_change_pct,
-        peak_errors,
-        run_modal,
-        run_rk4,
-    )
-    from vtool.files import write_atomic
+    from vtool.assessments.plate.report import case_run_dict, case_run_text, response_csv
+    from vtool.assessments.plate.study import run_case
 
     spec = _load_plate_spec(preset)
     settings = spec.study.transient
-    periods = periods or settings.periods
-    n_modes = exact_modes or settings.exact_modes
     case = _cases(spec, case_name)[0]
-    plate_ = spec.study.plate
-    model = build_model(plate_, case)
-    exact = exact_histories(plate_, load, periods, n_modes)
-    if scheme == "rk4":
-        resp = run_rk4(plate_, model, load, wh, periods)
-        halving = halving_change_pct(plate_, model, load, wh, periods)
-    else:
-        resp = run_modal(plate_, model, load, exact.tau)
-        halving = {}
-    errors = peak_errors(resp, exact)
+    run = run_case(spec.study.plate, case, load, scheme, wh, periods or settings.periods,
+                   exact_modes or settings.exact_modes)
+    if csv_path is not None:
+        _write(csv_path, response_csv(run.response, run.exact))
     if as_json:
-        click.echo(json.dumps({
-            "case": case.name, "KS": model.size, "load": load, "scheme": scheme,
-            "omega_max_h": wh if scheme == "rk4" else None, "steps": resp.steps,
-            "step_s": resp.step if scheme == "rk4" else None, "seconds": resp.seconds,
-            "peak_errors_pct": {k: (None if v != v else v) for k, v in errors.items()},
-            "halving_change_pct": halving, "exact_modes": n_modes,
-            "exact_peak_change_pct": exact.change_pct,
-            "exact_acceleration_converged": exact.acceleration_converged,
-        }, indent=2))
+        click.echo(json.dumps(case_run_dict(run), indent=2))
     else:
-        step = f"omega_max*h = {wh:g}, h = {resp.step:.4g} s, {resp.steps} steps" if scheme == "rk4" \
-            else f"exact modal integration of the reduced model at {resp.steps} times"
-        click.echo(f"case {case.name} ({case.element} {case.nx}x{case.ny}, KS = {model.size}), {load} step load, "
-                   f"{scheme}: {step}, {resp.seconds * 1e3:.2f} ms")
-        click.echo(f"{'quantity':<13} {'peak':>10} {'exact peak':>11} {'error %':>9}" +
-                   (f" {'halving h %':>12}" if halving else ""))
-        for q in ("displacement", "velocity", "acceleration"):
-            a = getattr(resp, q)
-            e = getattr(exact, q)
-            k = int(abs(e).argmax())
-            peak = a.max() if e[k] > 0 else a.min()
-            err = errors[q]
-            shown = "n/a" if err != err else f"{err:.3f}"
-            exact_shown = "n/a" if err != err else f"{e[k]:.4f}"
-            line = f"{q:<13} {peak:>10.4f} {exact_shown:>11} {shown:>9}"
-            if halving:
-                line += f" {halving[q]:>12.3f}"
-            click.echo(line)
-        click.echo(exact_note(exact))
+        click.echo(case_run_text(run))
         if plot:
             for q in ("displacement", "velocity", "acceleration"):
-                click.echo(_chart(resp, exact, q, LABELS[q]))
+                click.echo(_chart(run.response, run.exact, q, LABELS[q]))
     if csv_path is not None:
-        write_atomic(csv_path, response_csv(resp, exact))
         click.echo(f"wrote {csv_path}", err=True)
+
+
+def _write(path: Path, text: str) -> None:
+    """Write atomically; an unwritable path is an input error (one line), not a traceback."""
+    from vtool.files import write_atomic
+
+    try:
+        write_atomic(path, text)
+    except OSError as exc:
+        shown = str(path) if len(str(path)) <= 80 else str(path)[:77] + "..."
+        raise InputError("--csv", shown, f"a file in an existing, writable folder ({exc.strerror})") from None
 
 
 @plate.command("study")
@@ -213,7 +181,6 @@ def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *,
     """
     from vtool.assessments.plate.report import study_csv, study_dict, study_text
     from vtool.assessments.plate.study import run_study
-    from vtool.files import write_atomic
 
     result = run_study(spec.study, transient=transient)
     if as_json:
@@ -223,7 +190,7 @@ def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *,
         click.echo(spec.title)
         click.echo(study_text(result))
     if csv_path is not None:
-        write_atomic(csv_path, study_csv(result))
+        _write(csv_path, study_csv(result))
         click.echo(f"wrote {csv_path}", err=True)
     if plot and result.exact:
         _plot_full_model(spec, result)

@@ -8,7 +8,7 @@ assessment used (pulse or envelope).
 
 from __future__ import annotations
 
-import math
+import threading
 from typing import Any
 
 from textual import work
@@ -17,7 +17,6 @@ from textual.containers import VerticalScroll
 from textual.widgets import TabbedContent, TabPane
 from textual.worker import Worker, get_current_worker
 
-from vtool.app.cli.boom import design_series, limits_csv_rows
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, INTEGER, NUMBERS, TEXT, Field, dotted
 from vtool.app.tui.messages import AssessmentFinished
@@ -115,47 +114,28 @@ def switch_pulse(doc: dict[str, Any]) -> dict[str, Any]:
     return doc
 
 
-def _fmt(value: float, digits: int = 4) -> str:
-    return f"{value:.{digits}g}" if math.isfinite(value) else "inf"
+#: Points of the TUI's DAF chart: a chart is ~100 columns wide, so more is waste.
+CHART_POINTS = 501
 
 
-def limits_text(a: Any) -> str:
-    """The assessment as the CLI's table: DAF source, structures, allowable pressures."""
-    u = a.units
-    lines = [a.title, f"DAF source: {a.source}",
-             f"units: {u.name} (pressure {u.pressure}, also {u.alt_pressure})", "structures:"]
-    for s in a.structures:
-        freqs = ", ".join(f"{k} {v:.3f} Hz" for k, v in s.frequencies.items())
-        lines.append(f"  {s.name}: f: {freqs}")
-    lines.append("allowable peak overpressure:")
-    header = ("structure", "f source", "f [Hz]", "tau [s]", "tau/T", "criterion", "DAF",
-              f"p+ [{u.pressure}]", f"p+ [{u.alt_pressure}]", "note")
-    table = [header]
-    for r in a.rows:
-        note = ", ".join(n for n, on in (("tentative", r.tentative), ("f outside criterion range", not r.in_range))
-                         if on)
-        table.append((r.structure, r.frequency_source, f"{r.frequency:.3f}", f"{r.tau:g}", f"{r.ratio:.4f}",
-                      r.criterion, f"{r.daf:.4f}", _fmt(r.pressure), _fmt(r.pressure_alt), note))
-    widths = [max(len(str(row[i])) for row in table) for i in range(len(header))]
-    for row in table:
-        lines.append("  " + "  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
-    return "\n".join(lines)
+def daf_curves(spec: Any, assessment: Any, cancel: Any = None) -> dict[str, Any]:
+    """The overall DAF of the assessment's source against tau/T, for each response its criteria use.
 
-
-def daf_curves(spec: Any, assessment: Any) -> dict[str, Any]:
-    """The overall DAF of the assessment's source against tau/T, for each response its criteria use."""
+    At most :data:`CHART_POINTS` values of tau/T (step 0.01 up to 5, coarser beyond).
+    """
     import numpy as np
 
     from vtool.assessments.sonic_boom.assess import boom_source
-    from vtool.assessments.sonic_boom.spectra import daf_at, ratio_grid
+    from vtool.assessments.sonic_boom.spectra import daf_at
 
     top = max([2.5, *(1.1 * r.ratio for r in assessment.rows)])
-    ratio = ratio_grid(0.0, float(np.ceil(top * 10) / 10), 0.01)
+    stop = float(np.ceil(top * 10) / 10)
+    ratio = np.linspace(0.0, stop, min(CHART_POINTS, int(round(stop / 0.01)) + 1))
     source = boom_source(spec.boom)
     series = {}
     statements = []
     for quantity in dict.fromkeys(c.response for c in spec.criteria):
-        daf, statement = daf_at(source, ratio, quantity, spec.boom.damping)
+        daf, statement = daf_at(source, ratio, quantity, spec.boom.damping, cancel)
         series[f"{quantity} DAF"] = daf
         statements.append(statement)
     return {"ratio": ratio, "series": series, "statement": " | ".join(statements)}
@@ -163,6 +143,8 @@ def daf_curves(spec: Any, assessment: Any) -> dict[str, Any]:
 
 class BoomScreen(DomainScreen):
     MODE = "boom"
+    #: held by the running assessment; a new run waits for the cancelled one
+    run_lock = threading.Lock()
     KINDS = ("boom_wall", "boom_floor")
     DEFAULT_PRESET = "boom-brick-wall"
     TITLE_TEXT = "SONIC BOOM"
@@ -232,11 +214,22 @@ class BoomScreen(DomainScreen):
 
     @work(thread=True, exclusive=True, exit_on_error=False, group="run")
     def assess(self, spec: Any, run_id: int) -> None:
+        from vtool.assessments.cancel import Cancelled
         from vtool.assessments.sonic_boom.assess import assess
 
         worker = get_current_worker()
-        assessment = assess(spec)
-        daf = daf_curves(spec, assessment)
+
+        def cancel() -> bool:
+            return worker.is_cancelled
+
+        # the previous run (cancelled by this one: exclusive) releases the lock
+        # when it has stopped: only one run's arrays exist at a time
+        with self.run_lock:
+            try:
+                assessment = assess(spec, cancel)
+                daf = daf_curves(spec, assessment, cancel)
+            except Cancelled:
+                return
         if not worker.is_cancelled:
             self.post_message(AssessmentFinished(run_id, spec, assessment, daf))
 
@@ -245,10 +238,11 @@ class BoomScreen(DomainScreen):
         if not self.accept(message):
             return
         from vtool.app.plots import line_chart
+        from vtool.assessments.sonic_boom import report
 
         a, daf = message.assessment, message.daf
         self.results = a
-        self.limits_panel.set_text(limits_text(a))
+        self.limits_panel.set_text(report.limits_text(a))
         self.daf_chart.plot(lambda w, h, c: line_chart(daf["ratio"], daf["series"], title="overall DAF",
                                                        xlabel="tau/T", ylabel="DAF", width=w, height=h,
                                                        color=c))
@@ -257,7 +251,7 @@ class BoomScreen(DomainScreen):
         color = self.app.chart_color  # type: ignore[attr-defined]
         charts = []
         u = a.units
-        for name, freq, series in design_series(a):
+        for name, freq, series in report.design_series(a):
             chart = ChartView(id=None, color=color)
             chart.structure = name  # type: ignore[attr-defined]
             charts.append((chart, name, freq, series))
@@ -269,7 +263,7 @@ class BoomScreen(DomainScreen):
         self.set_status(f"done: {len(a.rows)} limits, {len(a.structures)} structure(s)")
 
     def write_csv(self, path: str) -> None:
-        from vtool.app.cli.boom import _write_csv
+        from vtool.assessments.sonic_boom.report import limits_csv
+        from vtool.files import write_atomic
 
-        header, rows = limits_csv_rows(self.results)
-        _write_csv(path, header, rows)  # type: ignore[arg-type]
+        write_atomic(path, limits_csv(self.results))

@@ -8,7 +8,7 @@ scheme, against the exact (Navier) reference.
 
 from __future__ import annotations
 
-import math
+import threading
 from dataclasses import dataclass
 from typing import Any
 
@@ -38,10 +38,20 @@ class PlateRun:
     study: Any  # StudyResult
     case: Any  # Case
     free: Any  # FreeVibration of the chosen case
-    response: Any  # transient Response
-    exact: Any  # ExactHistories
-    errors: dict[str, float]
+    run: Any  # CaseRun: the chosen case's transient against exact
     options: dict[str, Any]
+
+    @property
+    def response(self) -> Any:
+        return self.run.response
+
+    @property
+    def exact(self) -> Any:
+        return self.run.exact
+
+    @property
+    def errors(self) -> dict[str, float]:
+        return self.run.errors_pct
 
 
 def run_defaults(spec: Any) -> dict[str, Any]:
@@ -133,46 +143,29 @@ def preset_document(doc: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]
 
 def check_options(spec: Any, options: dict[str, Any]) -> dict[str, Any]:
     """Validate the run options (the same ranges as ``vtool plate transient``)."""
-    from vtool.assessments.plate.transient import LOADS, RK4_LIMIT_THESIS, SCHEMES
+    from vtool.assessments.plate.study import check_run_options
 
     names = [c.name for c in spec.study.cases]
     if options.get("case") not in names:
         raise InputError(f"{RUN}.case", options.get("case"), f"one of: {', '.join(names)}")
-    if options.get("load") not in LOADS:
-        raise InputError(f"{RUN}.load", options.get("load"), f"one of: {', '.join(LOADS)}")
-    if options.get("scheme") not in SCHEMES:
-        raise InputError(f"{RUN}.scheme", options.get("scheme"), f"one of: {', '.join(SCHEMES)}")
-    wh = options.get("omega_max_h")
-    if isinstance(wh, bool) or not isinstance(wh, int | float) or not 0.0 < wh <= RK4_LIMIT_THESIS:
-        raise InputError(f"{RUN}.omega_max_h", wh,
-                         f"> 0 and <= {RK4_LIMIT_THESIS} (omega_max*h, RK4 stability limit, thesis eq. 44)")
-    periods = options.get("periods")
-    if isinstance(periods, bool) or not isinstance(periods, int | float) or not 0.0 < periods <= 20.0:
-        raise InputError(f"{RUN}.periods", periods, "> 0 and <= 20 (exact fundamental periods)")
-    modes = options.get("exact_modes")
-    if isinstance(modes, bool) or not isinstance(modes, int) or not 2 <= modes <= 5000:
-        raise InputError(f"{RUN}.exact_modes", modes, "an integer >= 2 and <= 5000")
-    return {**options, "omega_max_h": float(wh), "periods": float(periods)}
+    check_run_options(options.get("load"), options.get("scheme"), options.get("omega_max_h"),  # type: ignore[arg-type]
+                      options.get("periods"), options.get("exact_modes"), prefix=f"{RUN}.")  # type: ignore[arg-type]
+    return {**options, "omega_max_h": float(options["omega_max_h"]), "periods": float(options["periods"])}
 
 
-def run_plate(spec: Any, options: dict[str, Any]) -> PlateRun:
+def run_plate(spec: Any, options: dict[str, Any], cancel: Any = None) -> PlateRun:
     """The study (as ``vtool solve``) and the chosen case's modes and transient (as ``vtool plate``)."""
     from vtool.assessments.plate.model import build_model
-    from vtool.assessments.plate.study import run_study
-    from vtool.assessments.plate.transient import exact_histories, peak_errors, run_modal, run_rk4
+    from vtool.assessments.plate.study import run_case, run_study
     from vtool.assessments.plate.vibration import free_vibration
 
-    study = run_study(spec.study, transient=True)
+    study = run_study(spec.study, transient=True, cancel=cancel)
     plate = spec.study.plate
     case = spec.study.case(options["case"])
-    model = build_model(plate, case)
-    free = free_vibration(plate, model, spec.study.frequencies)
-    exact = exact_histories(plate, options["load"], options["periods"], options["exact_modes"])
-    if options["scheme"] == "rk4":
-        response = run_rk4(plate, model, options["load"], options["omega_max_h"], options["periods"])
-    else:
-        response = run_modal(plate, model, options["load"], exact.tau)
-    return PlateRun(study, case, free, response, exact, peak_errors(response, exact), dict(options))
+    free = free_vibration(plate, build_model(plate, case), spec.study.frequencies)
+    run = run_case(plate, case, options["load"], options["scheme"], options["omega_max_h"],
+                   options["periods"], options["exact_modes"], halving=False, cancel=cancel)
+    return PlateRun(study, case, free, run, dict(options))
 
 
 def transient_chart(run: PlateRun, quantity: str, width: int, height: int, color: bool) -> str:
@@ -192,25 +185,18 @@ def transient_chart(run: PlateRun, quantity: str, width: int, height: int, color
 
 def case_text(run: PlateRun) -> str:
     """Modes of the chosen case, its transient peak errors and what it cost."""
-    from vtool.assessments.plate.report import exact_note, modes_text
+    from vtool.assessments.plate.report import case_run_text, modes_text
 
-    resp, o = run.response, run.options
-    step = (f"omega_max*h = {o['omega_max_h']:g}, h = {resp.step:.4g} s, {resp.steps} steps"
-            if resp.scheme == "rk4" else f"exact modal integration at {resp.steps} times")
-    lines = [modes_text(run.free, run.case), "",
-             f"transient: {resp.load} step load, {resp.scheme}: {step}",
-             f"{'quantity':<13} {'error %':>9}"]
-    for q in ("displacement", "velocity", "acceleration"):
-        err = run.errors[q]
-        lines.append(f"{q:<13} {'n/a' if math.isnan(err) else f'{err:.3f}':>9}")
-    lines.append(exact_note(run.exact))
-    lines += ["", f"cost: KS = {run.free.size}, eigenproblem {run.free.solve_seconds * 1e3:.3f} ms, "
-              f"time loop {resp.loop_seconds * 1e3:.2f} ms, {resp.operations:.3g} multiply-adds"]
-    return "\n".join(lines)
+    resp = run.response
+    return "\n".join([modes_text(run.free, run.case), "", case_run_text(run.run), "",
+                      f"cost: KS = {run.free.size}, eigenproblem {run.free.solve_seconds * 1e3:.3f} ms, "
+                      f"time loop {resp.loop_seconds * 1e3:.2f} ms, {resp.operations:.3g} multiply-adds"])
 
 
 class PlateScreen(DomainScreen):
     MODE = "plate"
+    #: held by the running study; a new run waits for the cancelled one
+    run_lock = threading.Lock()
     KINDS = ("plate",)
     DEFAULT_PRESET = "plate-table2"
     TITLE_TEXT = "PLATE (condensation)"
@@ -296,8 +282,20 @@ class PlateScreen(DomainScreen):
 
     @work(thread=True, exclusive=True, exit_on_error=False, group="run")
     def study(self, spec: Any, options: dict[str, Any], run_id: int) -> None:
+        from vtool.assessments.cancel import Cancelled
+
         worker = get_current_worker()
-        result = run_plate(spec, options)
+
+        def cancel() -> bool:
+            return worker.is_cancelled
+
+        # the previous run (cancelled by this one: exclusive) releases the lock
+        # when it has stopped: only one run's arrays exist at a time
+        with self.run_lock:
+            try:
+                result = run_plate(spec, options, cancel)
+            except Cancelled:
+                return
         if not worker.is_cancelled:
             self.post_message(PlateStudyFinished(run_id, spec, result))
 

@@ -121,13 +121,20 @@ class ExactResponse:
     acceleration_converged: bool
 
 
+_BLOCK = 1_000_000  # (time x mode) entries per block: bounded memory for any grid
+
+
 def _histories(t: np.ndarray, shapes: np.ndarray, qs: np.ndarray, omega: np.ndarray) -> tuple[np.ndarray, ...]:
     c = shapes * qs
-    wt = np.outer(t, omega)
-    cos = np.cos(wt)
-    disp = (1.0 - cos) @ c
-    vel = np.sin(wt) @ (c * omega)
-    acc = cos @ (c * omega**2)
+    cv, ca = c * omega, c * omega**2
+    disp, vel, acc = (np.empty(t.size) for _ in range(3))
+    rows = max(1, _BLOCK // max(omega.size, 1))
+    for lo in range(0, t.size, rows):
+        wt = np.outer(t[lo:lo + rows], omega)
+        cos = np.cos(wt)
+        disp[lo:lo + rows] = c.sum() - cos @ c
+        vel[lo:lo + rows] = np.sin(wt) @ cv
+        acc[lo:lo + rows] = cos @ ca
     return disp, vel, acc
 
 

@@ -19,6 +19,7 @@ from vtool.assessments.plate.assembly import Mesh, Plate, make_mesh
 from vtool.assessments.plate.constraints import restrict
 from vtool.assessments.plate.masters import MasterSetError, labelled_set, named_set
 from vtool.assessments.plate.reduction import guyan_T, henshell_ong_masters, irs_T, reduce
+from vtool.errors import RunError
 
 METHODS = ("guyan", "irs")
 
@@ -111,12 +112,20 @@ def build_model(plate: Plate, case: Case) -> ReducedModel:
     masters = master_positions(mesh, case.masters, free, M_c, K_c)
     if case.method not in METHODS:
         raise ValueError(f"method: {case.method!r} is not one of: {', '.join(METHODS)}")
-    if masters.size == free.size:
-        T = np.eye(free.size)
-    elif case.method == "irs":
-        T = irs_T(M_c, K_c, masters)
-    else:
-        T = guyan_T(K_c, masters)
+    try:
+        if masters.size == free.size:
+            T = np.eye(free.size)
+        elif case.method == "irs":
+            T = irs_T(M_c, K_c, masters)
+        else:
+            T = guyan_T(K_c, masters)
+    except np.linalg.LinAlgError as exc:
+        raise RunError(f"case {case.name}: the reduction failed ({exc}); the stiffness is not "
+                       "positive definite in floating point (check thickness, youngs_modulus, "
+                       "a, b and the mesh)") from None
+    if not (np.all(np.isfinite(T)) and np.all(np.isfinite(K_c)) and np.all(np.isfinite(M_c))):
+        raise RunError(f"case {case.name}: non-finite stiffness or mass (check thickness, "
+                       "youngs_modulus, density, a, b)")
     e_centre = mesh.point_vector(plate.a / 2.0, plate.b / 2.0)[free]
     M_R, K_R, f_R = reduce(M_c, K_c, f_c, T)
     centre_row = e_centre @ T

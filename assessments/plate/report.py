@@ -10,12 +10,15 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
+
 from vtool.assessments.plate.exact import NavierMode
 from vtool.assessments.plate.model import Case
-from vtool.assessments.plate.study import StudyResult, TransientRow
-from vtool.assessments.plate.transient import ExactHistories, Response
+from vtool.assessments.plate.study import CaseRun, StudyResult, TransientRow
+from vtool.assessments.plate.transient import SIGNED_PEAK_FLOOR, SIGNS, ExactHistories, Response
 from vtool.assessments.plate.vibration import FreeVibration
 
+SIGNED_KEYS = tuple(q + s for q in ("displacement", "velocity", "acceleration") for s in SIGNS)
 ELEMENT_TITLES = {"bfs16": "16-DOF element (bfs16)", "mason24": "24-DOF element (mason24)"}
 
 
@@ -83,11 +86,26 @@ def cost_table(result: StudyResult) -> str:
     return "\n".join(lines)
 
 
-def exact_note(exact: ExactHistories) -> str:
+def truncation_pct(exact: ExactHistories, fine: ExactHistories) -> dict[str, float]:
+    """Change of each exact peak magnitude from N to 4N modes, % of the 4N peak."""
+    out = {}
+    for q in ("displacement", "velocity", "acceleration"):
+        a = float(np.max(np.abs(getattr(exact, q))))
+        b = float(np.max(np.abs(getattr(fine, q))))
+        out[q] = (a - b) / b * 100.0 if b else 0.0
+    return out
+
+
+def exact_note(exact: ExactHistories, fine: ExactHistories | None = None) -> str:
     c = exact.change_pct
     text = (f"exact {exact.load} load: {exact.n_modes} modes; peak change when halved: "
             f"displacement {c['displacement']:.3f} %, velocity {c['velocity']:.2f} %, "
             f"acceleration {c['acceleration']:.1f} %")
+    if fine is not None:
+        t = truncation_pct(exact, fine)
+        text += (f"\n  truncation: {exact.n_modes}-mode peak against {fine.n_modes} modes: "
+                 f"displacement {t['displacement']:+.3f} %, velocity {t['velocity']:+.2f} %, "
+                 f"acceleration {t['acceleration']:+.1f} %")
     if not exact.acceleration_converged:
         text += ("\n  point-load acceleration does not converge with the number of modes "
                  "(its series terms do not decay): no exact value, its errors are not reported")
@@ -112,8 +130,35 @@ def transient_table(result: StudyResult) -> str:
         lines.append(row)
     lines.append("'modal': exact integration of the reduced model (no step limit); halving: largest "
                  "change when h is halved, % of peak")
-    for ex in result.exact.values():
-        lines.append(exact_note(ex))
+    for load, ex in result.exact.items():
+        lines.append(exact_note(ex, result.exact_4n.get(load)))
+    lines += list(result.warnings)
+    return "\n".join(lines)
+
+
+def signed_table(result: StudyResult) -> str:
+    """Positive and negative peak errors, and the errors against the 4N-mode reference."""
+    if not result.transient:
+        return ""
+    n = result.study.transient.exact_modes
+    fine = bool(result.exact_4n)
+    head = (f"{'load':<8} {'case':<5} {'wmax*h':>7} " + "".join(
+        f"{q[:4] + s:>8}" for q in ("displacement", "velocity", "acceleration") for s in ("+", "-")))
+    if fine:
+        head += f"   {f'vs {4 * n} modes: disp':>20} {'vel':>8} {'acc':>8}"
+    lines = [f"Positive (+) and negative (-) peak errors against the {n}-mode exact reference (%)"
+             + (f", and the peak errors against {4 * n} modes" if fine else ""), head]
+    for r in result.transient:
+        wh = "modal" if math.isnan(r.omega_max_h) else f"{r.omega_max_h:.2f}"
+        row = f"{r.load:<8} {r.case:<5} {wh:>7} " + "".join(_pct(r.signed_pct.get(k, math.nan))
+                                                         for k in SIGNED_KEYS)
+        if fine:
+            e = r.errors_4n_pct
+            row += (f"   {_pct(e.get('displacement', math.nan), 20)} {_pct(e.get('velocity', math.nan))}"
+                    f" {_pct(e.get('acceleration', math.nan))}")
+        lines.append(row)
+    lines.append(f"n/a: no converged exact value, or the exact history's extreme of that sign is "
+                 f"below {SIGNED_PEAK_FLOOR:.0%} of its largest magnitude")
     return "\n".join(lines)
 
 
@@ -149,7 +194,7 @@ def study_text(result: StudyResult) -> str:
                                                   "percentage errors of the lowest natural frequencies"))
     parts.append(convergence_table(result))
     parts.append(cost_table(result))
-    for text in (transient_table(result), optimum_table(result)):
+    for text in (transient_table(result), signed_table(result), optimum_table(result)):
         if text:
             parts.append(text)
     parts.append(f"study time {result.seconds:.1f} s")
@@ -161,9 +206,15 @@ def _row_dict(r: TransientRow) -> dict[str, Any]:
         "case": r.case, "KS": r.size, "load": r.load,
         "omega_max_h": None if math.isnan(r.omega_max_h) else r.omega_max_h,
         "steps": r.steps, "seconds": r.seconds, "operations": r.operations,
-        "errors_pct": {k: (None if math.isnan(v) else v) for k, v in r.errors_pct.items()},
+        "errors_pct": _nan_none(r.errors_pct),
+        "signed_errors_pct": _nan_none(r.signed_pct),
+        "errors_4n_modes_pct": _nan_none(r.errors_4n_pct),
         "halving_pct": r.halving_pct,
     }
+
+
+def _nan_none(values: dict[str, float]) -> dict[str, float | None]:
+    return {k: (None if math.isnan(v) else v) for k, v in values.items()}
 
 
 def study_dict(result: StudyResult) -> dict[str, Any]:
@@ -183,7 +234,13 @@ def study_dict(result: StudyResult) -> dict[str, Any]:
         "eigen_time_exponent": result.eigen_exponent,
         "transient": [_row_dict(r) for r in result.transient],
         "exact": {k: {"modes": e.n_modes, "peak_change_pct": e.change_pct,
-                      "acceleration_converged": e.acceleration_converged} for k, e in result.exact.items()},
+                      "acceleration_converged": e.acceleration_converged,
+                      "check_modes": result.exact_4n[k].n_modes if k in result.exact_4n else None,
+                      "truncation_pct": truncation_pct(e, result.exact_4n[k]) if k in result.exact_4n
+                      else None}
+                  for k, e in result.exact.items()},
+        "window_periods": result.study.transient.periods,
+        "warnings": list(result.warnings),
         "optima": [
             {"load": o.load, "quantity": o.quantity, "limit_pct": None if math.isnan(o.limit_pct) else o.limit_pct,
              "case": o.row.case if o.row else None, "KS": o.row.size if o.row else None,
@@ -205,9 +262,12 @@ def study_csv(result: StudyResult) -> str:
         lines.append(f"convergence,{r.element}-{r.n}x{r.n},{r.size},,,fundamental_error,1-1,{r.fundamental_error_pct:.6g},%")
     for r in result.transient:
         wh = "modal" if math.isnan(r.omega_max_h) else f"{r.omega_max_h:g}"
-        for q, v in r.errors_pct.items():
-            value = "" if math.isnan(v) else f"{v:.6g}"
-            lines.append(f"transient,{r.case},{r.size},{r.load},{wh},{q}_peak_error,,{value},%")
+        for suffix, errors in (("_peak_error", r.errors_pct), ("_peak_error_4n_modes", r.errors_4n_pct),
+                               ("_peak_error", r.signed_pct)):
+            for q, v in errors.items():
+                value = "" if math.isnan(v) else f"{v:.6g}"
+                name = q.replace("+", "_positive").replace("-", "_negative")
+                lines.append(f"transient,{r.case},{r.size},{r.load},{wh},{name}{suffix},,{value},%")
         lines.append(f"cost,{r.case},{r.size},{r.load},{wh},time_loop,,{r.seconds:.6g},s")
         lines.append(f"cost,{r.case},{r.size},{r.load},{wh},steps,,{r.steps},1")
     return "\n".join(lines) + "\n"
@@ -232,7 +292,6 @@ def modes_csv(free: FreeVibration) -> str:
 
 def response_csv(resp: Response, exact: ExactHistories | None) -> str:
     """Non-dimensional histories; the exact reference interpolated at the same times."""
-    import numpy as np
 
     head = "t_over_T,displacement_w_over_p0_mw2,velocity_v_over_p0_mw,acceleration_a_over_p0_m"
     cols = [resp.tau, resp.displacement, resp.velocity, resp.acceleration]
@@ -243,3 +302,46 @@ def response_csv(resp: Response, exact: ExactHistories | None) -> str:
     rows = np.column_stack(cols)
     body = "\n".join(",".join(f"{v:.8g}" for v in row) for row in rows)
     return head + "\n" + body + "\n"
+
+
+def case_run_text(run: CaseRun) -> str:
+    """``vtool plate transient``'s table: peaks, exact peaks, errors (both signs), halving check."""
+    resp = run.response
+    step = (f"omega_max*h = {run.omega_max_h:g}, h = {resp.step:.4g} s, {resp.steps} steps"
+            if resp.scheme == "rk4" else f"exact modal integration of the reduced model at {resp.steps} times")
+    c = run.case
+    lines = [f"case {c.name} ({c.element} {c.nx}x{c.ny}, KS = {run.size}), {resp.load} step load, "
+             f"{resp.scheme}: {step}, {resp.seconds * 1e3:.2f} ms",
+             f"{'quantity':<13} {'peak':>10} {'exact peak':>11} {'error %':>9} {'+ peak %':>9} "
+             f"{'- peak %':>9}" + (f" {'halving h %':>12}" if run.halving_pct else "")]
+    for q in ("displacement", "velocity", "acceleration"):
+        a, e = getattr(resp, q), getattr(run.exact, q)
+        k = int(np.argmax(np.abs(e)))
+        peak = float(np.max(a)) if e[k] > 0 else float(np.min(a))
+        err = run.errors_pct[q]
+        exact_shown = "n/a" if math.isnan(err) else f"{e[k]:.4f}"
+        line = (f"{q:<13} {peak:>10.4f} {exact_shown:>11} {_pct(err, 9)} {_pct(run.signed_pct[q + '+'], 9)}"
+                f" {_pct(run.signed_pct[q + '-'], 9)}")
+        if run.halving_pct:
+            line += f" {run.halving_pct[q]:>12.3f}"
+        lines.append(line)
+    lines.append(exact_note(run.exact))
+    lines += list(run.warnings)
+    return "\n".join(lines)
+
+
+def case_run_dict(run: CaseRun) -> dict[str, Any]:
+    resp = run.response
+    rk4 = resp.scheme == "rk4"
+    return {
+        "case": run.case.name, "KS": run.size, "load": resp.load, "scheme": resp.scheme,
+        "omega_max_h": run.omega_max_h if rk4 else None, "steps": resp.steps,
+        "step_s": resp.step if rk4 else None, "seconds": resp.seconds,
+        "time_unit": "t/T (exact fundamental period)", "window_periods": float(resp.tau[-1]),
+        "peak_errors_pct": _nan_none(run.errors_pct),
+        "signed_peak_errors_pct": _nan_none(run.signed_pct),
+        "halving_change_pct": run.halving_pct, "exact_modes": run.exact.n_modes,
+        "exact_peak_change_pct": run.exact.change_pct,
+        "exact_acceleration_converged": run.exact.acceleration_converged,
+        "warnings": list(run.warnings),
+    }

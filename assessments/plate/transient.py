@@ -35,15 +35,18 @@ full model at ω_max h = 1 matches the reading used here.)
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
 
+from vtool.assessments.cancel import Cancel, check
 from vtool.assessments.plate.assembly import Plate
 from vtool.assessments.plate.exact import ExactResponse, lowest_modes, step_response
 from vtool.assessments.plate.model import ReducedModel
+from vtool.errors import InputError
 
 LOADS = ("uniform", "point")
 SCHEMES = ("rk4", "modal")
@@ -51,6 +54,10 @@ SCHEMES = ("rk4", "modal")
 RK4_STABILITY_LIMIT = 2.0 * np.sqrt(2.0)
 #: The thesis' rounded limit (eq. 44); ω_max h above it is rejected.
 RK4_LIMIT_THESIS = 2.8
+#: Smallest ω_max h accepted (the thesis went down to 0.5).
+MIN_OMEGA_MAX_H = 0.01
+#: Cost guard of one RK4 run: steps x 2 KS stored values (8 bytes each: 400 MB).
+MAX_RK4_VALUES = 5e7
 
 
 @dataclass(frozen=True)
@@ -140,16 +147,25 @@ def rk4_reference(A: np.ndarray, g: np.ndarray, h: float, steps: int) -> np.ndar
 
 
 def run_rk4(plate: Plate, model: ReducedModel, load: str, omega_max_h: float,
-            periods: float = 1.5) -> Response:
+            periods: float = 1.5, cancel: Cancel | None = None) -> Response:
     """RK4 from rest at the given ω_max·h over ``periods`` exact fundamental periods."""
-    if not 0.0 < omega_max_h <= RK4_LIMIT_THESIS:
-        raise ValueError(f"omega_max_h: {omega_max_h} is outside (0, {RK4_LIMIT_THESIS}] (RK4 stability)")
+    if not (math.isfinite(omega_max_h) and MIN_OMEGA_MAX_H <= omega_max_h <= RK4_LIMIT_THESIS):
+        raise InputError("omega_max_h", omega_max_h,
+                         f"in [{MIN_OMEGA_MAX_H:g}, {RK4_LIMIT_THESIS:g}] (RK4 stability; smaller "
+                         "steps buy nothing the modal back end does not give exactly)")
     s = scales(plate, load)
     F = _load_vector(model, load, s)
     start = time.perf_counter()
     w_max = omega_max(model)
     h = omega_max_h / w_max
-    steps = int(np.ceil(periods * s.period / h))
+    steps_f = periods * s.period / h
+    cost = steps_f * 2 * model.size
+    if not (math.isfinite(steps_f) and cost <= MAX_RK4_VALUES):
+        raise InputError("transient", f"{steps_f:.3g} RK4 steps x {2 * model.size} states",
+                         f"<= {MAX_RK4_VALUES:.0e} stored values (fewer periods, a larger "
+                         "omega_max_h, or the modal back end)")
+    check(cancel)
+    steps = int(np.ceil(steps_f))
     cho = sla.cho_factor(model.M)
     A = sla.cho_solve(cho, model.K)
     g = sla.cho_solve(cho, F)
@@ -161,6 +177,8 @@ def run_rk4(plate: Plate, model: ReducedModel, load: str, omega_max_h: float,
     for k in range(steps):
         y = R @ y + r
         Y[k + 1] = y
+        if k % 4096 == 4095:
+            check(cancel)
     loop_seconds = time.perf_counter() - loop_start
     q, v = Y[:, :n], Y[:, n:]
     acc = g[None, :] - q @ A.T
@@ -210,14 +228,19 @@ class ExactHistories:
     acceleration_converged: bool
 
 
-def exact_histories(plate: Plate, load: str, periods: float = 1.5, n_modes: int = 200,
-                    samples_per_period: int = 40) -> ExactHistories:
-    """The exact reference on a grid fine enough for its highest mode."""
-    s = scales(plate, load)
+def exact_samples(plate: Plate, periods: float, n_modes: int, samples_per_period: int = 40) -> int:
+    """Time samples of :func:`exact_histories`: ``samples_per_period`` per period of the top mode."""
     top = lowest_modes(plate, n_modes)[-1].omega
     w11 = lowest_modes(plate, 1)[0].omega
-    n = int(np.ceil(periods * samples_per_period * top / w11)) + 1
-    tau = np.linspace(0.0, periods, n)
+    return int(np.ceil(periods * samples_per_period * top / w11)) + 1
+
+
+def exact_histories(plate: Plate, load: str, periods: float = 1.5, n_modes: int = 200,
+                    samples_per_period: int = 40, tau: np.ndarray | None = None) -> ExactHistories:
+    """The exact reference on a grid fine enough for its highest mode (or on ``tau``)."""
+    s = scales(plate, load)
+    if tau is None:
+        tau = np.linspace(0.0, periods, exact_samples(plate, periods, n_modes, samples_per_period))
     r: ExactResponse = step_response(plate, load, tau * s.period, n_modes)
     return ExactHistories(
         load, tau, s.load * r.displacement / s.displacement, s.load * r.velocity / s.velocity,
@@ -226,6 +249,42 @@ def exact_histories(plate: Plate, load: str, periods: float = 1.5, n_modes: int 
          "acceleration": 100 * r.change_acceleration},
         r.acceleration_converged,
     )
+
+
+#: A negative (positive) peak smaller than this fraction of the largest |value|
+#: is not reported: the history hardly swings to that side.
+SIGNED_PEAK_FLOOR = 0.05
+SIGNS = ("+", "-")
+
+
+def signed_peak_error_pct(approx: np.ndarray, exact: np.ndarray, sign: str) -> float:
+    """Percentage error (eq. 40) of the largest positive (``+``) or negative (``-``) value.
+
+    NaN when the exact history's extreme of that sign is below
+    :data:`SIGNED_PEAK_FLOOR` of its largest magnitude.
+    """
+    e = float(np.max(exact)) if sign == "+" else float(np.min(exact))
+    scale = float(np.max(np.abs(exact)))
+    if scale == 0.0 or abs(e) < SIGNED_PEAK_FLOOR * scale or (e > 0) != (sign == "+"):
+        return float("nan")
+    a = float(np.max(approx)) if sign == "+" else float(np.min(approx))
+    return (a - e) / e * 100.0
+
+
+def peak_at_end(exact: np.ndarray, tau: np.ndarray, margin: float = 0.02,
+                near: float = 0.95) -> bool:
+    """True when the window may cut the history's peak short.
+
+    Either the largest |value| lies in the last ``margin`` periods, or |value|
+    is still rising at the end and already within ``near`` of the largest:
+    the true peak may lie just past the window (the point-load deflection
+    of the 40:27 plate peaks at t/T = 1.517, past a 1.5-period window).
+    """
+    mag = np.abs(exact)
+    k = int(np.argmax(mag))
+    if tau[k] >= tau[-1] - margin:
+        return True
+    return bool(mag.size > 1 and mag[-1] > mag[-2] and mag[-1] >= near * mag[k])
 
 
 def peak_error_pct(approx: np.ndarray, exact: np.ndarray) -> float:
@@ -255,11 +314,23 @@ def peak_errors(resp: Response, exact: ExactHistories) -> dict[str, float]:
     return out
 
 
+def signed_peak_errors(resp: Response, exact: ExactHistories) -> dict[str, float]:
+    """Errors of the positive and negative peaks: keys ``displacement+``, ``displacement-``, ..."""
+    out = {}
+    for name in QUANTITIES:
+        for sign in SIGNS:
+            if name == "acceleration" and not exact.acceleration_converged:
+                out[name + sign] = float("nan")
+            else:
+                out[name + sign] = signed_peak_error_pct(getattr(resp, name), getattr(exact, name), sign)
+    return out
+
+
 def halving_change_pct(plate: Plate, model: ReducedModel, load: str, omega_max_h: float,
-                       periods: float = 1.5) -> dict[str, float]:
+                       periods: float = 1.5, cancel: Cancel | None = None) -> dict[str, float]:
     """The thesis' accuracy check: rerun with h/2, largest change as % of each peak."""
-    coarse = run_rk4(plate, model, load, omega_max_h, periods)
-    fine = run_rk4(plate, model, load, omega_max_h / 2.0, periods)
+    coarse = run_rk4(plate, model, load, omega_max_h, periods, cancel)
+    fine = run_rk4(plate, model, load, max(omega_max_h / 2.0, MIN_OMEGA_MAX_H), periods, cancel)
     out = {}
     for name in QUANTITIES:
         a = getattr(coarse, name)

@@ -11,10 +11,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vtool.assessments.cancel import Cancel
 from vtool.assessments.sonic_boom.criteria import Criterion, allowable_pressure
 from vtool.assessments.sonic_boom.pulses import Pulse, make_pulse, read_pulse_csv
 from vtool.assessments.sonic_boom.response import check_damping
 from vtool.assessments.sonic_boom.spec import (
+    DURATION_LIMITS,
+    FREQUENCY_LIMITS,
     BoomFloorSpec,
     BoomLoading,
     BoomWallSpec,
@@ -105,6 +108,11 @@ def wall_structure(wall: WallSpec, units: UnitSystem) -> Structure:
         b = wall.height
     elif wall.net_area is not None:
         b = pseudo_height(wall.net_area, wall.base_width)
+        if wall.pseudo_height_rule == "whole-unit":
+            if b < 0.5:
+                raise InputError(f"walls.{wall.name}.pseudo_height_rule", wall.pseudo_height_rule,
+                                 f"exact (net_area/base_width = {b:.3g} {units.length} rounds to 0)")
+            b = float(round(b))
     else:
         b = None
     freqs: dict[str, float] = {}
@@ -117,7 +125,8 @@ def wall_structure(wall: WallSpec, units: UnitSystem) -> Structure:
     if not freqs:
         raise InputError(f"walls.{wall.name}", "no frequency",
                          "net_area or height (plate formula), or measured_frequency")
-    return Structure(wall.name, m, 1.0, freqs, details)
+    return check_frequencies(Structure(wall.name, m, 1.0, freqs, details),
+                             "thickness, youngs_modulus, poisson_ratio, surface_weight, sizes")
 
 
 def floor_structure(floor: FloorSpec, units: UnitSystem) -> Structure:
@@ -129,7 +138,19 @@ def floor_structure(floor: FloorSpec, units: UnitSystem) -> Structure:
     if floor.measured_frequency is not None:
         freqs["measured"] = floor.measured_frequency
     details = {"stiffness": k, "mass": M, "loaded_area": osc.loaded_area}
-    return Structure(floor.name, M, osc.loaded_area, freqs, details)
+    return check_frequencies(Structure(floor.name, M, osc.loaded_area, freqs, details),
+                             "columns, youngs_modulus, moment_of_inertia, storey_height, "
+                             "floor_weight")
+
+
+def check_frequencies(structure: Structure, inputs: str) -> Structure:
+    """Refuse a structure frequency outside :data:`FREQUENCY_LIMITS` before any DAF work."""
+    low, high = FREQUENCY_LIMITS
+    for source, f in structure.frequencies.items():
+        if not (math.isfinite(f) and low <= f <= high):
+            raise InputError(f"{structure.name} {source} frequency", f"{f:.4g}",
+                             f"in [{low:g}, {high:g}] (check {inputs})", "Hz")
+    return structure
 
 
 def _static_per_pressure(structure: Structure, frequency: np.ndarray | float) -> np.ndarray:
@@ -146,13 +167,14 @@ def _static_per_pressure(structure: Structure, frequency: np.ndarray | float) ->
 
 
 def _daf_table(source: Pulse | EnvelopeSpec, ratios: dict[str, list[np.ndarray]],
-               damping: float) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], str]:
+               damping: float, cancel: Cancel | None = None
+               ) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], str]:
     """One DAF evaluation per quantity over every ``tau/T`` any result needs."""
     table: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     statements = []
     for quantity, parts in ratios.items():
         grid = np.unique(np.concatenate(parts))
-        daf, statement = daf_at(source, grid, quantity, damping)
+        daf, statement = daf_at(source, grid, quantity, damping, cancel)
         table[quantity] = (grid, daf)
         statements.append(statement)
     return table, " | ".join(statements)
@@ -164,8 +186,11 @@ def _lookup(table: dict[str, tuple[np.ndarray, np.ndarray]], quantity: str,
     return daf[np.searchsorted(grid, ratio)]
 
 
-def assess(spec: BoomWallSpec | BoomFloorSpec) -> Assessment:
-    """Allowable peak overpressures for every structure, frequency, tau and criterion."""
+def assess(spec: BoomWallSpec | BoomFloorSpec, cancel: Cancel | None = None) -> Assessment:
+    """Allowable peak overpressures for every structure, frequency, tau and criterion.
+
+    ``cancel`` is polled between DAF evaluations (:mod:`vtool.assessments.cancel`).
+    """
     source = boom_source(spec.boom)
     units = spec.units
     if isinstance(spec, BoomWallSpec):
@@ -175,6 +200,10 @@ def assess(spec: BoomWallSpec | BoomFloorSpec) -> Assessment:
     taus = spec.boom.positive_durations
     if isinstance(source, Pulse) and source.tau_seconds is not None:
         taus = (source.tau_seconds,)  # a tabulated pulse fixes its own duration
+        low, high = DURATION_LIMITS
+        if not low <= source.tau_seconds <= high:
+            raise InputError(f"{source.label} positive duration", f"{source.tau_seconds:.4g}",
+                             f"in [{low:g}, {high:g}] (time column in seconds?)", "s")
     design = spec.design
     freqs = np.linspace(design.f_min, design.f_max, design.points)
     needed: dict[str, list[np.ndarray]] = {}
@@ -184,7 +213,7 @@ def assess(spec: BoomWallSpec | BoomFloorSpec) -> Assessment:
             parts.append(tau * freqs)
             for st in structures:
                 parts.append(tau * np.array(list(st.frequencies.values())))
-    table, statement = _daf_table(source, needed, spec.boom.damping)
+    table, statement = _daf_table(source, needed, spec.boom.damping, cancel)
 
     rows: list[LimitRow] = []
     for st in structures:

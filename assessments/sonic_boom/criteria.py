@@ -94,12 +94,31 @@ class Criterion:
         return (self.f_min is None or frequency_hz >= self.f_min) and (
             self.f_max is None or frequency_hz <= self.f_max)
 
+    @property
+    def quantity(self) -> str:
+        """The quantity the value limits, by its unit: velocity, displacement or acceleration."""
+        return UNITS[self.unit][1]
+
+    def rule(self) -> str:
+        """The limit with the quantity it bounds and its unit, then how it is applied.
+
+        ``peak velocity <= 4.5 in/s``; a steady-state velocity or acceleration
+        limit read on the displacement: ``velocity <= 0.04 in/s, applied as peak
+        displacement <= 0.04 in/s / (2 pi f)``.
+        """
+        head = f"{self.quantity} <= {self.value:g} {self.unit}"
+        if self.response == self.quantity:
+            return f"peak {head}"
+        power = "" if self.quantity == "velocity" else "^2"
+        return (f"steady-state {head}, applied as peak {self.response} <= "
+                f"{self.value:g} {self.unit} / (2 pi f){power}")
+
     def describe(self) -> str:
         tag = " [tentative]" if self.tentative else ""
         band = ""
         if self.f_min is not None or self.f_max is not None:
             band = f", {self.f_min or 0:g}-{self.f_max if self.f_max is not None else 'inf'} Hz"
-        return f"{self.name}: peak {self.response} <= {self.value:g} {self.unit}{band}{tag} ({self.source})"
+        return f"{self.name}: {self.rule()}{band}{tag} ({self.source})"
 
 
 #: Built-in criteria. The first two are the thesis' (section 1.5); the

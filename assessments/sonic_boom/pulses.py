@@ -44,6 +44,7 @@ from __future__ import annotations
 import csv
 import math
 import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -54,6 +55,7 @@ from vtool.errors import InputError
 #: pulse types in the thesis' order (VELDAF's KOM = 1..5).
 PULSE_TYPES: tuple[str, ...] = ("N", "P", "Q", "R", "T")
 _NARROWEST = 1e-9  # segments shorter than this (units of tau) are treated as jumps
+MAX_PARAMETER = 100.0  # largest s, r2, alpha, |beta|: a pulse 100 tau long is no boom
 
 
 @dataclass(frozen=True)
@@ -184,6 +186,10 @@ def validate(params: PulseParams, prefix: str = "") -> PulseParams:
     p = params.resolved()
     if not (math.isfinite(p.s) and p.s >= 1.0):
         raise InputError(name("s"), p.s, ">= 1 (total / positive duration)")
+    for key in ("s", "r2", "alpha", "beta"):
+        value = getattr(p, key)
+        if value is not None and math.isfinite(value) and abs(value) > MAX_PARAMETER:
+            raise InputError(name(key), value, f"|{key}| <= {MAX_PARAMETER:g}")
     if not (math.isfinite(p.r1) and 0.0 <= p.r1 < 1.0):
         raise InputError(name("r1"), p.r1, "in [0, 1) (rise time / positive duration)")
     if p.kind == "N" and p.r1 != 0.0:
@@ -242,7 +248,9 @@ def make_pulse(params: PulseParams) -> Pulse:
         alpha, beta, r2 = float(p.alpha), float(p.beta), float(p.r2)  # type: ignore[arg-type]
         segs.append(Segment(0.0, r1, 1.0, -(1.0 - alpha * (1.0 - r1)) / r1))
         segs.append(Segment(r1, s, alpha * (1.0 - r1), -alpha))
-        if r2 > 0.0 and beta != 0.0:
+        if r2 > 0.0:
+            # VELDAF's forced window ends at WST1 = WST + WTR2 whatever beta is:
+            # with beta = 0 the pressure is zero there but the motion is still "forced"
             segs.append(Segment(s, s + r2, beta, -beta / r2))
     # A ramp narrower than 1e-9 tau is a jump for any oscillator this tool
     # models; dropping it avoids slopes of 1e14 that no arithmetic survives.
@@ -300,26 +308,85 @@ def tabulated(times: np.ndarray, pressures: np.ndarray, label: str = "tabulated"
     return Pulse(label, tuple(segs), tau_seconds=tau, peak_pressure=peak)
 
 
-def read_pulse_csv(path: str | os.PathLike[str]) -> Pulse:
-    """Read a ``time [s], pressure`` CSV (an optional header row) as a tabulated pulse."""
-    path = Path(path)
+#: Largest pulse CSV read (bytes) and most rows: a recorded boom at 100 kHz
+#: for one second is 100 000 rows, about 3 MB.
+MAX_CSV_BYTES = 16 * 2**20
+MAX_CSV_ROWS = 200_000
+_SHOWN = 40  # characters of an offending cell echoed in an error
+
+
+def shorten(text: object, limit: int = _SHOWN) -> str:
+    """``text`` cut to ``limit`` characters (an echoed bad value stays readable)."""
+    text = str(text)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _read_bounded(path: Path) -> str:
+    """The file's text: a regular file of at most :data:`MAX_CSV_BYTES`, never a device or pipe."""
+    shown = shorten(str(path), 80)
     try:
-        text = path.read_text(encoding="utf-8")
+        info = path.stat()
     except OSError as exc:
-        raise InputError("pulse csv", str(path), f"a readable file ({exc.strerror})") from None
-    rows = [row for row in csv.reader(text.splitlines()) if row and any(c.strip() for c in row)]
+        raise InputError("pulse csv", shown, f"an existing file ({exc.strerror})") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise InputError("pulse csv", shown, "a regular file (not a device, pipe or folder)")
+    if info.st_size > MAX_CSV_BYTES:
+        raise InputError("pulse csv", f"{shown} ({info.st_size} bytes)",
+                         f"at most {MAX_CSV_BYTES} bytes (resample the record)")
+    try:
+        with path.open("rb") as handle:
+            data = handle.read(MAX_CSV_BYTES + 1)
+    except OSError as exc:
+        raise InputError("pulse csv", shown, f"a readable file ({exc.strerror})") from None
+    if len(data) > MAX_CSV_BYTES:
+        raise InputError("pulse csv", shown, f"at most {MAX_CSV_BYTES} bytes (resample the record)")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError("pulse csv", shown,
+                         f"UTF-8 text (byte {exc.start} is not): time [s], pressure rows") from None
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def read_pulse_csv(path: str | os.PathLike[str]) -> Pulse:
+    """Read a ``time [s], pressure`` CSV (an optional header row) as a tabulated pulse.
+
+    The file must be a regular file of bounded size (:data:`MAX_CSV_BYTES`,
+    :data:`MAX_CSV_ROWS`); an error names the row and echoes only the
+    offending cell, cut to a readable length.
+    """
+    path = Path(path)
+    text = _read_bounded(path)
+    lines = text.splitlines()
+    if len(lines) > MAX_CSV_ROWS + 1:
+        raise InputError(f"{path.name}", f"{len(lines)} rows", f"at most {MAX_CSV_ROWS} rows")
+    try:
+        rows = [row for row in csv.reader(lines) if row and any(c.strip() for c in row)]
+    except csv.Error as exc:
+        raise InputError(path.name, "unreadable CSV", f"comma-separated rows ({shorten(exc)})") from None
     times: list[float] = []
     pressures: list[float] = []
     for number, row in enumerate(rows, start=1):
+        if len(row) < 2:
+            if number == 1:
+                continue  # header
+            raise InputError(f"{path.name} row {number}", f"{len(row)} column",
+                             "two columns: time, pressure")
         try:
-            values = [float(c) for c in row[:2]]
+            values = [float(cell) for cell in row[:2]]
         except ValueError:
             if number == 1:
                 continue  # header
-            raise InputError(f"{path.name} row {number}", ",".join(row),
-                             "two numbers: time, pressure") from None
-        if len(values) != 2:
-            raise InputError(f"{path.name} row {number}", ",".join(row), "two columns: time, pressure")
+            column = next(i for i, c in enumerate(row[:2]) if not _is_number(c))
+            raise InputError(f"{path.name} row {number} column {column + 1}",
+                             shorten(row[column].strip()), "a number (time [s], pressure)") from None
         if times and values[0] <= times[-1]:
             raise InputError(f"{path.name} row {number}", values[0],
                              f"a time > {times[-1]:g} (strictly increasing)", "s")

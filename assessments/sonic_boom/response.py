@@ -54,6 +54,14 @@ from vtool.errors import InputError
 
 QUANTITIES: tuple[str, ...] = ("displacement", "velocity")
 _GRID = math.pi / 5.0  # bracketing grid: at most 1/10 of the fastest period
+#: Largest tau/T accepted: a pulse 10^4 natural periods long is quasi-static,
+#: far beyond any boom (the thesis stops at 2.5).
+MAX_RATIO = 1.0e4
+#: Cost guard: grid samples (batch x cells, summed over segments) one call may
+#: evaluate; about 100 bytes each at peak (a few seconds, < 1 GB).
+MAX_SAMPLES = 5_000_000
+#: Cost guard of an envelope (its members run one after another).
+MAX_ENVELOPE_SAMPLES = 100_000_000
 
 
 def phi1(z: np.ndarray) -> np.ndarray:
@@ -341,8 +349,42 @@ def _ratios(ratio: np.ndarray | float) -> np.ndarray:
     ratio = np.atleast_1d(np.asarray(ratio, dtype=float))
     if ratio.ndim != 1 or not np.all(np.isfinite(ratio)) or np.any(ratio < 0.0):
         bad = ratio[~(np.isfinite(ratio) & (ratio >= 0.0))]
-        raise InputError("tau/T", float(bad[0]) if bad.size else ratio.tolist(), ">= 0")
+        raise InputError("tau/T", float(bad[0]) if bad.size else "not a list", ">= 0")
+    if ratio.size and float(np.max(ratio)) > MAX_RATIO:
+        raise InputError("tau/T", float(np.max(ratio)),
+                         f"<= {MAX_RATIO:g} (positive duration x natural frequency; check the "
+                         "durations, frequencies and structure properties)")
     return ratio
+
+
+def samples_estimate(pulse: Pulse, ratio: np.ndarray | float) -> int:
+    """Grid samples :func:`peak_response` evaluates per quantity (the cost guard's measure).
+
+    Each segment is gridded at a tenth of the fastest period over the whole
+    batch: ``n_ratios x (ceil(max(2 pi r_max L, kappa L) / (pi/5)) + 1)``.
+    """
+    ratio = np.atleast_1d(np.asarray(ratio, dtype=float))
+    if ratio.size == 0:
+        return 0
+    top = 2.0 * math.pi * float(np.max(ratio))
+    cells = 0.0
+    for seg in pulse.segments:
+        span = max(top * seg.length, seg.length * seg.freq, 2.0 * _GRID) / _GRID
+        if not span < 1e18:  # inf or absurd: the guard refuses it
+            return 2**62
+        cells += math.ceil(span) + 1
+    return int(min(cells * ratio.size, 2**62))
+
+
+def check_cost(pulses: list[Pulse], ratio: np.ndarray | float, limit: int = MAX_SAMPLES) -> int:
+    """Refuse (InputError) responses whose grids exceed ``limit`` samples; returns the estimate."""
+    estimate = sum(samples_estimate(p, ratio) for p in pulses)
+    if estimate > limit:
+        size = np.atleast_1d(np.asarray(ratio)).size
+        raise InputError("tau/T grid", f"{size} values x {len(pulses)} pulse(s) = {estimate:.3g} samples",
+                         f"<= {limit:.0e} samples (use fewer tau/T values, a coarser step, "
+                         "fewer envelope members or shorter pulses)")
+    return estimate
 
 
 def end_state(pulse: Pulse, ratio: np.ndarray | float, damping: float = 0.0
@@ -372,6 +414,7 @@ def peak_response(pulse: Pulse, ratio: np.ndarray | float, damping: float = 0.0,
     for q in quantities:
         if q not in QUANTITIES:
             raise InputError("quantity", q, f"one of: {', '.join(QUANTITIES)}")
+    check_cost([pulse], ratio)
     live = np.nonzero(ratio > 0.0)[0]
     u = 2.0 * math.pi * ratio[live]
     n = u.size

@@ -12,6 +12,12 @@ from vtool.assessments.sonic_boom.criteria import Criterion
 from vtool.assessments.sonic_boom.pulses import PulseParams
 from vtool.assessments.sonic_boom.spectra import EnvelopeSpec
 
+#: Structure frequencies (Hz) accepted: measured, from the plate formula or the
+#: column model, and the design-curve range.
+FREQUENCY_LIMITS: tuple[float, float] = (1e-2, 1e3)
+#: Boom positive durations (s) accepted: booms last 0.05-0.5 s.
+DURATION_LIMITS: tuple[float, float] = (1e-4, 10.0)
+
 
 @dataclass(frozen=True)
 class UnitSystem:
@@ -26,6 +32,8 @@ class UnitSystem:
     metres_per_length: float
     alt_pressure: str  # a second pressure unit engineers quote booms in
     alt_per_pressure: float
+    pascals_per_pressure: float = 1.0
+    newtons_per_force: float = 1.0
 
     @property
     def mass(self) -> str:
@@ -35,7 +43,7 @@ class UnitSystem:
 UNIT_SYSTEMS: dict[str, UnitSystem] = {
     # the thesis' system; g = 386.4 in/s^2 as in its arithmetic (section 1.5.2)
     "in-lbf-s": UnitSystem("in-lbf-s", "in", "lbf", "psi", "lbf/in^2", 386.4, 0.0254,
-                           "lb/ft^2", 144.0),
+                           "lb/ft^2", 144.0, 6894.757293168361, 4.4482216152605),
     "m-N-s": UnitSystem("m-N-s", "m", "N", "Pa", "N/m^2", 9.80665, 1.0, "kPa", 1e-3),
 }
 
@@ -57,7 +65,11 @@ class BoomLoading:
 
 @dataclass(frozen=True)
 class WallSpec:
-    """One wall. The plate height is ``height`` or ``net_area / base_width``."""
+    """One wall. The plate height is ``height`` or ``net_area / base_width``.
+
+    ``pseudo_height_rule`` (:data:`PSEUDO_HEIGHT_RULES`) says whether that
+    quotient is used as is or rounded to a whole length unit.
+    """
 
     name: str
     base_width: float
@@ -68,6 +80,12 @@ class WallSpec:
     net_area: float | None = None
     height: float | None = None
     measured_frequency: float | None = None  # Hz
+    pseudo_height_rule: str = "exact"  # or "whole-unit": round net_area/base_width as the thesis
+
+
+#: How the pseudo-height ``b = net area / a`` is taken: ``exact``, or rounded to
+#: a whole length unit (``whole-unit``) as the thesis prints "31565/207 = 152 in".
+PSEUDO_HEIGHT_RULES: tuple[str, ...] = ("exact", "whole-unit")
 
 
 @dataclass(frozen=True)

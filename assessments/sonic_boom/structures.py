@@ -26,9 +26,10 @@ loaded by ``F = p * l * d`` (storey height times face width, equation 12),
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
-from vtool.errors import InputError
+from vtool.errors import InputError, RunError
 
 
 def _positive(name: str, value: float, unit: str = "") -> float:
@@ -37,18 +38,32 @@ def _positive(name: str, value: float, unit: str = "") -> float:
     return float(value)
 
 
+def _finite(what: str, compute: Callable[[], float], inputs: str) -> float:
+    """``compute()``, or RunError naming the quantity and the inputs that drove it out of range."""
+    try:
+        value = float(compute())
+    except (OverflowError, ZeroDivisionError, ValueError):
+        value = math.nan
+    if not (math.isfinite(value) and value > 0.0):
+        raise RunError(f"{what} is not a finite positive number (check {inputs})")
+    return value
+
+
 def flexural_rigidity(E: float, h: float, nu: float) -> float:
     """``D = E h^3 / (12 (1 - nu^2))``."""
     _positive("youngs_modulus", E)
     _positive("thickness", h)
     if not (math.isfinite(nu) and -1.0 < nu < 0.5):
         raise InputError("poisson_ratio", nu, "in (-1, 0.5)")
-    return E * h**3 / (12.0 * (1.0 - nu * nu))
+    return _finite("flexural rigidity D", lambda: E * h**3 / (12.0 * (1.0 - nu * nu)),
+                   "youngs_modulus, thickness, poisson_ratio")
 
 
 def pseudo_height(net_area: float, base_width: float) -> float:
     """The thesis' rule: ``b = net area / a``."""
-    return _positive("net_area", net_area) / _positive("base_width", base_width)
+    _positive("net_area", net_area)
+    _positive("base_width", base_width)
+    return _finite("pseudo-height", lambda: net_area / base_width, "net_area, base_width")
 
 
 def plate_omega(a: float, b: float, D: float, mass_per_area: float) -> float:
@@ -57,15 +72,20 @@ def plate_omega(a: float, b: float, D: float, mass_per_area: float) -> float:
     _positive("height", b)
     _positive("flexural rigidity", D)
     _positive("mass per unit area", mass_per_area)
-    return math.pi**2 * (1.0 / a**2 + 1.0 / b**2) * math.sqrt(D / mass_per_area)
+    return _finite("plate frequency",
+                   lambda: math.pi**2 * (1.0 / a**2 + 1.0 / b**2) * math.sqrt(D / mass_per_area),
+                   "base_width, net_area or height, thickness, youngs_modulus, surface_weight")
 
 
 def floor_stiffness(columns: int, E: float, I: float, l: float) -> float:
     """``k = 12 n E I / l^3`` for ``n`` columns fixed at both ends (equation 11)."""
     if columns < 1:
         raise InputError("columns", columns, ">= 1")
-    return 12.0 * columns * _positive("youngs_modulus", E) * _positive(
-        "moment_of_inertia", I) / _positive("storey_height", l) ** 3
+    _positive("youngs_modulus", E)
+    _positive("moment_of_inertia", I)
+    _positive("storey_height", l)
+    return _finite("column stiffness k", lambda: 12.0 * columns * E * I / l**3,
+                   "columns, youngs_modulus, moment_of_inertia, storey_height")
 
 
 @dataclass(frozen=True)

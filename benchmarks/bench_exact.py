@@ -1,0 +1,77 @@
+"""Exact back end benchmark: example 1A (850 degrees), with the newmark back end in the same run.
+
+Run: ``python3 benchmarks/bench_exact.py [--write]``. Prints figures, asserts nothing;
+``--write`` also writes them into the ``exact-1a`` block of docs/valvetrain.md.
+
+1. Warm wall time and CPU time of a whole run (simulate on an assembled mechanism),
+   best of several, with the BLAS threads limited to one (vtool.threads), and the
+   ratio to the 50 ms target.
+2. The newmark back end (1 us, with its refinement after events) in the same run.
+The scan samples, events and peak forces are the columns a test regenerates.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+from vtool.markdown import replace_block, table
+from vtool.presets import load_preset
+from vtool.solvers.exact import ExactBackend
+from vtool.solvers.model import assemble
+from vtool.solvers.newmark import NewmarkBackend
+from vtool.threads import limited
+
+TARGET_S = 0.050
+ROOT = Path(__file__).resolve().parent.parent
+DOC = ROOT / "docs" / "valvetrain.md"
+BLOCK = "exact-1a"
+
+
+def best_times(backend: object, mechanism: object, repeat: int) -> tuple[float, float, object]:
+    backend.simulate(mechanism)  # warm-up (numba kernels, imports)
+    wall = cpu = float("inf")
+    trace = None
+    for _ in range(repeat):
+        started, started_cpu = time.perf_counter(), time.process_time()
+        trace = backend.simulate(mechanism)
+        wall = min(wall, time.perf_counter() - started)
+        cpu = min(cpu, time.process_time() - started_cpu)
+    return wall, cpu, trace
+
+
+HEADER = ("run", "wall time (ms)", "CPU time (ms)", "wall / 50 ms target", "scan samples", "events",
+          "peak F1, F2, F7 (lbf)")
+
+
+def deterministic(trace: object) -> tuple[str, str, str]:
+    """The columns a test can regenerate: scan samples, events, peak forces."""
+    peaks = ", ".join(f"{p:.4f}" for p in trace.peak_force)
+    return str(trace.statistics.steps), str(trace.statistics.events), peaks
+
+
+def row(label: str, wall: float, cpu: float, trace: object) -> list[str]:
+    return [label, f"{wall * 1e3:.1f}", f"{cpu * 1e3:.1f}", f"{wall / TARGET_S:.2f}", *deterministic(trace)]
+
+
+def main() -> None:
+    mechanism = assemble(load_preset("gnilka-1a"))
+    with limited():
+        wall, cpu, trace = best_times(ExactBackend(), mechanism, 9)
+    rows = [row("1A, this version (1 BLAS thread), best of 9", wall, cpu, trace)]
+    print(f"exact 1A, this version: {wall * 1e3:.1f} ms wall, {cpu * 1e3:.1f} ms CPU (best of 9); "
+          f"{trace.statistics.steps} scan samples, {trace.statistics.events} events; "
+          f"wall / target {TARGET_S * 1e3:.0f} ms = {wall / TARGET_S:.2f}")
+    newmark = NewmarkBackend()
+    newmark_wall, newmark_cpu, newmark_trace = best_times(newmark, mechanism, 9)
+    rows.append(row("1A, newmark at 1 us in the same run, best of 9", newmark_wall, newmark_cpu, newmark_trace))
+    print(f"newmark 1A in the same run: {newmark_wall * 1e3:.1f} ms wall; exact / newmark = "
+          f"{wall / newmark_wall:.1f}")
+    if "--write" in sys.argv:
+        replace_block(DOC, BLOCK, table(HEADER, rows))
+        print(f"wrote the {BLOCK} block of {DOC.relative_to(ROOT)}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
