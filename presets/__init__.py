@@ -94,7 +94,11 @@ def load_document(doc: dict[str, Any]) -> Any:
 
 def load_preset(name_or_path: str | os.PathLike[str]) -> Any:
     """Find, parse and validate a preset; returns the spec for its kind."""
-    return load_document(read_document(find_preset(name_or_path)))
+    path = find_preset(name_or_path)
+    doc = read_document(path)
+    if kind_of(doc) == "valvetrain":  # resolves a cam lift_table file against the preset's folder
+        return loader_for("valvetrain").load(doc, folder=path.parent)
+    return load_document(doc)
 
 
 def preset_info(path: Path) -> PresetInfo:

@@ -9,20 +9,24 @@ preset round-trips. See ``presets/gnilka-1a.toml`` for a commented example.
 from __future__ import annotations
 
 import re
+from dataclasses import replace
+from pathlib import Path
 from typing import Any
 
 from vtool.errors import InputError
 from vtool.presets.fields import Table
+from vtool.presets.lift_table import read_lift_table
+from vtool.solvers.assembly import split_members, unsplit_members
 from vtool.solvers.spec import (
     BAR,
     BEAM,
     ELEMENT_SIZE,
     ENABLED,
     EXTERNAL,
+    IMPACT_LAWS,
     INTERNAL,
     PINNED,
     REMOVED,
-    IMPACT_LAWS,
     START_VELOCITIES,
     CamSpec,
     ClearanceSpec,
@@ -40,10 +44,14 @@ from vtool.solvers.units import UNIT_SYSTEMS, UnitSystem
 
 STATIC_START = "static-start"
 MAX_DAMPING_RATIO = 1.0
+MAX_ELEMENTS = 64
 
 
-def load(doc: dict[str, Any]) -> MechanismSpec:
-    """Validate a parsed valve-train preset and return its frozen spec."""
+def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
+    """Validate a parsed valve-train preset and return its frozen spec.
+
+    ``folder`` resolves a ``[cam] lift_table`` file (default: the working folder).
+    """
     top = Table(doc, "")
     top.string("kind", choices=("valvetrain",))
     title = top.string("title", default="")
@@ -54,7 +62,7 @@ def load(doc: dict[str, Any]) -> MechanismSpec:
 
     coordinates = _coordinates(top)
     n = len(coordinates)
-    cam = _cam(top.table("cam"), n, units)  # type: ignore[arg-type]
+    cam = _cam(top.table("cam"), n, units, folder)  # type: ignore[arg-type]
     seat_table = top.table("seat", required=False)
     seat = _seat(seat_table, n, cam, units) if seat_table is not None else None
     prescribed = {cam.coordinate} | ({seat.coordinate} if seat else set())
@@ -67,7 +75,7 @@ def load(doc: dict[str, Any]) -> MechanismSpec:
     contact = _contact(top.table("contact", required=False))
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances))  # type: ignore[arg-type]
     top.finish()
-    return MechanismSpec(
+    spec = MechanismSpec(
         title=title,
         units=units_name,
         gravity=gravity,
@@ -82,6 +90,12 @@ def load(doc: dict[str, Any]) -> MechanismSpec:
         notes=notes,
         contact=contact,
     )
+    spec = split_members(spec)
+    if seat is not None and seat.lash is not None:
+        from vtool.solvers.lash import seat_position
+
+        spec = replace(spec, seat=replace(spec.seat, position=float(seat_position(spec, seat.lash))))
+    return spec
 
 
 def _contact(t: Table | None) -> ContactSpec:
@@ -114,11 +128,16 @@ def _coordinate_ref(t: Table, key: str, allowed: set[int], what: str) -> int:
     return value
 
 
-def _cam(t: Table, n: int, units: UnitSystem) -> CamSpec:
+def _cam(t: Table, n: int, units: UnitSystem, folder: Path | None = None) -> CamSpec:
     coordinate = t.integer("coordinate", min_value=n + 1)
     name = t.string("name", default="cam")
-    profile = t.string("profile", default="harmonic", choices=("harmonic",))
-    amplitude = t.number("amplitude", unit=units.length, min_exclusive=0.0)
+    profile = t.string("profile", default="harmonic", choices=("harmonic", "table"))
+    table: dict[str, Any] = {}
+    if profile == "table":
+        table = _cam_table(t, units, folder)
+        amplitude = 0.5 * max(table["lifts"])
+    else:
+        amplitude = t.number("amplitude", unit=units.length, min_exclusive=0.0)
     raw_offset = t.raw("offset", STATIC_START)
     if raw_offset == STATIC_START:
         offset = None
@@ -128,8 +147,35 @@ def _cam(t: Table, n: int, units: UnitSystem) -> CamSpec:
         offset = t.number("offset", unit=units.length, min_value=0.0)
     else:
         raise InputError(t.field("offset"), raw_offset, f'"{STATIC_START}" or a number', units.length)
+    if table and offset is not None:
+        raise InputError(t.field("offset"), offset, f'"{STATIC_START}" for a table cam (its base circle carries '
+                         f"the spring preload)", units.length)
     t.finish()
-    return CamSpec(coordinate, amplitude, offset, name, profile)
+    return CamSpec(coordinate, amplitude, offset, name, profile, **table)
+
+
+def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
+    """A lift table (file or inline arrays) and its fit setting; see solvers/cam.py."""
+    from vtool.solvers.cam import fit_table, normalize_table
+
+    lift_table = t.string("lift_table", default="") or None
+    if lift_table is not None:
+        if t.has("angles") or t.has("lifts"):
+            raise InputError(t.field("angles"), t.raw("angles"), "no inline table beside lift_table")
+        angles, lifts = read_lift_table(t.field("lift_table"), lift_table, folder, units.length)
+    else:
+        angles = t.numbers("angles", unit="deg")
+        lifts = t.numbers("lifts", unit=units.length)
+    theta, lift = normalize_table(angles, lifts, t.path, units.length)
+    if lift.min() < 0.0 or lift.max() <= 0.0:
+        raise InputError(t.field("lifts"), float(lift.min()), "lifts >= 0 (0 = base circle), not all 0", units.length)
+    harmonics = t.integer("harmonics", default=0, min_value=0) or None
+    tolerance = t.number("tolerance", unit=units.length, required=False, min_exclusive=0.0)
+    if (harmonics is None) == (tolerance is None):
+        raise InputError(t.field("harmonics"), harmonics, "either harmonics (>= 1) or tolerance, not both")
+    fit_table(theta, lift, harmonics, tolerance, t.path, units.length)  # refuse a table that cannot be fitted
+    return dict(angles=tuple(theta.tolist()), lifts=tuple(lift.tolist()), harmonics=harmonics,
+                tolerance=tolerance, lift_table=lift_table)
 
 
 def _seat(t: Table, n: int, cam: CamSpec, units: UnitSystem) -> SeatSpec:
@@ -137,9 +183,12 @@ def _seat(t: Table, n: int, cam: CamSpec, units: UnitSystem) -> SeatSpec:
     if coordinate == cam.coordinate:
         raise InputError(t.field("coordinate"), coordinate, f"a number other than the cam's ({cam.coordinate})")
     name = t.string("name", default="seat")
-    position = t.number("position", unit=units.length)
+    lash = t.number("lash", unit=units.length, required=False)
+    if (lash is not None) == t.has("position"):
+        raise InputError(t.field("position"), t.raw("position"), "either position or lash, not both", units.length)
+    position = 0.0 if lash is not None else t.number("position", unit=units.length)
     t.finish()
-    return SeatSpec(coordinate, position, name)
+    return SeatSpec(coordinate, position, name, lash)
 
 
 def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
@@ -175,6 +224,7 @@ def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
                 raise InputError(t.field("position"), raw, "two numbers [x, y]", units.length)
             position = (raw[0], raw[1])
         direction = t.number("direction", unit="deg", default=0.0)
+        elements = t.integer("elements", default=1, min_value=1, max_value=MAX_ELEMENTS)
         t.finish()
         where = t.path
         if element == BEAM and stiffness is not None:
@@ -189,7 +239,7 @@ def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
             raise InputError(f"{where}.specific_weight", None, "a specific_weight, density or mass > 0", units.specific_weight)
         members.append(
             MemberSpec(name, element, length, tuple(coords), modulus, diameter, area, inertia,
-                       specific_weight, density, stiffness, mass, position, direction)
+                       specific_weight, density, stiffness, mass, position, direction, elements)
         )
     if not members:
         raise InputError("members", {}, "at least one [members.NAME] table")
@@ -320,6 +370,7 @@ def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
 
 def dump(spec: MechanismSpec) -> dict[str, Any]:
     """The preset document for a spec (inverse of :func:`load`)."""
+    spec = unsplit_members(spec)
     doc: dict[str, Any] = {"kind": "valvetrain", "title": spec.title}
     if spec.notes:
         doc["notes"] = spec.notes
@@ -337,15 +388,23 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         if m.position is not None:
             entry["position"] = list(m.position)
             entry["direction"] = m.direction
+        if m.elements > 1:
+            entry["elements"] = m.elements
         members[m.name] = entry
     doc["members"] = members
     cam = spec.cam
-    doc["cam"] = {
-        "coordinate": cam.coordinate, "name": cam.name, "profile": cam.profile,
-        "amplitude": cam.amplitude, "offset": STATIC_START if cam.offset is None else cam.offset,
-    }
+    doc["cam"] = {"coordinate": cam.coordinate, "name": cam.name, "profile": cam.profile,
+                  "offset": STATIC_START if cam.offset is None else cam.offset}
+    if cam.profile == "harmonic":
+        doc["cam"]["amplitude"] = cam.amplitude
+    else:
+        # inline, so a saved copy does not depend on the table file's folder
+        doc["cam"].update({"angles": list(cam.angles), "lifts": list(cam.lifts)})
+        doc["cam"].update({"harmonics": cam.harmonics} if cam.harmonics else {"tolerance": cam.tolerance})
     if spec.seat is not None:
-        doc["seat"] = {"coordinate": spec.seat.coordinate, "name": spec.seat.name, "position": spec.seat.position}
+        seat = spec.seat
+        doc["seat"] = {"coordinate": seat.coordinate, "name": seat.name}
+        doc["seat"].update({"position": seat.position} if seat.lash is None else {"lash": seat.lash})
     doc["clearances"] = [
         {"name": c.name, "ahead": c.ahead, "behind": c.behind, "kind": c.kind,
          "state": c.state, "restitution": c.restitution} | ({"impact": c.impact} if c.impact else {})

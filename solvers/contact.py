@@ -71,8 +71,9 @@ def source_series(mechanism: Mechanism) -> SourceSeries:
 
 def cam_lift_series(mechanism: Mechanism) -> tuple[float, np.ndarray, np.ndarray]:
     """(c0, a_k, b_k) of the cam lift; the thesis' harmonic cam is c0 = A, b_1 = A."""
-    cam = mechanism.spec.cam
-    return cam.amplitude, np.zeros(1), np.array([cam.amplitude])
+    from vtool.solvers.cam import lift_series
+
+    return lift_series(mechanism.spec.cam)
 
 
 @dataclass

@@ -99,6 +99,37 @@ def build_layer(spec: MechanismSpec, M: np.ndarray, K: np.ndarray, closed: froze
     K_L = T.T @ K @ T
     modes = undamped_modes(M_L, K_L)
     damping = spec.damping.for_layer(frozenset(closed))
-    ratios = mode_ratios(len(kept), damping.default_ratio, damping.mode_ratios)
+    overrides = damping.mode_ratios
+    if overrides and any(m.nodes for m in spec.members):
+        overrides = _follow_split_modes(spec, closed, kept, modes, overrides)
+    ratios = mode_ratios(len(kept), damping.default_ratio, overrides)
     C_L = modal_damping(M_L, modes, ratios, spec.damping.factor)
     return Layer(frozenset(closed), kept, T, M_L, K_L, C_L, modes, ratios)
+
+
+def _follow_split_modes(spec: MechanismSpec, closed: frozenset[str], kept: tuple[int, ...], modes,  # type: ignore[no-untyped-def]
+                        overrides: tuple[tuple[int, float], ...]) -> tuple[tuple[int, float], ...]:
+    """Per-mode damping overrides number the modes of the preset's one-element model.
+
+    In a model with split members (more, and new low, modes) each override
+    goes to the mode whose shape over the preset's coordinates best matches
+    (largest MAC) the one-element model's mode of that number.
+    """
+    from dataclasses import replace
+
+    from vtool.solvers.assembly import assemble_full, unsplit_members
+
+    plain = unsplit_members(spec)
+    plain = replace(plain, members=tuple(replace(m, elements=1) for m in plain.members))
+    M, K = assemble_full(plain)
+    reference = build_layer(plain, M, K, closed)
+    rows = [j for j, number in enumerate(kept) if number <= plain.n_coordinates]
+    split_shapes = modes.shapes[rows]
+    moved = []
+    for number, ratio in overrides:
+        if not 1 <= number <= reference.size:
+            continue
+        phi = reference.modes.shapes[:, number - 1]
+        mac = (phi @ split_shapes) ** 2 / ((phi @ phi) * np.einsum("ij,ij->j", split_shapes, split_shapes))
+        moved.append((int(np.argmax(mac)) + 1, ratio))
+    return tuple(moved)

@@ -80,11 +80,20 @@ class Mechanism:
 
     @cached_property
     def start(self) -> StaticStart:
-        return static_start(self.spec, self.start_layer, self.omega)
+        start = static_start(self.spec, self.start_layer, self.omega)
+        if self.spec.cam.profile != "harmonic":  # a lift table: start where its lift puts the cam
+            from vtool.solvers.cam import table_start
+
+            start = table_start(self.spec, start, self.omega)
+        return start
 
     def cam_position(self, t: np.ndarray | float) -> np.ndarray | float:
-        cam = self.spec.cam
-        return cam.amplitude * np.sin(self.omega * np.asarray(t)) + self.start.cam_offset
+        from vtool.solvers.cam import derivatives, lift_series
+
+        c0, a, b = lift_series(self.spec.cam)
+        lift = derivatives(c0, a, b, self.omega * np.atleast_1d(np.asarray(t, dtype=float)))[0]
+        position = self.start.cam_offset - c0 + lift
+        return position if np.ndim(t) else float(position[0])
 
 
 def assemble(spec: MechanismSpec) -> Mechanism:

@@ -83,6 +83,8 @@ class MemberSpec:
     mass: float | None = None
     position: tuple[float, float] | None = None  # drawing only: end a in the plane (length units)
     direction: float = 0.0  # drawing only: axis from end a to end b, degrees from +x
+    elements: int = 1  # equal elements the member is split into (see solvers.assembly.sub_elements)
+    nodes: tuple[int, ...] = ()  # internal coordinates of a split member, node by node (beams: w, theta)
 
 
 @dataclass(frozen=True)
@@ -108,8 +110,14 @@ class ClearanceSpec:
 
 @dataclass(frozen=True)
 class CamSpec:
-    """Harmonic cam: q_cam = amplitude * sin(omega t) + offset.
+    """The cam: q_cam = base + L(omega t) (see :mod:`vtool.solvers.cam`).
 
+    ``profile = "harmonic"``: the thesis' cam, L = A + A sin(omega t), A =
+    ``amplitude``. ``profile = "table"``: a lift table (``angles`` in deg from
+    the preset's angle zero, ``lifts`` in length units) fitted by a Fourier
+    series of ``harmonics`` terms, or of the fewest terms that meet
+    ``tolerance`` (length); ``lift_table`` is the CSV file it was read from,
+    as written in the preset. ``amplitude`` of a table cam is half its lift.
     ``offset = None`` applies the thesis' static-start rule (XZERO, see
     :mod:`vtool.solvers.initial`).
     """
@@ -119,6 +127,11 @@ class CamSpec:
     offset: float | None = None
     name: str = "cam"
     profile: str = "harmonic"
+    angles: tuple[float, ...] = ()
+    lifts: tuple[float, ...] = ()
+    harmonics: int | None = None
+    tolerance: float | None = None
+    lift_table: str | None = field(default=None, compare=False)  # provenance only
 
 
 @dataclass(frozen=True)
@@ -128,6 +141,7 @@ class SeatSpec:
     coordinate: int
     position: float
     name: str = "seat"
+    lash: float | None = None  # when the preset gave the lash, position was computed from it
 
 
 @dataclass(frozen=True)

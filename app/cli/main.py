@@ -30,6 +30,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "accuracy": ("vtool.app.cli.accuracy", "accuracy"),
     "sweep": ("vtool.app.cli.sweep", "sweep"),
     "compare": ("vtool.app.cli.compare", "compare"),
+    "cam": ("vtool.app.cli.cam", "cam"),
+    "size": ("vtool.app.cli.size", "size"),
     "tui": ("vtool.app.cli.tui", "tui"),
 }
 

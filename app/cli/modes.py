@@ -16,6 +16,7 @@ def modes(preset: str, as_json: bool) -> None:
     """Natural frequencies (rad/s, Hz) and mass-normalised mode shapes of every
     contact layer, with the static start (cam offset XZERO, follower force FZERO)."""
     from vtool.presets import load_preset
+    from vtool.solvers.assembly import surge_labels
     from vtool.solvers.model import assemble
 
     spec = load_preset(preset)
@@ -44,22 +45,32 @@ def modes(preset: str, as_json: bool) -> None:
                     0.0 if w == 0.0 else z for w, z in zip(layer.modes.omega, layer.damping_ratios, strict=True)
                 ],
                 "mode_shapes_columns": layer.modes.shapes.tolist(),
+                "surge": surge_labels(spec, layer.T @ layer.modes.shapes),
             }
         )
+    if spec.seat is not None:
+        from vtool.solvers.lash import lash_of
+
+        report["seat_position"] = {"value": spec.seat.position, "unit": units.length}
+        report["lash"] = {"value": lash_of(spec), "unit": units.length}
     if as_json:
         click.echo(json.dumps(report, indent=2))
         return
     click.echo(f"{spec.title}  [{spec.units}]")
     click.echo(f"cam offset XZERO   = {mechanism.start.cam_offset:.8f} {units.length}")
     click.echo(f"follower force FZERO = {mechanism.start.follower_force:.8g} {units.force}")
+    if spec.seat is not None:
+        click.echo(f"seat position      = {spec.seat.position:.8g} {units.length}, "
+                   f"lash {report['lash']['value']:.6g} {units.length} (follower clearance on the base circle)")
     for layer, entry in zip(mechanism.all_layers(), report["layers"], strict=True):
         click.echo("")
         click.echo(f"Layer {layer.label()}  ({layer.size} coordinates)")
-        click.echo(f"  {'mode':>4} {'omega (rad/s)':>14} {'f (Hz)':>12} {'zeta':>6}")
-        for i, (w, f, z) in enumerate(
-            zip(entry["omega_rad_s"], entry["frequency_hz"], entry["damping_ratio"], strict=True), start=1
+        click.echo(f"  {'mode':>4} {'omega (rad/s)':>14} {'f (Hz)':>12} {'zeta':>6}  kind")
+        for i, (w, f, z, kind) in enumerate(
+            zip(entry["omega_rad_s"], entry["frequency_hz"], entry["damping_ratio"], entry["surge"], strict=True),
+            start=1,
         ):
-            click.echo(f"  {i:>4} {w:>14.6g} {f:>12.6g} {z:>6.3g}")
+            click.echo(f"  {i:>4} {w:>14.6g} {f:>12.6g} {z:>6.3g}  {kind}".rstrip())
         click.echo("  mode shapes (mass-normalised, columns = modes):")
         header = "".join(f"{i:>11}" for i in range(1, layer.size + 1))
         click.echo(f"  {'':>4}{header}")

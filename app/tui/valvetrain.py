@@ -50,7 +50,10 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
         Field(("run", "beta"), "Newmark beta", group="Run"),
         Field(("run", "gamma"), "Newmark gamma", group="Run"),
         Field(("run", "output_interval"), "output every", "deg", group="Run"),
-        Field(("cam", "amplitude"), "cam amplitude", u.length, group="Cam and spring"),
+        *([Field(("cam", "amplitude"), "cam amplitude", u.length, group="Cam and spring")]
+          if "amplitude" in doc["cam"] else
+          [Field(("cam", key), f"cam {key}", u.length if key == "tolerance" else "", group="Cam and spring")
+           for key in ("harmonics", "tolerance") if key in doc["cam"]]),
         Field(("initial", "spring_preload"), "spring preload", u.force, group="Cam and spring"),
         Field(("initial", "lever_ratio"), "lever ratio", group="Cam and spring"),
     ]
@@ -59,7 +62,8 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
             fields.append(Field(("members", name, "stiffness"), f"{name} rate", u.stiffness,
                                 group="Cam and spring"))
     if "seat" in doc:
-        fields.append(Field(("seat", "position"), "seat position", u.length, group="Clearances"))
+        key = "lash" if "lash" in doc["seat"] else "position"
+        fields.append(Field(("seat", key), f"seat {key}", u.length, group="Clearances"))
     for i, c in enumerate(doc["clearances"]):
         states = ("enabled", "removed") if c["kind"] == "external" else ("enabled", "pinned", "removed")
         fields.append(Field(("clearances", i, "state"), f"{c['name']} state", kind=CHOICE, choices=states,

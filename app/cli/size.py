@@ -1,0 +1,35 @@
+"""``vtool size PRESET --rpm-max R``: elements per member and cam harmonics the speed range needs."""
+
+from __future__ import annotations
+
+import click
+
+
+@click.command()
+@click.argument("preset")
+@click.option("--rpm-max", type=float, required=True, help="Top of the speed range (rev/min).")
+@click.option("--tolerance", type=float, default=0.01, show_default=True,
+              help="Relative change of peak forces and seating velocity that counts as converged.")
+@click.option("--max-elements", type=int, default=8, show_default=True, help="Most elements tried per member.")
+def size(preset: str, rpm_max: float, tolerance: float, max_elements: int) -> None:
+    """Size the model to the question: the highest cam harmonic that matters at
+    RPM_MAX, and the elements per member (and Fourier harmonics of a table cam)
+    beyond which refinement changes peak forces and seating velocity by less
+    than the tolerance; every row is a measured run with its cost."""
+    from vtool.errors import InputError
+    from vtool.presets import load_preset
+    from vtool.solvers.size import size_study, study_text
+
+    spec = load_preset(preset)
+    if spec.kind != "valvetrain":
+        raise click.BadParameter(f"{preset} is a {spec.kind} preset; `vtool size` needs a valvetrain preset",
+                                 param_hint="PRESET")
+    if not rpm_max > 0 or rpm_max > 1e6:
+        raise InputError("--rpm-max", rpm_max, "> 0 and <= 1e6", "rev/min")
+    if not 0 < tolerance < 1:
+        raise InputError("--tolerance", tolerance, "> 0 and < 1 (a fraction)")
+    if not 1 <= max_elements <= 64:
+        raise InputError("--max-elements", max_elements, "an integer in 1..64")
+    study = size_study(spec, rpm_max, tolerance, max_elements,
+                       progress=lambda run: click.echo(f"size: running {run}", err=True))
+    click.echo(study_text(study, spec.title))

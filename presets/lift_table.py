@@ -1,0 +1,50 @@
+"""Read a cam lift table from CSV: two columns, cam angle (deg) and lift (length units).
+
+A header row (any non-numeric first line) and ``#`` comment lines are
+skipped; commas, semicolons, tabs or spaces separate the columns. The file is
+resolved against the preset's folder, must be a regular file and at most
+:data:`MAX_BYTES` long, so a wrong path (a device, a FIFO, a huge log) fails
+with one line instead of a hang.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from vtool.errors import InputError
+
+MAX_BYTES = 4_000_000
+_SPLIT = re.compile(r"[,;\t ]+")
+
+
+def read_lift_table(field: str, name: str, folder: Path | None, unit: str) -> tuple[list[float], list[float]]:
+    """(angles_deg, lifts) from the CSV ``name`` (relative to ``folder``)."""
+    path = Path(name) if Path(name).is_absolute() or folder is None else Path(folder) / name
+    if not path.is_file():
+        raise InputError(field, str(path), "an existing regular file (relative to the preset's folder)")
+    if path.stat().st_size > MAX_BYTES:
+        raise InputError(field, str(path), f"a file of at most {MAX_BYTES} bytes")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(field, str(path), f"a readable UTF-8 text file ({exc})") from None
+    angles: list[float] = []
+    lifts: list[float] = []
+    first = True
+    for number, line in enumerate(text.splitlines(), start=1):
+        cells = [c for c in _SPLIT.split(line.split("#", 1)[0].strip()) if c]
+        if not cells:
+            continue
+        header, first = first, False
+        try:
+            values = [float(c) for c in cells]
+        except ValueError:
+            if header:
+                continue
+            values = []
+        if len(values) != 2:
+            raise InputError(f"{field} line {number}", line.strip(), "two numbers: angle (deg), lift", unit)
+        angles.append(values[0])
+        lifts.append(values[1])
+    return angles, lifts
