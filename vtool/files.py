@@ -1,27 +1,115 @@
-"""Atomic file output: a failed run never leaves a half-written file."""
+"""Atomic file output: a failed run never leaves a half-written file.
+
+:func:`write_atomic` writes a temporary file beside the target and renames it
+over the target, so an existing file is either replaced whole or left intact
+(also under SIGINT; SIGKILL can leave the hidden temporary, which the next
+write to the same path removes). It refuses, in one line
+(:class:`vtool.errors.InputError`), a missing or read-only folder, a folder or
+a device node at the output path, and an empty path; a symlink is written
+through to its target (the link itself is kept). A failure while writing (a
+full disk) is a :class:`vtool.errors.RunError`; nothing partial is left.
+"""
 
 from __future__ import annotations
 
+import errno
 import os
+import stat
 import tempfile
+import time
 from pathlib import Path
 
+from vtool.errors import InputError, RunError
 
-def write_atomic(path: str | os.PathLike[str], text: str) -> None:
-    """Write text to ``path`` through a temporary file and a rename.
+#: Temporaries of a dead process (or older than this, in s, when it cannot be told) are removed.
+STALE_AFTER = 3600.0
+
+
+def _tmp_prefix(path: Path) -> str:
+    return f".{path.name}."
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):
+        return True
+    return True
+
+
+def clean_stale_temporaries(path: str | os.PathLike[str]) -> list[Path]:
+    """Remove hidden ``.NAME.PID.*.tmp`` files a killed write to ``path`` left; returns them."""
+    path = Path(path)
+    removed = []
+    try:
+        siblings = list(path.parent.glob(f"{_tmp_prefix(path)}*.tmp"))
+    except OSError:
+        return removed
+    for tmp in siblings:
+        middle = tmp.name[len(_tmp_prefix(path)):].split(".")[0]
+        try:
+            stale = (not _pid_alive(int(middle))) if middle.isdigit() else (
+                time.time() - tmp.stat().st_mtime > STALE_AFTER)
+            if stale:
+                tmp.unlink()
+                removed.append(tmp)
+        except OSError:
+            continue
+    return removed
+
+
+def check_output_path(path: str | os.PathLike[str], field: str = "output") -> Path:
+    """The real file to write for ``path`` (symlinks followed), or a one-line InputError."""
+    if str(path) == "":
+        raise InputError(field, "", "a file path")
+    path = Path(path)
+    target = Path(os.path.realpath(path)) if path.is_symlink() else path
+    directory = target.parent if str(target.parent) else Path(".")
+    if not directory.is_dir():
+        raise InputError(field, str(path), f"a file in an existing folder ({directory} does not exist)")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise InputError(field, str(path), f"a file in a writable folder ({directory} is read-only)")
+    try:
+        mode = target.stat().st_mode
+    except FileNotFoundError:
+        return target
+    except OSError as exc:
+        raise InputError(field, str(path), f"a writable file path ({exc.strerror})") from None
+    if stat.S_ISDIR(mode):
+        raise InputError(field, str(path), "a file path, not a folder")
+    if not stat.S_ISREG(mode):
+        raise InputError(field, str(path), "a regular file path (not a device, pipe or socket)")
+    if not os.access(target, os.W_OK):
+        raise InputError(field, str(path), "a writable file (this one is read-only)")
+    return target
+
+
+def write_atomic(path: str | os.PathLike[str], text: str, field: str = "output") -> None:
+    """Write text to ``path`` through a temporary file and a rename (see module doc).
 
     A failure part-way leaves any existing file untouched and no partial file.
     """
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
+    target = check_output_path(path, field)
+    directory = target.parent if str(target.parent) else Path(".")
+    clean_stale_temporaries(target)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f"{_tmp_prefix(target)}{os.getpid()}.", suffix=".tmp",
+                                   dir=directory)
+    except OSError as exc:
+        raise InputError(field, str(path), f"a file in a writable folder ({exc.strerror})") from None
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
             handle.write(text)
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
+        os.replace(tmp, target)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        reason = "the disk is full" if exc.errno in (errno.ENOSPC, errno.EDQUOT) else exc.strerror
+        raise RunError(f"could not write {path}: {reason}; nothing was written") from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
