@@ -113,3 +113,38 @@ def write_atomic(path: str | os.PathLike[str], text: str, field: str = "output")
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def finite_json(data: object) -> tuple[object, list[str]]:
+    """``data`` with every NaN or infinite float replaced by ``None``, and where each was.
+
+    JSON has no NaN or Infinity; :func:`json_text` writes the places as
+    ``"non_finite": ["clearances[2].peak_force: nan", ...]`` beside them.
+    """
+    import math
+
+    places: list[str] = []
+
+    def clean(value: object, where: str) -> object:
+        if isinstance(value, float) and not math.isfinite(value):
+            places.append(f"{where}: {value}")
+            return None
+        if isinstance(value, dict):
+            return {k: clean(v, f"{where}.{k}" if where else str(k)) for k, v in value.items()}
+        if isinstance(value, list | tuple):
+            return [clean(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        if hasattr(value, "tolist") and hasattr(value, "dtype"):  # numpy scalars and arrays
+            return clean(value.tolist(), where)
+        return value
+
+    return clean(data, ""), places
+
+
+def json_text(data: object, indent: int | None = 2) -> str:
+    """Strict JSON (no NaN/Infinity): non-finite numbers become null, listed under ``non_finite``."""
+    import json
+
+    cleaned, places = finite_json(data)
+    if places and isinstance(cleaned, dict):
+        cleaned["non_finite"] = places
+    return json.dumps(cleaned, indent=indent, allow_nan=False)

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
-import json
 import math
 
 import click
 import numpy as np
+
+from vtool.errors import RunError
+from vtool.files import json_text
 
 
 @click.command()
@@ -16,13 +18,17 @@ def modes(preset: str, as_json: bool) -> None:
     """Natural frequencies (rad/s, Hz) and mass-normalised mode shapes of every
     contact layer, with the static start (cam offset XZERO, follower force FZERO)."""
     from vtool.presets import load_preset
+    from vtool.presets.kinds import require_kind
     from vtool.solvers.model import assemble
+    from vtool.solvers.run import NUMERICAL_FAILURES
 
     spec = load_preset(preset)
-    if getattr(spec, "kind", "") != "valvetrain":
-        raise click.BadParameter(f"{preset} is a {spec.kind} preset; `vtool modes` needs a valvetrain preset",
-                                 param_hint="PRESET")
-    mechanism = assemble(spec)
+    require_kind(spec, "valvetrain", "`vtool modes`")
+    try:
+        mechanism = assemble(spec)
+    except NUMERICAL_FAILURES as exc:
+        raise RunError(f"assembling the mechanism failed ({type(exc).__name__}); check the members' "
+                       "sections, moduli and masses") from None
     units = spec.unit_system
     report = {
         "preset": preset,
@@ -47,7 +53,7 @@ def modes(preset: str, as_json: bool) -> None:
             }
         )
     if as_json:
-        click.echo(json.dumps(report, indent=2))
+        click.echo(json_text(report))
         return
     click.echo(f"{spec.title}  [{spec.units}]")
     click.echo(f"cam offset XZERO   = {mechanism.start.cam_offset:.8f} {units.length}")
