@@ -101,7 +101,7 @@ class Table:
         expected = _range_text(min_value, min_exclusive, max_value, max_exclusive)
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise InputError(self.field(key), value, f"a number {expected}".strip(), unit)
-        value = as_float(value)
+        given, value = value, as_float(value)
         bad = (
             not math.isfinite(value)
             or (min_value is not None and value < min_value)
@@ -110,7 +110,7 @@ class Table:
             or (max_exclusive is not None and value >= max_exclusive)
         )
         if bad:
-            raise InputError(self.field(key), value, expected or "a finite number", unit)
+            raise InputError(self.field(key), given, expected or "a finite number", unit)
         return value
 
     def integer(

@@ -78,7 +78,7 @@ BOUNDS: dict[str, tuple[float, float]] = {
 #: [run] ranges (and of the --rpm, --dt, --degrees flags): key -> (min, max, unit).
 RUN_LIMITS: dict[str, tuple[float, float, str]] = {
     "rpm": (1e-3, 1e6, "rev/min"),
-    "degrees": (1e-3, 3.6e6, "deg"),
+    "degrees": (1e-6, 3.6e6, "deg"),
     "time_step": (1e-12, 1e-1, "s"),
     "output_interval": (1e-6, 3.6e6, "deg"),
 }

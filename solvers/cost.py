@@ -83,6 +83,9 @@ class CostError(InputError):
 
     def one_line(self) -> str:
         c = self.cost
+        if self.what == "short":
+            return (f"run too short: {c.t_end:.3g} s of motion is less than one time step ({c.backend}); "
+                    "to proceed: more --degrees or a smaller --dt")
         if self.what == "steps":
             limit = (f"more than the limit of {self.max_steps:.3g} steps; to proceed: fewer --degrees, "
                      f"a higher --rpm, a larger --dt (newmark), or --max-steps {math.ceil(c.steps):.3g}")
@@ -96,6 +99,8 @@ def check(cost: Estimate, max_steps: float | None = None, max_bytes: float | Non
     """Refuse (:class:`CostError`, exit 2) a run above the limits; returns ``cost``."""
     max_steps = MAX_STEPS if max_steps is None else max_steps
     max_bytes = MAX_BYTES if max_bytes is None else max_bytes
+    if not cost.steps >= 1.0:
+        raise CostError(cost, max_steps, max_bytes, "short")
     if not cost.steps <= max_steps:
         raise CostError(cost, max_steps, max_bytes, "steps")
     if not cost.bytes <= max_bytes:

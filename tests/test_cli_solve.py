@@ -68,7 +68,7 @@ def test_overrides_change_the_run() -> None:
         (["--dt", "0"], "--dt: got 0.0, expected >= 1e-12 and <= 0.1 s"),
         (["--dt", "1e-5"], "stability limit"),
         (["--rpm", "-1"], "--rpm: got -1.0, expected >= 0.001 and <= 1e+06 rev/min"),
-        (["--degrees", "0"], "--degrees: got 0.0, expected >= 0.001 and <= 3.6e+06 deg"),
+        (["--degrees", "0"], "--degrees: got 0.0, expected >= 1e-06 and <= 3.6e+06 deg"),
         (["--backend", "euler"], "'euler' is not one of 'exact', 'newmark', 'scipy'"),
     ],
 )

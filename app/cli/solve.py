@@ -48,7 +48,7 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @click.option("--rpm", type=float, callback=_run_flag("rpm"),
               help="Cam speed (rev/min, 0.001 to 1e6); default: the preset's.")
 @click.option("--degrees", type=float, callback=_run_flag("degrees"),
-              help="Degrees of cam rotation to run (0.001 to 3.6e6); default: the preset's.")
+              help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's.")
 @click.option("--max-steps", type=float, callback=_max_steps,
               help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}).")
 @click.option("--csv", "csv_path", type=click.Path(path_type=Path),
