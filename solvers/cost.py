@@ -88,7 +88,7 @@ class CostError(InputError):
                     "to proceed: more --degrees or a smaller --dt")
         if self.what == "steps":
             limit = (f"more than the limit of {self.max_steps:.3g} steps; to proceed: fewer --degrees, "
-                     f"a higher --rpm, a larger --dt (newmark), or --max-steps {math.ceil(c.steps):.3g}")
+                     f"a higher --rpm, a larger --dt (newmark), or --max-steps {math.ceil(c.steps):d}")
         else:
             limit = (f"more than the limit of {self.max_bytes / 1e9:g} GB of output; to proceed: fewer "
                      "--degrees, a larger run.output_interval, or no --every-step")
