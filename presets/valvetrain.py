@@ -152,7 +152,7 @@ def _coordinates(top: Table) -> tuple[CoordinateSpec, ...]:
     if not tables:
         raise InputError("coordinates", [], "at least one [[coordinates]] entry")
     _count("coordinates", tables, MAX_COORDINATES, "coordinates")
-    result = []
+    result: list[CoordinateSpec] = []
     for number, t in enumerate(tables, start=1):
         name = t.string("name")
         motion = t.string("motion", choices=("translation", "rotation"))
@@ -260,7 +260,7 @@ def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
 
 
 def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int) -> tuple[ClearanceSpec, ...]:
-    result = []
+    result: list[ClearanceSpec] = []
     elastic = set(range(1, n + 1))
     tables = top.array_of_tables("clearances")
     _count("clearances", tables, MAX_CLEARANCES, "clearances (2^n configurations)")
@@ -316,7 +316,7 @@ def _damping(t: Table | None, names: dict[str, ClearanceSpec]) -> DampingSpec:
         return DampingSpec()
     factor = t.number("factor", default=1.0, min_value=0.0, max_value=1e6)
     default_ratio = _ratio(t, "default_ratio", 0.1)
-    layers = []
+    layers: list[LayerDampingSpec] = []
     for lt in t.array_of_tables("layers", required=False):
         closed = _names(lt, "closed", names, (INTERNAL,))
         ratio = _ratio(lt, "default_ratio", default_ratio)
@@ -465,7 +465,7 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         "lever_ratio": spec.initial.lever_ratio,
     }
     damping: dict[str, Any] = {"factor": spec.damping.factor, "default_ratio": spec.damping.default_ratio}
-    layers = []
+    layers: list[dict[str, Any]] = []
     for layer in spec.damping.layers:
         entry = {"closed": list(layer.closed), "default_ratio": layer.default_ratio}
         if layer.mode_ratios:

@@ -42,7 +42,7 @@ def _pid_alive(pid: int) -> bool:
 def clean_stale_temporaries(path: str | os.PathLike[str]) -> list[Path]:
     """Remove hidden ``.NAME.PID.*.tmp`` files a killed write to ``path`` left; returns them."""
     path = Path(path)
-    removed = []
+    removed: list[Path] = []
     try:
         siblings = list(path.parent.glob(f"{_tmp_prefix(path)}*.tmp"))
     except OSError:
