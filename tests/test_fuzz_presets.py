@@ -18,6 +18,7 @@ hold the reproducers of every signature issue 14 listed.
 
 from __future__ import annotations
 
+import copy
 import math
 import os
 import time
@@ -81,17 +82,17 @@ def mutated_text(draw: st.DrawFn) -> bytes:
         if op == "add" or not keys:
             if isinstance(target, dict):
                 name = draw(st.sampled_from(["rmp", "lenght", "extra", "seat", "damping", "zeta"]))
-                target[name] = draw(st.sampled_from(BAD_VALUES))
+                target[name] = copy.deepcopy(draw(st.sampled_from(BAD_VALUES)))
             else:
-                target.append(draw(st.sampled_from(BAD_VALUES)))
+                target.append(copy.deepcopy(draw(st.sampled_from(BAD_VALUES))))
             continue
         key = draw(st.sampled_from(keys))
         if op == "delete":
             del target[key]
         elif op == "duplicate" and isinstance(target, list):
-            target.append(target[key])
+            target.append(copy.deepcopy(target[key]))
         else:
-            target[key] = draw(st.sampled_from(BAD_VALUES))
+            target[key] = copy.deepcopy(draw(st.sampled_from(BAD_VALUES)))
     try:
         text = tomli_w.dumps(doc)
     except (TypeError, ValueError):  # e.g. a list mixing tables and numbers: no TOML for it

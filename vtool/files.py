@@ -13,6 +13,7 @@ full disk) is a :class:`vtool.errors.RunError`; nothing partial is left.
 from __future__ import annotations
 
 import errno
+import glob
 import os
 import stat
 import tempfile
@@ -44,7 +45,7 @@ def clean_stale_temporaries(path: str | os.PathLike[str]) -> list[Path]:
     path = Path(path)
     removed: list[Path] = []
     try:
-        siblings = list(path.parent.glob(f"{_tmp_prefix(path)}*.tmp"))
+        siblings = list(path.parent.glob(f"{glob.escape(_tmp_prefix(path))}*.tmp"))
     except OSError:
         return removed
     for tmp in siblings:

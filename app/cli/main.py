@@ -78,7 +78,7 @@ class LazyGroup(click.Group):
             click.echo(f"error: {one_line(exc.format_message(), 300)}", err=True)
             code = exc.exit_code
         except click.exceptions.Abort:
-            click.echo("aborted", err=True)
+            click.echo("interrupted: nothing was written", err=True)
             code = 130
         except KeyboardInterrupt:
             click.echo("interrupted: nothing was written", err=True)
