@@ -23,6 +23,8 @@ from vtool.errors import InputError
 
 #: Longest list a preset may give for one field (coordinates, members, quantities, ...).
 MAX_LIST = 1000
+#: Longest string field (titles, notes, names).
+MAX_STRING = 10_000
 
 
 def as_float(value: Any) -> float:
@@ -138,6 +140,8 @@ class Table:
             raise InputError(self.field(key), value, expected)
         if choices and value not in choices:
             raise InputError(self.field(key), value, f"one of: {', '.join(choices)}")
+        if len(value) > MAX_STRING:
+            raise InputError(self.field(key), value, f"a string of at most {MAX_STRING:,} characters")
         return value
 
     def boolean(self, key: str, *, default: bool | None = None) -> bool:

@@ -324,7 +324,7 @@ def _damping(t: Table | None, names: dict[str, ClearanceSpec]) -> DampingSpec:
         mt = lt.table("mode_ratios", required=False)
         if mt is not None:
             for key in list(mt.data):
-                if not key.isdigit() or not 1 <= int(key) <= MAX_COORDINATES:
+                if not (key.isdigit() and len(key) <= 3 and 1 <= int(key) <= MAX_COORDINATES):
                     raise InputError(mt.field(key), key, "a mode number 1, 2, ... (ascending frequency)")
                 overrides.append((int(key), _ratio(mt, key)))
             mt.finish()

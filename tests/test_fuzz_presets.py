@@ -283,3 +283,14 @@ def test_parse_text_and_load_document_refuse_non_documents() -> None:
         parse_text("a = [1,\n")
     with pytest.raises(InputError, match="a TOML document"):
         load_document([1, 2])  # type: ignore[arg-type]
+
+
+def test_a_mode_number_with_thousands_of_digits_and_a_huge_title_are_refused() -> None:
+    doc = base_doc("gnilka-1a")
+    doc["damping"]["layers"][1]["mode_ratios"] = {"9" * 5000: 0.5}
+    with pytest.raises(InputError, match=r"expected a mode number 1, 2, ..."):
+        load_document(doc)
+    doc = base_doc("gnilka-1a")
+    doc["title"] = "t" * 100_000
+    with pytest.raises(InputError, match=r"^title: got 'ttt.*characters\), expected a string of at most 10,000"):
+        load_document(doc)

@@ -62,7 +62,8 @@ class InputError(ValueError):
     def one_line(self) -> str:
         unit = f" {self.unit}" if self.unit else ""
         value = "missing" if self.value is None else shown(self.value)
-        return one_line(f"{self.field}: got {value}, expected {self.expected}{unit}", 400)
+        field = self.field if len(self.field) <= MAX_SHOWN else f"{self.field[: MAX_SHOWN - 3]}..."
+        return one_line(f"{field}: got {value}, expected {self.expected}{unit}", 400)
 
 
 class RunError(RuntimeError):
