@@ -79,7 +79,8 @@ class CostError(InputError):
         self.max_steps = max_steps
         self.max_bytes = max_bytes
         self.what = what
-        super().__init__("run", cost.describe(), what)
+        # the field a form marks: the step for a run shorter than one step, else the length of run
+        super().__init__("run.time_step" if what == "short" else "run.degrees", cost.describe(), what)
 
     def one_line(self) -> str:
         c = self.cost

@@ -1,7 +1,7 @@
 """Preset fuzzer: any valve-train preset gives a run, one clean line (exit 2 or 1), never a traceback.
 
 A seeded hypothesis fuzzer mutates the shipped valve-train presets (delete or
-add keys, wrong types, 0, negatives, NaN, +-inf, 1e+-300, ints too large for
+add keys, numbers scaled by 1e-8 to 1e8, wrong types, 0, negatives, NaN, +-inf, 1e+-300, ints too large for
 a float, huge arrays and strings, duplicated entries, invalid UTF-8, tables
 and arrays nested 5,000 deep) and runs each through ``vtool solve`` in
 process. Every case must end with exit code 0, 1 or 2; a non-zero exit prints
@@ -78,7 +78,8 @@ def mutated_text(draw: st.DrawFn) -> bytes:
     for _ in range(draw(st.integers(1, 3))):
         target = at(doc, draw(st.sampled_from(containers(doc))))
         keys = list(target) if isinstance(target, dict) else list(range(len(target)))
-        op = draw(st.sampled_from(["delete", "replace", "replace", "replace", "add", "duplicate"]))
+        op = draw(st.sampled_from(["delete", "replace", "replace", "replace", "add", "duplicate",
+                                   "scale", "scale", "scale"]))
         if op == "add" or not keys:
             if isinstance(target, dict):
                 name = draw(st.sampled_from(["rmp", "lenght", "extra", "seat", "damping", "zeta"]))
@@ -89,6 +90,10 @@ def mutated_text(draw: st.DrawFn) -> bytes:
         key = draw(st.sampled_from(keys))
         if op == "delete":
             del target[key]
+        elif op == "scale":  # a valid-looking number far from the thesis value: exercises the runs
+            value = target[key]
+            if isinstance(value, int | float) and not isinstance(value, bool):
+                target[key] = value * 10.0 ** draw(st.integers(-8, 8))
         elif op == "duplicate" and isinstance(target, list):
             target.append(copy.deepcopy(target[key]))
         else:
@@ -138,7 +143,11 @@ def check_case(tmp_path: Path, data: bytes) -> tuple[int, float]:
     else:
         assert len(errors) == 1 and len(errors[0]) <= 600, result.stderr[:2000]
         assert errors[0].startswith(("error: ", "run failed: "))
-    log(f"preset exit={result.exit_code} seconds={seconds:.3f} {errors[0][:60] if errors else ''}")
+    import resource
+
+    rss_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    log(f"preset exit={result.exit_code} seconds={seconds:.3f} maxrss_mb={rss_mb:.0f} "
+        f"{errors[0][:60] if errors else ''}")
     return result.exit_code, seconds
 
 
