@@ -167,7 +167,7 @@ def test_warnings_are_one_line_each(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("where, text", [
     ("missing/dir/x.csv", "a file in an existing folder"),
-    ("", "expected a file path"),
+    ("", "--csv: got '', expected a file path"),
     (".", "a file path, not a folder"),
     ("/dev/null", "a regular file path (not a device"),
 ])
@@ -231,7 +231,7 @@ def test_stale_temporaries_of_a_killed_write_are_cleaned_on_the_next_write(tmp_p
 def test_sigkill_during_a_run_leaves_the_existing_file_intact(tmp_path: Path) -> None:
     out = tmp_path / "out.csv"
     out.write_text("previous\n")
-    proc = subprocess.Popen([sys.executable, "-m", "vtool", "solve", "gnilka-1a", "--degrees", "20000",
+    proc = subprocess.Popen([sys.executable, "-m", "vtool", "solve", "gnilka-1a", "--degrees", "2000000",
                              "--csv", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     time.sleep(3.0)
     proc.send_signal(signal.SIGKILL)

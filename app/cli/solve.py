@@ -51,14 +51,14 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
               help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's.")
 @click.option("--max-steps", type=float, callback=_max_steps,
               help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}).")
-@click.option("--csv", "csv_path", type=click.Path(path_type=Path),
+@click.option("--csv", "csv_path", type=click.Path(),  # a str: '' stays '' in the error
               help="Write the response as CSV (per output interval, or per step with --every-step).")
 @click.option("--every-step", is_flag=True, help="CSV rows at every time step (and event) instead of per degree.")
 @click.option("--plot", is_flag=True, help="Draw force, displacement and configuration charts (not with --json).")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary (with the event list) as JSON.")
 @click.option("--events", "show_events", is_flag=True, help="Also print the event list.")
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
-          max_steps: float | None, csv_path: Path | None, every_step: bool, plot: bool, as_json: bool,
+          max_steps: float | None, csv_path: str | None, every_step: bool, plot: bool, as_json: bool,
           show_events: bool) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
@@ -72,8 +72,7 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
 
     if as_json and plot:
         raise InputError("--plot", "with --json", "one of --json (machine-readable stdout) or --plot")
-    if csv_path is not None:
-        check_output_path(csv_path, "--csv")
+    csv_file = None if csv_path is None else Path(check_output_path(csv_path, "--csv") and csv_path)
     spec = load_preset(preset)
     kind = KINDS[spec.kind]
     if spec.kind != "valvetrain":
@@ -84,9 +83,9 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
             if value is not None:
                 raise InputError(flag, value, f"no {flag} for {preset}: it is a {spec.kind} preset "
                                  f"({flag} applies to valvetrain presets)")
-        resolve(kind.solve)(spec, csv_path, plot, as_json)
+        resolve(kind.solve)(spec, csv_file, plot, as_json)
         return
-    run_valvetrain(spec, backend, dt, rpm, degrees, csv_path, every_step, plot, as_json, show_events,
+    run_valvetrain(spec, backend, dt, rpm, degrees, csv_file, every_step, plot, as_json, show_events,
                    max_steps=max_steps)
 
 
