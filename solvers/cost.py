@@ -10,10 +10,13 @@ The work is
   1/16 of the shortest period; solve_ivp's steps are of the same order);
 
 and the memory is that of the output rows, ``degrees / output_interval + 1``
-(or one per step with ``every_step``), each ``3 (n + n_s) + n_c + 2`` floats
-(coordinates with velocities and accelerations, contact forces, time and
-configuration), counted three times (the chunks, the joined trace and its
-CSV text), plus the ``2^n_c`` configuration tables of ``6 n²`` floats.
+(or one per step with ``every_step``), each ``3 (n + n_s) + n_c + 2 + n_q``
+values (coordinates with velocities and accelerations, contact forces, time
+and configuration, the preset's extra quantities), counted as
+:data:`BYTES_PER_VALUE` bytes each (the kernel's buffers, the joined trace,
+the CSV table and its text: measured 3.7 GB peak for 900,000 rows of 47
+values, which this counts as 2.9 GB), plus the ``2^n_c`` configuration tables
+of ``6 n²`` floats.
 
 :func:`check` refuses a run above :data:`MAX_STEPS` steps or
 :data:`MAX_BYTES` bytes with one line giving the estimate and how to proceed
@@ -36,7 +39,8 @@ MAX_BYTES = 2e9
 #: Samples per period of the highest natural frequency (exact, scipy).
 SAMPLES_PER_PERIOD = 16.0
 BYTES_PER_FLOAT = 8
-COPIES = 3
+#: Bytes per output value over the whole run: float copies (8 x 6) and about 20 characters of CSV.
+BYTES_PER_VALUE = 8 * 6 + 20
 
 
 @dataclass(frozen=True)
@@ -56,7 +60,7 @@ class Estimate:
 
 def estimate(*, backend: str, rpm: float, degrees: float, time_step: float, output_interval: float,
              every_step: bool, omega_max: float, n_coordinates: int, n_sources: int,
-             n_clearances: int) -> Estimate:
+             n_clearances: int, n_quantities: int = 0) -> Estimate:
     """The cost of one run (see module doc); all inputs in the preset's units."""
     omega = rpm * 2.0 * math.pi / 60.0
     t_end = math.radians(degrees) / omega if omega > 0 else math.inf
@@ -65,9 +69,9 @@ def estimate(*, backend: str, rpm: float, degrees: float, time_step: float, outp
     else:
         steps = t_end * omega_max / (2.0 * math.pi) * SAMPLES_PER_PERIOD
     rows = steps + 1 if every_step else degrees / output_interval + 1
-    columns = 3 * (n_coordinates + n_sources) + n_clearances + 2
+    columns = 3 * (n_coordinates + n_sources) + n_clearances + 2 + n_quantities
     tables = 2.0**n_clearances * 6 * n_coordinates**2
-    size = (rows * columns * COPIES + tables) * BYTES_PER_FLOAT
+    size = rows * columns * BYTES_PER_VALUE + tables * BYTES_PER_FLOAT
     return Estimate(backend, steps, rows, size, t_end)
 
 

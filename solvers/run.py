@@ -37,7 +37,7 @@ def run_cost(mechanism: Mechanism, every_step: bool = False) -> cost.Estimate:
     return cost.estimate(backend=r.backend, rpm=r.rpm, degrees=r.degrees, time_step=r.time_step,
                          output_interval=r.output_interval, every_step=every_step, omega_max=omega_max,
                          n_coordinates=spec.n_coordinates, n_sources=n_sources,
-                         n_clearances=len(spec.clearances))
+                         n_clearances=len(spec.clearances), n_quantities=len(r.quantities))
 
 
 def _assemble(spec: MechanismSpec) -> Mechanism:

@@ -146,6 +146,10 @@ def check_case(tmp_path: Path, data: bytes) -> tuple[int, float]:
         assert errors[0].startswith(("error: ", "run failed: "))
     import resource
 
+    keep = os.environ.get("VTOOL_FUZZ_SAVE_SLOW")  # a folder: cases over 10 s are copied there
+    if keep and seconds > 10.0:
+        Path(keep, f"slow-{seconds:.0f}s-{time.monotonic_ns()}.toml").write_bytes(data)
+
     rss_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     log(f"preset exit={result.exit_code} seconds={seconds:.3f} maxrss_mb={rss_mb:.0f} "
         f"{errors[0][:60] if errors else ''}")
@@ -304,3 +308,15 @@ def test_a_mode_number_with_thousands_of_digits_and_a_huge_title_are_refused() -
     doc["title"] = "t" * 100_000
     with pytest.raises(InputError, match=r"^title: got 'ttt.*characters\), expected a string of at most 10,000"):
         load_document(doc)
+
+
+def test_a_run_whose_output_would_take_gigabytes_is_refused() -> None:
+    """Found by the fuzzer: output every 1e-4 degree over 90 degrees (900,001 rows of 47 values)
+    peaked at 3.7 GB; the memory estimate now refuses it."""
+    from vtool.solvers.cost import CostError
+    from vtool.solvers.run import simulate
+
+    doc = base_doc("gnilka-1a")
+    doc["run"]["output_interval"] = 1e-4
+    with pytest.raises(CostError, match=r"about 2,8\d\d MB .* more than the limit of 2 GB of output"):
+        simulate(load_document(doc))
