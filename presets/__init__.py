@@ -1,15 +1,12 @@
 """Presets: TOML files describing one study, and the loaders that turn them into specs.
 
-Every preset has a top-level ``kind`` that picks its loader:
+Every preset has a top-level ``kind`` that picks its loader from the one
+kinds table, :data:`vtool.presets.kinds.KINDS` (kind -> spec type, loader,
+solve function, TUI screen).
 
-=============  ===============================  ==================================
-kind           loader module                    spec it returns
-=============  ===============================  ==================================
-valvetrain     :mod:`vtool.presets.valvetrain`  :class:`vtool.solvers.spec.MechanismSpec`
-boom_wall      :mod:`vtool.presets.boom`        sonic-boom wall assessment
-boom_floor     :mod:`vtool.presets.boom`        sonic-boom floor assessment
-plate          :mod:`vtool.presets.plate`       condensed-plate study
-=============  ===============================  ==================================
+Reading a file is guarded: a file over :data:`MAX_PRESET_BYTES`, invalid
+UTF-8, invalid TOML and tables or arrays nested too deep for the parser are
+each one :class:`vtool.errors.InputError` line.
 
 A preset is found by path, or by the name of a shipped file in this folder
 (``gnilka-1a`` finds ``gnilka-1a.toml``).
@@ -24,18 +21,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from vtool.errors import InputError
+from vtool.errors import InputError, one_line
 from vtool.files import write_atomic
+from vtool.presets.kinds import KINDS, kind_named
 
 PRESET_DIR = Path(__file__).resolve().parent
 
 #: kind -> module whose ``load(doc: dict) -> spec`` and ``dump(spec) -> dict`` handle it.
-LOADERS: dict[str, str] = {
-    "valvetrain": "vtool.presets.valvetrain",
-    "boom_wall": "vtool.presets.boom",
-    "boom_floor": "vtool.presets.boom",
-    "plate": "vtool.presets.plate",
-}
+LOADERS: dict[str, str] = {name: kind.loader for name, kind in KINDS.items()}
+
+#: Largest preset file read (bytes); the shipped ones are below 10 kB.
+MAX_PRESET_BYTES = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -69,27 +65,47 @@ def read_document(path: str | os.PathLike[str]) -> dict[str, Any]:
     path = Path(path)
     try:
         with path.open("rb") as handle:
-            return tomllib.load(handle)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(str(path), "invalid TOML", f"valid TOML ({exc})") from None
+            data = handle.read(MAX_PRESET_BYTES + 1)
     except OSError as exc:
         raise InputError("preset", str(path), f"a readable file ({exc.strerror})") from None
+    if len(data) > MAX_PRESET_BYTES:
+        raise InputError("preset", str(path), f"a file of at most {MAX_PRESET_BYTES:,} bytes")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise InputError(str(path), f"byte 0x{data[exc.start]:02x} on line {line}",
+                         "UTF-8 text (TOML files are UTF-8)") from None
+    return parse_text(text, str(path))
+
+
+def parse_text(text: str, where: str = "<preset>") -> dict[str, Any]:
+    """Parse preset TOML text; syntax errors and too-deep nesting are one-line InputErrors."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(where, "invalid TOML", f"valid TOML ({one_line(str(exc), 200)})") from None
+    except RecursionError:
+        raise InputError(where, "arrays or tables nested too deep",
+                         "valid TOML nested a few levels deep") from None
 
 
 def kind_of(doc: dict[str, Any]) -> str:
-    kind = doc.get("kind")
-    if kind not in LOADERS:
-        raise InputError("kind", kind, f"one of: {', '.join(LOADERS)}")
-    return kind
+    return kind_named(doc.get("kind")).name
 
 
 def loader_for(kind: str) -> Any:
-    return importlib.import_module(LOADERS[kind])
+    return importlib.import_module(kind_named(kind).loader)
 
 
 def load_document(doc: dict[str, Any]) -> Any:
     """Validate a parsed preset document and return its frozen spec."""
-    return loader_for(kind_of(doc)).load(doc)
+    if not isinstance(doc, dict):
+        raise InputError("<preset>", type(doc).__name__, "a TOML document (a table)")
+    try:
+        return loader_for(kind_of(doc)).load(doc)
+    except RecursionError:
+        raise InputError("<preset>", "values nested too deep", "the fields of a preset") from None
 
 
 def load_preset(name_or_path: str | os.PathLike[str]) -> Any:

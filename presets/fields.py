@@ -14,11 +14,31 @@ Example::
 
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Iterator
 from typing import Any
 
 from vtool.errors import InputError
+
+#: Longest list a preset may give for one field (coordinates, members, quantities, ...).
+MAX_LIST = 1000
+#: Longest string field (titles, notes, names).
+MAX_STRING = 10_000
+
+
+def as_float(value: Any) -> float:
+    """``float(value)`` for an int or float; an int too large for a float gives inf (refused later)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
+def closest(key: str, known: list[str]) -> str:
+    """`` (did you mean `rpm`?)`` for the known key nearest to ``key``, or ``""``."""
+    match = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
+    return f" (did you mean `{match[0]}`?)" if match else ""
 
 
 def _kind_of(value: Any) -> str:
@@ -56,6 +76,10 @@ class Table:
         if key in self.data:
             return self.data[key]
         if required:
+            typo = difflib.get_close_matches(key, [str(k) for k in self.data], n=1, cutoff=0.6)
+            if typo and typo[0] not in self._used:
+                raise InputError(self.field(typo[0]), self.data[typo[0]],
+                                 f"no such field (unknown key) (did you mean `{key}`?)")
             raise InputError(self.field(key), None, "a value (required field)")
         return default
 
@@ -79,7 +103,7 @@ class Table:
         expected = _range_text(min_value, min_exclusive, max_value, max_exclusive)
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise InputError(self.field(key), value, f"a number {expected}".strip(), unit)
-        value = float(value)
+        given, value = value, as_float(value)
         bad = (
             not math.isfinite(value)
             or (min_value is not None and value < min_value)
@@ -88,7 +112,7 @@ class Table:
             or (max_exclusive is not None and value >= max_exclusive)
         )
         if bad:
-            raise InputError(self.field(key), value, expected or "a finite number", unit)
+            raise InputError(self.field(key), given, expected or "a finite number", unit)
         return value
 
     def integer(
@@ -116,6 +140,8 @@ class Table:
             raise InputError(self.field(key), value, expected)
         if choices and value not in choices:
             raise InputError(self.field(key), value, f"one of: {', '.join(choices)}")
+        if len(value) > MAX_STRING:
+            raise InputError(self.field(key), value, f"a string of at most {MAX_STRING:,} characters")
         return value
 
     def boolean(self, key: str, *, default: bool | None = None) -> bool:
@@ -142,6 +168,8 @@ class Table:
         value = self._get(key, [], required)
         if not isinstance(value, list):
             raise InputError(self.field(key), _kind_of(value), "an array of tables")
+        if len(value) > MAX_LIST:
+            raise InputError(self.field(key), f"{len(value)} entries", f"at most {MAX_LIST} entries")
         return [Table(item, f"{self.field(key)}[{i}]") for i, item in enumerate(value)]
 
     def numbers(self, key: str, *, unit: str = "", default: list[float] | None = None) -> list[float]:
@@ -150,16 +178,32 @@ class Table:
             isinstance(v, bool) or not isinstance(v, int | float) for v in value
         ):
             raise InputError(self.field(key), value, "a list of numbers", unit)
-        return [float(v) for v in value]
+        if len(value) > MAX_LIST:
+            raise InputError(self.field(key), f"{len(value)} numbers", f"at most {MAX_LIST} numbers", unit)
+        numbers = [as_float(v) for v in value]
+        if not all(math.isfinite(v) for v in numbers):
+            raise InputError(self.field(key), value, "a list of finite numbers", unit)
+        return numbers
 
     def raw(self, key: str, default: Any = None) -> Any:
         return self._get(key, default, False)
 
     def finish(self) -> None:
-        """Reject keys that were never read (typos, unsupported settings)."""
+        """Reject keys that were never read (typos, unsupported settings), naming the closest known key.
+
+        Known keys are those the loader asked for, read or missing; a required
+        key asked for after an unknown one would report itself as missing, so
+        loaders that want the typo named call :meth:`check_unknown` first.
+        """
+        self.check_unknown(())
+
+    def check_unknown(self, known: tuple[str, ...] | list[str]) -> None:
+        """Reject keys neither read so far nor in ``known``, with the closest known key."""
+        allowed = sorted(self._used | set(known))
         for key in self.data:
-            if key not in self._used:
-                raise InputError(self.field(key), self.data[key], "no such field (unknown key)")
+            if key not in allowed:
+                raise InputError(self.field(key), self.data[key],
+                                 f"no such field (unknown key){closest(str(key), allowed)}")
 
 
 def _range_text(

@@ -4,17 +4,31 @@
 :class:`vtool.errors.InputError` naming the field, value, allowed range and
 unit. ``dump(spec)`` writes the same structure back, so a loaded-then-saved
 preset round-trips. See ``presets/gnilka-1a.toml`` for a commented example.
+
+Every number is finite and within a stated physical range (:data:`BOUNDS`,
+:data:`RUN_LIMITS`, the counts below), checked before any numerics, so no
+preset can reach the solver with values its floating-point arithmetic cannot
+carry. The ranges are wide (the same numbers in either unit system) and are
+listed in ``docs/limits.md``. The [run] settings are checked by
+:func:`check_run`, which also checks ``--rpm``, ``--dt``, ``--degrees`` and
+``--backend`` overrides (:func:`with_run_overrides`).
+
+A missing [damping] section loads with the default (ratio 0.1 on every mode,
+factor 1) and a :class:`vtool.errors.PresetWarning` saying so.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import math
 import re
+import warnings
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from vtool.errors import InputError
-from vtool.presets.fields import Table
+from vtool.errors import InputError, PresetWarning
+from vtool.presets.fields import Table, as_float
 from vtool.presets.lift_table import read_lift_table
 from vtool.solvers.assembly import split_members, unsplit_members
 from vtool.solvers.spec import (
@@ -46,6 +60,37 @@ STATIC_START = "static-start"
 MAX_DAMPING_RATIO = 1.0
 MAX_ELEMENTS = 64
 
+#: Most elastic coordinates, members, clearances (2^n configurations) and extra output quantities.
+MAX_COORDINATES = 100
+MAX_MEMBERS = 500
+MAX_CLEARANCES = 8
+MAX_QUANTITIES = 100
+
+#: Physical range of each kind of magnitude, in the preset's unit system (wide enough for both).
+BOUNDS: dict[str, tuple[float, float]] = {
+    "length": (1e-6, 1e4),
+    "area": (1e-12, 1e8),
+    "inertia": (1e-24, 1e16),
+    "modulus": (1e-3, 1e13),
+    "specific_weight": (1e-9, 1e9),
+    "density": (1e-12, 1e9),
+    "stiffness": (1e-6, 1e13),
+    "mass": (1e-15, 1e9),
+    "gravity": (1e-3, 1e5),
+    "force": (0.0, 1e9),
+    "lever_ratio": (1e-3, 1e3),
+    "position": (-1e4, 1e4),
+    "direction": (-3600.0, 3600.0),
+}
+
+#: [run] ranges (and of the --rpm, --dt, --degrees flags): key -> (min, max, unit).
+RUN_LIMITS: dict[str, tuple[float, float, str]] = {
+    "rpm": (1e-3, 1e6, "rev/min"),
+    "degrees": (1e-6, 3.6e6, "deg"),
+    "time_step": (1e-12, 1e-1, "s"),
+    "output_interval": (1e-6, 3.6e6, "deg"),
+}
+
 
 def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     """Validate a parsed valve-train preset and return its frozen spec.
@@ -53,12 +98,13 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     ``folder`` resolves a ``[cam] lift_table`` file (default: the working folder).
     """
     top = Table(doc, "")
+    top.check_unknown(TOP_KEYS)
     top.string("kind", choices=("valvetrain",))
     title = top.string("title", default="")
     notes = top.string("notes", default="")
     units_name = top.string("units", choices=tuple(UNIT_SYSTEMS))
     units = UNIT_SYSTEMS[units_name]
-    gravity = top.number("gravity", unit=units.acceleration, default=units.gravity, min_exclusive=0.0)
+    gravity = _magnitude(top, "gravity", units.acceleration, "gravity", default=units.gravity)
 
     coordinates = _coordinates(top)
     n = len(coordinates)
@@ -71,7 +117,13 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     names = {c.name: c for c in clearances}
     cam_name = next(c.name for c in clearances if c.behind == cam.coordinate)
     initial = _initial(top.table("initial"), names, cam_name, units)  # type: ignore[arg-type]
-    damping = _damping(top.table("damping", required=False), names)
+    damping_table = top.table("damping", required=False)
+    if damping_table is None:
+        warnings.warn(PresetWarning(
+            f"no [damping] section: modal damping ratio {DampingSpec().default_ratio:g} on every mode "
+            f"of every contact layer, factor {DampingSpec().factor:g} (add [damping] to choose)"),
+            stacklevel=2)
+    damping = _damping(damping_table, names)
     contact = _contact(top.table("contact", required=False))
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances))  # type: ignore[arg-type]
     top.finish()
@@ -108,11 +160,28 @@ def _contact(t: Table | None) -> ContactSpec:
     return ContactSpec(impact, scale)
 
 
+TOP_KEYS = ("kind", "title", "notes", "units", "gravity", "coordinates", "members", "cam", "seat",
+            "clearances", "initial", "contact", "damping", "run")
+
+
+def _magnitude(t: Table, key: str, unit: str, what: str, *, default: float | None = None,
+               required: bool | None = None) -> float:
+    """A number within :data:`BOUNDS` ``[what]`` (``None`` when optional and absent)."""
+    low, high = BOUNDS[what]
+    return t.number(key, unit=unit, default=default, required=required, min_value=low, max_value=high)
+
+
+def _count(field: str, items: list[Any] | tuple[Any, ...], most: int, what: str) -> None:
+    if len(items) > most:
+        raise InputError(field, f"{len(items)} {what}", f"at most {most} {what}")
+
+
 def _coordinates(top: Table) -> tuple[CoordinateSpec, ...]:
     tables = top.array_of_tables("coordinates")
     if not tables:
         raise InputError("coordinates", [], "at least one [[coordinates]] entry")
-    result = []
+    _count("coordinates", tables, MAX_COORDINATES, "coordinates")
+    result: list[CoordinateSpec] = []
     for number, t in enumerate(tables, start=1):
         name = t.string("name")
         motion = t.string("motion", choices=("translation", "rotation"))
@@ -129,7 +198,7 @@ def _coordinate_ref(t: Table, key: str, allowed: set[int], what: str) -> int:
 
 
 def _cam(t: Table, n: int, units: UnitSystem, folder: Path | None = None) -> CamSpec:
-    coordinate = t.integer("coordinate", min_value=n + 1)
+    coordinate = t.integer("coordinate", min_value=n + 1, max_value=n + 2)
     name = t.string("name", default="cam")
     profile = t.string("profile", default="harmonic", choices=("harmonic", "table"))
     table: dict[str, Any] = {}
@@ -137,14 +206,14 @@ def _cam(t: Table, n: int, units: UnitSystem, folder: Path | None = None) -> Cam
         table = _cam_table(t, units, folder)
         amplitude = 0.5 * max(table["lifts"])
     else:
-        amplitude = t.number("amplitude", unit=units.length, min_exclusive=0.0)
+        amplitude = _magnitude(t, "amplitude", units.length, "length")
     raw_offset = t.raw("offset", STATIC_START)
     if raw_offset == STATIC_START:
         offset = None
     elif isinstance(raw_offset, int | float) and not isinstance(raw_offset, bool):
         # the static start puts the follower on the cam with force k_eff * offset: a negative
         # offset would start with the cam contact in tension
-        offset = t.number("offset", unit=units.length, min_value=0.0)
+        offset = t.number("offset", unit=units.length, min_value=0.0, max_value=BOUNDS["length"][1])
     else:
         raise InputError(t.field("offset"), raw_offset, f'"{STATIC_START}" or a number', units.length)
     if table and offset is not None:
@@ -179,14 +248,15 @@ def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, An
 
 
 def _seat(t: Table, n: int, cam: CamSpec, units: UnitSystem) -> SeatSpec:
-    coordinate = t.integer("coordinate", min_value=n + 1)
+    coordinate = t.integer("coordinate", min_value=n + 1, max_value=n + 2)
     if coordinate == cam.coordinate:
         raise InputError(t.field("coordinate"), coordinate, f"a number other than the cam's ({cam.coordinate})")
     name = t.string("name", default="seat")
     lash = t.number("lash", unit=units.length, required=False)
     if (lash is not None) == t.has("position"):
         raise InputError(t.field("position"), t.raw("position"), "either position or lash, not both", units.length)
-    position = 0.0 if lash is not None else t.number("position", unit=units.length)
+    low, high = BOUNDS["position"]
+    position = 0.0 if lash is not None else t.number("position", unit=units.length, min_value=low, max_value=high)
     t.finish()
     return SeatSpec(coordinate, position, name, lash)
 
@@ -195,7 +265,7 @@ def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
     members = []
     for name, t in top.tables("members"):
         element = t.string("element", choices=(BAR, BEAM))
-        length = t.number("length", unit=units.length, min_exclusive=0.0)
+        length = _magnitude(t, "length", units.length, "length")
         coords = t.raw("coordinates")
         size = ELEMENT_SIZE[element]
         valid = (
@@ -208,22 +278,25 @@ def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
                 t.field("coordinates"), coords,
                 f"{size} signed coordinate numbers, each in -{n}..{n} (0 = ground)",
             )
-        opt = dict(required=False, min_exclusive=0.0)
-        diameter = t.number("diameter", unit=units.length, **opt)  # type: ignore[arg-type]
-        area = t.number("area", unit=f"{units.length}^2", **opt)  # type: ignore[arg-type]
-        inertia = t.number("inertia", unit=f"{units.length}^4", **opt)  # type: ignore[arg-type]
-        modulus = t.number("modulus", unit=units.pressure, **opt)  # type: ignore[arg-type]
-        specific_weight = t.number("specific_weight", unit=units.specific_weight, **opt)  # type: ignore[arg-type]
-        density = t.number("density", unit=units.density, **opt)  # type: ignore[arg-type]
-        stiffness = t.number("stiffness", unit=units.stiffness, **opt)  # type: ignore[arg-type]
-        mass = t.number("mass", unit=units.mass, **opt)  # type: ignore[arg-type]
+        diameter = _magnitude(t, "diameter", units.length, "length", required=False)
+        area = _magnitude(t, "area", f"{units.length}^2", "area", required=False)
+        inertia = _magnitude(t, "inertia", f"{units.length}^4", "inertia", required=False)
+        modulus = _magnitude(t, "modulus", units.pressure, "modulus", required=False)
+        specific_weight = _magnitude(t, "specific_weight", units.specific_weight, "specific_weight",
+                                     required=False)
+        density = _magnitude(t, "density", units.density, "density", required=False)
+        stiffness = _magnitude(t, "stiffness", units.stiffness, "stiffness", required=False)
+        mass = _magnitude(t, "mass", units.mass, "mass", required=False)
         position = None
         if t.has("position"):
             raw = t.numbers("position", unit=units.length)
-            if len(raw) != 2:
-                raise InputError(t.field("position"), raw, "two numbers [x, y]", units.length)
+            low, high = BOUNDS["position"]
+            if len(raw) != 2 or not all(low <= v <= high for v in raw):
+                raise InputError(t.field("position"), raw, f"two numbers [x, y], each in {low:g}..{high:g}",
+                                 units.length)
             position = (raw[0], raw[1])
-        direction = t.number("direction", unit="deg", default=0.0)
+        low, high = BOUNDS["direction"]
+        direction = t.number("direction", unit="deg", default=0.0, min_value=low, max_value=high)
         elements = t.integer("elements", default=1, min_value=1, max_value=MAX_ELEMENTS)
         t.finish()
         where = t.path
@@ -243,6 +316,7 @@ def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
         )
     if not members:
         raise InputError("members", {}, "at least one [members.NAME] table")
+    _count("members", members, MAX_MEMBERS, "members")
     used = {abs(c) for m in members for c in m.coordinates if c}
     for number in range(1, n + 1):
         if number not in used:
@@ -251,9 +325,11 @@ def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
 
 
 def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int) -> tuple[ClearanceSpec, ...]:
-    result = []
+    result: list[ClearanceSpec] = []
     elastic = set(range(1, n + 1))
-    for t in top.array_of_tables("clearances"):
+    tables = top.array_of_tables("clearances")
+    _count("clearances", tables, MAX_CLEARANCES, "clearances (2^n configurations)")
+    for t in tables:
         name = t.string("name")
         if any(c.name == name for c in result):
             raise InputError(t.field("name"), name, "a name not used by another clearance")
@@ -283,8 +359,8 @@ def _initial(t: Table, names: dict[str, ClearanceSpec], cam_name: str, units: Un
         if names[name].kind == EXTERNAL and name != cam_name:
             # the static start loads the mechanism at the follower only; it cannot put the valve on its seat
             raise InputError(t.field("closed"), name, f"only the cam clearance ('{cam_name}') and internal clearances")
-    preload = t.number("spring_preload", unit=units.force, min_value=0.0)
-    ratio = t.number("lever_ratio", min_exclusive=0.0)
+    preload = _magnitude(t, "spring_preload", units.force, "force")
+    ratio = _magnitude(t, "lever_ratio", "", "lever_ratio")
     velocities = t.string("velocities", default=InitialSpec.velocities, choices=START_VELOCITIES)
     t.finish()
     return InitialSpec(closed, preload, ratio, velocities)
@@ -293,7 +369,7 @@ def _initial(t: Table, names: dict[str, ClearanceSpec], cam_name: str, units: Un
 def _names(t: Table, key: str, names: dict[str, ClearanceSpec], kinds: tuple[str, ...] = (EXTERNAL, INTERNAL)) -> tuple[str, ...]:
     value = t.raw(key, None)
     allowed = [n for n, c in names.items() if c.kind in kinds]
-    if not isinstance(value, list) or any(v not in allowed for v in value):
+    if not isinstance(value, list) or any(not isinstance(v, str) or v not in allowed for v in value):
         raise InputError(t.field(key), value, f"a list of clearance names from: {', '.join(allowed)}")
     return tuple(value)
 
@@ -305,9 +381,9 @@ def _ratio(t: Table, key: str, default: float | None = None) -> float:
 def _damping(t: Table | None, names: dict[str, ClearanceSpec]) -> DampingSpec:
     if t is None:
         return DampingSpec()
-    factor = t.number("factor", default=1.0, min_value=0.0)
+    factor = t.number("factor", default=1.0, min_value=0.0, max_value=1e6)
     default_ratio = _ratio(t, "default_ratio", 0.1)
-    layers = []
+    layers: list[LayerDampingSpec] = []
     for lt in t.array_of_tables("layers", required=False):
         closed = _names(lt, "closed", names, (INTERNAL,))
         ratio = _ratio(lt, "default_ratio", default_ratio)
@@ -315,12 +391,15 @@ def _damping(t: Table | None, names: dict[str, ClearanceSpec]) -> DampingSpec:
         mt = lt.table("mode_ratios", required=False)
         if mt is not None:
             for key in list(mt.data):
-                if not key.isdigit() or int(key) < 1:
+                if not (key.isdigit() and len(key) <= 3 and 1 <= int(key) <= MAX_COORDINATES):
                     raise InputError(mt.field(key), key, "a mode number 1, 2, ... (ascending frequency)")
                 overrides.append((int(key), _ratio(mt, key)))
             mt.finish()
         lt.finish()
-        layers.append(LayerDampingSpec(tuple(sorted(closed)), ratio, tuple(sorted(overrides))))
+        if any(set(layer.closed) == set(closed) for layer in layers):
+            raise InputError(lt.field("closed"), list(closed),
+                             "a set of closed clearances no other [[damping.layers]] entry names")
+        layers.append(LayerDampingSpec(tuple(sorted(set(closed))), ratio, tuple(sorted(overrides))))
     t.finish()
     largest = max([default_ratio] + [lay.default_ratio for lay in layers]
                   + [r for lay in layers for _, r in lay.mode_ratios])
@@ -344,6 +423,7 @@ def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...
                 f"(i in {sorted(forces)})")
     if not isinstance(value, list):
         raise InputError(t.field("quantities"), value, expected)
+    _count(t.field("quantities"), value, MAX_QUANTITIES, "quantities")
     for item in value:
         match = QUANTITY.fullmatch(item) if isinstance(item, str) else None
         ok = match is not None and (
@@ -355,17 +435,62 @@ def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...
     return tuple(value)
 
 
+RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta", "gamma", "quantities")
+
+
 def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
-    rpm = t.number("rpm", unit="rev/min", min_exclusive=0.0)
-    degrees = t.number("degrees", unit="deg", min_exclusive=0.0)
-    time_step = t.number("time_step", unit="s", min_exclusive=0.0)
+    t.check_unknown(RUN_KEYS)
+    def limited(key: str, default: float | None = None) -> float:
+        low, high, unit = RUN_LIMITS[key]
+        return t.number(key, unit=unit, default=default, min_value=low, max_value=high)
+
+    rpm = limited("rpm")
+    degrees = limited("degrees")
+    time_step = limited("time_step")
     backend = t.string("backend", default="newmark")
-    output_interval = t.number("output_interval", unit="deg", default=1.0, min_exclusive=0.0)
-    beta = t.number("beta", default=1.0 / 6.0, min_exclusive=0.0, max_value=0.5)
-    gamma = t.number("gamma", default=0.5, min_value=0.5, max_value=1.0)
+    output_interval = limited("output_interval", 1.0)
+    beta = t.number("beta", default=1.0 / 6.0)
+    gamma = t.number("gamma", default=0.5)
     quantities = _quantities(t, *names)
     t.finish()
-    return RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities)
+    return check_run(RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities))
+
+
+def check_run_value(key: str, value: Any, field: str | None = None) -> Any:
+    """One [run] setting checked against :data:`RUN_LIMITS` (and beta, gamma, backend); returns it.
+
+    ``field`` names it in the error (default ``run.KEY``; the CLI passes ``--rpm``).
+    """
+    field = field or f"run.{key}"
+    if key == "backend":
+        from vtool.solvers.backends import available
+
+        if value not in available():
+            raise InputError(field, value, f"one of the installed back ends: {', '.join(available())}")
+        return value
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise InputError(field, value, "a number")
+    number = as_float(value)
+    if key == "beta":
+        low, high, unit, text = 0.0, 0.5, "", "> 0 and <= 0.5"
+        ok = math.isfinite(number) and low < number <= high
+    elif key == "gamma":
+        low, high, unit, text = 0.5, 1.0, "", ">= 0.5 and <= 1"
+        ok = math.isfinite(number) and low <= number <= high
+    else:
+        low, high, unit = RUN_LIMITS[key]
+        text = f">= {low:g} and <= {high:g}"
+        ok = math.isfinite(number) and low <= number <= high
+    if not ok:
+        raise InputError(field, value, text, unit)
+    return number
+
+
+def check_run(run: RunSpec) -> RunSpec:
+    """The [run] settings checked by :func:`check_run_value`, field by field; returns ``run``."""
+    for key in ("rpm", "degrees", "time_step", "output_interval", "beta", "gamma", "backend"):
+        check_run_value(key, getattr(run, key))
+    return run
 
 
 def dump(spec: MechanismSpec) -> dict[str, Any]:
@@ -418,7 +543,7 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
     }
     doc["contact"] = {"impact": spec.contact.impact, "rocker_scale": spec.contact.rocker_scale}
     damping: dict[str, Any] = {"factor": spec.damping.factor, "default_ratio": spec.damping.default_ratio}
-    layers = []
+    layers: list[dict[str, Any]] = []
     for layer in spec.damping.layers:
         entry = {"closed": list(layer.closed), "default_ratio": layer.default_ratio}
         if layer.mode_ratios:
@@ -437,12 +562,31 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
     return doc
 
 
+RPM_IN_TITLE = re.compile(r"\b\d{1,3}(?:,\d{3})*(?:\.\d+)?\s*RPM\b|\b\d+(?:\.\d+)?\s*RPM\b", re.IGNORECASE)
+
+
+def rpm_title(title: str, rpm: float) -> str:
+    """The title with its speed replaced by ``rpm`` and marked ``(override)``, or the speed appended."""
+    speed = f"{rpm:,.0f}" if rpm >= 10 and float(rpm).is_integer() else f"{rpm:,.6g}"
+    text = f"{speed} RPM (override)"
+    if RPM_IN_TITLE.search(title):
+        return RPM_IN_TITLE.sub(text, title, count=1)
+    return f"{title} at {text}" if title else f"at {text}"
+
+
 def with_run_overrides(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
-    """The spec with some [run] settings changed, validated like a preset.
+    """The spec with some [run] settings changed, checked by :func:`check_run` as the loader does.
 
     ``changes`` uses the preset's [run] keys (rpm, degrees, time_step, backend,
-    output_interval, beta, gamma); ``None`` values are ignored.
+    output_interval, beta, gamma); ``None`` values are ignored. A changed speed
+    is written into the title ("... 10,500 RPM (override) ...").
     """
-    doc = dump(spec)
-    doc["run"].update({key: value for key, value in changes.items() if value is not None})
-    return load(doc)
+    given = {key: value for key, value in changes.items() if value is not None}
+    unknown = sorted(set(given) - set(RUN_KEYS))
+    if unknown:
+        raise InputError(f"run.{unknown[0]}", given[unknown[0]], f"one of: {', '.join(RUN_KEYS)}")
+    run = check_run(dataclasses.replace(spec.run, **given))
+    title = spec.title
+    if "rpm" in given and run.rpm != spec.run.rpm:
+        title = rpm_title(title, run.rpm)
+    return dataclasses.replace(spec, run=run, title=title)

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+from vtool.errors import RunError
+
 #: A mode whose ω is below this fraction of the largest ω is a rigid-body mode.
 RIGID_BODY_TOLERANCE = 1e-7
 
@@ -37,10 +39,22 @@ class Modes:
 def undamped_modes(M: np.ndarray, K: np.ndarray) -> Modes:
     """Solve K φ = ω² M φ; rigid-body eigenvalues are set to exactly zero.
 
+    A mass matrix that is not positive definite (to working precision) is a
+    :class:`vtool.errors.RunError` naming the inputs that make it so.
+
     Each shape is signed so that its largest-magnitude entry is positive, which
     makes printed shapes reproducible.
     """
-    eigenvalues, shapes = scipy.linalg.eigh(K, M)
+    if not (np.all(np.isfinite(M)) and np.all(np.isfinite(K))):
+        raise RunError("natural modes: the mass or stiffness matrix has non-finite entries; "
+                       "check the members' section, modulus, density and gravity")
+    try:
+        eigenvalues, shapes = scipy.linalg.eigh(K, M)
+    except (np.linalg.LinAlgError, ValueError) as exc:
+        raise RunError(f"natural modes could not be computed ({str(exc).splitlines()[0][:80]}): the mass "
+                       "matrix is not positive definite to working precision; check the members' "
+                       "mass, density, specific_weight, section and gravity (masses of very different "
+                       "size)") from None
     scale = max(float(np.max(np.abs(eigenvalues))), 1e-300)
     eigenvalues = np.where(np.abs(eigenvalues) < RIGID_BODY_TOLERANCE**2 * scale, 0.0, eigenvalues)
     omega = np.sqrt(np.clip(eigenvalues, 0.0, None))

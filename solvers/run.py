@@ -1,17 +1,63 @@
 """One call from a valve-train spec to its trace: assemble, pick the back end, simulate.
 
 The CLI, the TUI, the benchmarks and a user's own script all go through
-:func:`simulate`, so they share one code path.
+:func:`simulate`, so they share one code path. Before the back end starts,
+the run's cost is estimated and refused above the limits
+(:mod:`vtool.solvers.cost`), and a seat the valve never reaches is a
+:class:`vtool.errors.PresetWarning` (:mod:`vtool.solvers.preflight`). A
+numerical failure inside the run (a singular matrix, an overflow, a
+non-finite result) is a :class:`vtool.errors.RunError` naming what failed.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 
-from vtool.solvers import backends
-from vtool.solvers.model import assemble
+import numpy as np
+
+from vtool.errors import PresetWarning, RunError
+from vtool.solvers import backends, cost
+from vtool.solvers.damping import undamped_modes
+from vtool.solvers.model import Mechanism, assemble
+from vtool.solvers.preflight import seat_reach_warning
 from vtool.solvers.spec import MechanismSpec
 from vtool.solvers.trace import Trace
+
+#: Numerical failures turned into a RunError (the input is valid but the numbers are not).
+NUMERICAL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError)
+
+
+def run_cost(mechanism: Mechanism, every_step: bool = False) -> cost.Estimate:
+    """The estimated steps and memory of the spec's run on this mechanism."""
+    spec = mechanism.spec
+    r = spec.run
+    omega_max = float(undamped_modes(mechanism.M, mechanism.K).omega.max())
+    n_sources = 1 + (spec.seat is not None)
+    return cost.estimate(backend=r.backend, rpm=r.rpm, degrees=r.degrees, time_step=r.time_step,
+                         output_interval=r.output_interval, every_step=every_step, omega_max=omega_max,
+                         n_coordinates=spec.n_coordinates, n_sources=n_sources,
+                         n_clearances=len(spec.clearances), n_quantities=len(r.quantities))
+
+
+def _assemble(spec: MechanismSpec) -> Mechanism:
+    try:
+        return assemble(spec)
+    except NUMERICAL_FAILURES as exc:
+        raise RunError(f"assembling the mechanism failed ({type(exc).__name__}: {str(exc)[:80]}); "
+                       "check the members' sections, moduli and masses") from None
+
+
+def _check_finite(trace: Trace) -> Trace:
+    for name in ("q", "qd", "qdd", "contact_force"):
+        values = getattr(trace, name)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            row = int(np.argwhere(bad)[0][0])
+            raise RunError(f"the run diverged: non-finite {name} at t = {trace.time[row]:.6g} s "
+                           f"(cam angle {trace.cam_angle[row]:.4g} deg); likely too large a time step "
+                           "or stiffnesses and masses of very different size")
+    return trace
 
 
 def simulate(
@@ -21,15 +67,31 @@ def simulate(
     progress: Callable[[float], None] | None = None,
     cancel: Callable[[], bool] | None = None,
     options: object | None = None,
+    max_steps: float | None = None,
+    max_bytes: float | None = None,
 ) -> Trace:
-    """Run the preset's back end (``spec.run.backend``) on the assembled mechanism."""
+    """Run the preset's back end (``spec.run.backend``) on the assembled mechanism.
+
+    ``max_steps`` and ``max_bytes`` override the cost limits
+    (:data:`vtool.solvers.cost.MAX_STEPS`, :data:`vtool.solvers.cost.MAX_BYTES`).
+    """
     backend = backends.get(spec.run.backend)()
-    mechanism = assemble(spec)
+    mechanism = _assemble(spec)
+    cost.check(run_cost(mechanism, every_step), max_steps, max_bytes)
+    reach = seat_reach_warning(mechanism)
+    if reach is not None:
+        warnings.warn(PresetWarning(reach), stacklevel=2)
     if options is None:
         options = backend.options_from_run(spec.run, every_step)
-    return backend.simulate(
-        mechanism,
-        options,
-        progress=progress if backend.supports_progress else None,
-        cancel=cancel if backend.supports_cancel else None,
-    )
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            trace = backend.simulate(
+                mechanism,
+                options,
+                progress=progress if backend.supports_progress else None,
+                cancel=cancel if backend.supports_cancel else None,
+            )
+    except NUMERICAL_FAILURES as exc:
+        raise RunError(f"{spec.run.backend} run failed ({type(exc).__name__}: {str(exc)[:80]}); likely "
+                       "input: the time step, or stiffnesses and masses of very different size") from None
+    return _check_finite(trace)

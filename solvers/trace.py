@@ -176,9 +176,9 @@ class Trace:
         self.write_csv_to(buffer, quantities)
         return buffer.getvalue()
 
-    def write_csv(self, path: str, quantities: tuple[str, ...] | None = None) -> None:
+    def write_csv(self, path: str, quantities: tuple[str, ...] | None = None, field: str = "output") -> None:
         """Write the CSV atomically, block by block (the preset's quantities by default)."""
-        with open_atomic(path) as handle:
+        with open_atomic(path, field) as handle:
             self.write_csv_to(handle, self.spec.run.quantities if quantities is None else quantities)
 
     # ----- summary -----

@@ -85,7 +85,7 @@ BROKEN = {
     "r1-out-of-range.toml": "boom.r1: got 1.2, expected >= 0 and < 1",
     "negative-mass.toml": "walls[0].surface_weight: got -0.2473, expected >= 1.45e-07 and <= 145 lbf/in^2",
     "negative-frequency.toml": "walls[0].measured_frequency: got -17.5, expected >= 0.01 and <= 1000 Hz",
-    "unknown-key.toml": "walls[0].thicknes: got 4.5, expected no such field (unknown key)",
+    "unknown-key.toml": "walls[0].thicknes: got 4.5, expected no such field (unknown key) (did you mean `thickness`?)",
 }
 
 

@@ -557,14 +557,14 @@ def test_many_events_are_all_recorded() -> None:
 
 LIMITS = [
     # (path in the preset, bad value, field, expected, unit)
-    (("run", "rpm"), 0.0, "run.rpm", "> 0", "rev/min"),
-    (("run", "degrees"), 0.0, "run.degrees", "> 0", "deg"),
-    (("run", "time_step"), 0.0, "run.time_step", "> 0", "s"),
-    (("run", "output_interval"), 0.0, "run.output_interval", "> 0", "deg"),
+    (("run", "rpm"), 0.0, "run.rpm", ">= 0.001 and <= 1e+06", "rev/min"),
+    (("run", "degrees"), 0.0, "run.degrees", ">= 1e-06 and <= 3.6e+06", "deg"),
+    (("run", "time_step"), 0.0, "run.time_step", ">= 1e-12 and <= 0.1", "s"),
+    (("run", "output_interval"), 0.0, "run.output_interval", ">= 1e-06 and <= 3.6e+06", "deg"),
     (("run", "beta"), 0.0, "run.beta", "> 0 and <= 0.5", ""),
     (("run", "beta"), 0.6, "run.beta", "> 0 and <= 0.5", ""),
     (("run", "gamma"), 0.4, "run.gamma", ">= 0.5 and <= 1", ""),
-    (("cam", "amplitude"), 0.0, "cam.amplitude", "> 0", "in"),
+    (("cam", "amplitude"), 0.0, "cam.amplitude", ">= 1e-06 and <= 10000", "in"),
     (("cam", "offset"), -1.0, "cam.offset", ">= 0", "in"),
     (("clearances", 2, "restitution"), 1.1, "clearances[2].restitution", ">= 0 and <= 1", ""),
     (("clearances", 0, "restitution"), -0.1, "clearances[0].restitution", ">= 0 and <= 1", ""),
@@ -572,11 +572,11 @@ LIMITS = [
     (("damping", "layers", 1, "mode_ratios", "2"), 1.5, "damping.layers[1].mode_ratios.2", ">= 0 and <= 1", ""),
     (("damping", "factor"), -1.0, "damping.factor", ">= 0", ""),
     (("initial", "spring_preload"), -1.0, "initial.spring_preload", ">= 0", "lbf"),
-    (("initial", "lever_ratio"), 0.0, "initial.lever_ratio", "> 0", ""),
-    (("members", "valve_spring", "stiffness"), 0.0, "members.valve_spring.stiffness", "> 0", "lbf/in"),
-    (("members", "pushrod", "length"), -9.0, "members.pushrod.length", "> 0", "in"),
-    (("members", "pushrod", "modulus"), 0.0, "members.pushrod.modulus", "> 0", "lbf/in^2"),
-    (("gravity",), 0.0, "gravity", "> 0", "in/s^2"),
+    (("initial", "lever_ratio"), 0.0, "initial.lever_ratio", ">= 0.001 and <= 1000", ""),
+    (("members", "valve_spring", "stiffness"), 0.0, "members.valve_spring.stiffness", ">= 1e-06 and <= 1e+13", "lbf/in"),
+    (("members", "pushrod", "length"), -9.0, "members.pushrod.length", ">= 1e-06 and <= 10000", "in"),
+    (("members", "pushrod", "modulus"), 0.0, "members.pushrod.modulus", ">= 0.001 and <= 1e+13", "lbf/in^2"),
+    (("gravity",), 0.0, "gravity", ">= 0.001 and <= 100000", "in/s^2"),
 ]
 
 

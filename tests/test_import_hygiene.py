@@ -13,6 +13,8 @@ HEADLESS = [
     "vtool.presets",
     "vtool.errors",
     "vtool.files",
+    "vtool.units",
+    "vtool.numba_cache",
 ]
 
 
@@ -53,3 +55,22 @@ def test_cli_help_imports_no_numerics() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""
+
+
+def test_import_linter_contracts_are_kept(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """pyproject's import-linter contracts (layers, no UI below app/, solvers without presets)."""
+    from tests import typing_tree
+
+    result = typing_tree.run_lint_imports(typing_tree.build(tmp_path))
+    assert result.returncode == 0, result.stdout[-4000:] + result.stderr[-2000:]
+    assert "0 broken" in result.stdout
+
+
+def test_the_kinds_table_names_importable_code() -> None:
+    """Every dotted path in presets/kinds.py KINDS resolves (the CLI and the TUI read it)."""
+    from vtool.presets.kinds import KINDS, resolve
+
+    for kind in KINDS.values():
+        assert isinstance(resolve(kind.spec_type), type)
+        assert hasattr(resolve(kind.loader), "load") and callable(resolve(kind.solve))
+        assert resolve(kind.screen).__name__ == kind.screen

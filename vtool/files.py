@@ -1,52 +1,165 @@
-"""Atomic file output: a failed run never leaves a half-written file."""
+"""Atomic file output: a failed run never leaves a half-written file.
+
+:func:`write_atomic` writes a temporary file beside the target and renames it
+over the target, so an existing file is either replaced whole or left intact
+(also under SIGINT; SIGKILL can leave the hidden temporary, which the next
+write to the same path removes). It refuses, in one line
+(:class:`vtool.errors.InputError`), a missing or read-only folder, a folder or
+a device node at the output path, and an empty path; a symlink is written
+through to its target (the link itself is kept). A failure while writing (a
+full disk) is a :class:`vtool.errors.RunError`; nothing partial is left.
+"""
 
 from __future__ import annotations
 
 import contextlib
+import errno
+import glob
 import os
+import stat
 import tempfile
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TextIO
 
+from vtool.errors import InputError, RunError
 
-def write_atomic(path: str | os.PathLike[str], text: str) -> None:
-    """Write text to ``path`` through a temporary file and a rename.
+#: Temporaries of a dead process (or older than this, in s, when it cannot be told) are removed.
+STALE_AFTER = 3600.0
+
+
+def _tmp_prefix(path: Path) -> str:
+    return f".{path.name}."
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):
+        return True
+    return True
+
+
+def clean_stale_temporaries(path: str | os.PathLike[str]) -> list[Path]:
+    """Remove hidden ``.NAME.PID.*.tmp`` files a killed write to ``path`` left; returns them."""
+    path = Path(path)
+    removed: list[Path] = []
+    try:
+        siblings = list(path.parent.glob(f"{glob.escape(_tmp_prefix(path))}*.tmp"))
+    except OSError:
+        return removed
+    for tmp in siblings:
+        middle = tmp.name[len(_tmp_prefix(path)):].split(".")[0]
+        try:
+            stale = (not _pid_alive(int(middle))) if middle.isdigit() else (
+                time.time() - tmp.stat().st_mtime > STALE_AFTER)
+            if stale:
+                tmp.unlink()
+                removed.append(tmp)
+        except OSError:
+            continue
+    return removed
+
+
+def check_output_path(path: str | os.PathLike[str], field: str = "output") -> Path:
+    """The real file to write for ``path`` (symlinks followed), or a one-line InputError."""
+    if str(path) == "":
+        raise InputError(field, "", "a file path")
+    path = Path(path)
+    target = Path(os.path.realpath(path)) if path.is_symlink() else path
+    directory = target.parent if str(target.parent) else Path(".")
+    if not directory.is_dir():
+        raise InputError(field, str(path), f"a file in an existing folder ({directory} does not exist)")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise InputError(field, str(path), f"a file in a writable folder ({directory} is read-only)")
+    try:
+        mode = target.stat().st_mode
+    except FileNotFoundError:
+        return target
+    except OSError as exc:
+        raise InputError(field, str(path), f"a writable file path ({exc.strerror})") from None
+    if stat.S_ISDIR(mode):
+        raise InputError(field, str(path), "a file path, not a folder")
+    if not stat.S_ISREG(mode):
+        raise InputError(field, str(path), "a regular file path (not a device, pipe or socket)")
+    if not os.access(target, os.W_OK):
+        raise InputError(field, str(path), "a writable file (this one is read-only)")
+    return target
+
+
+def write_atomic(path: str | os.PathLike[str], text: str, field: str = "output") -> None:
+    """Write text to ``path`` through a temporary file and a rename (see module doc).
 
     A failure part-way leaves any existing file untouched and no partial file.
     """
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
-            handle.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with open_atomic(path, field) as handle:
+        handle.write(text)
 
 
 @contextlib.contextmanager
-def open_atomic(path: str | os.PathLike[str]) -> Iterator[TextIO]:
+def open_atomic(path: str | os.PathLike[str], field: str = "output") -> Iterator[TextIO]:
     """A text file handle whose content replaces ``path`` only when the block ends without error.
 
-    For output written in pieces (a long CSV): like :func:`write_atomic`, a
-    failure part-way leaves any existing file untouched and no partial file.
+    For output written in pieces (a long CSV written block by block); the same
+    checks and guarantees as :func:`write_atomic` (see the module doc).
     """
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
+    target = check_output_path(path, field)
+    directory = target.parent if str(target.parent) else Path(".")
+    clean_stale_temporaries(target)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f"{_tmp_prefix(target)}{os.getpid()}.", suffix=".tmp",
+                                   dir=directory)
+    except OSError as exc:
+        raise InputError(field, str(path), f"a file in a writable folder ({exc.strerror})") from None
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
             yield handle
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
+        os.replace(tmp, target)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        reason = "the disk is full" if exc.errno in (errno.ENOSPC, errno.EDQUOT) else exc.strerror
+        raise RunError(f"could not write {path}: {reason}; nothing was written") from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def finite_json(data: object) -> tuple[object, list[str]]:
+    """``data`` with every NaN or infinite float replaced by ``None``, and where each was.
+
+    JSON has no NaN or Infinity; :func:`json_text` writes the places as
+    ``"non_finite": ["clearances[2].peak_force: nan", ...]`` beside them.
+    """
+    import math
+
+    places: list[str] = []
+
+    def clean(value: object, where: str) -> object:
+        if isinstance(value, float) and not math.isfinite(value):
+            places.append(f"{where}: {value}")
+            return None
+        if isinstance(value, dict):
+            return {k: clean(v, f"{where}.{k}" if where else str(k)) for k, v in value.items()}
+        if isinstance(value, list | tuple):
+            return [clean(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        if hasattr(value, "tolist") and hasattr(value, "dtype"):  # numpy scalars and arrays
+            return clean(value.tolist(), where)
+        return value
+
+    return clean(data, ""), places
+
+
+def json_text(data: object, indent: int | None = 2) -> str:
+    """Strict JSON (no NaN/Infinity): non-finite numbers become null, listed under ``non_finite``."""
+    import json
+
+    cleaned, places = finite_json(data)
+    if places and isinstance(cleaned, dict):
+        cleaned["non_finite"] = places
+    return json.dumps(cleaned, indent=indent, allow_nan=False)

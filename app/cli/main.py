@@ -7,7 +7,8 @@ table :data:`COMMANDS` maps its name to ``module:attribute`` so that
 User mistakes (:class:`vtool.errors.InputError`, click usage errors) end with a
 one-line message on stderr and exit code 2; a failed run
 (:class:`vtool.errors.RunError`) ends with its message and exit code 1. No
-traceback is shown for either.
+traceback is shown for either. Warnings (:class:`vtool.errors.PresetWarning`)
+are one ``warning: ...`` line each on stderr.
 """
 
 from __future__ import annotations
@@ -15,11 +16,13 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import sys
+import warnings
+from typing import Any
 
 import click
 
 from vtool import __version__
-from vtool.errors import InputError, RunError
+from vtool.errors import InputError, PresetWarning, RunError, one_line
 
 COMMANDS: dict[str, tuple[str, str]] = {
     "solve": ("vtool.app.cli.solve", "solve"),
@@ -53,14 +56,45 @@ class LazyGroup(click.Group):
         return getattr(importlib.import_module(module), attribute)
 
     def invoke(self, ctx: click.Context):  # type: ignore[no-untyped-def]
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", PresetWarning)
+            warnings.showwarning = _show_warning
+            try:
+                return super().invoke(ctx)
+            except InputError as exc:
+                click.echo(f"error: {exc.one_line()}", err=True)
+                ctx.exit(2)
+            except RunError as exc:
+                click.echo(f"run failed: {one_line(str(exc), 400)}", err=True)
+                ctx.exit(1)
+
+    def main(self, *args: Any, **kwargs: Any) -> Any:
+        """click's main, with usage errors on one line (``error: ...``, exit 2) instead of four."""
+        standalone = kwargs.pop("standalone_mode", True)
         try:
-            return super().invoke(ctx)
-        except InputError as exc:
-            click.echo(f"error: {exc.one_line()}", err=True)
-            ctx.exit(2)
-        except RunError as exc:
-            click.echo(f"run failed: {exc}", err=True)
-            ctx.exit(1)
+            result = super().main(*args, standalone_mode=False, **kwargs)
+            code = result if isinstance(result, int) else 0
+        except click.exceptions.UsageError as exc:
+            where = f" (see `{exc.ctx.command_path} --help`)" if exc.ctx is not None else ""
+            click.echo(f"error: {one_line(exc.format_message(), 300)}{where}", err=True)
+            code = 2
+        except click.ClickException as exc:
+            click.echo(f"error: {one_line(exc.format_message(), 300)}", err=True)
+            code = exc.exit_code
+        except click.exceptions.Abort:
+            click.echo("interrupted: nothing was written", err=True)
+            code = 130
+        except KeyboardInterrupt:
+            click.echo("interrupted: nothing was written", err=True)
+            code = 130
+        if standalone:
+            sys.exit(code)
+        return code
+
+
+def _show_warning(message: Warning | str, category: type[Warning], *args: Any, **kwargs: Any) -> None:
+    """Every warning as one line on stderr: ``warning: ...``."""
+    click.echo(f"warning: {one_line(str(message), 400)}", err=True)
 
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
-import json
 import math
 
 import click
 import numpy as np
+
+from vtool.errors import RunError
+from vtool.files import json_text
 
 
 @click.command()
@@ -17,13 +19,17 @@ def modes(preset: str, as_json: bool) -> None:
     contact layer, with the static start (cam offset XZERO, follower force FZERO)."""
     from vtool.presets import load_preset
     from vtool.solvers.assembly import surge_labels
+    from vtool.presets.kinds import require_kind
     from vtool.solvers.model import assemble
+    from vtool.solvers.run import NUMERICAL_FAILURES
 
     spec = load_preset(preset)
-    if getattr(spec, "kind", "") != "valvetrain":
-        raise click.BadParameter(f"{preset} is a {spec.kind} preset; `vtool modes` needs a valvetrain preset",
-                                 param_hint="PRESET")
-    mechanism = assemble(spec)
+    require_kind(spec, "valvetrain", "`vtool modes`")
+    try:
+        mechanism = assemble(spec)
+    except NUMERICAL_FAILURES as exc:
+        raise RunError(f"assembling the mechanism failed ({type(exc).__name__}); check the members' "
+                       "sections, moduli and masses") from None
     units = spec.unit_system
     report = {
         "preset": preset,
@@ -54,7 +60,7 @@ def modes(preset: str, as_json: bool) -> None:
         report["seat_position"] = {"value": spec.seat.position, "unit": units.length}
         report["lash"] = {"value": lash_of(spec), "unit": units.length}
     if as_json:
-        click.echo(json.dumps(report, indent=2))
+        click.echo(json_text(report))
         return
     click.echo(f"{spec.title}  [{spec.units}]")
     click.echo(f"cam offset XZERO   = {mechanism.start.cam_offset:.8f} {units.length}")

@@ -42,5 +42,5 @@ def copy_command(name: str, dest: Path, force: bool) -> None:
     target = dest / source.name if dest.is_dir() else dest
     if target.exists() and not force:
         raise InputError("dest", str(target), "a path that does not exist yet (or --force)")
-    write_atomic(target, source.read_text(encoding="utf-8"))
+    write_atomic(target, source.read_text(encoding="utf-8"), "DEST")
     click.echo(f"copied {source.stem} to {target}")

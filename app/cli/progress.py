@@ -1,4 +1,4 @@
-"""A progress bar for runs longer than a second (stderr, nothing for short runs)."""
+"""A progress bar for runs longer than a second (stderr, nothing for short runs or a non-terminal)."""
 
 from __future__ import annotations
 
@@ -16,10 +16,12 @@ class DelayedProgress:
         self.started = time.perf_counter()
         self.bar = None
         self.shown = 0
+        # a bar on a file or pipe is one label with no newline, which would run into an error line
+        self.interactive = click.get_text_stream("stderr").isatty()
 
     def __call__(self, fraction: float) -> None:
         if self.bar is None:
-            if time.perf_counter() - self.started < self.delay:
+            if time.perf_counter() - self.started < self.delay or not self.interactive:
                 return
             self.bar = click.progressbar(length=1000, label=self.label, file=click.get_text_stream("stderr"))
             self.bar.__enter__()

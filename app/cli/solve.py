@@ -1,62 +1,106 @@
-"""``vtool solve PRESET``: the one batch entry point for every preset kind."""
+"""``vtool solve PRESET``: the one batch entry point for every preset kind.
+
+The preset's kind picks what runs, from the one kinds table
+(:data:`vtool.presets.kinds.KINDS`). The valve-train flags are checked at the
+flag, by the same function the preset loader uses
+(:func:`vtool.presets.valvetrain.check_run_value`); ``--backend`` lists the
+installed back ends. The output path is checked before the run starts, and
+a run's cost is estimated and refused above ``--max-steps`` before the back
+end starts (:mod:`vtool.solvers.cost`).
+"""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
+from typing import Any
 
 import click
 
 from vtool.app.cli.options import impact_option, start_velocities_option
+from vtool.errors import InputError
+from vtool.solvers.backends import available
+from vtool.solvers.cost import MAX_STEPS
+
+
+def _run_flag(key: str) -> Any:
+    """A click callback checking a [run] override with the loader's own check."""
+
+    def callback(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
+        if value is None:
+            return None
+        from vtool.presets.valvetrain import check_run_value
+
+        return check_run_value(key, value, f"--{param.name}" if key != "time_step" else "--dt")
+
+    return callback
+
+
+def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
+    if value is not None and not 1.0 <= value <= 1e12:
+        raise InputError("--max-steps", value, ">= 1 and <= 1e12 steps")
+    return value
 
 
 @click.command()
 @click.argument("preset")
-@click.option("--backend", help="Back end (newmark, ...); default: the preset's.")
-@click.option("--dt", type=float, help="Time step (s); default: the preset's.")
-@click.option("--rpm", type=float, help="Cam speed (rev/min); default: the preset's.")
-@click.option("--degrees", type=float, help="Degrees of cam rotation to run; default: the preset's.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("--backend", type=click.Choice(available()), help="Back end; default: the preset's.")
+@click.option("--dt", type=float, callback=_run_flag("time_step"),
+              help="Time step (s, 1e-12 to 0.1); default: the preset's.")
+@click.option("--rpm", type=float, callback=_run_flag("rpm"),
+              help="Cam speed (rev/min, 0.001 to 1e6); default: the preset's.")
+@click.option("--degrees", type=float, callback=_run_flag("degrees"),
+              help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's.")
+@click.option("--max-steps", type=float, callback=_max_steps,
+              help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}).")
+@click.option("--csv", "csv_path", type=click.Path(),  # a str: '' stays '' in the error
               help="Write the response as CSV (per output interval, or per step with --every-step).")
 @click.option("--every-step", is_flag=True, help="CSV rows at every time step (and event) instead of per degree.")
-@click.option("--plot", is_flag=True, help="Draw force, displacement and configuration charts.")
+@click.option("--plot", is_flag=True, help="Draw force, displacement and configuration charts (not with --json).")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary (with the event list) as JSON.")
 @click.option("--events", "show_events", is_flag=True, help="Also print the event list.")
 @impact_option
 @start_velocities_option
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
-          csv_path: Path | None, every_step: bool, plot: bool, as_json: bool, show_events: bool,
-          impact: str | None, start: str | None) -> None:
+          max_steps: float | None, csv_path: str | None, every_step: bool, plot: bool, as_json: bool,
+          show_events: bool, impact: str | None, start: str | None) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
     peak forces, valve seating velocities, bounces per revolution, run
     statistics). Files are written only when the run succeeds.
     """
+    from vtool.files import check_output_path
     from vtool.presets import load_preset
+    from vtool.presets.kinds import KINDS, resolve
 
+    if as_json and plot:
+        raise InputError("--plot", "with --json", "one of --json (machine-readable stdout) or --plot")
+    csv_file = None if csv_path is None else Path(check_output_path(csv_path, "--csv") and csv_path)
     spec = load_preset(preset)
+    kind = KINDS[spec.kind]
     if spec.kind != "valvetrain":
-        given = [name for name, value in (("--backend", backend), ("--dt", dt), ("--rpm", rpm),
-                                          ("--degrees", degrees), ("--impact", impact), ("--start", start))
-                 if value is not None]
-        if given or every_step or show_events:
-            raise click.BadParameter(f"{', '.join(given) or '--every-step/--events'} applies to valvetrain "
-                                     f"presets only; {preset} is a {spec.kind} preset", param_hint="options")
-        module = "boom" if spec.kind.startswith("boom") else "plate"
-        solve_preset = __import__(f"vtool.app.cli.{module}", fromlist=["solve_preset"]).solve_preset
-        solve_preset(spec, csv_path, plot, as_json)
+        given = {"--backend": backend, "--dt": dt, "--rpm": rpm, "--degrees": degrees,
+                 "--max-steps": max_steps, "--every-step": every_step or None,
+                 "--events": show_events or None, "--impact": impact, "--start": start}
+        for flag, value in given.items():
+            if value is not None:
+                raise InputError(flag, value, f"no {flag} for {preset}: it is a {spec.kind} preset "
+                                 f"({flag} applies to valvetrain presets)")
+        resolve(kind.solve)(spec, csv_file, plot, as_json)
         return
     if impact is not None or start is not None:
         from vtool.solvers.compare import with_model
 
         spec = with_model(spec, impact, start)
-    run_valvetrain(spec, backend, dt, rpm, degrees, csv_path, every_step, plot, as_json, show_events)
+    run_valvetrain(spec, backend, dt, rpm, degrees, csv_file, every_step, plot, as_json, show_events,
+                   max_steps=max_steps)
 
 
-def run_valvetrain(spec, backend, dt, rpm, degrees, csv_path, every_step, plot, as_json,  # type: ignore[no-untyped-def]
-                   show_events) -> None:
+def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float | None,
+                   degrees: float | None, csv_path: Path | None, every_step: bool, plot: bool,
+                   as_json: bool, show_events: bool, *, max_steps: float | None = None) -> None:
     from vtool.app.cli.progress import DelayedProgress
+    from vtool.files import json_text
     from vtool.presets.valvetrain import with_run_overrides
     from vtool.solvers.run import simulate
 
@@ -64,13 +108,13 @@ def run_valvetrain(spec, backend, dt, rpm, degrees, csv_path, every_step, plot, 
     announce_compile(spec.run.backend)
     progress = DelayedProgress(f"{spec.run.backend} {spec.run.degrees:g} deg")
     try:
-        trace = simulate(spec, every_step=every_step, progress=progress)
+        trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps)
     finally:
         progress.close()
     if csv_path is not None:
-        trace.write_csv(str(csv_path))
+        trace.write_csv(str(csv_path), field="--csv")
     if as_json:
-        click.echo(json.dumps(trace.summary(), indent=2))
+        click.echo(json_text(trace.summary()))
     else:
         click.echo(trace.summary_text())
         if show_events:

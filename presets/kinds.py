@@ -1,0 +1,81 @@
+"""The one table of preset kinds: what each ``kind`` loads into and who runs and shows it.
+
+Every place that dispatches on a preset's kind reads :data:`KINDS`: the
+loader (:func:`vtool.presets.load_document`), ``vtool solve`` and the TUI. The
+entries name code by dotted path strings (``module:attribute`` or a module),
+so this table imports nothing: the presets layer never imports ``app/``, and
+the CLI imports only the module of the kind it runs.
+
+=============  ==========================================  ================================  ==============================  ========================
+kind           spec type                                   loader (``load``/``dump``)        solve (``vtool solve``)         TUI screen module
+=============  ==========================================  ================================  ==============================  ========================
+valvetrain     vtool.solvers.spec:MechanismSpec            vtool.presets.valvetrain          vtool.app.cli.solve:run_valvetrain  vtool.app.tui.valvetrain
+boom_wall      vtool.assessments.sonic_boom.spec:BoomWallSpec   vtool.presets.boom           vtool.app.cli.boom:solve_preset     vtool.app.tui.boom
+boom_floor     vtool.assessments.sonic_boom.spec:BoomFloorSpec  vtool.presets.boom           vtool.app.cli.boom:solve_preset     vtool.app.tui.boom
+plate          vtool.presets.plate:PlateSpec               vtool.presets.plate               vtool.app.cli.plate:solve_preset    vtool.app.tui.plate
+=============  ==========================================  ================================  ==============================  ========================
+
+``solve`` functions of boom and plate take ``(spec, csv_path, plot, as_json)``;
+the valve train's takes more options (see :mod:`vtool.app.cli.solve`).
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from typing import Any
+
+from vtool.errors import InputError
+
+
+@dataclass(frozen=True)
+class Kind:
+    """One preset kind (see the module table). Paths are ``module:attribute`` or a module."""
+
+    name: str
+    description: str
+    spec_type: str
+    loader: str
+    solve: str
+    screen: str
+    #: the flags of ``vtool solve`` that apply to this kind beyond --csv/--plot/--json
+    run_options: tuple[str, ...] = ()
+
+
+KINDS: dict[str, Kind] = {
+    "valvetrain": Kind("valvetrain", "valve-train dynamics (Gnilka 1971)",
+                       "vtool.solvers.spec:MechanismSpec", "vtool.presets.valvetrain",
+                       "vtool.app.cli.solve:run_valvetrain", "vtool.app.tui.valvetrain",
+                       ("--backend", "--dt", "--rpm", "--degrees", "--every-step", "--events",
+                        "--max-steps")),
+    "boom_wall": Kind("boom_wall", "sonic-boom wall assessment",
+                      "vtool.assessments.sonic_boom.spec:BoomWallSpec", "vtool.presets.boom",
+                      "vtool.app.cli.boom:solve_preset", "vtool.app.tui.boom"),
+    "boom_floor": Kind("boom_floor", "sonic-boom floor assessment",
+                       "vtool.assessments.sonic_boom.spec:BoomFloorSpec", "vtool.presets.boom",
+                       "vtool.app.cli.boom:solve_preset", "vtool.app.tui.boom"),
+    "plate": Kind("plate", "condensed-plate study", "vtool.presets.plate:PlateSpec",
+                  "vtool.presets.plate", "vtool.app.cli.plate:solve_preset", "vtool.app.tui.plate"),
+}
+
+
+def resolve(path: str) -> Any:
+    """The object at a dotted path ``module:attribute`` (or the module itself)."""
+    module, _, attribute = path.partition(":")
+    loaded = importlib.import_module(module)
+    return getattr(loaded, attribute) if attribute else loaded
+
+
+def kind_named(name: Any, field: str = "kind") -> Kind:
+    """The :class:`Kind` called ``name``; an unknown name is an InputError listing the kinds."""
+    if not isinstance(name, str) or name not in KINDS:
+        raise InputError(field, name, f"one of: {', '.join(KINDS)}")
+    return KINDS[name]
+
+
+def require_kind(spec: Any, wanted: str | tuple[str, ...], what: str, field: str = "preset") -> None:
+    """The one wrong-kind check: ``spec`` must be of kind ``wanted`` for ``what`` (e.g. `vtool modes`)."""
+    allowed = (wanted,) if isinstance(wanted, str) else wanted
+    kind = getattr(spec, "kind", None)
+    if kind not in allowed:
+        raise InputError(field, kind, f"a {' or '.join(allowed)} preset for {what}")

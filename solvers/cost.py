@@ -1,0 +1,113 @@
+"""Cost guard: the steps and memory a valve-train run will need, estimated before it starts.
+
+A run covers ``t_end = degrees / (6 rpm)`` seconds (cam speed ω = 2π rpm / 60).
+The work is
+
+* ``newmark``: ``t_end / Δt`` steps (plus the short refined stretches after
+  events, not counted);
+* ``exact`` and ``scipy``: about 16 samples per period of the highest
+  natural frequency, ``16 t_end ω_max / 2π`` (the exact back end scans at
+  1/16 of the shortest period; solve_ivp's steps are of the same order);
+
+and the memory is that of the output rows, ``degrees / output_interval + 1``
+(or one per step with ``every_step``), each ``3 (n + n_s) + n_c + 2 + n_q``
+values (coordinates with velocities and accelerations, contact forces, time
+and configuration, the preset's extra quantities), counted as
+:data:`BYTES_PER_VALUE` bytes each (the kernel's buffers, the joined trace,
+the CSV table and its text: measured 3.7 GB peak for 900,000 rows of 47
+values, which this counts as 2.9 GB), plus the ``2^n_c`` configuration tables
+of ``6 n²`` floats.
+
+:func:`check` refuses a run above :data:`MAX_STEPS` steps or
+:data:`MAX_BYTES` bytes with one line giving the estimate and how to proceed
+(``--max-steps``, fewer degrees, a coarser step or output interval). At about
+1 million Newmark steps per second on the development machine, the default
+limit bounds a run at roughly a minute.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from vtool.errors import InputError
+
+#: Default largest number of steps (or samples) of one run.
+MAX_STEPS = 5e7
+#: Default largest memory of one run's output (bytes).
+MAX_BYTES = 2e9
+#: Samples per period of the highest natural frequency (exact, scipy).
+SAMPLES_PER_PERIOD = 16.0
+BYTES_PER_FLOAT = 8
+#: Bytes per output value over the whole run: float copies (8 x 6) and about 20 characters of CSV.
+BYTES_PER_VALUE = 8 * 6 + 20
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """What a run will cost: steps (or samples), output rows and bytes."""
+
+    backend: str
+    steps: float
+    rows: float
+    bytes: float
+    t_end: float  # s
+
+    def describe(self) -> str:
+        return (f"{self.steps:.3g} steps, {self.rows:.3g} output rows, about "
+                f"{self.bytes / 1e6:,.0f} MB")
+
+
+def estimate(*, backend: str, rpm: float, degrees: float, time_step: float, output_interval: float,
+             every_step: bool, omega_max: float, n_coordinates: int, n_sources: int,
+             n_clearances: int, n_quantities: int = 0) -> Estimate:
+    """The cost of one run (see module doc); all inputs in the preset's units."""
+    omega = rpm * 2.0 * math.pi / 60.0
+    t_end = math.radians(degrees) / omega if omega > 0 else math.inf
+    if backend == "newmark":
+        steps = t_end / time_step if time_step > 0 else math.inf
+    else:
+        steps = t_end * omega_max / (2.0 * math.pi) * SAMPLES_PER_PERIOD
+    rows = steps + 1 if every_step else degrees / output_interval + 1
+    columns = 3 * (n_coordinates + n_sources) + n_clearances + 2 + n_quantities
+    tables = 2.0**n_clearances * 6 * n_coordinates**2
+    size = rows * columns * BYTES_PER_VALUE + tables * BYTES_PER_FLOAT
+    return Estimate(backend, steps, rows, size, t_end)
+
+
+class CostError(InputError):
+    """A run that would take more steps or memory than allowed; says how to proceed."""
+
+    def __init__(self, cost: Estimate, max_steps: float, max_bytes: float, what: str) -> None:
+        self.cost = cost
+        self.max_steps = max_steps
+        self.max_bytes = max_bytes
+        self.what = what
+        # the field a form marks: the step for a run shorter than one step, else the length of run
+        super().__init__("run.time_step" if what == "short" else "run.degrees", cost.describe(), what)
+
+    def one_line(self) -> str:
+        c = self.cost
+        if self.what == "short":
+            return (f"run too short: {c.t_end:.3g} s of motion is less than one time step ({c.backend}); "
+                    "to proceed: more --degrees or a smaller --dt")
+        if self.what == "steps":
+            limit = (f"more than the limit of {self.max_steps:.3g} steps; to proceed: fewer --degrees, "
+                     f"a higher --rpm, a larger --dt (newmark), or --max-steps {math.ceil(c.steps):d}")
+        else:
+            limit = (f"more than the limit of {self.max_bytes / 1e9:g} GB of output; to proceed: fewer "
+                     "--degrees, a larger run.output_interval, or no --every-step")
+        return f"run too large: {c.describe()} ({c.backend}, {c.t_end:.3g} s of motion), {limit}"
+
+
+def check(cost: Estimate, max_steps: float | None = None, max_bytes: float | None = None) -> Estimate:
+    """Refuse (:class:`CostError`, exit 2) a run above the limits; returns ``cost``."""
+    max_steps = MAX_STEPS if max_steps is None else max_steps
+    max_bytes = MAX_BYTES if max_bytes is None else max_bytes
+    if not cost.steps >= 1.0:
+        raise CostError(cost, max_steps, max_bytes, "short")
+    if not cost.steps <= max_steps:
+        raise CostError(cost, max_steps, max_bytes, "steps")
+    if not cost.bytes <= max_bytes:
+        raise CostError(cost, max_steps, max_bytes, "memory")
+    return cost

@@ -1,0 +1,35 @@
+"""Static typing: mypy resolves every `vtool.*` import and runs clean on solvers/ and presets/.
+
+mypy runs on the installed layout built by :mod:`tests.typing_tree` (the
+editable install's import hook is invisible to it), with pyproject's
+``[tool.mypy]`` configuration; ``py.typed`` ships in the wheel.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from tests import typing_tree
+
+
+@pytest.fixture(scope="module")
+def tree(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return typing_tree.build(tmp_path_factory.mktemp("typing"))
+
+
+@pytest.mark.skipif(shutil.which("mypy") is None and not Path(typing_tree.sys.executable).with_name("mypy").exists(),
+                    reason="mypy is in the dev extra")
+def test_mypy_is_clean_on_solvers_and_presets(tree: Path) -> None:
+    result = typing_tree.run_mypy(tree)
+    assert result.returncode == 0, result.stdout[-4000:] + result.stderr[-2000:]
+    assert "Success: no issues found" in result.stdout
+    assert "Cannot find implementation or library stub" not in result.stdout
+
+
+def test_py_typed_is_shipped() -> None:
+    assert (typing_tree.ROOT / "vtool" / "py.typed").exists()
+    text = (typing_tree.ROOT / "pyproject.toml").read_text(encoding="utf-8")
+    assert '"vtool" = ["py.typed"]' in text
