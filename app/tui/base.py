@@ -27,6 +27,7 @@ does the rest the same way on every screen:
 
 from __future__ import annotations
 
+import copy
 import threading
 import time
 from abc import ABCMeta, abstractmethod
@@ -49,6 +50,13 @@ from vtool.errors import InputError
 
 PROGRESS_INTERVAL = 0.05  # s between progress messages: the bar needs no more
 NARROW = 120  # columns below which a finished run hides the form
+
+
+def path_problem(error: Exception, path: str) -> Exception:
+    """A file error as the house reports it: OSError and InputError as they are, else the path's field."""
+    if isinstance(error, OSError | InputError):
+        return error
+    return InputError("path", path, "a file path that can be written (no NUL or other control characters)")
 
 
 class FormProblem:
@@ -95,7 +103,8 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         self.results: Any = None  # what the last finished run returned
         self.results_spec: Any = None
         self.messages_seen: list[Any] = []  # typed run messages, in order (tests read them)
-        self.loaded_doc: dict[str, Any] = {}  # the document as loaded (what "changed" means)
+        self.loaded_doc: dict[str, Any] = {}  # the preset document as loaded (what a save compares)
+        self.start_doc: dict[str, Any] = {}  # the form's document as loaded (what a star compares)
         self.status_log: list[str] = []  # every status message, in order
         self._run_lock = threading.Lock()  # held by the thread of the run that computes
 
@@ -150,8 +159,13 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         self.status.update(text)
 
     def show_progress(self, running: bool) -> None:
-        """The bar shows only while a run goes, from 0 % (never a stale 100 %)."""
-        self.progress.update(total=1.0, progress=0)
+        """The bar shows only while a run goes (never a stale 100 %).
+
+        A run starts with a pulsing bar (no total) that turns into a
+        percentage at its worker's first :class:`RunProgressed`; a worker
+        that reports no progress still shows that it is working.
+        """
+        self.progress.update(total=None if running else 1.0, progress=0)
         self.set_class(running, "-running")
 
     # ----- what a domain screen provides -----
@@ -205,6 +219,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         self.spec = spec
         self.problem = None
         await self.form.set_fields(self.fields_for(spec, self.base_doc), self.base_doc)
+        self.start_doc = copy.deepcopy(self.base_doc)  # with a screen's run options, if any
         self.query_one("#spec-title", Static).update(f"{Path(source).stem}: {getattr(spec, 'title', '')}")
         self.clear_results()
         self.show_progress(False)
@@ -229,7 +244,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         else:
             self.spec, self.problem = spec, None
         self.form.show_error(self.problem)
-        self.form.mark_changed(self.loaded_doc)
+        self.form.mark_changed(self.start_doc)
         return self.spec
 
     def on_field_edited(self, message: FieldEdited) -> None:
@@ -302,7 +317,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         message.stop()
         if message.run_id == self.run_id and self.running:
             self.messages_seen.append(message)
-            self.progress.update(progress=min(max(message.fraction, 0.0), 1.0))
+            self.progress.update(total=1.0, progress=min(max(message.fraction, 0.0), 1.0))
 
     def accept(self, message: Any) -> bool:
         """True when a finished-run message belongs to the current run."""
@@ -349,14 +364,14 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             try:
                 kept = self.save_document(document, path)
             except (OSError, ValueError) as exc:  # ValueError: InputError, a NUL in the path
-                self.app.report_error("Save failed", exc)  # type: ignore[attr-defined]
+                self.app.report_error("Save failed", path_problem(exc, path))  # type: ignore[attr-defined]
                 return
             full = str(Path(path).resolve())
             self.app.remember(full)  # type: ignore[attr-defined]
             self.source = full
             self.loaded_doc = self.loader().dump(spec)
-            self.base_doc = self.loader().dump(spec)
-            self.form.mark_changed(self.loaded_doc)
+            self.start_doc = self.form.apply(self.base_doc)
+            self.form.mark_changed(self.start_doc)
             note = "comments kept, changes marked '# was'" if kept else "written afresh (no source file)"
             self.set_status(f"saved {path} ({note})")
             self.notify(f"saved {path}")
@@ -394,7 +409,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             try:
                 self.write_csv(path)
             except (OSError, ValueError) as exc:  # ValueError: InputError, a NUL in the path
-                self.app.report_error("Export failed", exc)  # type: ignore[attr-defined]
+                self.app.report_error("Export failed", path_problem(exc, path))  # type: ignore[attr-defined]
                 return
             self.set_status(f"wrote {path}")
             self.notify(f"wrote {path}")
