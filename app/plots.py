@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -17,35 +18,70 @@ _LOCK = threading.Lock()
 
 
 Curve = tuple[str, np.ndarray, np.ndarray]
+Ticks = tuple[Sequence[float], Sequence[str]]
 
 
-def _render(curves: list[Curve], *, title: str, xlabel: str, ylabel: str, width: int, height: int,
-            color: bool, xlim: tuple[float, float] | None = None, ylim: tuple[float, float] | None = None,
-            xlog: bool = False) -> str:
-    """Draw labelled (x, y) curves with plotext and return the text (the one place plotext is used)."""
+@dataclass(frozen=True)
+class Panel:
+    """One plot of a (possibly stacked) figure: labelled curves over a common x."""
+
+    curves: list[Curve]
+    title: str = ""
+    ylabel: str = ""
+    ylim: tuple[float, float] | None = None
+    yticks: Ticks | None = None  # positions and names (e.g. one lane per clearance)
+
+
+def _reset(plt) -> None:  # type: ignore[no-untyped-def]
+    """Empty plotext's one global figure, subplots included (``clf`` clears only the active one)."""
+    plt.main().clear_figure()  # the master figure: its __init__ forgets every subplot
+
+
+def _render(panels: list[Panel], *, xlabel: str, width: int, height: int, color: bool,
+            xlim: tuple[float, float] | None = None, xlog: bool = False) -> str:
+    """Draw panels stacked top to bottom with plotext; return the text (the one place plotext is used)."""
     import plotext as plt
 
     with _LOCK:
-        plt.clf()
+        _reset(plt)
         plt.plotsize(max(int(width), 20), max(int(height), 8))
-        plt.theme("pro" if color else "clear")
-        for label, xs, ys in curves:
-            plt.plot(np.asarray(xs, dtype=float).tolist(), np.asarray(ys, dtype=float).tolist(),
-                     label=label, marker="braille")
-        if xlim is not None:
-            plt.xlim(*xlim)
-        if ylim is not None:
-            plt.ylim(*ylim)
-        if xlog:
-            plt.xscale("log")
-        plt.title(title)
-        plt.xlabel(xlabel)
-        plt.ylabel(ylabel)
+        if len(panels) > 1:
+            plt.subplots(len(panels), 1)
+        for number, panel in enumerate(panels, start=1):
+            if len(panels) > 1:
+                plt.subplot(number, 1)
+            plt.theme("pro" if color else "clear")
+            for label, xs, ys in panel.curves:
+                plt.plot(np.asarray(xs, dtype=float).tolist(), np.asarray(ys, dtype=float).tolist(),
+                         label=label, marker="braille")
+            if xlim is not None:
+                plt.xlim(*xlim)
+            if panel.ylim is not None:
+                plt.ylim(*panel.ylim)
+            if panel.yticks is not None:
+                plt.yticks(list(panel.yticks[0]), list(panel.yticks[1]))
+            if xlog:
+                plt.xscale("log")
+            plt.title(panel.title)
+            plt.ylabel(panel.ylabel)
+            if number == len(panels):
+                plt.xlabel(xlabel)
         text = plt.build()
-        plt.clf()
+        _reset(plt)
     if not color:
         text = plt.uncolorize(text)
     return text
+
+
+def _curves(xs: np.ndarray, series: Mapping[str, Sequence[float] | np.ndarray], step: bool) -> list[Curve]:
+    curves = []
+    for label, values in series.items():
+        ys = np.asarray(values, dtype=float)
+        if step:
+            curves.append((label, np.repeat(xs, 2)[1:], np.repeat(ys, 2)[:-1]))
+        else:
+            curves.append((label, xs, ys))
+    return curves
 
 
 def line_chart(
@@ -61,22 +97,37 @@ def line_chart(
     step: bool = False,
     ylim: tuple[float, float] | None = None,
     xlog: bool = False,
+    yticks: Ticks | None = None,
 ) -> str:
     """A line chart of one or more series against a common x, as text.
 
     ``step=True`` draws the series as a staircase (for configuration traces);
-    ``color=False`` gives plain text for files and tests.
+    ``yticks`` names positions on the y axis; ``color=False`` gives plain
+    text for files and tests.
+    """
+    panel = Panel(_curves(np.asarray(x, dtype=float), series, step), title, ylabel, ylim, yticks)
+    return _render([panel], xlabel=xlabel, width=width, height=height, color=color, xlog=xlog)
+
+
+def stacked_chart(
+    x: Sequence[float] | np.ndarray,
+    groups: Sequence[tuple[str, Mapping[str, Sequence[float] | np.ndarray]]],
+    *,
+    title: str = "",
+    xlabel: str = "",
+    width: int = 100,
+    height: int = 22,
+    color: bool = True,
+) -> str:
+    """Groups of series (one y unit each) as panels stacked over a common x, as text.
+
+    ``groups`` is ``[(ylabel, {label: values}), ...]``: quantities of different
+    units never share an axis; the title goes on the top panel.
     """
     xs = np.asarray(x, dtype=float)
-    curves = []
-    for label, values in series.items():
-        ys = np.asarray(values, dtype=float)
-        if step:
-            curves.append((label, np.repeat(xs, 2)[1:], np.repeat(ys, 2)[:-1]))
-        else:
-            curves.append((label, xs, ys))
-    return _render(curves, title=title, xlabel=xlabel, ylabel=ylabel, width=width, height=height, color=color,
-                   ylim=ylim, xlog=xlog)
+    panels = [Panel(_curves(xs, series, False), title if i == 0 else "", ylabel)
+              for i, (ylabel, series) in enumerate(groups)]
+    return _render(panels, xlabel=xlabel, width=width, height=height, color=color)
 
 
 def shape_chart(
@@ -97,5 +148,5 @@ def shape_chart(
     fixed ``xlim`` / ``ylim`` keep the frame still between animation frames.
     """
     curves = [(label, np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)) for label, (xs, ys) in shapes.items()]
-    return _render(curves, title=title, xlabel=xlabel, ylabel=ylabel, width=width, height=height, color=color,
-                   xlim=xlim, ylim=ylim)
+    return _render([Panel(curves, title, ylabel, ylim)], xlabel=xlabel, width=width, height=height,
+                   color=color, xlim=xlim)

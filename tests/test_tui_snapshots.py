@@ -23,31 +23,61 @@ async def test_valvetrain_at_80x24_shows_form_units_chart_status_and_keys() -> N
     app = create_app("gnilka-1d", remember=False, chart_color=False)
     async with app.run_test(size=(80, 24)) as pilot:
         await pilot.pause()
-        app.screen.form.row("run.degrees").editor.value = "90"
-        await pilot.press("ctrl+r")
-        await pilot.pause()
-        await app.workers.wait_for_complete()
+        screen = app.screen
+        assert app.focused is screen.form.row("run.rpm").editor  # typing starts at the first field
+        screen.form.row("run.degrees").editor.value = "90"
         text = await shot(app, pilot, 80)
         lines = text.splitlines()
         assert len(lines) == 24
         assert lines[0].startswith(" VALVE TRAIN") and "Forces" in lines[0] and "Config" in lines[0]
         assert any("cam speed" in line and "11000" in line and "rev/min" in line for line in lines)
-        assert any("cam degrees" in line and "90" in line and "deg" in line for line in lines)
-        assert "contact forces (lbf)" in text and "cam angle (deg)" in text
-        assert "done:" in lines[-2] and "100%" in lines[-2]
+        assert any("*cam degrees" in line and "90" in line and "deg" in line for line in lines)
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        await app.workers.wait_for_complete()
+        text = await shot(app, pilot, 80)
+        lines = text.splitlines()
+        # below 120 columns a run hides the form: the chart gets the width, the bar is gone
+        assert "VALVE TRAIN" not in text and "contact forces (lbf)" in text and "cam angle (deg)" in text
+        assert max(len(line) for line in lines) > 75
+        assert lines[-2].startswith("done:") and "%" not in lines[-2]
         for key in ("^r Run", "^s Save", "^e CSV", "^f Form", "^t Tab", "^q Quit", "^o Open", "f1 Help",
                     "f2-4 Screen"):
             assert key in lines[-1], key
-        # the help screen lists every key
+        await pilot.press("ctrl+f")  # the form comes back
+        text = await shot(app, pilot, 80)
+        assert "VALVE TRAIN" in text and "cam speed" in text
+        # a long status message wraps: nothing is cut
+        message = "cannot run: " + "members.pushrod.length: got -1, expected a number > 0 in; " * 2
+        screen.set_status(message.strip())
+        text = await shot(app, pilot, 80)
+        assert " ".join(text.split()).count("expected a number > 0 in") == 2
+        # the help screen lists every key, rendered once (Markdown)
         await pilot.press("f1")
         text = await shot(app, pilot, 80)
-        assert "ctrl+r  run" in text and "escape  cancel" in text and "f2  valve train" in text
+        assert "ctrl+r run" in text and "escape cancel" in text and "f2 valve train" in text
+        assert text.count("Valve-train dynamics") == 1
         await pilot.press("escape")
-        # form hidden: the chart takes the full width
-        await pilot.press("ctrl+f")
-        text = await shot(app, pilot, 80)
-        assert "VALVE TRAIN" not in text and "contact forces (lbf)" in text
-        assert max(len(line) for line in text.splitlines()) > 75
+
+
+async def test_valvetrain_at_120x40_keeps_the_form_beside_named_configuration_lanes() -> None:
+    app = create_app("gnilka-1d", remember=False, chart_color=False)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        screen.form.row("run.degrees").editor.value = "90"
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        await app.workers.wait_for_complete()
+        await pilot.press("ctrl+t", "ctrl+t")
+        text = await shot(app, pilot, 120)
+        lines = text.splitlines()
+        assert len(lines) == 40
+        assert "VALVE TRAIN" in text and "cam speed" in text  # wide enough: the form stays
+        assert "configuration" in text
+        for c in screen.trace.spec.clearances:  # the y axis names the lanes
+            if c.state != "removed":
+                assert any(f"{c.name}┤" in line or f"{c.name}└" in line for line in lines), c.name
 
 
 async def test_wide_terminal_adds_the_summary_beside_the_charts() -> None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import asyncio
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -315,6 +316,13 @@ async def test_save_then_load_round_trips_and_is_remembered(tmp_path) -> None:  
         assert screen.form.value("run.rpm") == "9500"
         assert screen.form.value("clearances[2].restitution") == "0.25"
         assert screen.validate() == edited
+    # the file keeps the shipped preset's comments and provenance; changed values are noted
+    text = path.read_text(encoding="utf-8")
+    shipped = (Path(valvetrain.__file__).parent / "gnilka-1c.toml").read_text(encoding="utf-8")
+    comments = [line for line in shipped.splitlines() if line.startswith("#")]
+    assert comments and all(line in text.splitlines() for line in comments)
+    assert "rpm = 9500 # was 11000.0" in text
+    assert sum("# was" in line or "; was" in line for line in text.splitlines()) == 2
     again = make_app(None, tmp_path)
     assert again.recent.items[0] == str(path.resolve())
     assert "gnilka-1a" in again.recent.items
@@ -340,11 +348,22 @@ async def test_animation_steps_through_the_deformed_mechanism() -> None:
         shapes = deformed_members(trace.spec, trace.q[2, :n], 2.0)
         xlim, ylim = animation.limits()
         w, h = animation.size
-        title = f"cam {trace.cam_angle[2]:.1f} deg, row 3/{len(trace.time)}, scale x2, paused"
+        title = f"cam {trace.cam_angle[2]:.1f} deg, row 3/{len(trace.time)}, scale x2, speed x1, paused"
         assert animation.frame_text == shape_chart(shapes, title=title, xlabel="in", width=w, height=h,
                                                    color=False, xlim=xlim, ylim=ylim)
+        # the frame is fitted to the moving members: the 36-in spring bar (given by its rate) is not
+        spring = next(m for m in trace.spec.members if m.stiffness is not None)
+        assert spring.name not in animation.fitted_members() and spring.length == 36.0
+        assert ylim[1] - ylim[0] < 0.5 * spring.length
+        # a run plays in PLAY_SECONDS at x1 whatever its rows; ] doubles the speed
+        from vtool.app.tui.animation import FPS, PLAY_SECONDS
+
+        await pilot.press("right_square_bracket")
+        assert animation.speed == 2.0
+        assert animation.rows_per_tick == pytest.approx(max(len(trace.time) / (PLAY_SECONDS * FPS),
+                                                            1.0 / FPS) * 2.0)
         await pilot.press("space")
-        await pilot.pause(0.3)
+        await pilot.pause(0.5)
         assert animation.playing and animation.row > 2
         await pilot.press("space")
         assert not animation.playing
@@ -359,3 +378,98 @@ async def test_unknown_preset_on_the_command_line_shows_an_error_and_opens_the_d
         await pilot.press("escape")
         await pilot.pause()
         assert isinstance(app.screen, ValveTrainScreen) and app.screen.source == "gnilka-1a"
+
+
+async def test_changed_fields_are_starred_and_the_thesis_quantities_can_all_be_plotted() -> None:
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        assert app.focused is screen.form.row("run.rpm").editor  # typing starts at the first field
+        await put(pilot, screen, "run.degrees", "40")
+        row = screen.form.row("run.degrees")
+        assert row.has_class("-changed") and "*cam degrees" in str(row.query_one("Label").render())
+        await put(pilot, screen, "run.degrees", "850")  # back to the preset's value: no star
+        assert not row.has_class("-changed")
+        await put(pilot, screen, "run.degrees", "40")
+        await run_and_wait(pilot, app)
+        trace = screen.trace
+        pick = screen.quantity_list
+        quantities = [pick.get_option_at_index(i).value for i in range(pick.option_count)]
+        assert quantities == list(trace.spec.run.quantities) and len(quantities) == 11  # Gnilka's list
+        chosen = ("q1-q9", "q7-q6", "F7")
+        screen.quantity_list.deselect_all()
+        for q in chosen:
+            screen.quantity_list.select(q)
+        await pilot.pause()
+        screen.tabs.active = "tab-displacements"
+        await pilot.pause(0.2)
+        w, h = screen.displacement_chart.size
+        picked = screen.selected_quantities()
+        assert sorted(picked) == sorted(chosen)
+        assert screen.displacement_chart.chart_text == charts.displacement_chart(trace, picked, w, h,
+                                                                                 color=False)
+        assert "lbf" in screen.displacement_chart.chart_text  # the force has its own panel
+        # the configuration chart names its lanes
+        text = charts.configuration_chart(trace, 80, 14, color=False)
+        for c in trace.spec.clearances:
+            if c.state != "removed":
+                assert any(line.strip().startswith(c.name) for line in text.splitlines()), c.name
+
+
+async def test_dialog_on_top_ignores_screen_keys_and_open_preset_still_works() -> None:
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        app.report_error("Run failed", RunError("diverged"))
+        await pilot.pause()
+        await pilot.press("ctrl+o", "f3", "f1")  # ignored: the dialog has the keys
+        await pilot.pause()
+        assert isinstance(app.screen, ErrorDialog)
+        assert await app.open_preset("gnilka-1a")  # e.g. a recent file chosen from a menu
+        await pilot.pause()
+        assert app.screen is screen and screen.source == "gnilka-1a"
+
+
+async def test_error_dialogs_show_one_line_never_an_exception_name(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    import vtool.solvers.run as run_module
+
+    def singular(spec, **kwargs):  # type: ignore[no-untyped-def]
+        raise np.linalg.LinAlgError("Singular matrix\nmore detail")
+
+    monkeypatch.setattr(run_module, "simulate", singular)
+    app = make_app("gnilka-1c")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        await run_and_wait(pilot, app)
+        assert isinstance(app.screen, ErrorDialog)
+        assert app.errors_shown == ["the run could not be completed: singular matrix"]
+
+
+async def test_a_new_run_cancels_and_joins_the_old_one_before_it_starts(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    import vtool.solvers.run as run_module
+
+    real = run_module.simulate
+    log: list[str] = []
+
+    def watched(spec, **kwargs):  # type: ignore[no-untyped-def]
+        log.append(f"start {spec.run.degrees:g}")
+        try:
+            return real(spec, **kwargs)
+        finally:
+            log.append(f"end {spec.run.degrees:g}")
+
+    monkeypatch.setattr(run_module, "simulate", watched)
+    app = make_app("gnilka-1d")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        await put(pilot, screen, "run.degrees", "1000000")
+        app.simulate_key("ctrl+r")
+        assert await until(lambda: bool(screen.messages_seen), 30.0)
+        await put(pilot, screen, "run.degrees", "30")
+        app.simulate_key("ctrl+r")
+        assert await until(lambda: screen.results is not None, 60.0)
+        assert log == ["start 1e+06", "end 1e+06", "start 30", "end 30"]
+        assert screen.results.spec.run.degrees == 30 and app.errors_shown == []

@@ -4,6 +4,15 @@ Members are drawn from their element shape functions by
 :func:`vtool.solvers.shapes.deformed_members` (displacements times a scale,
 as the thesis' graphics display did); the frame limits are fixed over the
 whole run at the current scale so the picture does not jump.
+
+The frame is fitted to the members that carry the motion: a member given
+by its ``stiffness`` (the valve spring, whose drawn length is its wire
+length, 36 in in Gnilka's presets, kept for its mass) is drawn but left out
+of the fit, so it enters the frame from its edge instead of shrinking the
+rocker and valve to a few cells.
+
+A run plays in :data:`PLAY_SECONDS` at speed x1 whatever its number of
+rows; ``]`` / ``[`` double / halve the speed.
 """
 
 from __future__ import annotations
@@ -18,6 +27,7 @@ from textual.timer import Timer
 from textual.widgets import Static
 
 FPS = 10
+PLAY_SECONDS = 10.0  # one run at speed x1
 
 
 class MechanismAnimation(Static, can_focus=True):
@@ -29,6 +39,8 @@ class MechanismAnimation(Static, can_focus=True):
         Binding("left", "step(-1)", "Back", show=False),
         Binding("plus,equals_sign", "scale(2)", "Scale+"),
         Binding("minus", "scale(0.5)", "Scale-", show=False),
+        Binding("right_square_bracket", "speed(2)", "Faster"),
+        Binding("left_square_bracket", "speed(0.5)", "Slower", show=False),
         Binding("home", "first", "First", show=False),
     ]
 
@@ -45,6 +57,8 @@ class MechanismAnimation(Static, can_focus=True):
         self.trace: Any = None
         self.color = color
         self.playing = False
+        self.speed = 1.0
+        self._phase = 0.0  # fractional rows carried between ticks
         self.frame_text = ""
         self._timer: Timer | None = None
         self._limits: tuple[tuple[float, float], tuple[float, float]] | None = None
@@ -76,13 +90,21 @@ class MechanismAnimation(Static, can_focus=True):
 
         return deformed_members(self.trace.spec, self.elastic_q(row), self.scale)
 
+    def fitted_members(self) -> set[str]:
+        """The members the frame is fitted to: all but those given by a spring rate."""
+        members = self.trace.spec.members
+        fitted = {m.name for m in members if getattr(m, "stiffness", None) is None}
+        return fitted or {m.name for m in members}
+
     def limits(self) -> tuple[tuple[float, float], tuple[float, float]]:
         if self._limits is None:
             xs, ys = [], []
+            fitted = self.fitted_members()
             for row in range(0, self.rows, max(1, self.rows // 60)):
-                for x, y in self.shapes(row).values():
-                    xs.append(x)
-                    ys.append(y)
+                for name, (x, y) in self.shapes(row).items():
+                    if name in fitted:
+                        xs.append(x)
+                        ys.append(y)
             x_all = np.concatenate(xs) if xs else np.zeros(1)
             y_all = np.concatenate(ys) if ys else np.zeros(1)
             pad_x = 0.1 * max(float(np.ptp(x_all)), 1e-9)
@@ -105,7 +127,7 @@ class MechanismAnimation(Static, can_focus=True):
         xlim, ylim = self.limits()
         state = "playing" if self.playing else "paused"
         title = (f"cam {self.trace.cam_angle[row]:.1f} deg, row {row + 1}/{self.rows}, "
-                 f"scale x{self.scale:g}, {state}")
+                 f"scale x{self.scale:g}, speed x{self.speed:g}, {state}")
         self.frame_text = shape_chart(self.shapes(row), title=title, xlabel=spec.unit_system.length,
                                       width=width, height=height, color=self.color, xlim=xlim, ylim=ylim)
         self.update(Text.from_ansi(self.frame_text, no_wrap=True) if self.color
@@ -136,9 +158,21 @@ class MechanismAnimation(Static, can_focus=True):
             self._timer.stop()
             self._timer = None
 
+    @property
+    def rows_per_tick(self) -> float:
+        return max(self.rows / (PLAY_SECONDS * FPS), 1.0 / FPS) * self.speed
+
     def _tick(self) -> None:
         if self.rows:
-            self.row = (self.row + 1) % self.rows
+            self._phase += self.rows_per_tick
+            advance = int(self._phase)
+            self._phase -= advance
+            if advance:
+                self.row = (self.row + advance) % self.rows
+
+    def action_speed(self, factor: float) -> None:
+        self.speed = min(max(self.speed * factor, 1.0 / 16), 64.0)
+        self.draw()
 
     def action_step(self, delta: int) -> None:
         if self.rows:

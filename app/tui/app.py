@@ -12,7 +12,9 @@ from typing import Any, ClassVar
 
 from textual.app import App
 from textual.binding import Binding, BindingType
+from textual.screen import ModalScreen
 
+from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.boom import BoomScreen
 from vtool.app.tui.dialogs import ErrorDialog, HelpScreen, OpenDialog
 from vtool.app.tui.plate import PlateScreen
@@ -79,11 +81,19 @@ class VtoolApp(App[None]):
     # ----- errors -----
     @staticmethod
     def error_text(error: BaseException | None) -> str:
+        """The house's one-line message: never an exception class name or a traceback."""
         if isinstance(error, InputError):
             return error.one_line()
-        if isinstance(error, RunError | OSError):
-            return str(error)
-        return f"{type(error).__name__}: {error}"
+        if isinstance(error, OSError) and error.strerror:
+            where = f"{error.filename}: " if error.filename else ""
+            return f"{where}{error.strerror.lower()}"
+        lines = str(error).strip().splitlines() if error is not None else []
+        text = lines[0].strip() if lines else ""
+        if isinstance(error, RunError):
+            return text or "the run could not be completed"
+        if not text:
+            return "the run could not be completed (an internal error; please report the preset)"
+        return f"the run could not be completed: {text[0].lower()}{text[1:]}"
 
     def report_error(self, title: str, error: BaseException | None) -> None:
         """Show an error dialog (the app's one way of reporting a failure)."""
@@ -103,6 +113,8 @@ class VtoolApp(App[None]):
     def action_open(self) -> None:
         from vtool.presets import list_presets
 
+        if isinstance(self.screen, ModalScreen):
+            return  # a dialog is on top: it has the keys
         shipped = [(i.name, i.kind, i.title) for i in list_presets()]
         self.push_screen(OpenDialog(shipped, self.recent.items), self._open_chosen)
 
@@ -121,20 +133,32 @@ class VtoolApp(App[None]):
         item = name if not Path(name).is_file() else str(Path(name).resolve())
         if mode in self.mounted_modes:
             await self.switch_mode(mode)
-            await self.screen.load_spec(spec, item)  # type: ignore[attr-defined]
+            screen = self.domain_screen()
+            if screen is None:
+                return False
+            await screen.load_spec(spec, item)
         else:
             self._pending[mode] = (spec, item)
             await self.switch_mode(mode)
         self.remember(item)
         return True
 
+    def domain_screen(self) -> DomainScreen | None:
+        """The current mode's domain screen, after closing any dialog left on top of it."""
+        while isinstance(self.screen, ModalScreen) and len(self.screen_stack) > 1:
+            self.pop_screen()
+        return self.screen if isinstance(self.screen, DomainScreen) else None
+
     def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """Screen-level actions are ignored while a dialog is on top (it has the keys)."""
+        if action in ("open", "switch_mode", "help") and isinstance(self.screen, ModalScreen):
+            return False
         if action == "open" and getattr(self.screen, "running", False):
             return False  # finish or cancel the run first (escape)
         return True
 
     def action_help(self) -> None:
-        if not isinstance(self.screen, HelpScreen):
+        if not isinstance(self.screen, ModalScreen):
             self.push_screen(HelpScreen())
 
 

@@ -9,14 +9,30 @@ does the rest the same way on every screen:
   (the CLI's messages, shown beside the field); an invalid form blocks
   the run, the save and shows why;
 * a run is a thread worker (``exclusive``: a new run cancels the old);
+  the worker enters :meth:`run_slot` before it allocates, which waits for
+  the cancelled run's thread to leave (a thread cannot be killed: it polls
+  ``is_cancelled`` and returns), so two runs never hold memory at once;
+  :meth:`progress_reporter` gives it a throttled progress callback;
   its failure reaches :meth:`on_worker_state_changed`, the one place that
   turns worker errors into the error dialog;
-* results carry the run id, so a late message from a cancelled run is ignored.
+* results carry the run id, so a late message from a cancelled run is ignored;
+* the status line wraps (never cut) and every message is kept in
+  ``status_log``; the progress bar shows only while a run goes and starts
+  at 0 % on every run;
+* below 120 columns a finished run hides the form so the result tables are
+  not cut (ctrl+f shows it again);
+* saving edits the preset file itself (:mod:`vtool.app.tui.presetfile`):
+  comments and layout stay, changed values get a ``# was ...`` note.
 """
 
 from __future__ import annotations
 
+import copy
+import threading
+import time
 from abc import ABCMeta, abstractmethod
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -25,12 +41,22 @@ from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
 from textual.widgets import Footer, ProgressBar, Static, TabbedContent
-from textual.worker import Worker, WorkerState
+from textual.worker import Worker, WorkerState, get_current_worker
 
 from vtool.app.tui.dialogs import PathDialog
 from vtool.app.tui.form import Field, ParamForm
 from vtool.app.tui.messages import FieldEdited, RunProgressed
 from vtool.errors import InputError
+
+PROGRESS_INTERVAL = 0.05  # s between progress messages: the bar needs no more
+NARROW = 120  # columns below which a finished run hides the form
+
+
+def path_problem(error: Exception, path: str) -> Exception:
+    """A file error as the house reports it: OSError and InputError as they are, else the path's field."""
+    if isinstance(error, OSError | InputError):
+        return error
+    return InputError("path", path, "a file path that can be written (no NUL or other control characters)")
 
 
 class FormProblem:
@@ -77,6 +103,10 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         self.results: Any = None  # what the last finished run returned
         self.results_spec: Any = None
         self.messages_seen: list[Any] = []  # typed run messages, in order (tests read them)
+        self.loaded_doc: dict[str, Any] = {}  # the preset document as loaded (what a save compares)
+        self.start_doc: dict[str, Any] = {}  # the form's document as loaded (what a star compares)
+        self.status_log: list[str] = []  # every status message, in order
+        self._run_lock = threading.Lock()  # held by the thread of the run that computes
 
     # ----- layout -----
     def compose(self) -> ComposeResult:
@@ -125,7 +155,18 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         return True
 
     def set_status(self, text: str) -> None:
+        self.status_log.append(text)
         self.status.update(text)
+
+    def show_progress(self, running: bool) -> None:
+        """The bar shows only while a run goes (never a stale 100 %).
+
+        A run starts with a pulsing bar (no total) that turns into a
+        percentage at its worker's first :class:`RunProgressed`; a worker
+        that reports no progress still shows that it is working.
+        """
+        self.progress.update(total=None if running else 1.0, progress=0)
+        self.set_class(running, "-running")
 
     # ----- what a domain screen provides -----
     @abstractmethod
@@ -162,6 +203,11 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
 
             spec, source = load_preset(self.DEFAULT_PRESET), self.DEFAULT_PRESET
         await self.load_spec(spec, source)
+        self.focus_first_field()
+
+    def focus_first_field(self) -> None:
+        if self.form.fields:
+            self.form.row(self.form.fields[0].path).editor.focus()
 
     async def load_spec(self, spec: Any, source: str) -> None:
         """Show ``spec`` in the form (the document its loader dumps) and clear old results."""
@@ -169,12 +215,14 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             self.worker.cancel()
         self.source = source
         self.base_doc = self.loader().dump(spec)
+        self.loaded_doc = self.loader().dump(spec)
         self.spec = spec
         self.problem = None
         await self.form.set_fields(self.fields_for(spec, self.base_doc), self.base_doc)
+        self.start_doc = copy.deepcopy(self.base_doc)  # with a screen's run options, if any
         self.query_one("#spec-title", Static).update(f"{Path(source).stem}: {getattr(spec, 'title', '')}")
         self.clear_results()
-        self.progress.update(progress=0)
+        self.show_progress(False)
         self.set_status(f"loaded {source}; ctrl+r runs")
         self.after_load()
 
@@ -191,11 +239,12 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             self.extra_checks(spec)
         except InputError as exc:
             self.spec, self.problem = None, exc
-        except (TypeError, ValueError, KeyError, IndexError) as exc:
+        except (TypeError, ValueError, KeyError, IndexError, ArithmeticError) as exc:
             self.spec, self.problem = None, FormProblem(f"invalid form: {exc}")
         else:
             self.spec, self.problem = spec, None
         self.form.show_error(self.problem)
+        self.form.mark_changed(self.start_doc)
         return self.spec
 
     def on_field_edited(self, message: FieldEdited) -> None:
@@ -223,7 +272,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             return
         self.run_id += 1
         self.messages_seen.clear()
-        self.progress.update(total=1.0, progress=0)
+        self.show_progress(True)
         self.set_status("running... (escape cancels)")
         self.worker = self.start_run(spec, self.run_id)
         self.refresh_bindings()
@@ -232,14 +281,43 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         if self.running and self.worker is not None:
             self.worker.cancel()
             self.set_status("cancelled")
-            self.progress.update(progress=0)
+            self.show_progress(False)
             self.refresh_bindings()
+
+    @contextmanager
+    def run_slot(self) -> Iterator[bool]:
+        """In a worker thread: wait until the previous (cancelled) run's thread has left.
+
+        Yields False when this run was itself cancelled while waiting (then
+        it must return at once); the slot is held until the block ends.
+        """
+        worker = get_current_worker()
+        while not self._run_lock.acquire(timeout=0.02):
+            if worker.is_cancelled:
+                yield False
+                return
+        try:
+            yield not worker.is_cancelled
+        finally:
+            self._run_lock.release()
+
+    def progress_reporter(self, run_id: int) -> Callable[[float], None]:
+        """A progress callback for a worker: posts :class:`RunProgressed`, at most every 50 ms."""
+        last = [0.0]
+
+        def report(fraction: float) -> None:
+            now = time.monotonic()
+            if now - last[0] >= PROGRESS_INTERVAL or fraction >= 1.0:
+                last[0] = now
+                self.post_message(RunProgressed(run_id, fraction))
+
+        return report
 
     def on_run_progressed(self, message: RunProgressed) -> None:
         message.stop()
         if message.run_id == self.run_id and self.running:
             self.messages_seen.append(message)
-            self.progress.update(progress=min(max(message.fraction, 0.0), 1.0))
+            self.progress.update(total=1.0, progress=min(max(message.fraction, 0.0), 1.0))
 
     def accept(self, message: Any) -> bool:
         """True when a finished-run message belongs to the current run."""
@@ -247,7 +325,10 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             return False
         self.messages_seen.append(message)
         self.results, self.results_spec = None, message.spec
-        self.progress.update(progress=1.0)
+        self.show_progress(False)
+        if self.size.width < NARROW and not self.has_class("-form-hidden"):
+            self.add_class("-form-hidden")
+            self.notify("form hidden to show the results: ctrl+f shows it", timeout=3)
         return True
 
     def on_worker_state_changed(self, event: Worker.StateChanged) -> None:
@@ -256,9 +337,10 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             return
         self.refresh_bindings()
         self.app.refresh_bindings()
+        if event.state in (WorkerState.SUCCESS, WorkerState.ERROR, WorkerState.CANCELLED):
+            self.set_class(False, "-running")
         if event.state == WorkerState.ERROR:
             error = event.worker.error
-            self.progress.update(progress=0)
             if isinstance(error, InputError):
                 self.problem = error
                 self.form.show_error(error)
@@ -274,24 +356,46 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             self._refuse("save")
             return
         default = Path(self.source).name if self.source.endswith(".toml") else f"{Path(self.source).stem}.toml"
+        document = self.current_document()
 
         def save(path: str | None) -> None:
             if not path:
                 return
-            from vtool.presets import save_spec
-
             try:
-                save_spec(spec, path)
-            except OSError as exc:
-                self.app.report_error("Save failed", exc)  # type: ignore[attr-defined]
+                kept = self.save_document(document, path)
+            except (OSError, ValueError) as exc:  # ValueError: InputError, a NUL in the path
+                self.app.report_error("Save failed", path_problem(exc, path))  # type: ignore[attr-defined]
                 return
             full = str(Path(path).resolve())
             self.app.remember(full)  # type: ignore[attr-defined]
             self.source = full
-            self.set_status(f"saved {path}")
+            self.loaded_doc = self.loader().dump(spec)
+            self.start_doc = self.form.apply(self.base_doc)
+            self.form.mark_changed(self.start_doc)
+            note = "comments kept, changes marked '# was'" if kept else "written afresh (no source file)"
+            self.set_status(f"saved {path} ({note})")
             self.notify(f"saved {path}")
 
         self.app.push_screen(PathDialog("Save preset as", default), save)
+
+    def save_document(self, document: dict[str, Any], path: str) -> bool:
+        """Write the form's document as a preset; True when the source file's comments were kept."""
+        import tomli_w
+
+        from vtool.app.tui.presetfile import save_text
+        from vtool.files import write_atomic
+        from vtool.presets import find_preset
+
+        loader = self.loader()
+        try:
+            source: Path | None = Path(find_preset(self.source))
+        except InputError:
+            source = None
+        text, kept = save_text(source, self.loaded_doc, document,
+                               lambda doc: loader.dump(loader.load(doc)),
+                               lambda: tomli_w.dumps(loader.dump(loader.load(document))))
+        write_atomic(path, text)
+        return kept
 
     def action_export(self) -> None:
         if self.results is None:
@@ -304,8 +408,8 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
                 return
             try:
                 self.write_csv(path)
-            except (OSError, InputError) as exc:
-                self.app.report_error("Export failed", exc)  # type: ignore[attr-defined]
+            except (OSError, ValueError) as exc:  # ValueError: InputError, a NUL in the path
+                self.app.report_error("Export failed", path_problem(exc, path))  # type: ignore[attr-defined]
                 return
             self.set_status(f"wrote {path}")
             self.notify(f"wrote {path}")

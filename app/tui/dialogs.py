@@ -9,7 +9,7 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical, VerticalScroll
 from textual.screen import ModalScreen
-from textual.widgets import Button, Input, Label, OptionList, Static
+from textual.widgets import Button, Input, Label, Markdown, OptionList, Static
 from textual.widgets.option_list import Option
 
 
@@ -112,29 +112,36 @@ class PathDialog(ModalScreen[str | None]):
 
 
 HELP = """\
-vtool: valve-train dynamics, sonic-boom and plate checks
+# vtool
 
-Screens
-  f2  valve train     f3  sonic boom     f4  plate
+Valve-train dynamics, sonic-boom and plate checks.
 
-Everywhere
-  ctrl+r  run (validated form; a bad field blocks the run)
-  escape  cancel the running job
-  ctrl+o  open a shipped or recent preset, or a path
-  ctrl+s  save the form as a preset (TOML)
-  ctrl+e  export the current results as CSV (same as `vtool solve --csv`)
-  ctrl+f  hide / show the form (full-width charts)
-  ctrl+t  next result tab (left / right also switch tabs when they have focus)
-  tab     next field        shift+tab  previous field
-  f1      this help         ctrl+q     quit
+## Screens
 
-Valve-train animation tab (focus it with ctrl+t, then tab)
-  space  play / pause     left / right  step one output row
-  + / -  deformation scale x2 / /2      home  first row
+- `f2` valve train, `f3` sonic boom, `f4` plate
 
-Fields show their unit on the right; a bad value shows the same message as
-the CLI below the field. Forms edit the preset document, so a saved preset
-loads back to the same form.
+## Everywhere
+
+- `ctrl+r` run (validated form; a bad field blocks the run)
+- `escape` cancel the running job
+- `ctrl+o` open a shipped or recent preset, or a path
+- `ctrl+s` save the form as a preset (the file's comments kept, changes noted `# was ...`)
+- `ctrl+e` export the current results as CSV (same as `vtool solve --csv`)
+- `ctrl+f` hide / show the form (a run hides it below 120 columns)
+- `ctrl+t` next result tab
+- `tab` / `shift+tab` next / previous field
+- `f1` this help, `ctrl+q` quit
+
+## Valve-train animation tab
+
+- `space` play / pause, `home` first row
+- `left` / `right` step one output row
+- `+` / `-` deformation scale x2 / /2
+- `]` / `[` play faster / slower (x1 plays a run in 10 s)
+
+Fields show their unit on the right; a starred label is a value changed
+from the loaded preset. A bad value shows the same message as the CLI
+below the field. The status line keeps every message (it wraps, never cuts).
 """
 
 
@@ -146,7 +153,7 @@ class HelpScreen(ModalScreen[None]):
 
     def compose(self) -> ComposeResult:
         with VerticalScroll(id="help-dialog", classes="dialog"):
-            yield Static(Text(HELP, no_wrap=True), id="help-text")
+            yield Markdown(HELP, id="help-text")
 
     def action_close(self) -> None:
         self.dismiss(None)

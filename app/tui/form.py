@@ -9,6 +9,7 @@ the preset loader, so the messages are exactly the CLI's
 from __future__ import annotations
 
 import copy
+import math
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -100,13 +101,27 @@ def format_value(value: Any) -> str:
 
 
 def _number(text: str) -> Any:
-    """An int or float when the text is one; otherwise the text (the loader reports it)."""
-    for convert in (int, float):
+    """An int or float when the text is one; otherwise the text (the loader reports it).
+
+    A number no float holds (a pasted run of 400 digits, ``1e999``, ``inf``)
+    is kept as its text, so nothing downstream converts it: the loader says
+    "expected a number".
+    """
+    try:
+        value = int(text)
+    except ValueError:
+        pass
+    else:
         try:
-            return convert(text)
-        except ValueError:
-            continue
-    return text  # the loader reports "got 'abc', expected a number ..."
+            float(value)
+        except OverflowError:
+            return text
+        return value
+    try:
+        number = float(text)
+    except ValueError:
+        return text  # the loader reports "got 'abc', expected a number ..."
+    return number if math.isfinite(number) else text
 
 
 def parse_value(field: Field, text: str) -> Any:
@@ -130,12 +145,14 @@ class FieldRow(Widget):
     FieldRow .field-error { color: $error; height: auto; display: none; column-span: 3; }
     FieldRow.-invalid .field-error { display: block; }
     FieldRow.-invalid Input { color: $error; }
+    FieldRow.-changed .field-label { color: $warning; text-style: bold; }
     """
 
     def __init__(self, field: Field, value: Any) -> None:
         super().__init__(id=field.widget_id)
         self.field = field
         self.initial = value
+        self.error: str | None = None
 
     def compose(self) -> ComposeResult:
         f = self.field
@@ -169,7 +186,16 @@ class FieldRow(Widget):
         else:
             editor.value = text
 
+    def mark_changed(self, changed: bool) -> None:
+        """Changed from the loaded preset: the label is highlighted and starred."""
+        if changed != self.has_class("-changed"):
+            self.set_class(changed, "-changed")
+            self.query_one(".field-label", Label).update(("*" if changed else "") + self.field.label)
+
     def show_error(self, message: str | None) -> None:
+        if message == self.error:
+            return  # every edit re-shows every row's state: touch only what changed
+        self.error = message
         self.set_class(bool(message), "-invalid")
         self.query_one(".field-error", Static).update(message or "")
 
@@ -187,6 +213,7 @@ class ParamForm(VerticalScroll):
     def __init__(self, *, id: str | None = None) -> None:
         super().__init__(id=id)
         self.fields: list[Field] = []
+        self.general_error: str | None = None
         self._filling = False
 
     def compose(self) -> ComposeResult:
@@ -239,6 +266,13 @@ class ParamForm(VerticalScroll):
                 set_path(out, f.path, parse_value(f, text))
         return out
 
+    def mark_changed(self, loaded: dict[str, Any]) -> None:
+        """Mark the rows whose text differs from the loaded document's value."""
+        for row in self.query(FieldRow):
+            before = format_value(get_path(loaded, row.field.path))
+            row.mark_changed(row.text.strip() != before and
+                             parse_value(row.field, row.text) != parse_value(row.field, before))
+
     def show_error(self, error: Any | None) -> str | None:
         """Show an :class:`InputError` beside its field (or above the form); None clears.
 
@@ -253,8 +287,10 @@ class ParamForm(VerticalScroll):
             if here:
                 shown_at = row.field.name
         general = message if (message is not None and shown_at is None) else None
-        self.set_class(general is not None, "-invalid")
-        self.query_one("#form-error", Static).update(general or "")
+        if general != self.general_error:
+            self.general_error = general
+            self.set_class(general is not None, "-invalid")
+            self.query_one("#form-error", Static).update(general or "")
         return shown_at
 
     def on_input_changed(self, event: Input.Changed) -> None:

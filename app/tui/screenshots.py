@@ -1,9 +1,10 @@
 """Screenshots of the app: SVG from Textual, and the same screen as plain text.
 
-``python -m vtool.app.tui.screenshots OUTDIR`` renders every screen at
-80 x 24 (after a run of its default preset) into ``OUTDIR/*.svg`` and
-``OUTDIR/*.txt``; the documentation's figures come from here, and the
-snapshot tests read the text the same way.
+``python -m vtool.app.tui.screenshots OUTDIR`` renders every screen (after
+a run of its default preset, at 80 x 24 and wider) into ``OUTDIR/*.svg`` and
+``OUTDIR/*.txt``; given ``docs/tui`` it also rewrites the screen captures
+quoted in README.md and docs/tui.md (generated blocks). The snapshot tests
+read the text the same way.
 """
 
 from __future__ import annotations
@@ -56,24 +57,42 @@ async def _capture(mode: str, preset: str, size: tuple[int, int], keys: tuple[st
 
 
 SHOTS = (
+    # below 120 columns a finished run hides the form (ctrl+f shows it)
     ("valvetrain-forces", "valvetrain", "gnilka-1a", (80, 24), ()),
+    ("valvetrain-form", "valvetrain", "gnilka-1a", (120, 40), ()),
+    ("valvetrain-quantities", "valvetrain", "gnilka-1a", (120, 40), ("ctrl+t",)),
     ("valvetrain-configuration-wide", "valvetrain", "gnilka-1a", (170, 40), ("ctrl+t", "ctrl+t")),
-    ("valvetrain-animation", "valvetrain", "gnilka-1a", (80, 24), ("ctrl+f", "ctrl+t", "ctrl+t", "ctrl+t",
-                                                                   "ctrl+t", "ctrl+t")),
-    ("boom-limits", "boom", "boom-brick-wall", (80, 24), ("ctrl+f",)),
+    ("valvetrain-animation", "valvetrain", "gnilka-1a", (80, 24), ("ctrl+t",) * 5),
+    ("boom-limits", "boom", "boom-brick-wall", (80, 24), ()),
     ("boom-daf", "boom", "boom-brick-wall", (80, 24), ("ctrl+t",)),
     ("plate-transient", "plate", "plate-table2", (120, 32), ("ctrl+t",)),
 )
 
+#: screens quoted in the docs, as generated blocks (file relative to the repository, block name)
+DOC_BLOCKS = {
+    "valvetrain-form": (("README.md", "tui-valvetrain"), ("docs/tui.md", "tui-valvetrain")),
+    "valvetrain-animation": (("docs/tui.md", "tui-animation"),),
+    "boom-limits": (("docs/tui.md", "tui-boom"),),
+    "plate-transient": (("docs/tui.md", "tui-plate"),),
+}
+
 
 def main(outdir: str) -> None:
+    """Write every shot into ``outdir``; when it is a repository's docs/tui, update the docs' blocks."""
+    from vtool.markdown import replace_block
+
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
+    root = out.resolve().parent.parent
     for name, mode, preset, size, keys in SHOTS:
         svg, text = asyncio.run(_capture(mode, preset, size, keys))
         (out / f"{name}.svg").write_text(svg, encoding="utf-8")
         (out / f"{name}.txt").write_text(text + "\n", encoding="utf-8")
         print(f"wrote {out / name}.svg and .txt")
+        for doc, block in DOC_BLOCKS.get(name, ()):
+            if (root / doc).is_file():
+                replace_block(root / doc, block, f"```\n{text}\n```")
+                print(f"updated {doc} block {block}")
 
 
 if __name__ == "__main__":

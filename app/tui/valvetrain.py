@@ -1,23 +1,27 @@
-"""The valve-train screen: mechanism and run form, simulation worker, charts, animation."""
+"""The valve-train screen: mechanism and run form, simulation worker, charts, animation.
+
+The result tabs are one list (:meth:`ValveTrainScreen.result_panes`): a new
+tab (e.g. a sweep) is one more ``TabPane`` appended there.
+"""
 
 from __future__ import annotations
 
-import time
 from typing import Any
 
 from textual import work
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.widgets import SelectionList, TabbedContent, TabPane
+from textual.widgets.selection_list import Selection
 from textual.worker import Worker, get_current_worker
 
 from vtool.app.tui.animation import MechanismAnimation
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, Field
-from vtool.app.tui.messages import RunProgressed, SimulationFinished
+from vtool.app.tui.messages import SimulationFinished
 from vtool.app.tui.widgets import ChartView, TextPanel
 
-PROGRESS_INTERVAL = 0.05  # s between progress messages
+DEFAULT_PLOTTED = 4  # displacement quantities ticked after a load (all are in the list)
 
 MEMBER_KEYS = (
     ("length", "length", "length"),
@@ -88,9 +92,21 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
 
 
 def displacement_quantities(spec: Any) -> list[str]:
-    """The preset's plotted (non-force) quantities, else the elastic coordinates."""
-    chosen = [q for q in spec.run.quantities if not q.startswith("F")]
-    return chosen or [f"q{i}" for i in range(1, spec.n_coordinates + 1)]
+    """Every quantity the preset names (Gnilka's 11 printed ones), else the elastic coordinates."""
+    return list(spec.run.quantities) or [f"q{i}" for i in range(1, spec.n_coordinates + 1)]
+
+
+def quantity_unit(spec: Any, quantity: str) -> str:
+    """The unit of ``q7``, ``q1-q9`` (a coordinate's) or ``F2`` (a force), for the pick list."""
+    import re
+
+    units = spec.unit_system
+    if quantity.startswith("F"):
+        return units.force
+    number = int(re.findall(r"\d+", quantity)[0])
+    if number <= spec.n_coordinates and spec.coordinates[number - 1].motion == "rotation":
+        return "rad"
+    return units.length
 
 
 class ValveTrainScreen(DomainScreen):
@@ -99,27 +115,27 @@ class ValveTrainScreen(DomainScreen):
     DEFAULT_PRESET = "gnilka-1a"
     TITLE_TEXT = "VALVE TRAIN"
 
-    def compose_results(self) -> ComposeResult:
+    def result_panes(self) -> list[TabPane]:
+        """The result tabs, in order: a new tab is one more pane in this list."""
         color = self.app.chart_color  # type: ignore[attr-defined]
+        return [
+            TabPane("Forces", ChartView("contact forces appear here after a run (ctrl+r)",
+                                        id="force-chart", color=color), id="tab-forces"),
+            TabPane("Quant.", Horizontal(
+                SelectionList[str](id="quantities"),
+                ChartView("the quantities ticked on the left appear here after a run",
+                          id="displacement-chart", color=color)), id="tab-displacements"),
+            TabPane("Config", ChartView("closed clearances against cam angle appear here after a run",
+                                        id="configuration-chart", color=color), id="tab-configuration"),
+            TabPane("Events", TextPanel("no run yet", id="events"), id="tab-events"),
+            TabPane("Summary", TextPanel("no run yet", id="summary"), id="tab-summary"),
+            TabPane("Anim.", MechanismAnimation(id="animation", color=color), id="tab-animation"),
+        ]
+
+    def compose_results(self) -> ComposeResult:
         with Horizontal(id="results-row"):
             with TabbedContent(id="results-tabs"):
-                with TabPane("Forces", id="tab-forces"):
-                    yield ChartView("contact forces appear here after a run (ctrl+r)", id="force-chart",
-                                    color=color)
-                with TabPane("Displ.", id="tab-displacements"):
-                    with Horizontal():
-                        yield SelectionList[str](id="quantities")
-                        yield ChartView("displacements appear here after a run", id="displacement-chart",
-                                        color=color)
-                with TabPane("Config", id="tab-configuration"):
-                    yield ChartView("closed clearances against cam angle appear here after a run",
-                                    id="configuration-chart", color=color)
-                with TabPane("Events", id="tab-events"):
-                    yield TextPanel("no run yet", id="events")
-                with TabPane("Summary", id="tab-summary"):
-                    yield TextPanel("no run yet", id="summary")
-                with TabPane("Anim.", id="tab-animation"):
-                    yield MechanismAnimation(id="animation", color=color)
+                yield from self.result_panes()
             yield TextPanel("", id="side-panel")
 
     # ----- typed access to the children -----
@@ -160,7 +176,9 @@ class ValveTrainScreen(DomainScreen):
         quantities = displacement_quantities(self.spec)
         selection = self.quantity_list
         selection.clear_options()
-        selection.add_options([(q, q, i < 4) for i, q in enumerate(quantities)])
+        ticked = [q for q in quantities if not q.startswith("F")][:DEFAULT_PLOTTED] or quantities[:1]
+        selection.add_options([Selection(f"{q} ({quantity_unit(self.spec, q)})", q, q in ticked)
+                               for q in quantities])
 
     def selected_quantities(self) -> tuple[str, ...]:
         return tuple(self.quantity_list.selected)
@@ -184,15 +202,11 @@ class ValveTrainScreen(DomainScreen):
         from vtool.solvers.run import simulate
 
         worker = get_current_worker()
-        last = [0.0]
-
-        def progress(fraction: float) -> None:
-            now = time.monotonic()
-            if now - last[0] >= PROGRESS_INTERVAL:  # the bar needs no more; the UI keeps the GIL
-                last[0] = now
-                self.post_message(RunProgressed(run_id, fraction))
-
-        trace = simulate(spec, progress=progress, cancel=lambda: worker.is_cancelled)
+        with self.run_slot() as go:  # the cancelled run's thread has left before this one allocates
+            if not go:
+                return
+            trace = simulate(spec, progress=self.progress_reporter(run_id),
+                             cancel=lambda: worker.is_cancelled)
         if not worker.is_cancelled:
             self.post_message(SimulationFinished(run_id, spec, trace))
 

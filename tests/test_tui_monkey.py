@@ -1,0 +1,132 @@
+"""A seeded monkey: random keys, clicks and pasted garbage across the three screens, no crash.
+
+Each sequence starts a fresh app (the valve-train screen, its default preset
+cut to a short run so runs finish inside a sequence) and sends ``EVENTS``
+random events: screen keys (run, cancel, save, export, open, help, tabs,
+f2-f4), field navigation and typing, clicks anywhere (dialogs included) and
+pasted text (long digit runs, ``1e999``, ``nan``, control characters,
+paths that cannot be written). The app must never hit an uncaught
+exception; an error dialog is the expected answer to bad input.
+
+CI runs one sequence of 30 events (30 to 60 s on the shared, loaded 2-core
+machine, where a Textual event costs 1 to 2 s); ``VTOOL_MONKEY=1000`` runs
+1,000 sequences of 50 events and prints what it found::
+
+    VTOOL_MONKEY=1000 .venv/bin/python -m pytest -q -s tests/test_tui_monkey.py
+
+A failure names the seed; ``VTOOL_MONKEY_SEED=<seed> VTOOL_MONKEY=1`` replays it.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import time
+from dataclasses import dataclass, field
+
+import pytest
+from textual import events
+from textual.pilot import OutOfBounds
+
+from vtool.app.tui.app import create_app
+
+pytestmark = pytest.mark.asyncio
+
+SEQUENCES = int(os.environ.get("VTOOL_MONKEY", "1"))
+EVENTS = int(os.environ.get("VTOOL_MONKEY_EVENTS", "50" if "VTOOL_MONKEY" in os.environ else "30"))
+FIRST_SEED = int(os.environ.get("VTOOL_MONKEY_SEED", "0"))
+SIZES = ((80, 24), (120, 40), (100, 30))
+
+SCREEN_KEYS = ("ctrl+r", "ctrl+r", "escape", "escape", "ctrl+s", "ctrl+e", "ctrl+o", "ctrl+f", "ctrl+t",
+               "f1", "f2", "f3", "f4", "enter", "enter")
+MOVE_KEYS = ("tab", "tab", "shift+tab", "up", "down", "left", "right", "home", "end", "pageup",
+             "pagedown", "space", "backspace", "delete", "ctrl+u")
+TYPED_KEYS = tuple("0123456789.-eE+x,[] ") + ("plus", "minus", "left_square_bracket",
+                                             "right_square_bracket")
+GARBAGE = ("1" * 400, "9" * 40, "-" + "9" * 320, "1e999", "-1e999", "1e-400", "nan", "inf", "-0", "0",
+           "", "   ", "abc", "ünï©ødé ☃", "1,2,,3", "[[x]]", "0.5, 1e308, 1e309", "\x00", "a\nb",
+           "\t", "/nonexistent/dir/x.toml", "/proc/version", "gnilka-1b", "boom-tall-building",
+           "plate-table3", ".", "..", "x" * 300, "1_000", "0x1F", "1e5", "-5", "3.14159")
+
+
+@dataclass
+class Found:
+    crashes: list[str] = field(default_factory=list)
+    internal: list[str] = field(default_factory=list)  # error dialogs for non-user errors
+
+
+def garbage(rng: random.Random) -> str:
+    if rng.random() < 0.3:
+        return "".join(rng.choice("0123456789.,-+e ") for _ in range(rng.randint(1, 60)))
+    return rng.choice(GARBAGE)
+
+
+async def send(pilot, app, rng: random.Random) -> str:  # type: ignore[no-untyped-def]
+    """One random event; returns its description."""
+    roll = rng.random()
+    if roll < 0.35:
+        key = rng.choice(SCREEN_KEYS)
+    elif roll < 0.6:
+        key = rng.choice(MOVE_KEYS)
+    elif roll < 0.75:
+        key = rng.choice(TYPED_KEYS)
+    elif roll < 0.88:
+        text = garbage(rng)
+        target = app.focused
+        if target is not None:
+            target.post_message(events.Paste(text))
+        await pilot.pause()
+        return f"paste {text[:20]!r} into {type(target).__name__}"
+    else:
+        width, height = app.size
+        x, y = rng.randrange(width), rng.randrange(height - 1)  # the footer's Quit would end the app
+        try:
+            await pilot.click(offset=(x, y))
+        except OutOfBounds:
+            pass
+        return f"click {x},{y}"
+    await pilot.press(key)
+    return key
+
+
+def internal_errors(app, start: int) -> list[str]:  # type: ignore[no-untyped-def]
+    return [t for t in app.errors_shown[start:] if t.startswith("the run could not be completed")]
+
+
+async def one_sequence(seed: int, found: Found, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    rng = random.Random(seed)
+    app = create_app("gnilka-1d", remember=False, chart_color=False)
+    done: list[str] = []
+    try:
+        async with app.run_test(size=rng.choice(SIZES)) as pilot:
+            await pilot.pause()
+            app.screen.form.row("run.degrees").editor.value = "40"  # runs finish within a sequence
+            await pilot.pause()
+            for _ in range(EVENTS):
+                done.append(await send(pilot, app, rng))
+                if app._exception is not None or not app.is_running:
+                    break
+            app.workers.cancel_all()
+            await pilot.pause()
+    except Exception as exc:  # the monkey's one job: record what escaped the app
+        found.crashes.append(f"seed {seed}: {type(exc).__name__}: {exc} after {done[-5:]}")
+        return
+    found.internal += [f"seed {seed}: {t}" for t in internal_errors(app, 0)]
+
+
+async def test_monkey_finds_no_crash(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    monkeypatch.chdir(tmp_path)  # saves and exports land here
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path))
+    found = Found()
+    started = time.perf_counter()
+    for seed in range(FIRST_SEED, FIRST_SEED + SEQUENCES):
+        await one_sequence(seed, found, tmp_path)
+        if SEQUENCES > 10:  # a long run reports as it goes (pytest -s)
+            print(f"seed {seed}: {len(found.crashes)} crashes so far, "
+                  f"{time.perf_counter() - started:.0f} s", flush=True)
+    elapsed = time.perf_counter() - started
+    print(f"\nTUI monkey: {SEQUENCES} sequences of {EVENTS} events in {elapsed:.0f} s: "
+          f"{len(found.crashes)} crashes, {len(found.internal)} internal-error dialogs")
+    for line in found.crashes + found.internal:
+        print("  ", line[:300])
+    assert not found.crashes, "\n".join(found.crashes)
