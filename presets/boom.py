@@ -194,7 +194,7 @@ def _range3(t: Table, key: str, default: tuple[float, ...]) -> tuple[float, ...]
     values = t.numbers(key)
     if len(values) != 3 or not values[2] > 0.0 or values[1] < values[0]:
         raise InputError(t.field(key), values, "[first, last, step] with last >= first, step > 0")
-    return _steps(*values, field=t.field(key))
+    return _steps(values[0], values[1], values[2], field=t.field(key))
 
 
 def _boom(t: Table, base: str | Path | None) -> BoomLoading:

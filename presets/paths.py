@@ -196,7 +196,7 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> Sweep
     if count > max_points:
         raise InputError("--set", count, f"a grid of at most {max_points} points")
     points = []
-    for index, values in enumerate(grid(fields)):
-        points.append(Point(index, values, load_document(set_fields(doc, dict(values)))))
+    for index, assignment in enumerate(grid(fields)):
+        points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)))))
     units = tuple((path, field_unit(doc, path)) for path, _ in fields)
     return SweepPlan(doc, spec, units, tuple(points))

@@ -50,10 +50,17 @@ pull (an impact so released is a bounce: two events at one instant).
 
 from __future__ import annotations
 
-import numpy as np
-from numba import njit
+import os
 
-jit = njit(cache=True, nogil=True, error_model="numpy")
+import numpy as np
+
+from vtool import numba_cache
+
+numba_cache.configure(os.path.dirname(os.path.abspath(__file__)))  # before numba: a read-only install caches elsewhere
+
+from numba import njit  # noqa: E402 (after the cache folder is chosen)
+
+jit = njit(cache=numba_cache.CACHE_ENABLED, nogil=True, error_model="numpy")
 
 # ----- slots of the integer and float parameter vectors -----
 IP_N, IP_NCL, IP_NS, IP_NH, IP_EVERY, IP_ZSTICK, IP_ZSTOP = range(7)

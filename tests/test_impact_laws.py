@@ -32,7 +32,7 @@ def chain_doc(masses: int, law: str, restitution: float, scale: float = 1.0) -> 
         "initial": {"closed": ["cam"], "spring_preload": 10.0, "lever_ratio": 1.0},
         "contact": {"impact": law, "rocker_scale": scale},
         "damping": {"default_ratio": 0.0},
-        "run": {"rpm": 1e-6, "degrees": 1.0, "time_step": 1e-6},
+        "run": {"rpm": 1.0, "degrees": 1.0, "time_step": 1e-6},
     }
     if masses == 3:
         doc["members"]["spring3"] = dict(SPRING, coordinates=[0, 3])

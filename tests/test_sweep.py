@@ -77,7 +77,7 @@ def test_grid_varies_the_first_field_fastest() -> None:
     (["--set", "members.spring.stiffness=100"], "members.spring: got missing"),
     (["--set", "run.rpm=5000:4000:250"], "sign of stop - start"),
     (["--set", "run.rpm=,"], "non-empty"),
-    (["--set", "run.rpm=-100:100:100"], "run.rpm: got -100.0, expected"),
+    (["--set", "run.rpm=-100:100:100"], "run.rpm: got -100, expected"),
     (["--set", "clearances[2].restitution=0.5,1.5"], "clearances[2].restitution: got 1.5, expected"),
     (["--set", "run.rpm=9000", "--scheduler", "tcp://127.0.0.1:9"], "--scheduler: got 'tcp://127.0.0.1:9'"),
     (["--set", "run.rpm=9000", "--metric", "nonsense"], "--metric: got 'nonsense'"),

@@ -140,7 +140,7 @@ def _write(path: Path, text: str) -> None:
     from vtool.files import write_atomic
 
     try:
-        write_atomic(path, text)
+        write_atomic(path, text, "--csv")
     except OSError as exc:
         raise InputError("--csv", shorten(str(path), 80),
                          f"a file in an existing, writable folder ({exc.strerror})") from None

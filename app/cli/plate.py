@@ -154,7 +154,7 @@ def _write(path: Path, text: str) -> None:
     from vtool.files import write_atomic
 
     try:
-        write_atomic(path, text)
+        write_atomic(path, text, "--csv")
     except OSError as exc:
         shown = str(path) if len(str(path)) <= 80 else str(path)[:77] + "..."
         raise InputError("--csv", shown, f"a file in an existing, writable folder ({exc.strerror})") from None

@@ -209,11 +209,15 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         if self.form.fields:
             self.form.row(self.form.fields[0].path).editor.focus()
 
+    def on_source_changed(self, source: str) -> None:
+        """Hook: a screen that keeps the preset's name elsewhere (the valve train's sweep tab) updates it."""
+
     async def load_spec(self, spec: Any, source: str) -> None:
         """Show ``spec`` in the form (the document its loader dumps) and clear old results."""
         if self.running and self.worker is not None:
             self.worker.cancel()
         self.source = source
+        self.on_source_changed(source)
         self.base_doc = self.loader().dump(spec)
         self.loaded_doc = self.loader().dump(spec)
         self.spec = spec

@@ -19,7 +19,9 @@ from vtool.app.tui.animation import MechanismAnimation
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, Field
 from vtool.app.tui.messages import SimulationFinished
+from vtool.app.tui.sweep import SweepPane
 from vtool.app.tui.widgets import ChartView, TextPanel
+from vtool.solvers.spec import IMPACT_LAWS, START_VELOCITIES
 
 DEFAULT_PLOTTED = 4  # displacement quantities ticked after a load (all are in the list)
 
@@ -60,6 +62,8 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
            for key in ("harmonics", "tolerance") if key in doc["cam"]]),
         Field(("initial", "spring_preload"), "spring preload", u.force, group="Cam and spring"),
         Field(("initial", "lever_ratio"), "lever ratio", group="Cam and spring"),
+        Field(("initial", "velocities"), "start velocities", kind=CHOICE, choices=START_VELOCITIES,
+              group="Cam and spring"),
     ]
     for name, member in doc["members"].items():
         if "stiffness" in member:
@@ -68,6 +72,8 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
     if "seat" in doc:
         key = "lash" if "lash" in doc["seat"] else "position"
         fields.append(Field(("seat", key), f"seat {key}", u.length, group="Clearances"))
+    fields.append(Field(("contact", "impact"), "impact law", kind=CHOICE, choices=IMPACT_LAWS, group="Clearances"))
+    fields.append(Field(("contact", "rocker_scale"), "rocker SCALE", group="Clearances"))
     for i, c in enumerate(doc["clearances"]):
         states = ("enabled", "removed") if c["kind"] == "external" else ("enabled", "pinned", "removed")
         fields.append(Field(("clearances", i, "state"), f"{c['name']} state", kind=CHOICE, choices=states,
@@ -130,7 +136,13 @@ class ValveTrainScreen(DomainScreen):
             TabPane("Events", TextPanel("no run yet", id="events"), id="tab-events"),
             TabPane("Summary", TextPanel("no run yet", id="summary"), id="tab-summary"),
             TabPane("Anim.", MechanismAnimation(id="animation", color=color), id="tab-animation"),
+            TabPane("Sweep", SweepPane(self.DEFAULT_PRESET, workers=None, id="sweep"), id="tab-sweep"),
         ]
+
+    def on_source_changed(self, source: str) -> None:
+        """The sweep tab sweeps the preset the form shows (as loaded; save the form to sweep edits)."""
+        for pane in self.query(SweepPane):
+            pane.preset = source
 
     def compose_results(self) -> ComposeResult:
         with Horizontal(id="results-row"):
