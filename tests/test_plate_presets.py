@@ -55,7 +55,7 @@ def test_table2_case_definitions() -> None:
 
 
 @given(
-    a=st.floats(0.01, 1e3), aspect=st.floats(0.01, 100.0), h=st.floats(1e-4, 1.0),
+    a=st.floats(0.01, 1e3), aspect=st.floats(0.011, 90.0), h=st.floats(1e-4, 1.0),
     nu=st.floats(-0.9, 0.49),
     nx=st.sampled_from([4, 8]), method=st.sampled_from(["guyan", "irs"]),
     masters=st.sampled_from(["all", "interior-w", "centre-w", "five-cross-w"]),

@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import click
-import numpy as np
 
 from vtool.errors import RunError
 from vtool.files import json_text
@@ -18,8 +17,8 @@ def modes(preset: str, as_json: bool) -> None:
     """Natural frequencies (rad/s, Hz) and mass-normalised mode shapes of every
     contact layer, with the static start (cam offset XZERO, follower force FZERO)."""
     from vtool.presets import load_preset
-    from vtool.solvers.assembly import surge_labels
     from vtool.presets.kinds import require_kind
+    from vtool.solvers.assembly import surge_labels
     from vtool.solvers.model import assemble
     from vtool.solvers.run import NUMERICAL_FAILURES
 
@@ -80,6 +79,8 @@ def modes(preset: str, as_json: bool) -> None:
         click.echo("  mode shapes (mass-normalised, columns = modes):")
         header = "".join(f"{i:>11}" for i in range(1, layer.size + 1))
         click.echo(f"  {'':>4}{header}")
+        import numpy as np  # here, not at import: `vtool --help` loads no numpy
+
         shapes = layer.modes.shapes
         shown = np.where(np.abs(shapes) < 1e-9 * np.abs(shapes).max(axis=0), 0.0, shapes)  # round-off noise
         for row, k in enumerate(layer.kept):
