@@ -169,7 +169,7 @@ def test_three_back_ends_agree_on_every_thesis_preset(name: str) -> None:
             assert np.abs(np.array([e.cam_angle for e in trace.events]) - exact_angles).max() < tolerance
 
 
-@pytest.mark.parametrize("name", ["gnilka-1a", "gnilka-2"])
+@pytest.mark.parametrize("name", ["gnilka-1a", "gnilka-1b", "gnilka-1c", "gnilka-1d", "gnilka-2", "gnilka-3"])
 def test_exact_events_converge_with_the_event_tolerance(name: str) -> None:
     """Halving the exact back end's event tolerance moves no event by more than 1e-6 degrees."""
     from vtool.solvers.exact import ExactBackend, ExactOptions

@@ -133,3 +133,16 @@ def test_solve_dispatches_boom_and_plate_presets() -> None:
     refused = run("solve", "boom-brick-wall", "--dt", "1e-6")
     assert refused.exit_code == 2 and "(--dt applies to valvetrain presets)" in refused.output
     assert refused.output.count("\n") == 1
+
+
+@pytest.mark.parametrize("name", ["gnilka-1a", "gnilka-1b", "gnilka-1c", "gnilka-1d", "gnilka-2", "gnilka-3",
+                                  "ramped-cam"])
+def test_compare_runs_for_every_valvetrain_preset(tmp_path: Path, name: str) -> None:
+    """`vtool compare` (every law, both starts) runs on every shipped valve-train preset; JSON and CSV agree."""
+    out = tmp_path / "compare.csv"
+    result = run("compare", name, "--degrees", "120", "--start", "thesis,quasi-static", "--json", "--csv", str(out))
+    assert result.exit_code == 0, result.output
+    rows = json.loads(result.output)["rows"]
+    assert [(r["impact"], r["start"]) for r in rows] == [(law, start) for law in ("local", "thesis", "momentum")
+                                                         for start in ("thesis", "quasi-static")]
+    assert len(out.read_text().splitlines()) == 1 + len(rows)
