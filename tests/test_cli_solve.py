@@ -142,7 +142,7 @@ def test_compare_runs_for_every_valvetrain_preset(tmp_path: Path, name: str) -> 
     out = tmp_path / "compare.csv"
     result = run("compare", name, "--degrees", "120", "--start", "thesis,quasi-static", "--json", "--csv", str(out))
     assert result.exit_code == 0, result.output
-    rows = json.loads(result.output)["rows"]
+    rows = json.loads(result.stdout)["rows"]  # a preset warning goes to stderr
     assert [(r["impact"], r["start"]) for r in rows] == [(law, start) for law in ("local", "thesis", "momentum")
                                                          for start in ("thesis", "quasi-static")]
     assert len(out.read_text().splitlines()) == 1 + len(rows)
