@@ -57,6 +57,9 @@ class LazyGroup(click.Group):
 
     def invoke(self, ctx: click.Context):  # type: ignore[no-untyped-def]
         with warnings.catch_warnings():
+            # a library's deprecation notice is not the user's business: only our warnings are shown
+            warnings.simplefilter("ignore", DeprecationWarning)
+            warnings.simplefilter("ignore", PendingDeprecationWarning)
             warnings.simplefilter("always", PresetWarning)
             warnings.showwarning = _show_warning
             try:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import time
 
 import click
@@ -17,13 +18,13 @@ class DelayedProgress:
         self.bar = None
         self.shown = 0
         # a bar on a file or pipe is one label with no newline, which would run into an error line
-        self.interactive = click.get_text_stream("stderr").isatty()
+        self.interactive = sys.stderr.isatty()
 
     def __call__(self, fraction: float) -> None:
         if self.bar is None:
             if time.perf_counter() - self.started < self.delay or not self.interactive:
                 return
-            self.bar = click.progressbar(length=1000, label=self.label, file=click.get_text_stream("stderr"))
+            self.bar = click.progressbar(length=1000, label=self.label, file=sys.stderr)
             self.bar.__enter__()
         done = int(1000 * min(max(fraction, 0.0), 1.0))
         self.bar.update(done - self.shown)
