@@ -69,21 +69,25 @@ IP_SIZE = 8
  FP_GAPNOISE, FP_REFINE, FP_REFWIN, FP_FTOL, FP_TREV) = range(15)
 FP_SIZE = 16
 # clearance table columns (int) and float columns
-CL_AHEAD, CL_BEHIND, CL_SRC, CL_MON, CL_PIN, CL_BIT, CL_LAW = range(7)
-CL_SIZE = 7
+CL_AHEAD, CL_BEHIND, CL_SRC, CL_MON, CL_PIN, CL_BIT, CL_LAW, CL_SOFT = range(8)
+CL_SIZE = 8  # CL_SOFT: 1 for a compliant (spring-dashpot) clearance: no impact, no tie
 CLF_E, CLF_SCALE = range(2)
 # impact laws
 LAW_MOMENTUM, LAW_LOCAL, LAW_THESIS = range(3)
 # event kinds
 EV_OPENED, EV_CLOSED, EV_RELEASED = range(3)
-# configuration integer table: built, m, nf, then kept[n], group[n], source of each z index[n]
-CI_BUILT, CI_M, CI_NF = range(3)
-CI_HEAD = 3
+# configuration integer table: built, m, nf, source coupling, then kept[n], group[n], source of each z index[n]
+CI_BUILT, CI_M, CI_NF, CI_SRC = range(4)
+CI_HEAD = 4
 # configuration matrices
 CM_MFF, CM_CFF, CM_KFF, CM_SINV, CM_SINVF, CM_MINVFF = range(6)
 CM_SIZE = 6
-# monitor kind per (configuration, clearance): (type, ahead z index, behind z index or -1 - source)
-MK_NONE, MK_GAP, MK_FORCE = range(3)
+# monitor per (configuration, clearance): (kind, ahead z index, behind z index or -1 - source, m)
+MK_KIND, MK_AHEAD, MK_BEHIND, MK_M = range(4)
+MK_SIZE = 4
+MK_NONE, MK_GAP, MK_FORCE, MK_OVERLAP = range(4)  # MK_OVERLAP: a closed compliant clearance
+# peak rows: contact force over the run, after the first revolution, overlap of compliant contacts
+PEAK_ALL, PEAK_LATE, PEAK_OVERLAP = range(3)
 # run status
 FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED, CHATTER = range(1, 7)
 # integer and float state slots
@@ -160,10 +164,12 @@ def set_prescribed(ci, c, n, src, z, zd, zdd):
 
 
 @jit
-def free_rhs(ci, cm, cp, c, z, zd, zdd, rhs):
-    """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P): the thesis' ΔP on the right."""
+def free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
+    """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
+    right, and the sources' pull through closed compliant contacts (``cp[c, f, 3n:]``)."""
     nf = ci[c, CI_NF]
     m = ci[c, CI_M]
+    coupled = ci[c, CI_SRC]
     for f in range(nf):
         s = 0.0
         for g in range(nf):
@@ -171,6 +177,9 @@ def free_rhs(ci, cm, cp, c, z, zd, zdd, rhs):
         for p in range(m - nf):
             j = nf + p
             s -= cp[c, f, 3 * p] * zdd[j] + cp[c, f, 3 * p + 1] * zd[j] + cp[c, f, 3 * p + 2] * z[j]
+        if coupled:
+            for j in range(src.shape[0]):
+                s -= cp[c, f, 3 * n + j] * src[j]
         rhs[f] = s
 
 
@@ -216,7 +225,7 @@ def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1,
         z1[j] = z[j] + h * zd[j] + h * h * (0.5 - beta) * zdd[j]
         zd1[j] = zd[j] + h * (1.0 - gamma) * zdd[j]
     set_prescribed(ci, c, n, src1, z1, zd1, zdd1)
-    free_rhs(ci, cm, cp, c, z1, zd1, zdd1, rhs)
+    free_rhs(ci, cm, cp, c, n, src1, z1, zd1, zdd1, rhs)
     if which == 2:
         cholesky_solve(nf, L, rhs, sol)
     else:
@@ -236,7 +245,7 @@ def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1,
 def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
     """Free accelerations of configuration c from its equations of motion (prescribed set from src)."""
     set_prescribed(ci, c, n, src, z, zd, zdd)
-    free_rhs(ci, cm, cp, c, z, zd, zdd, rhs)
+    free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs)
     nf = ci[c, CI_NF]
     for f in range(nf):
         s = 0.0
@@ -246,20 +255,31 @@ def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
 
 
 @jit
+def contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src):
+    """Contact force of closed clearance k: its row on (z, ż, z̈, sources, 1)."""
+    f = mon[c, k, 3 * n + 3 * ns]
+    for j in range(mk[c, k, MK_M]):
+        f += mon[c, k, j] * z[j] + mon[c, k, n + j] * zd[j] + mon[c, k, 2 * n + j] * zdd[j]
+    for j in range(3 * ns):
+        f += mon[c, k, 3 * n + j] * src[j]
+    return f
+
+
+@jit
 def monitor_value(mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src):
-    """Contact force (closed) or gap + allowance (open) of clearance k; 0 when not monitored."""
-    kind = mk[c, k, 0]
-    if kind == MK_GAP:
-        behind = mk[c, k, 2]
+    """What changes sign at clearance k's next event; 0 when not monitored.
+
+    Open: gap + allowance. Closed rigid: the contact force. Closed compliant:
+    the overlap δ = -gap + allowance (the contact ends when the parts part).
+    """
+    kind = mk[c, k, MK_KIND]
+    if kind == MK_GAP or kind == MK_OVERLAP:
+        behind = mk[c, k, MK_BEHIND]
         other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
-        return z[mk[c, k, 1]] - other + gap_noise
+        gap = z[mk[c, k, MK_AHEAD]] - other
+        return (gap if kind == MK_GAP else -gap) + gap_noise
     if kind == MK_FORCE:
-        f = mon[c, k, 3 * n + 3 * ns]
-        for j in range(mk[c, k, 1]):  # mk[c, k, 1] holds m for force rows
-            f += mon[c, k, j] * z[j] + mon[c, k, n + j] * zd[j] + mon[c, k, 2 * n + j] * zdd[j]
-        for j in range(3 * ns):
-            f += mon[c, k, 3 * n + j] * src[j]
-        return f
+        return contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src)
     return 0.0
 
 
@@ -278,8 +298,8 @@ def record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src, out_t,
         out_q[row, 1, n + s] = src[3 * s + 1]
         out_q[row, 2, n + s] = src[3 * s + 2]
     for k in range(ncl):
-        if mk[c, k, 0] == MK_FORCE:
-            out_F[row, k] = monitor_value(mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src)
+        if mk[c, k, MK_KIND] == MK_FORCE or mk[c, k, MK_KIND] == MK_OVERLAP:
+            out_F[row, k] = contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src)
         else:
             out_F[row, k] = 0.0
 
@@ -391,7 +411,7 @@ def impact_momentum(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, e
     idx = np.empty(ncl, dtype=np.int64)
     nc = 0
     for k in range(ncl):
-        if (c & cl[k, CL_BIT]) or closing[k]:
+        if ((c & cl[k, CL_BIT]) and not cl[k, CL_SOFT]) or closing[k]:
             idx[nc] = k
             nc += 1
     G = np.zeros((nc, n))
@@ -467,7 +487,7 @@ def impact_momentum(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, e
 def prescribed_velocity(cl, c, ncl, coordinate, src):
     """Velocity of the source a coordinate is tied to in configuration c, or nan if it is free."""
     for k in range(ncl):
-        if (c & cl[k, CL_BIT]) and cl[k, CL_BEHIND] < 0 and cl[k, CL_AHEAD] == coordinate:
+        if (c & cl[k, CL_BIT]) and not cl[k, CL_SOFT] and cl[k, CL_BEHIND] < 0 and cl[k, CL_AHEAD] == coordinate:
             return src[3 * cl[k, CL_SRC] + 1]
     return np.nan
 
@@ -521,13 +541,27 @@ def impact_local(ip, fp, cl, clf, mass, c, k, src, v, stick, ev_f, ev_i, ist, t)
 
 
 @jit
+def snap_shut(cl, k, x, src):
+    """Clearance k's gap (or overlap) set to exactly zero: it is within the time tolerance of zero."""
+    x[cl[k, CL_AHEAD]] = x[cl[k, CL_BEHIND]] if cl[k, CL_BEHIND] >= 0 else src[3 * cl[k, CL_SRC]]
+
+
+@jit
+def relative_velocity(cl, k, v, src):
+    """Velocity of clearance k's gap: v_ahead - v_behind (or the source's)."""
+    behind = cl[k, CL_BEHIND]
+    return v[cl[k, CL_AHEAD]] - (v[behind] if behind >= 0 else src[3 * cl[k, CL_SRC] + 1])
+
+
+@jit
 def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t):
     """Apply the impact law of every closing clearance at t; returns the new configuration mask.
 
     Local-law closings are applied one after the other (each changes only its
     own coordinates); momentum-law closings are solved together with every
     closed contact (:func:`impact_momentum`). Gaps are snapped shut (they are
-    within the time tolerance).
+    within the time tolerance). A compliant clearance closes with no jump: its
+    spring and dashpot take over (the event records its approach velocity).
     """
     ncl = ip[IP_NCL]
     mask = c
@@ -536,9 +570,11 @@ def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist,
     for k in range(ncl):
         if not closing[k]:
             continue
-        a = cl[k, CL_AHEAD]
-        x[a] = x[cl[k, CL_BEHIND]] if cl[k, CL_BEHIND] >= 0 else src[3 * cl[k, CL_SRC]]
-        if cl[k, CL_LAW] == LAW_MOMENTUM:
+        snap_shut(cl, k, x, src)
+        if cl[k, CL_SOFT]:
+            mask |= cl[k, CL_BIT]
+            add_event(ev_f, ev_i, ist, t, k, EV_CLOSED, relative_velocity(cl, k, v, src), c, mask)
+        elif cl[k, CL_LAW] == LAW_MOMENTUM:
             momentum[k] = 1
             any_momentum = True
         else:
@@ -569,7 +605,7 @@ def settle(ip, fp, cl, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist,
         worst = -1
         worst_f = -fp[FP_FTOL]
         for k in range(ncl):
-            if mk[c, k, 0] == MK_FORCE and cl[k, CL_MON]:
+            if mk[c, k, MK_KIND] == MK_FORCE and cl[k, CL_MON]:
                 f = monitor_value(mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z, zd, zdd, src)
                 if f < worst_f:
                     worst = k
@@ -629,6 +665,22 @@ def locate_event(ci, cm, cp, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi
     return lo
 
 
+@jit
+def track_peaks(mk, mon, c, n, ns, ncl, gap_noise, after, phi, z, zd, zdd, src, peak):
+    """Raise the peak contact forces (and compliant overlaps) with the monitors ``phi`` at a step's end."""
+    for k in range(ncl):
+        kind = mk[c, k, MK_KIND]
+        force = phi[k]
+        if kind == MK_OVERLAP:
+            force = contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src)
+            peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
+        elif kind != MK_FORCE:
+            continue
+        peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], force)
+        if after:
+            peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], force)
+
+
 # ----- the hot loop -----
 @jit
 def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist, fst, c,
@@ -654,6 +706,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
     fine = dt / fp[FP_REFINE]
     m = ci[c, CI_M]
     nf = ci[c, CI_NF]
+    coupled = ci[c, CI_SRC]
     rows = out_t.shape[0]
     t = fst[F_T]
     while True:
@@ -705,6 +758,9 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             for p in range(m - nf):
                 j = nf + p
                 acc -= cp[c, f, 3 * p] * zdd1[j] + cp[c, f, 3 * p + 1] * zd1[j] + cp[c, f, 3 * p + 2] * z1[j]
+            if coupled:
+                for j in range(3 * ns):
+                    acc -= cp[c, f, 3 * n + j] * src1[j]
             rhs[f] = acc
         for f in range(nf):
             acc = 0.0
@@ -715,12 +771,13 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             zd1[f] += gamma * h * acc
         # monitors (see monitor_value): stop before a sign change
         for k in range(ncl):
-            kind = mk[c, k, 0]
+            kind = mk[c, k, MK_KIND]
             value = 0.0
-            if kind == MK_GAP:
-                behind = mk[c, k, 2]
+            if kind == MK_GAP or kind == MK_OVERLAP:
+                behind = mk[c, k, MK_BEHIND]
                 other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
-                value = z1[mk[c, k, 1]] - other + gap_noise
+                value = z1[mk[c, k, MK_AHEAD]] - other
+                value = (value if kind == MK_GAP else -value) + gap_noise
                 if value < 0.0:
                     return t
             elif kind == MK_FORCE:
@@ -786,7 +843,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
                 out_q[row, 2, n + s] = srco[3 * s + 2]
             for k in range(ncl):
                 force = 0.0
-                if mk[c, k, 0] == MK_FORCE:
+                if mk[c, k, MK_KIND] == MK_FORCE or mk[c, k, MK_KIND] == MK_OVERLAP:
                     force = mon[c, k, 3 * n + 3 * ns]
                     for j in range(m):
                         force += mon[c, k, j] * zo[j] + mon[c, k, n + j] * zdo[j] + mon[c, k, 2 * n + j] * zddo[j]
@@ -798,11 +855,24 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
         # accept: peaks, state, time
         after = t1 >= t_rev
         for k in range(ncl):
-            if mk[c, k, 0] == MK_FORCE:
-                if phi[k] > peak[0, k]:
-                    peak[0, k] = phi[k]
-                if after and phi[k] > peak[1, k]:
-                    peak[1, k] = phi[k]
+            kind = mk[c, k, MK_KIND]
+            if kind == MK_FORCE:
+                if phi[k] > peak[PEAK_ALL, k]:
+                    peak[PEAK_ALL, k] = phi[k]
+                if after and phi[k] > peak[PEAK_LATE, k]:
+                    peak[PEAK_LATE, k] = phi[k]
+            elif kind == MK_OVERLAP:
+                force = mon[c, k, 3 * n + 3 * ns]
+                for j in range(m):
+                    force += mon[c, k, j] * z1[j] + mon[c, k, n + j] * zd1[j]
+                for j in range(3 * ns):
+                    force += mon[c, k, 3 * n + j] * src1[j]
+                if force > peak[PEAK_ALL, k]:
+                    peak[PEAK_ALL, k] = force
+                if after and force > peak[PEAK_LATE, k]:
+                    peak[PEAK_LATE, k] = force
+                if phi[k] - gap_noise > peak[PEAK_OVERLAP, k]:
+                    peak[PEAK_OVERLAP, k] = phi[k] - gap_noise
         for j in range(m):
             z[j] = z1[j]
             zd[j] = zd1[j]
@@ -830,9 +900,10 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
     ist[I_CFG]; everything needed to resume is in the arguments, so Python may
     build a configuration or empty a buffer and call again. Output rows at the
     output instants are interpolated inside the step by the linear-acceleration
-    interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); ``peak[0]`` holds
-    the peak contact forces over every step, ``peak[1]`` those after the first
-    cam revolution.
+    interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); ``peak[PEAK_ALL]``
+    holds the peak contact forces over every step, ``peak[PEAK_LATE]`` those
+    after the first cam revolution, ``peak[PEAK_OVERLAP]`` the largest overlap
+    of each compliant contact.
     """
     n, ncl, ns, nh = ip[IP_N], ip[IP_NCL], ip[IP_NS], ip[IP_NH]
     every = ip[IP_EVERY]
@@ -885,7 +956,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src0,
                            out_t, out_q, out_F, out_c, ist[I_NOUT])
                 for k in range(ncl):
-                    peak[0, k] = max(peak[0, k], out_F[ist[I_NOUT], k])
+                    peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], out_F[ist[I_NOUT], k])
                 ist[I_NOUT] += 1
                 ist[I_NEXT_OUT] = 1
                 ist[I_STARTED] = 1
@@ -951,7 +1022,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                     layer_step(ci, cm, cp, c, beta, gamma, h, 2, L, n, src1, z, zd, zdd,
                                z1, zd1, zdd1, rhs, sol)
                     for k in range(ncl):
-                        if mk[c, k, 0] == MK_FORCE:
+                        if mk[c, k, MK_KIND] == MK_FORCE or mk[c, k, MK_KIND] == MK_OVERLAP:
                             phi[k] = monitor_value(mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1)
                 else:
                     for j in range(n):
@@ -1004,13 +1075,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                         status = OUTPUT_FULL
                         break
                 # peaks at the step's end
-                after = t + h >= t_rev
-                for k in range(ncl):
-                    if mk[c, k, 0] == MK_FORCE:
-                        if phi[k] > peak[0, k]:
-                            peak[0, k] = phi[k]
-                        if after and phi[k] > peak[1, k]:
-                            peak[1, k] = phi[k]
+                track_peaks(mk, mon, c, n, ns, ncl, gap_noise, t + h >= t_rev, phi, z1, zd1, zdd1, src1, peak)
                 ist[I_STEPS] += 1
                 for j in range(n):
                     z[j] = z1[j]
@@ -1048,7 +1113,11 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
         stick = ist[I_RAPID] >= ip[IP_ZSTICK]
         for k in range(ncl):
             if (c & cl[k, CL_BIT]) and not (new_c & cl[k, CL_BIT]):
-                add_event(ev_f, ev_i, ist, t, k, EV_OPENED, 0.0, c, new_c)
+                u = 0.0
+                if cl[k, CL_SOFT]:  # the parts leave with their relative velocity; the overlap is shut
+                    snap_shut(cl, k, x, src0)
+                    u = relative_velocity(cl, k, v, src0)
+                add_event(ev_f, ev_i, ist, t, k, EV_OPENED, u, c, new_c)
         if any_closing:
             new_c = impact(ip, fp, cl, clf, mass, new_c, closing, src0, x, v, stick, ev_f, ev_i, ist, t)
         ist[I_CFG] = new_c

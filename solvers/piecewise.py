@@ -78,28 +78,32 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
     src = np.zeros((3 * ns, nb))  # the sources (x, v, a), s-major as the kernel's src vector
     for s in range(ns):
         src[3 * s:3 * s + 3] = source_coefficients(series, s)
-    G = np.zeros((ncl, n2))
-    H = np.zeros((ncl, nb))
+    G, H = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # monitors (kernel.monitor_value)
+    GF, HF = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # contact forces (kernel.contact_force)
     for k in range(ncl):
-        kind, ahead, behind = (int(v) for v in tables.mk[mask, k])
-        if kind == kernel.MK_GAP:
-            G[k] += Zy[0, ahead]
-            H[k] += Zb[0, ahead]
-            H[k, 0] += problem.gap_noise
+        kind, ahead, behind, _ = (int(v) for v in tables.mk[mask, k])
+        if kind in (kernel.MK_GAP, kernel.MK_OVERLAP):
+            sign = 1.0 if kind == kernel.MK_GAP else -1.0
+            G[k] += sign * Zy[0, ahead]
+            H[k] += sign * Zb[0, ahead]
             if behind >= 0:
-                G[k] -= Zy[0, behind]
-                H[k] -= Zb[0, behind]
+                G[k] -= sign * Zy[0, behind]
+                H[k] -= sign * Zb[0, behind]
             else:
-                H[k] -= src[3 * (-1 - behind)]
-        elif kind == kernel.MK_FORCE:
+                H[k] -= sign * src[3 * (-1 - behind)]
+            H[k, 0] += problem.gap_noise
+        if kind in (kernel.MK_FORCE, kernel.MK_OVERLAP):
             row = tables.mon[mask, k]
             for i in range(3):
                 coefficients = row[i * n:i * n + m]
-                G[k] += coefficients @ Zy[i]
-                H[k] += coefficients @ Zb[i]
-            H[k] += row[3 * n:3 * n + 3 * ns] @ src
-            H[k, 0] += row[3 * n + 3 * ns]
-    ss.P, ss.Q, ss.G, ss.H = P, Q, G, H
+                GF[k] += coefficients @ Zy[i]
+                HF[k] += coefficients @ Zb[i]
+            HF[k] += row[3 * n:3 * n + 3 * ns] @ src
+            HF[k, 0] += row[3 * n + 3 * ns]
+        if kind == kernel.MK_FORCE:
+            G[k], H[k] = GF[k], HF[k]
+    ss.P, ss.Q, ss.G, ss.H, ss.GF, ss.HF = P, Q, G, H, GF, HF
+    ss.compliant = tables.mk[mask, :, kernel.MK_KIND] == kernel.MK_OVERLAP
     return ss
 
 
@@ -128,6 +132,7 @@ class PiecewiseRun(ABC):
         self.rows: list[tuple[float, np.ndarray, np.ndarray, int]] = []
         self.peak = np.zeros(self.ncl)
         self.peak_late = np.zeros(self.ncl)
+        self.peak_overlap = np.zeros(self.ncl)
         self.t_rev = 2 * math.pi / problem.omega
         self.steps = 0
         self.next_out = 0
@@ -150,8 +155,20 @@ class PiecewiseRun(ABC):
         return z[:self.n], z[self.n:2 * self.n], z[2 * self.n:]
 
     def monitors(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
-        """Monitor values (contact force if closed, gap if open) at t; columns for arrays of t."""
+        """Monitor values (rigid contact force or compliant overlap if closed, gap if open) at t;
+        columns for arrays of t."""
         return ss.G @ y + ss.harmonic(ss.H, t)
+
+    def forces(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Contact forces (0 for an open clearance) at t; columns for arrays of t."""
+        return ss.GF @ y + ss.harmonic(ss.HF, t)
+
+    def track_overlap(self, ss: StateSpace, values: np.ndarray) -> None:
+        """Raise the peak overlaps of the closed compliant contacts with monitor values (columns or one)."""
+        if ss.compliant is not None and ss.compliant.any():
+            top = values.max(axis=1) if values.ndim == 2 else values
+            self.peak_overlap = np.where(ss.compliant, np.maximum(self.peak_overlap, top - self.problem.gap_noise),
+                                         self.peak_overlap)
 
     def state_of(self, ss: StateSpace, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         layer = self.problem.tables.layers[ss.mask]
@@ -181,9 +198,9 @@ class PiecewiseRun(ABC):
 
     def emit(self, ss: StateSpace, t: float, y: np.ndarray) -> None:
         x, v, a = self.full_state(ss, t, y)
-        values = self.monitors(ss, t, y)
-        F = np.where((ss.mask & self.closed_bit) != 0, values, 0.0)
+        F = self.forces(ss, t, y)
         self.track_peaks(ss, F, t)
+        self.track_overlap(ss, self.monitors(ss, t, y))
         src = self.sources(t).reshape(-1, 3)
         q3 = np.stack([np.concatenate([x, src[:, 0]]), np.concatenate([v, src[:, 1]]),
                        np.concatenate([a, src[:, 2]])])
@@ -262,9 +279,14 @@ class PiecewiseRun(ABC):
         self.last_event = t
         if self.rapid >= self.problem.rules.zeno_stop:
             raise RunError(f"chattering contact at t = {t:.6g} s in configuration {self.problem.label(c)}")
+        src = self.sources(t)
         for k in range(self.ncl):
             if (c & self.closed_bit[k]) and not (new_c & self.closed_bit[k]):
-                self.builder.add_event(t, k, EVENT_KINDS[kernel.EV_OPENED], 0.0, c, new_c)
+                u = 0.0
+                if self.problem.cl[k, kernel.CL_SOFT]:  # the parts leave with their relative velocity
+                    kernel.snap_shut(self.problem.cl, k, x, src)
+                    u = float(kernel.relative_velocity(self.problem.cl, k, v, src))
+                self.builder.add_event(t, k, EVENT_KINDS[kernel.EV_OPENED], u, c, new_c)
         if closing.any():
             stick = self.rapid >= self.problem.rules.zeno_stick
             problem = self.problem
@@ -281,7 +303,7 @@ class PiecewiseRun(ABC):
             self.builder.add_rows(np.array([r[0] for r in self.rows]), np.array([r[1] for r in self.rows]),
                                   np.array([r[2] for r in self.rows]),
                                   np.array([r[3] for r in self.rows], dtype=np.int64))
-        return {"steps": self.steps, "peak": self.peak, "peak_late": self.peak_late,
+        return {"steps": self.steps, "peak": self.peak, "peak_late": self.peak_late, "peak_overlap": self.peak_overlap,
                 "configurations": tuple(sorted(self.spaces)), "settings": settings}
 
 

@@ -98,6 +98,7 @@ class Trace:
     success: bool = True
     message: str = ""
     peak_force_after_first_revolution: np.ndarray | None = None  # per clearance, over every step
+    peak_overlap: np.ndarray | None = None  # per clearance, largest overlap of a compliant contact
 
     # ----- columns by the engineer's names -----
     def coordinate(self, number: int, rows: slice = slice(None)) -> np.ndarray:
@@ -272,7 +273,11 @@ class Trace:
                 "peak_force": float(self.peak_force[i]),
                 "peak_force_after_first_revolution": None if late is None else float(late[i]),
                 "peak_force_unit": units.force,
+                "contact": c.contact,
             }
+            if not c.rigid and self.peak_overlap is not None:
+                entry["peak_overlap"] = float(self.peak_overlap[i])
+                entry["peak_overlap_unit"] = units.length
             if c.kind == EXTERNAL and c.behind != self.spec.cam.coordinate:
                 entry["seating_velocities"] = [-e.relative_velocity for e in impacts]
                 entry["seating_velocity_unit"] = units.velocity
@@ -325,6 +330,10 @@ class Trace:
         for c in s["clearances"]:
             lines.append(f"{c['clearance']:<10} {c['force']:<6} {c['state']:<8} {c['impact_law']:<8} "
                          f"{c['separations']:>11} {c['impacts']:>8} {c['peak_force']:>18.6g}")
+        for c in s["clearances"]:
+            if "peak_overlap" in c:
+                lines.append(f"  {c['clearance']}: {c['contact']} contact, peak overlap "
+                             f"{c['peak_overlap']:.6g} {c['peak_overlap_unit']}")
         lines.append("")
         lines.append(f"episodes (events at one clearance within {s['episode_window_deg']:g} deg are one):")
         for c in s["clearances"]:
@@ -393,7 +402,7 @@ class TraceBuilder:
                                  int(before), int(after)))
 
     def build(self, peak: np.ndarray, statistics: RunStatistics, peak_late: np.ndarray | None = None,
-              sort: bool = False) -> Trace:
+              sort: bool = False, peak_overlap: np.ndarray | None = None) -> Trace:
         n = self.spec.n_coordinates + len(self.source_numbers)
         ncl = len(self.spec.clearances)
         rows = sum(len(b[0]) for b in self.blocks)
@@ -412,4 +421,5 @@ class TraceBuilder:
         numbers = tuple(range(1, self.spec.n_coordinates + 1)) + self.source_numbers
         return Trace(self.spec, t, cam_angle_deg(t, self.omega), numbers, q, qd, qdd, F, cfg,
                      tuple(self.events), np.array(peak, dtype=float), statistics,
-                     peak_force_after_first_revolution=None if peak_late is None else np.array(peak_late))
+                     peak_force_after_first_revolution=None if peak_late is None else np.array(peak_late),
+                     peak_overlap=None if peak_overlap is None else np.array(peak_overlap, dtype=float))

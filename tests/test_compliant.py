@@ -1,0 +1,108 @@
+"""Compliant (linear spring-dashpot) contacts: a drop test against its closed form, every back end.
+
+The drop test: one mass m on a soft spring k_s (tests.valvetrain_cases.sdof_doc),
+released from rest 0.01 in above a seat at 0 whose contact is a spring k_c
+and a dashpot c. While the mass overlaps the seat (x < 0),
+
+    m ẍ + c ẋ + (k_s + k_c) x = 0,   x(0) = 0,  ẋ(0) = -v0
+
+so x(t) = -(v0/ω_d) e^{-ζ ω_n t} sin ω_d t with ω_n² = (k_s + k_c)/m,
+ζ = c / (2 m ω_n), ω_d = ω_n √(1 - ζ²): the contact lasts π/ω_d and the
+mass leaves with v0 · exp(-ζ ω_n π/ω_d) (the rebound velocity).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tests.valvetrain_cases import SDOF_MASS, SDOF_STIFFNESS, sdof_doc, spec_from
+from vtool.errors import InputError
+from vtool.solvers import backends
+from vtool.solvers.model import assemble
+from vtool.solvers.trace import CLOSED, OPENED
+
+K_CONTACT = 1.0e6  # lbf/in
+RATIO = 0.2  # of critical, on the seat's local mass (the mass itself here)
+TOLERANCE = {"exact": 1e-8, "scipy": 1e-5, "newmark": 1e-4}
+
+
+def drop_doc(ratio: float = RATIO) -> dict:
+    doc = sdof_doc(seat=0.0, time_step=1e-7, degrees=5e-5)
+    doc["clearances"][1].update(contact="linear", contact_stiffness=K_CONTACT, contact_damping_ratio=ratio)
+    return doc
+
+
+def closed_form(ratio: float) -> tuple[float, float]:
+    """(contact duration s, rebound velocity / approach velocity)."""
+    m = SDOF_MASS / 3.0
+    c = 2.0 * ratio * math.sqrt(K_CONTACT * m)
+    omega_n = math.sqrt((SDOF_STIFFNESS + K_CONTACT) / m)
+    zeta = c / (2.0 * m * omega_n)
+    omega_d = omega_n * math.sqrt(1.0 - zeta**2)
+    return math.pi / omega_d, math.exp(-zeta * omega_n * math.pi / omega_d)
+
+
+def first_contact(name: str, ratio: float = RATIO):  # noqa: ANN201
+    spec = spec_from(drop_doc(ratio))
+    backend = backends.get(name)()
+    options = backend.options_from_run(spec.run)
+    if name == "scipy":
+        options = type(options)(**{**options.__dict__, "rtol": 1e-10})
+    trace = backend.simulate(assemble(spec), options)
+    seat = [e for e in trace.events if e.clearance == "seat"]
+    closing = next(e for e in seat if e.kind == CLOSED)
+    opening = next(e for e in seat if e.kind == OPENED and e.time > closing.time)
+    return trace, closing, opening
+
+
+@pytest.mark.parametrize("name", backends.available())
+def test_drop_test_matches_the_closed_form(name: str) -> None:
+    trace, closing, opening = first_contact(name)
+    duration, rebound = closed_form(RATIO)
+    tolerance = TOLERANCE.get(name, 1e-4)
+    assert opening.time - closing.time == pytest.approx(duration, rel=tolerance)
+    assert opening.relative_velocity / -closing.relative_velocity == pytest.approx(rebound, rel=tolerance)
+    # the approach velocity is the free fall on the soft spring: v0 = ω_s · 0.01 in
+    assert -closing.relative_velocity == pytest.approx(0.01 * math.sqrt(SDOF_STIFFNESS / (SDOF_MASS / 3)),
+                                                       rel=1e-3)
+    # peak force and overlap: the largest of k x + c ẋ and of x over the closed form's contact
+    m = SDOF_MASS / 3.0
+    c = 2.0 * RATIO * math.sqrt(K_CONTACT * m)
+    omega_n = math.sqrt((SDOF_STIFFNESS + K_CONTACT) / m)
+    zeta = c / (2.0 * m * omega_n)
+    omega_d = omega_n * math.sqrt(1.0 - zeta**2)
+    t = np.linspace(0.0, duration, 200001)
+    v0 = -closing.relative_velocity
+    overlap = v0 / omega_d * np.exp(-zeta * omega_n * t) * np.sin(omega_d * t)
+    rate = np.gradient(overlap, t)
+    summary = {c["clearance"]: c for c in trace.summary()["clearances"]}["seat"]
+    assert summary["contact"] == "linear"
+    assert summary["peak_overlap"] == pytest.approx(overlap.max(), rel=max(tolerance, 1e-6) * 10)
+    assert summary["peak_force"] == pytest.approx((K_CONTACT * overlap + c * rate).max(), rel=max(tolerance, 2e-5) * 10)
+
+
+def test_an_undamped_contact_returns_the_approach_velocity() -> None:
+    _, closing, opening = first_contact("exact", ratio=0.0)
+    assert opening.relative_velocity == pytest.approx(-closing.relative_velocity, rel=1e-9)
+
+
+def test_contact_keys_are_checked_in_one_line() -> None:
+    doc = drop_doc()
+    doc["clearances"][1]["contact_stiffness"] = -1.0
+    with pytest.raises(InputError, match="contact_stiffness"):
+        spec_from(doc)
+    doc = drop_doc()
+    doc["clearances"][1]["contact_damping"] = 3.0
+    with pytest.raises(InputError, match="not both"):
+        spec_from(doc)
+    doc = drop_doc()
+    doc["clearances"][1].update(contact="rigid")
+    with pytest.raises(InputError, match="rigid contact"):
+        spec_from(doc)
+    doc = drop_doc()
+    doc["clearances"][1].update(contact="hertz")
+    with pytest.raises(InputError, match="rigid, linear"):
+        spec_from(doc)
