@@ -113,13 +113,30 @@ class Partition:
     free: list[int]
     prescribed: list[int]
     sources: list[int]  # source index of each prescribed column
+    C: np.ndarray  # the configuration's modal damping over the layer's coordinates (see partition)
 
 
 def partition(mechanism: Mechanism, mask: int) -> Partition:
-    """Layer of the closed internal clearances; closed external ones prescribe their ahead end."""
+    """Layer of the closed rigid internal clearances; closed rigid external ones prescribe their ahead end.
+
+    Modal damping belongs to the contact state, not to the contact law: with
+    closed compliant internal contacts the configuration keeps the damping
+    C_t of the layer in which those pairs are tied (the preset's
+    ``damping.layers`` entry that names them), spread over each pair: with
+    R the map from the tied layer's coordinates to this layer's (q = R q_t)
+    and G = RᵀR, C = R G⁻¹ C_t G⁻¹ Rᵀ, so that Rᵀ C R = C_t. As the contact
+    stiffness grows the run so approaches the rigid run's.
+    """
     spec = mechanism.spec
     closed = closed_names(spec, mask)
     layer = mechanism.layer(frozenset(n for n in closed if spec.clearance(n).ties))
+    damping = layer.C
+    soft = frozenset(n for n in closed if spec.clearance(n).kind == INTERNAL and not spec.clearance(n).rigid)
+    if soft:
+        tied = mechanism.tied_layer(frozenset(n for n in closed if spec.clearance(n).kind == INTERNAL))
+        R = np.linalg.solve(layer.T.T @ layer.T, layer.T.T @ tied.T)
+        spread = R @ np.linalg.inv(R.T @ R)
+        damping = spread @ tied.C @ spread.T
     group = np.argmax(layer.T, axis=1)
     source_of = {number: s for s, (number, _, _) in enumerate(sources(spec))}
     prescribed: dict[int, int] = {}
@@ -128,7 +145,7 @@ def partition(mechanism: Mechanism, mask: int) -> Partition:
             prescribed[int(group[c.ahead - 1])] = source_of[c.behind]
     pres = sorted(prescribed)
     free = [j for j in range(layer.size) if j not in prescribed]
-    return Partition(layer, group, free, pres, [prescribed[j] for j in pres])
+    return Partition(layer, group, free, pres, [prescribed[j] for j in pres], damping)
 
 
 def internal_force_coefficients(
@@ -153,7 +170,7 @@ def internal_force_coefficients(
     g[ahead - 1], g[behind - 1] = 1.0, -1.0
     w = layer.T.T @ g  # selection over the open layer's coordinates
     springs = compliant_terms(mechanism, mask & ~bit)
-    M, C, K = layer.M, layer.C + springs.layer_C(layer.T), layer.K + springs.layer_K(layer.T)
+    M, C, K = layer.M, part.C + springs.layer_C(layer.T), layer.K + springs.layer_K(layer.T)
     S = layer.T.T @ springs.S
     row = np.linalg.solve(M[np.ix_(free, free)], w[free])  # M_FF⁻¹ w_F (M symmetric)
     scale = -1.0 / float(w[free] @ row)  # λ = scale * (relative acceleration with λ = 0)

@@ -151,7 +151,7 @@ class ConfigurationTables:
         ix = np.ix_(order, order)
         springs = compliant_terms(mechanism, mask)
         M_o = layer.M[ix]
-        C_o = (layer.C + springs.layer_C(layer.T))[ix]
+        C_o = (part.C + springs.layer_C(layer.T))[ix]
         K_o = (layer.K + springs.layer_K(layer.T))[ix]
         S_o = (layer.T.T @ springs.S)[order]
         ci = self.ci[mask]
@@ -190,7 +190,7 @@ class ConfigurationTables:
         layer = part.layer
         kept_full = [k - 1 for k in layer.kept]
         MT = mechanism.M @ layer.T
-        row_x, row_v, row_a = mechanism.K @ layer.T, MT @ np.linalg.solve(layer.M, layer.C), MT
+        row_x, row_v, row_a = mechanism.K @ layer.T, MT @ np.linalg.solve(layer.M, part.C), MT
         source_of = {number: s for s, (number, _, _) in enumerate(sources(spec))}
         for index, c in enumerate(spec.clearances):
             mk, mon = self.mk[mask, index], self.mon[mask, index]

@@ -24,7 +24,7 @@ from itertools import combinations
 import numpy as np
 
 from vtool.solvers.damping import Modes, modal_damping, mode_ratios, undamped_modes
-from vtool.solvers.spec import ENABLED, PINNED, MechanismSpec
+from vtool.solvers.spec import ENABLED, INTERNAL, PINNED, MechanismSpec
 
 
 @dataclass(frozen=True)
@@ -95,8 +95,11 @@ def possible_layers(spec: MechanismSpec) -> list[frozenset[str]]:
 
 
 def build_layer(spec: MechanismSpec, M: np.ndarray, K: np.ndarray, closed: frozenset[str]) -> Layer:
-    """Reduce the full (M, K) to one layer and compute its modes and modal damping."""
-    pairs = [(c.ahead, c.behind) for c in spec.clearances if c.ties and c.name in closed]
+    """Reduce the full (M, K) to one layer and compute its modes and modal damping.
+
+    Every internal clearance named in ``closed`` ties its pair (the caller
+    passes only the rigid ones, except for :meth:`Mechanism.tied_layer`)."""
+    pairs = [(c.ahead, c.behind) for c in spec.clearances if c.kind == INTERNAL and c.name in closed]
     T, kept = tie_matrix(spec.n_coordinates, pairs)
     M_L = T.T @ M @ T
     K_L = T.T @ K @ T

@@ -18,7 +18,7 @@ from vtool.solvers.assembly import assemble_full
 from vtool.solvers.damping import undamped_modes
 from vtool.solvers.initial import StaticStart, static_start
 from vtool.solvers.layers import Layer, build_layer, internal_layer_names, possible_layers
-from vtool.solvers.spec import MechanismSpec, RunSpec
+from vtool.solvers.spec import INTERNAL, MechanismSpec, RunSpec
 
 
 class Mechanism:
@@ -71,6 +71,16 @@ class Mechanism:
         _, pinned = internal_layer_names(self.spec)
         key = frozenset(closed) | frozenset(pinned)
         key = frozenset(n for n in key if self.spec.clearance(n).ties)
+        if key not in self._layers:
+            self._layers[key] = build_layer(self.spec, self.M, self.K, key)
+        return self._layers[key]
+
+    def tied_layer(self, closed: frozenset[str]) -> Layer:
+        """The layer with these internal clearances tied, compliant ones included: the layer whose modal
+        damping a configuration with closed compliant internal contacts keeps (see
+        :func:`vtool.solvers.configurations.partition`)."""
+        _, pinned = internal_layer_names(self.spec)
+        key = frozenset(n for n in frozenset(closed) | frozenset(pinned) if self.spec.clearance(n).kind == INTERNAL)
         if key not in self._layers:
             self._layers[key] = build_layer(self.spec, self.M, self.K, key)
         return self._layers[key]
