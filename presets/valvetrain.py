@@ -38,6 +38,7 @@ from vtool.solvers.spec import (
     ELEMENT_SIZE,
     ENABLED,
     EXTERNAL,
+    HERTZ,
     IMPACT_LAWS,
     INTERNAL,
     PINNED,
@@ -157,6 +158,8 @@ def _compliance_doc(c: ClearanceSpec) -> dict[str, Any]:
     if c.rigid:
         return {}
     doc: dict[str, Any] = {"contact": c.contact, "contact_stiffness": c.contact_stiffness}
+    if c.contact == HERTZ:
+        return doc | {"contact_exponent": c.contact_exponent}
     if c.contact_damping is not None:
         return doc | {"contact_damping": c.contact_damping}
     return doc | {"contact_damping_ratio": c.contact_damping_ratio or 0.0}
@@ -165,7 +168,7 @@ def _compliance_doc(c: ClearanceSpec) -> dict[str, Any]:
 def _compliance(t: Table, state: str, units: UnitSystem) -> dict[str, Any]:
     """A clearance's contact law and its spring, dashpot (linear) or exponent (hertz)."""
     contact = t.string("contact", default=RIGID, choices=CONTACT_LAWS)
-    keys = ("contact_stiffness", "contact_damping", "contact_damping_ratio")
+    keys = ("contact_stiffness", "contact_damping", "contact_damping_ratio", "contact_exponent")
     if contact == RIGID:
         for key in keys:
             if t.raw(key) is not None:
@@ -173,6 +176,17 @@ def _compliance(t: Table, state: str, units: UnitSystem) -> dict[str, Any]:
         return {}
     if state != ENABLED:
         raise InputError(t.field("contact"), contact, f"rigid for a {state} clearance")
+    if contact == HERTZ:
+        stiffness = t.number("contact_stiffness", unit=f"{units.force}/{units.length}^n", required=True,
+                             min_value=1e-6, max_value=1e16)
+        for key in ("contact_damping", "contact_damping_ratio"):
+            if t.raw(key) is not None:
+                raise InputError(t.field(key), t.raw(key), "no value for a hertz contact (its Hunt-Crossley "
+                                 "damping comes from the restitution)")
+        exponent = t.number("contact_exponent", default=1.5, min_value=1.0, max_value=3.0)
+        return {"contact": contact, "contact_stiffness": stiffness, "contact_exponent": exponent}
+    if t.raw("contact_exponent") is not None:
+        raise InputError(t.field("contact_exponent"), t.raw("contact_exponent"), "no value for a linear contact")
     stiffness = _magnitude(t, "contact_stiffness", units.stiffness, "stiffness", required=True)
     result: dict[str, Any] = {"contact": contact, "contact_stiffness": stiffness}
     if t.raw("contact_damping") is not None and t.raw("contact_damping_ratio") is not None:
@@ -394,6 +408,9 @@ def _initial(t: Table, names: dict[str, ClearanceSpec], cam_name: str, units: Un
     for name in closed:
         if names[name].state == REMOVED:
             raise InputError(t.field("closed"), name, "clearances that are not removed")
+        if names[name].contact == HERTZ:
+            raise InputError(t.field("closed"), name, "clearances with a rigid or linear contact (a hertz "
+                             "contact starts open: its static overlap is not linear)")
         if names[name].kind == EXTERNAL and name != cam_name:
             # the static start loads the mechanism at the follower only; it cannot put the valve on its seat
             raise InputError(t.field("closed"), name, f"only the cam clearance ('{cam_name}') and internal clearances")

@@ -42,7 +42,7 @@ import numpy as np
 
 from vtool.solvers.layers import Layer
 from vtool.solvers.model import Mechanism
-from vtool.solvers.spec import EXTERNAL, INTERNAL, LINEAR, PINNED, REMOVED, MechanismSpec
+from vtool.solvers.spec import EXTERNAL, HERTZ, INTERNAL, PINNED, REMOVED, MechanismSpec
 
 ROMAN = ("I", "II", "III", "IV", "V", "VI", "VII", "VIII")
 
@@ -150,7 +150,7 @@ def partition(mechanism: Mechanism, mask: int) -> Partition:
 
 def internal_force_coefficients(
     mechanism: Mechanism, mask: int, ahead: int, behind: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[int, float]]:
     """Coefficients of an internal clearance's contact force while it is closed in ``mask``.
 
     The force is the pair force (+λ on ahead, -λ on behind) that keeps the
@@ -159,7 +159,9 @@ def internal_force_coefficients(
     a_F = M_FF⁻¹ (f_F - C_FF v_F - K_FF x_F - M_FP a_P - C_FP v_P - K_FP x_P)
     and w selecting ahead minus behind, λ = -(wᵀ a)|_(λ=0) / (w_Fᵀ M_FF⁻¹ w_F).
     This is linear in the full state and the sources, so it is returned as
-    (fx[n], fv[n], fs[ns, 3]) with λ = fx·q + fv·q̇ + Σ_s fs[s]·(q_s, q̇_s, q̈_s).
+    (fx[n], fv[n], fs[ns, 3]) with λ = fx·q + fv·q̇ + Σ_s fs[s]·(q_s, q̇_s, q̈_s),
+    and a coefficient per closed Hertz contact j (its force F_j w_j adds
+    scale · rowᵀ w_j F_j).
     """
     spec = mechanism.spec
     bit = next(clearance_bit(spec, i) for i, c in enumerate(spec.clearances)
@@ -188,7 +190,8 @@ def internal_force_coefficients(
         fs[source, 1] += scale * -(row @ C[free, j])
         fs[source, 2] += scale * (w[j] - row @ M[free, j])
     fs -= scale * (row @ S[free]).reshape(fs.shape)
-    return fx, fv, fs
+    fh = {j: float(scale * (row @ (layer.T.T @ w)[free])) for j, w in springs.hertz.items()}
+    return fx, fv, fs, fh
 
 
 @dataclass(frozen=True)
@@ -212,6 +215,7 @@ class CompliantTerms:
     C: np.ndarray
     S: np.ndarray  # n x 3 ns
     force: dict[int, np.ndarray]  # clearance index -> row on (q, q̇, q̈, src)
+    hertz: dict[int, np.ndarray]  # closed Hertz clearance -> w over the full coordinates (its force acts as F w)
 
     def layer_K(self, T: np.ndarray) -> np.ndarray:
         return T.T @ self.K @ T
@@ -234,14 +238,23 @@ def contact_damping(mechanism: Mechanism, index: int) -> float:
 
 
 def compliant_terms(mechanism: Mechanism, mask: int) -> CompliantTerms:
-    """:class:`CompliantTerms` of the linear clearances closed in ``mask``."""
+    """:class:`CompliantTerms` of the compliant clearances closed in ``mask`` (a Hertz one is nonlinear:
+    only its direction w, see :func:`hertz_row`)."""
     spec = mechanism.spec
     n, ns = spec.n_coordinates, len(sources(spec))
     K, C, S = np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, 3 * ns))
-    force = {}
+    force: dict[int, np.ndarray] = {}
+    hertz: dict[int, np.ndarray] = {}
     source_of = {number: s for s, (number, _, _) in enumerate(sources(spec))}
     for index, c in enumerate(spec.clearances):
-        if c.contact != LINEAR or not mask & clearance_bit(spec, index):
+        if c.rigid or not mask & clearance_bit(spec, index):
+            continue
+        if c.contact == HERTZ:
+            w = np.zeros(n)
+            w[c.ahead - 1] = 1.0
+            if c.kind == INTERNAL:
+                w[c.behind - 1] = -1.0
+            hertz[index] = w
             continue
         k, d = c.contact_stiffness, contact_damping(mechanism, index)
         w = np.zeros(n)
@@ -257,4 +270,20 @@ def compliant_terms(mechanism: Mechanism, mask: int) -> CompliantTerms:
         C += d * np.outer(w, w)
         row[:n], row[n:2 * n] = -k * w, -d * w
         force[index] = row
-    return CompliantTerms(K, C, S, force)
+    return CompliantTerms(K, C, S, force, hertz)
+
+
+def hertz_row(mechanism: Mechanism, index: int) -> np.ndarray:
+    """The monitor row of a closed Hertz clearance: -w on q and on q̇, +1 on its source's x and v, so that
+    the row's q part gives the overlap δ and its q̇ part δ̇ (the kernel's ``overlap_and_rate``)."""
+    spec = mechanism.spec
+    n, ns = spec.n_coordinates, len(sources(spec))
+    c = spec.clearances[index]
+    row = np.zeros(3 * n + 3 * ns)
+    row[c.ahead - 1] = row[n + c.ahead - 1] = -1.0
+    if c.kind == INTERNAL:
+        row[c.behind - 1] = row[n + c.behind - 1] = 1.0
+    else:
+        s = next(s for s, (number, _, _) in enumerate(sources(spec)) if number == c.behind)
+        row[3 * n + 3 * s] = row[3 * n + 3 * s + 1] = 1.0
+    return row

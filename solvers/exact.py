@@ -45,7 +45,7 @@ from scipy.optimize import brentq
 from vtool.errors import InputError, RunError
 from vtool.solvers.contact import ContactProblem
 from vtool.solvers.model import Mechanism
-from vtool.solvers.piecewise import PiecewiseBackend, PiecewiseRun
+from vtool.solvers.piecewise import PiecewiseBackend, PiecewiseRun, refuse_hertz
 from vtool.solvers.spec import RunSpec
 from vtool.solvers.statespace import Propagator, StateSpace, shift_coefficients
 from vtool.solvers.trace import TraceBuilder
@@ -79,6 +79,7 @@ class ExactBackend(PiecewiseBackend):
     def check(self, mechanism: Mechanism, options: ExactOptions) -> None:
         if not 0.0 < options.time_tolerance < 1e-3:
             raise InputError("time_tolerance", options.time_tolerance, "> 0 and < 1e-3", "s")
+        refuse_hertz(mechanism, self.name)
 
     def settings(self, options: ExactOptions) -> dict:
         return {"time_tolerance_s": options.time_tolerance}

@@ -18,7 +18,7 @@ from vtool.solvers.assembly import assemble_full
 from vtool.solvers.damping import undamped_modes
 from vtool.solvers.initial import StaticStart, static_start
 from vtool.solvers.layers import Layer, build_layer, internal_layer_names, possible_layers
-from vtool.solvers.spec import INTERNAL, MechanismSpec, RunSpec
+from vtool.solvers.spec import INTERNAL, LINEAR, MechanismSpec, RunSpec
 
 
 class Mechanism:
@@ -49,11 +49,11 @@ class Mechanism:
 
     @cached_property
     def highest_frequency(self) -> float:
-        """omega_max of the unconstrained system with every compliant contact closed (rad/s): no
-        configuration is stiffer."""
+        """omega_max of the unconstrained system with every linear contact closed (rad/s): no
+        configuration is stiffer (a Hertz contact's stiffness grows with its overlap: not counted)."""
         K = self.K.copy()
         for c in self.spec.clearances:
-            if not c.rigid:
+            if c.contact == LINEAR:
                 w = np.zeros(len(K))
                 w[c.ahead - 1] = 1.0
                 if c.behind <= len(K):

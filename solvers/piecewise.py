@@ -29,11 +29,13 @@ from typing import Any
 
 import numpy as np
 
-from vtool.errors import RunError
+from vtool.errors import InputError, RunError
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.backends import Backend, Cancel, Progress
 from vtool.solvers.contact import EVENT_KINDS, ContactProblem, OrderedLayer
+from vtool.solvers.model import Mechanism
 from vtool.solvers.sources import SourceSeries
+from vtool.solvers.spec import HERTZ
 from vtool.solvers.statespace import StateSpace, from_layer
 from vtool.solvers.trace import TraceBuilder
 
@@ -102,8 +104,17 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
             HF[k, 0] += row[3 * n + 3 * ns]
         if kind == kernel.MK_FORCE:
             G[k], H[k] = GF[k], HF[k]
-    ss.P, ss.Q, ss.G, ss.H, ss.GF, ss.HF = P, Q, G, H, GF, HF
     ss.compliant = tables.mk[mask, :, kernel.MK_KIND] == kernel.MK_OVERLAP
+    hertz = np.flatnonzero(ss.compliant & (problem.cl[:, kernel.CL_SOFT] == kernel.SOFT_HERTZ))
+    ss.hertz = hertz
+    if hertz.size:  # F_j acts as F_j w_j: on ÿ through M_FF⁻¹ w_F, on the rigid forces through their rows
+        GF[hertz], HF[hertz] = 0.0, 0.0
+        w = -tables.mon[mask][hertz][:, :nf].T  # (nf, nh): the Hertz rows hold -w
+        ss.hertz_rate = np.vstack([np.zeros((nf, hertz.size)), np.linalg.solve(layer.M[:nf, :nf], w)])
+        head = 3 * n + 3 * ns + 1
+        ss.hertz_force = tables.mon[mask][:, head + hertz].copy()
+        ss.hertz_force[hertz, np.arange(hertz.size)] = 1.0
+    ss.P, ss.Q, ss.G, ss.H, ss.GF, ss.HF = P, Q, G, H, GF, HF
     return ss
 
 
@@ -157,11 +168,33 @@ class PiecewiseRun(ABC):
     def monitors(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
         """Monitor values (rigid contact force or compliant overlap if closed, gap if open) at t;
         columns for arrays of t."""
-        return ss.G @ y + ss.harmonic(ss.H, t)
+        linear = ss.G @ y + ss.harmonic(ss.H, t)
+        if ss.hertz is None or not ss.hertz.size or ss.hertz_force is None:
+            return linear
+        coupling = ss.hertz_force.copy()  # the rigid contacts' forces include the Hertz forces' pull
+        coupling[~(ss.mask & self.closed_bit != 0) | ss.compliant] = 0.0
+        return linear + coupling @ self.hertz_forces(ss, t, y)
 
     def forces(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
         """Contact forces (0 for an open clearance) at t; columns for arrays of t."""
-        return ss.GF @ y + ss.harmonic(ss.HF, t)
+        linear = ss.GF @ y + ss.harmonic(ss.HF, t)
+        if ss.hertz is None or not ss.hertz.size or ss.hertz_force is None:
+            return linear
+        return linear + ss.hertz_force @ self.hertz_forces(ss, t, y)
+
+    def hertz_forces(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Forces of the closed Hertz contacts (the kernel's ``hertz_law``) at t; columns for arrays of t."""
+        rows = ss.hertz
+        assert ss.G is not None and ss.H is not None
+        nf = ss.size // 2
+        delta = ss.G[rows] @ y + ss.harmonic(ss.H[rows], t) - self.problem.gap_noise
+        rate = ss.G[rows, :nf] @ y[nf:] + ss.H[rows] @ ss.basis_rate(t)
+        out = np.zeros(np.shape(delta))
+        for i, k in enumerate(rows):
+            for index in np.ndindex(np.shape(delta)[1:]):
+                at = (i, *index)
+                out[at] = kernel.hertz_law(self.problem.clf, int(k), float(delta[at]), float(rate[at]))[0]
+        return out
 
     def track_overlap(self, ss: StateSpace, values: np.ndarray) -> None:
         """Raise the peak overlaps of the closed compliant contacts with monitor values (columns or one)."""
@@ -247,7 +280,8 @@ class PiecewiseRun(ABC):
         m = problem.n
         while True:
             self.ist[kernel.I_NEV] = 0
-            result = int(kernel.settle(self.ip, self.fp, problem.cl, tables.ci, tables.cm, tables.cp, tables.mk,
+            result = int(kernel.settle(self.ip, self.fp, problem.cl, problem.clf, tables.ci, tables.cm, tables.cp,
+                                       tables.mk,
                                        tables.mon, mask, t, x, v, a, self.sources(t), self.ev_f, self.ev_i,
                                        self.ist, np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m)))
             self._take_events()
@@ -305,6 +339,14 @@ class PiecewiseRun(ABC):
                                   np.array([r[3] for r in self.rows], dtype=np.int64))
         return {"steps": self.steps, "peak": self.peak, "peak_late": self.peak_late, "peak_overlap": self.peak_overlap,
                 "configurations": tuple(sorted(self.spaces)), "settings": settings}
+
+
+def refuse_hertz(mechanism: Mechanism, backend: str) -> None:
+    """One line for a back end that integrates linear configurations only, given a Hertz contact."""
+    for c in mechanism.spec.clearances:
+        if c.contact == HERTZ:
+            raise InputError("run.backend", backend, f"newmark or scipy for a preset with a hertz contact "
+                             f"({c.name}: nonlinear between events, so the exact solution does not apply)")
 
 
 class PiecewiseBackend(Backend):

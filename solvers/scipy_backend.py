@@ -87,8 +87,14 @@ class _ScipyRun(PiecewiseRun):
         if atol is None:
             atol = np.concatenate([np.full(nf, self.x_scale), np.full(nf, self.v_scale)]) * self.options.rtol
 
-        def rhs(t: float, y: np.ndarray) -> np.ndarray:
-            return ss.A @ y + ss.forcing(t)
+        if ss.hertz is not None and ss.hertz.size:
+
+            def rhs(t: float, y: np.ndarray) -> np.ndarray:
+                return ss.A @ y + ss.forcing(t) + ss.hertz_rate @ self.hertz_forces(ss, t, y)
+        else:
+
+            def rhs(t: float, y: np.ndarray) -> np.ndarray:
+                return ss.A @ y + ss.forcing(t)
 
         events = []
         monitored = [int(k) for k in np.flatnonzero(self.monitored)]

@@ -37,10 +37,12 @@ MOMENTUM = "momentum"
 IMPACT_LAWS = (LOCAL, THESIS, MOMENTUM)
 
 #: Contact laws of a clearance (see :mod:`vtool.solvers.contact`): rigid (impact laws, ties and
-#: prescribed coordinates) or a linear spring-dashpot acting while the parts overlap.
+#: prescribed coordinates), a linear spring-dashpot acting while the parts overlap, or Hertz's
+#: k delta^n with Hunt-Crossley damping (Newmark and scipy back ends).
 RIGID = "rigid"
 LINEAR = "linear"
-CONTACT_LAWS = (RIGID, LINEAR)
+HERTZ = "hertz"
+CONTACT_LAWS = (RIGID, LINEAR, HERTZ)
 
 #: Start velocities (see :mod:`vtool.solvers.initial`).
 THESIS_START = "thesis"
@@ -114,6 +116,10 @@ class ClearanceSpec:
     A linear contact acts while the parts overlap (Kelvin–Voigt): near the
     end of a contact its dashpot may pull (F < 0), a known property of the
     model; the overlap, not the force, decides when the contact ends.
+    ``hertz``: F = k δⁿ (1 + 3(1 - e)/2 · δ̇/v⁻), n = ``contact_exponent``,
+    with the Hunt–Crossley damping of the clearance's restitution e at the
+    approach velocity v⁻ of the contact's closing; it never pulls. Nonlinear:
+    the Newmark back end iterates, scipy integrates it, exact refuses it.
     """
 
     name: str
@@ -127,6 +133,7 @@ class ClearanceSpec:
     contact_stiffness: float = 0.0  # force/length
     contact_damping: float | None = None  # force*time/length
     contact_damping_ratio: float | None = None  # of critical, on the local masses
+    contact_exponent: float = 1.5  # hertz
 
     @property
     def rigid(self) -> bool:

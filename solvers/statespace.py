@@ -84,6 +84,11 @@ class StateSpace:
     GF: np.ndarray | None = None  # (ncl, 2nf): contact forces from y (0 for an open clearance)
     HF: np.ndarray | None = None  # (ncl, 2K+1)
     compliant: np.ndarray | None = None  # bool per clearance: closed compliant (monitor = overlap)
+    # closed Hertz contacts (nonlinear, scipy only): their clearances, their forces' effect on y' and on
+    # the contact forces, per unit force
+    hertz: np.ndarray | None = None  # clearance indices
+    hertz_rate: np.ndarray | None = None  # (2nf, nh)
+    hertz_force: np.ndarray | None = None  # (ncl, nh)
     cache: dict = field(default_factory=dict, repr=False)  # per-back-end derived data
 
     @property

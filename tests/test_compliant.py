@@ -104,7 +104,11 @@ def test_contact_keys_are_checked_in_one_line() -> None:
         spec_from(doc)
     doc = drop_doc()
     doc["clearances"][1].update(contact="hertz")
-    with pytest.raises(InputError, match="rigid, linear"):
+    with pytest.raises(InputError, match="hertz contact"):  # its damping comes from the restitution
+        spec_from(doc)
+    doc = drop_doc()
+    doc["clearances"][1].update(contact="plastic")
+    with pytest.raises(InputError, match="rigid, linear, hertz"):
         spec_from(doc)
 
 
@@ -181,3 +185,92 @@ def test_vtool_solve_reports_the_peak_overlap(tmp_path) -> None:  # noqa: ANN001
     result = CliRunner().invoke(cli, ["solve", str(preset), "--json"])
     seat = next(c for c in json.loads(result.output)["clearances"] if c["clearance"] == "seat")
     assert seat["contact"] == "linear" and seat["peak_overlap_unit"] == "in" and 0 < seat["peak_overlap"] < 0.01
+
+
+# ----- Hertz contacts: F = k δ^n (1 + 3(1 - e)/2 · δ̇/v⁻), Newmark with iteration and scipy -----
+def hertz_doc(restitution: float = 1.0, backend: str = "newmark") -> dict:
+    """The drop test on a Hertz seat, the mass on a 1 lbf/in spring (its share of the contact force,
+    k_s δ / F, is 1.5e-5 at the peak): it reaches the seat at v0 = 0.316 in/s."""
+    doc = sdof_doc(seat=0.0, time_step=1e-6, degrees=4e-4)
+    doc["members"]["spring"]["stiffness"] = 1.0
+    doc["clearances"][1].update(contact="hertz", contact_stiffness=1e7, contact_exponent=1.5,
+                                restitution=restitution)
+    doc["run"]["backend"] = backend
+    return doc
+
+
+def hertz_contact(restitution: float, backend: str):  # noqa: ANN201
+    from vtool.solvers.run import simulate
+
+    trace = simulate(spec_from(hertz_doc(restitution, backend)))
+    seat = [e for e in trace.events if e.clearance == "seat"]
+    return trace, seat[0], seat[1]
+
+
+@pytest.mark.parametrize("backend", ["newmark", "scipy"])
+def test_hertz_drop_matches_its_closed_form(backend: str) -> None:
+    """Elastic Hertz impact (n = 3/2): δ_max = (5 m v0² / 4k)^(2/5), F_max = k δ_max^(3/2), the contact
+    lasts 2 δ_max/v0 ∫₀¹ (1 - x^(5/2))^(-1/2) dx = 2 δ_max/v0 · (2/5) B(2/5, 1/2), the mass leaves at v0."""
+    from scipy.special import beta
+
+    trace, closing, opening = hertz_contact(1.0, backend)
+    m, k, v0 = SDOF_MASS / 3.0, 1e7, -closing.relative_velocity
+    delta = (5.0 * m * v0**2 / (4.0 * k)) ** 0.4
+    duration = 2.0 * delta / v0 * 0.4 * beta(0.4, 0.5)
+    seat = trace.summary()["clearances"][1]
+    assert opening.kind == OPENED and closing.kind == CLOSED
+    assert opening.time - closing.time == pytest.approx(duration, rel=5e-5)
+    assert seat["peak_overlap"] == pytest.approx(delta, rel=5e-5)
+    assert seat["peak_force"] == pytest.approx(k * delta**1.5, rel=5e-5)
+    assert opening.relative_velocity == pytest.approx(v0, rel=1e-4)
+
+
+def test_hunt_crossley_damping_lowers_the_rebound() -> None:
+    ratios = []
+    for restitution in (1.0, 0.8, 0.5):
+        _, closing, opening = hertz_contact(restitution, "newmark")
+        ratios.append(opening.relative_velocity / -closing.relative_velocity)
+    assert ratios[0] > ratios[1] > ratios[2] > 0.0
+
+
+def test_hertz_seat_on_1a_newmark_and_scipy_agree() -> None:
+    import dataclasses
+
+    from tests.valvetrain_cases import thesis_doc
+    from vtool.solvers.run import simulate
+
+    doc = thesis_doc("gnilka-1a")
+    doc["run"]["degrees"] = 400.0
+    for c in doc["clearances"]:
+        if c["name"] == "seat":
+            c.update(contact="hertz", contact_stiffness=1e8, restitution=0.0)
+    spec = spec_from(doc)
+    newmark = simulate(dataclasses.replace(spec, run=dataclasses.replace(spec.run, time_step=2.5e-7)))
+    scipy = simulate(dataclasses.replace(spec, run=dataclasses.replace(spec.run, backend="scipy")))
+    assert [(e.clearance, e.kind) for e in newmark.events] == [(e.clearance, e.kind) for e in scipy.events]
+    assert max(abs(a.cam_angle - b.cam_angle) for a, b in zip(newmark.events, scipy.events, strict=True)) < 0.1
+    a, b = newmark.summary()["clearances"][2], scipy.summary()["clearances"][2]
+    assert a["peak_force"] == pytest.approx(b["peak_force"], rel=1e-3)
+    assert a["peak_overlap"] == pytest.approx(b["peak_overlap"], rel=1e-3)
+
+
+def test_exact_refuses_a_hertz_contact_in_one_line(tmp_path) -> None:  # noqa: ANN001
+    import tomli_w
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    preset = tmp_path / "hertz.toml"
+    preset.write_text(tomli_w.dumps(hertz_doc()))
+    result = CliRunner().invoke(cli, ["solve", str(preset), "--backend", "exact"])
+    assert result.exit_code == 2
+    assert result.output.count("\n") == 1 and "hertz contact" in result.output
+
+
+def test_a_hertz_contact_starts_open() -> None:
+    doc = hertz_doc()
+    doc["clearances"][0]["state"] = "enabled"
+    doc["clearances"][0].update(contact="hertz", contact_stiffness=1e7)
+    doc["initial"]["closed"] = ["cam"]
+    with pytest.raises(InputError, match="starts open"):
+        spec_from(doc)
