@@ -215,6 +215,21 @@ def cholesky_solve(nf, L, rhs, out):
         out[f] = s / L[f, f]
 
 
+@jit
+def effective_solve(cm, c, which, L, nf, b, out):
+    """out = S⁻¹ b: the stored inverse of the standard (``which`` 0) or refined (1) step, or the
+    Cholesky factor in L (2)."""
+    if which == 2:
+        cholesky_solve(nf, L, b, out)
+        return
+    slot = CM_SINV if which == 0 else CM_SINVF
+    for f in range(nf):
+        acc = 0.0
+        for g in range(nf):
+            acc += cm[c, slot, f, g] * b[g]
+        out[f] = acc
+
+
 # ----- Hertz contacts (Hunt-Crossley) -----
 @jit
 def hertz_law(clf, k, delta, rate):
@@ -283,15 +298,7 @@ def hertz_correction(ci, cm, cl, clf, mk, mon, c, beta, gamma, h, which, L, n, n
     for j in range(nc):
         for f in range(nf):
             w[f] = -mon[c, idx[j], f]
-        if which == 2:
-            cholesky_solve(nf, L, w, col)
-        else:
-            slot = CM_SINV if which == 0 else CM_SINVF
-            for f in range(nf):
-                acc = 0.0
-                for g in range(nf):
-                    acc += cm[c, slot, f, g] * w[g]
-                col[f] = acc
+        effective_solve(cm, c, which, L, nf, w, col)
         for f in range(nf):
             V[f, j] = col[f]
     A = np.zeros((nc, nc))  # δ_k per unit F_j, before the βh² and γh factors: -w_kᵀ V_j
@@ -353,15 +360,7 @@ def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1,
         zd1[j] = zd[j] + h * (1.0 - gamma) * zdd[j]
     set_prescribed(ci, c, n, src1, z1, zd1, zdd1)
     free_rhs(ci, cm, cp, c, n, src1, z1, zd1, zdd1, rhs)
-    if which == 2:
-        cholesky_solve(nf, L, rhs, sol)
-    else:
-        slot = CM_SINV if which == 0 else CM_SINVF
-        for f in range(nf):
-            s = 0.0
-            for g in range(nf):
-                s += cm[c, slot, f, g] * rhs[g]
-            sol[f] = s
+    effective_solve(cm, c, which, L, nf, rhs, sol)
     for f in range(nf):
         zdd1[f] = sol[f]
         z1[f] += beta * h * h * sol[f]
