@@ -116,8 +116,10 @@ class Backend(ABC):
         spec = mechanism.spec
         settings = dict(stats.get("settings", {}))
         settings.update(rpm=spec.run.rpm, degrees=spec.run.degrees,
-                        impact=sorted({spec.impact_law(c) for c in spec.clearances}),
+                        impact=sorted({spec.impact_law(c) for c in spec.clearances if c.rigid}),
                         rocker_scale=spec.contact.rocker_scale, start_velocities=spec.initial.velocities)
+        if any(not c.rigid for c in spec.clearances):
+            settings["contact"] = {c.name: c.contact for c in spec.clearances if not c.rigid}
         statistics = RunStatistics(self.name, int(stats["steps"]), len(builder.events), wall,
                                    tuple(sorted(stats.get("configurations", problem.tables.layers))), settings,
                                    compile_time=compile_time)

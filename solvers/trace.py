@@ -264,7 +264,7 @@ class Trace:
                 "clearance": c.name,
                 "force": self.force_label(i),
                 "state": c.state,
-                "impact_law": self.spec.impact_law(c),
+                "impact_law": self.spec.impact_law(c) if c.rigid else None,  # compliant: see "contact"
                 "events": sum(e.clearance == c.name for e in self.events),
                 "separations": len(self.events_at(c.name, (OPENED, RELEASED))),
                 "impacts": len(impacts),
@@ -328,7 +328,7 @@ class Trace:
         lines.append(f"{'clearance':<10} {'force':<6} {'state':<8} {'law':<8} {'separations':>11} {'impacts':>8} "
                      f"{'peak force (' + units.force + ')':>18}")
         for c in s["clearances"]:
-            lines.append(f"{c['clearance']:<10} {c['force']:<6} {c['state']:<8} {c['impact_law']:<8} "
+            lines.append(f"{c['clearance']:<10} {c['force']:<6} {c['state']:<8} {c['impact_law'] or c['contact']:<8} "
                          f"{c['separations']:>11} {c['impacts']:>8} {c['peak_force']:>18.6g}")
         for c in s["clearances"]:
             if "peak_overlap" in c:
