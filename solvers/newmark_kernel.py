@@ -1046,6 +1046,18 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
 
 
 
+@jit
+def arrive(ist, fst, target, grid_next, k_grid, j_target):
+    """Now at ``target``: the next standard grid point, or point ``j_target`` of the refined grid."""
+    if target == grid_next:
+        ist[I_GRID] = k_grid + 1
+        ist[I_SUB] = 0
+    else:
+        ist[I_SUB] = j_target
+    fst[F_T] = target
+    return target
+
+
 # ----- the run loop -----
 @jit
 def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
@@ -1154,13 +1166,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
             else:
                 h = min(grid_next, t_end) - t
             if h <= 1e-9 * dt:  # at a grid point but for round-off
-                t = target
-                if target == grid_next:
-                    ist[I_GRID] = k_grid + 1
-                    ist[I_SUB] = 0
-                else:
-                    ist[I_SUB] = j_target
-                fst[F_T] = t
+                t = arrive(ist, fst, target, grid_next, k_grid, j_target)
                 continue
             fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
             if h == dt:
@@ -1260,14 +1266,9 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 for j in range(3 * ns):
                     src0[j] = src1[j]
                 t = t + h
-                if abs(t - target) <= 1e-9 * dt:
-                    t = target
-                    if target == grid_next:
-                        ist[I_GRID] = k_grid + 1
-                        ist[I_SUB] = 0
-                    else:
-                        ist[I_SUB] = j_target
                 fst[F_T] = t
+                if abs(t - target) <= 1e-9 * dt:
+                    t = arrive(ist, fst, target, grid_next, k_grid, j_target)
             if fired:
                 event = True
                 break
