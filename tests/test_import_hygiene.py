@@ -51,7 +51,35 @@ def test_cli_help_imports_no_numerics() -> None:
         "from vtool.app.cli.main import cli\n"
         "r = CliRunner().invoke(cli, ['--help'])\n"
         "assert r.exit_code == 0, r.output\n"
-        "print(','.join(m for m in ('numba', 'scipy', 'textual') if m in sys.modules))\n"
+        "print(','.join(m for m in ('numpy', 'numba', 'scipy', 'textual') if m in sys.modules))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == ""
+
+
+def test_solve_imports_no_ui_and_no_study_tools() -> None:
+    """`vtool solve PRESET` (newmark) never imports the TUI, plotting, cluster, TOML-writing or test tools."""
+    code = (
+        "import sys\nfrom click.testing import CliRunner\n"
+        "from vtool.app.cli.main import cli\n"
+        "r = CliRunner().invoke(cli, ['solve', 'gnilka-1a'])\n"
+        "assert r.exit_code == 0, r.output\n"
+        "print(','.join(m for m in ('textual', 'plotext', 'dask', 'distributed', 'tomlkit', 'tomli_w',"
+        " 'hypothesis', 'pytest', 'scipy.optimize', 'scipy.integrate') if m in sys.modules))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == ""
+
+
+def test_the_model_needs_no_scipy() -> None:
+    """Loading, assembling (modes, modal damping of every layer) and costing a run import no scipy.linalg:
+    only a back end that needs it does (the newmark kernel's numba loads it for its BLAS check)."""
+    code = (
+        "import sys\nfrom vtool.presets import load_preset\n"
+        "from vtool.solvers.run import _assemble, run_cost\n"
+        "m = _assemble(load_preset('gnilka-1a'))\nrun_cost(m)\n"
+        "m.all_layers()\nm.start\n"
+        "print(','.join(k for k in ('scipy', 'numba') if k in sys.modules))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""
