@@ -9,11 +9,6 @@ m_i = φ_iᵀ M φ_i, modal stiffness k_i = φ_iᵀ K φ_i and a ratio ζ_i per 
 With mass-normalised modes (m_i = 1), Φ⁻¹ = Φᵀ M, so C = M Φ diag(2 ζ_i ω_i) Φᵀ M
 without any inverse. Rigid-body modes (ω_i = 0) get no damping, whatever ζ_i.
 The result is multiplied by the global damping factor (thesis COFD).
-
-The generalized problem is reduced to a standard one with the Cholesky
-factor M = L Lᵀ (as LAPACK's ``sygv`` does): (L⁻¹ K L⁻ᵀ) ψ = ω² ψ, φ = L⁻ᵀ ψ,
-so that numpy suffices and ``vtool solve`` does not import scipy.linalg
-(about 0.2 s of a 1 s process) for one small eigenproblem.
 """
 
 from __future__ import annotations
@@ -40,25 +35,6 @@ class Modes:
         return int(np.count_nonzero(self.omega == 0.0))
 
 
-def generalized_eigh(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Eigenvalues (ascending) and M-orthonormal eigenvectors of K φ = λ M φ, M symmetric positive definite.
-
-    With M = L Lᵀ: A = L⁻¹ K L⁻ᵀ (symmetrized), A ψ = λ ψ, φ = L⁻ᵀ ψ, so
-    Φᵀ M Φ = Ψᵀ Ψ = I. A mass matrix that is not positive definite raises
-    :class:`numpy.linalg.LinAlgError` (from the Cholesky factorization).
-    """
-    K, M = np.asarray(K, dtype=float), np.asarray(M, dtype=float)
-    if K.shape != M.shape or K.ndim != 2 or K.shape[0] != K.shape[1]:
-        raise ValueError(f"K and M must be square and of one size (got {K.shape} and {M.shape})")
-    if K.shape[0] == 0:
-        return np.zeros(0), np.zeros((0, 0))
-    L = np.linalg.cholesky(0.5 * (M + M.T))
-    X = np.linalg.solve(L, 0.5 * (K + K.T))  # L⁻¹ K
-    A = np.linalg.solve(L, X.T)  # L⁻¹ (L⁻¹ K)ᵀ = L⁻¹ K L⁻ᵀ
-    eigenvalues, psi = np.linalg.eigh(0.5 * (A + A.T))
-    return eigenvalues, np.linalg.solve(L.T, psi)
-
-
 def undamped_modes(M: np.ndarray, K: np.ndarray) -> Modes:
     """Solve K φ = ω² M φ; rigid-body eigenvalues are set to exactly zero.
 
@@ -71,8 +47,10 @@ def undamped_modes(M: np.ndarray, K: np.ndarray) -> Modes:
     if not (np.all(np.isfinite(M)) and np.all(np.isfinite(K))):
         raise RunError("natural modes: the mass or stiffness matrix has non-finite entries; "
                        "check the members' section, modulus, density and gravity")
+    import scipy.linalg  # here, not at import: loading the model alone needs no scipy (~0.2 s)
+
     try:
-        eigenvalues, shapes = generalized_eigh(K, M)
+        eigenvalues, shapes = scipy.linalg.eigh(K, M)
     except (np.linalg.LinAlgError, ValueError) as exc:
         raise RunError(f"natural modes could not be computed ({str(exc).splitlines()[0][:80]}): the mass "
                        "matrix is not positive definite to working precision; check the members' "

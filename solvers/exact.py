@@ -289,10 +289,8 @@ class _ExactRun(PiecewiseRun):
         late = times >= self.t_rev
         if late.any():
             self.peak_late = np.maximum(self.peak_late, forces[:, late].max(axis=1))
-        width = self.n + self.series.n_sources
-        x, v, a, forces = z[:, :width], z[:, width:2 * width], z[:, 2 * width:], forces.T
-        self.rows.extend((float(t_out), np.stack([x[i], v[i], a[i]]), forces[i], ss.mask)
-                         for i, t_out in enumerate(times))
+        self.rows.append((np.asarray(times, dtype=float), z.reshape(len(times), 3, -1), forces.T,
+                          np.full(len(times), ss.mask, dtype=np.int64)))
 
 
 ExactBackend.run_class = _ExactRun

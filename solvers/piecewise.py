@@ -125,7 +125,8 @@ class PiecewiseRun(ABC):
         self.every_step = every_step
         self.ip, self.fp = problem.parameters(t_end=self.t_end)
         self.spaces: dict[int, StateSpace] = {}
-        self.rows: list[tuple[float, np.ndarray, np.ndarray, int]] = []
+        # output rows not yet handed to the builder: blocks (t, q3, F, cfg), flushed in time order
+        self.rows: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self.peak = np.zeros(self.ncl)
         self.peak_late = np.zeros(self.ncl)
         self.t_rev = 2 * math.pi / problem.omega
@@ -187,7 +188,21 @@ class PiecewiseRun(ABC):
         src = self.sources(t).reshape(-1, 3)
         q3 = np.stack([np.concatenate([x, src[:, 0]]), np.concatenate([v, src[:, 1]]),
                        np.concatenate([a, src[:, 2]])])
-        self.rows.append((t, q3, F, ss.mask))
+        self.rows.append((np.array([t]), q3[None], F[None], np.array([ss.mask], dtype=np.int64)))
+
+    def flush_rows(self) -> None:
+        """Hand the rows emitted so far to the builder, in time order (stable: ties keep their order).
+
+        Called after every :meth:`advance`: a call's rows may interleave (outputs at the requested
+        angles and every-step samples) but all come before the next call's."""
+        if not self.rows:
+            return
+        blocks, self.rows = self.rows, []
+        t, q3, F, cfg = (np.concatenate(parts) for parts in zip(*blocks, strict=True))
+        if np.any(np.diff(t) < 0.0):
+            order = np.argsort(t, kind="stable")
+            t, q3, F, cfg = t[order], q3[order], F[order], cfg[order]
+        self.builder.add_rows(t, q3, F, cfg)
 
     def output_times(self, t0: float, t1: float) -> list[float]:
         """Requested output instants in (t0, t1] not yet written (and t = 0 at the start)."""
@@ -215,6 +230,7 @@ class PiecewiseRun(ABC):
         chunk = max(self.t_end / 200.0, 1e-12)
         while t < self.t_end * (1 - 1e-14):
             t, y, fired = self.advance(ss, t, y, min(t + chunk, self.t_end))
+            self.flush_rows()
             if fired:
                 mask, x, v, a = self.apply_events(ss, t, y, fired)
                 ss = self.space(mask)
@@ -276,11 +292,7 @@ class PiecewiseRun(ABC):
         return new_c, x, v, a
 
     def statistics(self, settings: dict[str, Any]) -> dict[str, Any]:
-        self.rows.sort(key=lambda row: row[0])
-        if self.rows:
-            self.builder.add_rows(np.array([r[0] for r in self.rows]), np.array([r[1] for r in self.rows]),
-                                  np.array([r[2] for r in self.rows]),
-                                  np.array([r[3] for r in self.rows], dtype=np.int64))
+        self.flush_rows()
         return {"steps": self.steps, "peak": self.peak, "peak_late": self.peak_late,
                 "configurations": tuple(sorted(self.spaces)), "settings": settings}
 

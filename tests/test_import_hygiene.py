@@ -71,20 +71,6 @@ def test_solve_imports_no_ui_and_no_study_tools() -> None:
     assert out.stdout.strip() == ""
 
 
-def test_the_model_needs_no_scipy() -> None:
-    """Loading, assembling (modes, modal damping of every layer) and costing a run import no scipy.linalg:
-    only a back end that needs it does (the newmark kernel's numba loads it for its BLAS check)."""
-    code = (
-        "import sys\nfrom vtool.presets import load_preset\n"
-        "from vtool.solvers.run import _assemble, run_cost\n"
-        "m = _assemble(load_preset('gnilka-1a'))\nrun_cost(m)\n"
-        "m.all_layers()\nm.start\n"
-        "print(','.join(k for k in ('scipy', 'numba') if k in sys.modules))\n"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == ""
-
-
 def test_import_linter_contracts_are_kept(tmp_path) -> None:  # type: ignore[no-untyped-def]
     """pyproject's import-linter contracts (layers, no UI below app/, solvers without presets)."""
     from tests import typing_tree
