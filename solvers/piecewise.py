@@ -24,6 +24,7 @@ contact problem's (:mod:`vtool.solvers.contact`, the kernel's ``impact`` and
 from __future__ import annotations
 
 import math
+import weakref
 from abc import ABC, abstractmethod
 from typing import Any
 
@@ -36,6 +37,11 @@ from vtool.solvers.contact import EVENT_KINDS, ContactProblem, OrderedLayer
 from vtool.solvers.sources import SourceSeries
 from vtool.solvers.statespace import StateSpace, from_layer
 from vtool.solvers.trace import TraceBuilder
+
+#: The state spaces of a mechanism's configurations, kept as long as its configuration tables: a
+#: second run of the same mechanism (a sweep, a benchmark, the TUI) reuses them and what the back
+#: ends derived from them (``StateSpace.cache``: eigendecompositions, scan powers).
+_SPACES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def source_coefficients(series: SourceSeries, s: int) -> np.ndarray:
@@ -112,6 +118,8 @@ class PiecewiseRun(ABC):
     """
 
     backend = "piecewise"
+    #: advance() returns at least this many times over a run (progress, cancel, rows to the builder)
+    progress_steps = 200
 
     def __init__(self, problem: ContactProblem, output_interval: float, every_step: bool,
                  builder: TraceBuilder) -> None:
@@ -142,8 +150,17 @@ class PiecewiseRun(ABC):
 
     # ----- configuration data -----
     def space(self, mask: int) -> StateSpace:
+        """Configuration ``mask``'s state space: built once per mechanism and cam motion (see _SPACES)."""
         if mask not in self.spaces:
-            self.spaces[mask] = state_space(self.problem, self.problem.build(mask))
+            problem = self.problem
+            layer = problem.build(mask)
+            series = problem.series
+            key = (mask, float(series.omega), problem.gap_noise, series.const.tobytes(), series.cos.tobytes(),
+                   series.sin.tobytes())
+            shared = _SPACES.setdefault(problem.tables, {})
+            if key not in shared:
+                shared[key] = state_space(problem, layer)
+            self.spaces[mask] = shared[key]
         return self.spaces[mask]
 
     def full_state(self, ss: StateSpace, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -227,7 +244,7 @@ class PiecewiseRun(ABC):
         t, y = 0.0, self.state_of(ss, x, v)
         for t_out in self.output_times(-1.0, 0.0):
             self.emit(ss, t_out, y)
-        chunk = max(self.t_end / 200.0, 1e-12)
+        chunk = max(self.t_end / self.progress_steps, 1e-12)
         while t < self.t_end * (1 - 1e-14):
             t, y, fired = self.advance(ss, t, y, min(t + chunk, self.t_end))
             self.flush_rows()
