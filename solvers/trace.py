@@ -162,11 +162,12 @@ class Trace:
         return f"{'' if number is None else number},{'+'.join(closed_names(self.spec, mask)) or 'none'}"
 
     def write_csv_to(self, handle, quantities: tuple[str, ...] = (), chunk: int = 20_000,  # type: ignore[no-untyped-def]
-                     header: bool = True) -> None:
+                     header: bool = True, compiled: bool | None = None) -> None:
         """Write the CSV in blocks of ``chunk`` rows (memory stays bounded by the block, not the run).
 
         Numbers are ``'%.10g' % value`` (:func:`vtool.csvrows.write_rows` writes the same text
-        about 5x faster); ``header=False`` leaves out the header row (a block of a streamed run).
+        about 5x faster; ``compiled`` as there: by default, for a large table or when compiled
+        already); ``header=False`` leaves out the header row (a block of a streamed run).
         """
         from vtool.csvrows import write_rows
 
@@ -178,7 +179,8 @@ class Trace:
         for start in range(0, len(self.time), chunk):
             rows = slice(start, min(start + chunk, len(self.time)))
             block = np.column_stack([column(rows) for column in columns])
-            write_rows(handle, block, labels, np.searchsorted(masks, self.configuration[rows]))
+            write_rows(handle, block, labels, np.searchsorted(masks, self.configuration[rows]),
+                       compiled=compiled if compiled is not None or len(self.time) < chunk else True)
 
     def csv_text(self, quantities: tuple[str, ...] = ()) -> str:
         """CSV with one header row naming each quantity and its unit."""
@@ -416,7 +418,8 @@ class CsvStream:
                 raise RunError(f"rows out of time order at t = {block.time[0]:.6g} s: the CSV cannot be "
                                "streamed (a back end must hand rows over in time order)")
             self.last_time = float(block.time[-1])
-        block.write_csv_to(self.handle, self.quantities, header=not self.header_written)
+        block.write_csv_to(self.handle, self.quantities, header=not self.header_written,
+                           compiled=True if self.thin else None)
         self.header_written = True
         self.rows += len(block.time)
         self.seconds += wallclock.perf_counter() - started

@@ -46,18 +46,22 @@ def test_the_formatter_writes_pythons_text_on_edges_ties_and_every_magnitude() -
     values = np.concatenate([values, np.zeros(-values.size % 5)]).reshape(-1, 5)
     labels = ["7,cam+rocker", ",none", "II,siège"]  # a label may be empty in parts or not ASCII
     which = rng.integers(0, len(labels), values.shape[0])
-    assert format_rows(values, labels, which) == reference(values, labels, which)
+    assert format_rows(values, labels, which, compiled=True) == reference(values, labels, which)
 
 
 @settings(max_examples=300, deadline=None)
 @given(st.lists(st.floats(allow_nan=True, allow_infinity=True), min_size=1, max_size=12))
 def test_the_formatter_agrees_with_python_for_any_float(numbers: list[float]) -> None:
     values = np.array(numbers)[None, :]
-    assert format_rows(values, ["x"], np.zeros(1, dtype=np.int64)) == python_row(values[0], "x")
+    assert format_rows(values, ["x"], np.zeros(1, dtype=np.int64), compiled=True) == python_row(values[0], "x")
 
 
-def test_no_rows_is_no_text() -> None:
+def test_no_rows_is_no_text_and_python_writes_the_same_text() -> None:
     assert format_rows(np.zeros((0, 3)), ["x"], np.zeros(0, dtype=np.int64)) == ""
+    values = np.array([[1.5, -0.0, 1e-300], [math.pi, 1e21, -7.25e-5]])
+    which = np.array([0, 1])
+    assert (format_rows(values, ["a", "b"], which, compiled=False)
+            == format_rows(values, ["a", "b"], which, compiled=True) == "1.5,-0,1e-300,a\n3.141592654,1e+21,-7.25e-05,b\n")
 
 
 @pytest.fixture(scope="module")

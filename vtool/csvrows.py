@@ -39,6 +39,9 @@ jit = njit(cache=numba_cache.CACHE_ENABLED, nogil=True, error_model="numpy")
 
 #: Characters one value can take at most (``-1.234567891e-100``) plus its comma.
 VALUE_WIDTH = 18
+#: Outputs of at least this many rows compile the kernel when it is not cached yet (smaller ones
+#: are written by Python: about 25 µs per row of 46 values, under a second for 20,000 rows).
+WORTH_COMPILING_ROWS = 20_000
 #: Fractions of s this close to one half are left to Python's correctly rounded formatting.
 TIE_MARGIN = 1e-5
 #: Decimal shifts 10^k, |k| <= MAX_SHIFT, are one multiplication by the nearest double.
@@ -173,7 +176,21 @@ def python_row(values: np.ndarray, label: str) -> str:
     return ",".join("%.10g" % value for value in values.tolist()) + "," + label + "\n"  # noqa: UP031
 
 
-def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray) -> list:  # type: ignore[type-arg]
+def ready() -> bool:
+    """True when the kernel needs no compiling: loaded in this process, or in numba's cache."""
+    if not hasattr(put_rows, "signatures") or put_rows.signatures:
+        return True  # NUMBA_DISABLE_JIT (plain Python), or compiled or loaded already
+    return compile_notice() is None
+
+
+def use_kernel(rows: int, compiled: bool | None) -> bool:
+    """``compiled`` if given; else the kernel when it is ready or the output is large enough to pay
+    for its compile (a few seconds, once): a per-degree CSV does not wait for it."""
+    return compiled if compiled is not None else (rows >= WORTH_COMPILING_ROWS or ready())
+
+
+def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
+            compiled: bool | None = None) -> list:  # type: ignore[type-arg]
     """The rows' UTF-8 text as a list of byte buffers (the kernel's, and Python's rows where it gave up)."""
     values = np.ascontiguousarray(values, dtype=np.float64)
     if values.ndim != 2:
@@ -181,6 +198,9 @@ def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray) -> 
     rows = values.shape[0]
     if rows == 0:
         return []
+    if not use_kernel(rows, compiled):
+        text = "".join(python_row(values[r], labels[int(label_of_row[r])]) for r in range(rows))
+        return [text.encode("utf-8")]
     encoded = [label.encode("utf-8") for label in labels]
     label_start = np.zeros(len(encoded) + 1, dtype=np.int64)
     label_start[1:] = np.cumsum([len(b) for b in encoded])
@@ -202,20 +222,26 @@ def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray) -> 
     return pieces
 
 
-def format_rows(values: np.ndarray, labels: list[str], label_of_row: np.ndarray) -> str:
-    """CSV text of the rows of ``values`` (2-D), each ending with ``labels[label_of_row[r]]``."""
-    return b"".join(bytes(piece) for piece in _encode(values, labels, label_of_row)).decode("utf-8")
+def format_rows(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
+                compiled: bool | None = None) -> str:
+    """CSV text of the rows of ``values`` (2-D), each ending with ``labels[label_of_row[r]]``.
+
+    ``compiled``: True for the kernel, False for Python's formatting (the same text), None to
+    choose (:func:`use_kernel`)."""
+    pieces = _encode(values, labels, label_of_row, compiled)
+    return b"".join(bytes(piece) for piece in pieces).decode("utf-8")
 
 
-def write_rows(handle, values: np.ndarray, labels: list[str], label_of_row: np.ndarray) -> None:  # type: ignore[no-untyped-def]
+def write_rows(handle, values: np.ndarray, labels: list[str], label_of_row: np.ndarray,  # type: ignore[no-untyped-def]
+               compiled: bool | None = None) -> None:
     """Write :func:`format_rows`'s text to a text handle; to a UTF-8 file's binary buffer directly
     (no text copy) when it has one."""
     binary = getattr(handle, "buffer", None)
     if binary is None or (getattr(handle, "encoding", "") or "").lower().replace("-", "") != "utf8":
-        handle.write(format_rows(values, labels, label_of_row))
+        handle.write(format_rows(values, labels, label_of_row, compiled))
         return
     handle.flush()  # what was written as text goes first
-    for piece in _encode(values, labels, label_of_row):
+    for piece in _encode(values, labels, label_of_row, compiled):
         binary.write(piece)
 
 
@@ -223,13 +249,20 @@ def write_rows(handle, values: np.ndarray, labels: list[str], label_of_row: np.n
 COMPILE_ESTIMATE_S = 5.0
 
 
+_cached: list[bool] = []  # the cache's answer, read once per process
+
+
 def compile_notice() -> str | None:
-    """The line to show before the first CSV output compiles the formatter, or None when it is cached."""
-    try:
-        cached = bool(put_rows._cache._cache_file._load_index())
-    except Exception:  # noqa: BLE001 (numba internals: a missing or unreadable index means "compile")
-        cached = False
-    if cached or not hasattr(put_rows, "signatures"):
+    """The line to show before the first large CSV output compiles the formatter, or None when it is
+    cached (or compiled in this process)."""
+    if not hasattr(put_rows, "signatures") or put_rows.signatures:
+        return None
+    if not _cached:
+        try:
+            _cached.append(bool(put_rows._cache._cache_file._load_index()))
+        except Exception:  # noqa: BLE001 (numba internals: a missing or unreadable index means "compile")
+            _cached.append(False)
+    if _cached[0]:
         return None
     return (f"compiling the CSV writer, once (about {COMPILE_ESTIMATE_S:.0f} s); "
             "later runs load it from the cache")

@@ -105,7 +105,7 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
     from vtool.solvers.run import simulate
 
     spec = with_run_overrides(spec, backend=backend, time_step=dt, rpm=rpm, degrees=degrees)
-    announce_compile(spec.run.backend, csv=csv_path is not None)
+    announce_compile(spec.run.backend, csv=csv_path is not None and every_step)
     progress = DelayedProgress(f"{spec.run.backend} {spec.run.degrees:g} deg")
     try:
         if csv_path is None:
@@ -137,7 +137,7 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
 
 def announce_compile(backend: str, csv: bool = False) -> None:
     """One line on stderr before a run that must first compile the solver (a new install's first run),
-    and one before the first CSV output compiles its number formatter (a few seconds, once)."""
+    and one before the first every-step CSV compiles its number formatter (a few seconds, once)."""
     from vtool.solvers.newmark import compile_notice
 
     notice = compile_notice(backend)
