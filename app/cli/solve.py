@@ -128,7 +128,7 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
             click.echo("")
             click.echo(trace.event_table())
         if csv_path is not None:
-            click.echo(f"wrote {stream.rows} rows to {csv_path}")
+            click.echo(f"wrote {stream.rows} rows to {csv_path} ({stream.seconds:.1f} s formatting and writing)")
     if plot:
         from vtool.app.valvetrain_charts import all_charts
 
