@@ -34,13 +34,16 @@ from vtool.solvers.assembly import split_members, unsplit_members
 from vtool.solvers.spec import (
     BAR,
     BEAM,
+    CONTACT_LAWS,
     ELEMENT_SIZE,
     ENABLED,
     EXTERNAL,
+    HERTZ,
     IMPACT_LAWS,
     INTERNAL,
     PINNED,
     REMOVED,
+    RIGID,
     START_VELOCITIES,
     CamSpec,
     ClearanceSpec,
@@ -113,7 +116,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     seat = _seat(seat_table, n, cam, units) if seat_table is not None else None
     prescribed = {cam.coordinate} | ({seat.coordinate} if seat else set())
     members = _members(top, n, units)
-    clearances = _clearances(top, n, prescribed, cam.coordinate)
+    clearances = _clearances(top, n, prescribed, cam.coordinate, units)
     names = {c.name: c for c in clearances}
     cam_name = next(c.name for c in clearances if c.behind == cam.coordinate)
     initial = _initial(top.table("initial"), names, cam_name, units)  # type: ignore[arg-type]
@@ -148,6 +151,53 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
 
         spec = replace(spec, seat=replace(spec.seat, position=float(seat_position(spec, seat.lash))))
     return spec
+
+
+def _compliance_doc(c: ClearanceSpec) -> dict[str, Any]:
+    """The contact keys of a clearance as a preset writes them (none for a rigid one)."""
+    if c.rigid:
+        return {}
+    doc: dict[str, Any] = {"contact": c.contact, "contact_stiffness": c.contact_stiffness}
+    if c.contact == HERTZ:
+        return doc | {"contact_exponent": c.contact_exponent}
+    if c.contact_damping is not None:
+        return doc | {"contact_damping": c.contact_damping}
+    return doc | {"contact_damping_ratio": c.contact_damping_ratio or 0.0}
+
+
+def _compliance(t: Table, state: str, units: UnitSystem) -> dict[str, Any]:
+    """A clearance's contact law and its spring, dashpot (linear) or exponent (hertz)."""
+    contact = t.string("contact", default=RIGID, choices=CONTACT_LAWS)
+    keys = ("contact_stiffness", "contact_damping", "contact_damping_ratio", "contact_exponent")
+    if contact == RIGID:
+        for key in keys:
+            if t.raw(key) is not None:
+                raise InputError(t.field(key), t.raw(key), 'no value for a rigid contact (set contact = "linear")')
+        return {}
+    if state != ENABLED:
+        raise InputError(t.field("contact"), contact, f"rigid for a {state} clearance")
+    if contact == HERTZ:
+        stiffness = t.number("contact_stiffness", unit=f"{units.force}/{units.length}^n", required=True,
+                             min_value=1e-6, max_value=1e16)
+        for key in ("contact_damping", "contact_damping_ratio"):
+            if t.raw(key) is not None:
+                raise InputError(t.field(key), t.raw(key), "no value for a hertz contact (its Hunt-Crossley "
+                                 "damping comes from the restitution)")
+        exponent = t.number("contact_exponent", default=1.5, min_value=1.0, max_value=3.0)
+        return {"contact": contact, "contact_stiffness": stiffness, "contact_exponent": exponent}
+    if t.raw("contact_exponent") is not None:
+        raise InputError(t.field("contact_exponent"), t.raw("contact_exponent"), "no value for a linear contact")
+    stiffness = _magnitude(t, "contact_stiffness", units.stiffness, "stiffness", required=True)
+    result: dict[str, Any] = {"contact": contact, "contact_stiffness": stiffness}
+    if t.raw("contact_damping") is not None and t.raw("contact_damping_ratio") is not None:
+        raise InputError(t.field("contact_damping"), t.raw("contact_damping"),
+                         "contact_damping or contact_damping_ratio, not both")
+    if t.raw("contact_damping") is not None:
+        result["contact_damping"] = t.number("contact_damping", unit=units.damping, min_value=0.0, max_value=1e12)
+    else:
+        result["contact_damping_ratio"] = t.number("contact_damping_ratio", default=0.0, min_value=0.0,
+                                                   max_value=10.0)
+    return result
 
 
 def _contact(t: Table | None) -> ContactSpec:
@@ -324,7 +374,8 @@ def _members(top: Table, n: int, units: UnitSystem) -> tuple[MemberSpec, ...]:
     return tuple(members)
 
 
-def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int) -> tuple[ClearanceSpec, ...]:
+def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int,
+                units: UnitSystem) -> tuple[ClearanceSpec, ...]:
     result: list[ClearanceSpec] = []
     elastic = set(range(1, n + 1))
     tables = top.array_of_tables("clearances")
@@ -344,8 +395,9 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int) -
             raise InputError(t.field("state"), state, "enabled or removed for an external clearance")
         restitution = t.number("restitution", default=0.0, min_value=0.0, max_value=1.0)
         impact = t.string("impact", choices=IMPACT_LAWS) if t.raw("impact") is not None else None
+        contact = _compliance(t, state, units)
         t.finish()
-        result.append(ClearanceSpec(name, ahead, behind, kind, state, restitution, impact))
+        result.append(ClearanceSpec(name, ahead, behind, kind, state, restitution, impact, **contact))
     if sum(c.behind == cam_coordinate for c in result) != 1:
         raise InputError("clearances", [c.name for c in result], f"exactly one clearance with behind = {cam_coordinate} (the cam)")
     return tuple(result)
@@ -356,6 +408,9 @@ def _initial(t: Table, names: dict[str, ClearanceSpec], cam_name: str, units: Un
     for name in closed:
         if names[name].state == REMOVED:
             raise InputError(t.field("closed"), name, "clearances that are not removed")
+        if names[name].contact == HERTZ:
+            raise InputError(t.field("closed"), name, "clearances with a rigid or linear contact (a hertz "
+                             "contact starts open: its static overlap is not linear)")
         if names[name].kind == EXTERNAL and name != cam_name:
             # the static start loads the mechanism at the follower only; it cannot put the valve on its seat
             raise InputError(t.field("closed"), name, f"only the cam clearance ('{cam_name}') and internal clearances")
@@ -533,6 +588,7 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
     doc["clearances"] = [
         {"name": c.name, "ahead": c.ahead, "behind": c.behind, "kind": c.kind,
          "state": c.state, "restitution": c.restitution} | ({"impact": c.impact} if c.impact else {})
+        | _compliance_doc(c)
         for c in spec.clearances
     ]
     doc["initial"] = {

@@ -17,7 +17,7 @@ The contract every back end follows (subclass :class:`Backend`)
    the end, adding rows and events to the
    :class:`~vtool.solvers.trace.TraceBuilder`; apply the shared event rules
    (kernel functions ``impact`` and ``settle``); return the statistics
-   (``steps``, ``peak``, ``peak_late``, ``configurations``, ``settings``).
+   (``steps``, ``peak``, ``peak_late``, ``peak_overlap``, ``configurations``, ``settings``).
    ``progress(f)`` is called with the fraction done (0..1) between chunks,
    ``cancel()`` polled between chunks (a true answer stops the run).
 5. Errors: a run that cannot be completed (divergence, endless chattering,
@@ -119,9 +119,12 @@ class Backend(ABC):
         spec = mechanism.spec
         settings = dict(stats.get("settings", {}))
         settings.update(rpm=spec.run.rpm, degrees=spec.run.degrees,
-                        impact=sorted({spec.impact_law(c) for c in spec.clearances}),
+                        impact=sorted({spec.impact_law(c) for c in spec.clearances if c.rigid}),
                         rocker_scale=spec.contact.rocker_scale, start_velocities=spec.initial.velocities)
+        if any(not c.rigid for c in spec.clearances):
+            settings["contact"] = {c.name: c.contact for c in spec.clearances if not c.rigid}
         statistics = RunStatistics(self.name, int(stats["steps"]), len(builder.events), wall,
                                    tuple(sorted(stats.get("configurations", problem.tables.layers))), settings,
                                    compile_time=compile_time)
-        return builder.build(stats["peak"], statistics, stats.get("peak_late"), sort=stats.get("sort", False))
+        return builder.build(stats["peak"], statistics, stats.get("peak_late"), sort=stats.get("sort", False),
+                             peak_overlap=stats.get("peak_overlap"))

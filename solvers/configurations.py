@@ -42,7 +42,7 @@ import numpy as np
 
 from vtool.solvers.layers import Layer
 from vtool.solvers.model import Mechanism
-from vtool.solvers.spec import ENABLED, EXTERNAL, INTERNAL, PINNED, REMOVED, MechanismSpec
+from vtool.solvers.spec import EXTERNAL, HERTZ, INTERNAL, PINNED, REMOVED, MechanismSpec
 
 ROMAN = ("I", "II", "III", "IV", "V", "VI", "VII", "VIII")
 
@@ -113,27 +113,44 @@ class Partition:
     free: list[int]
     prescribed: list[int]
     sources: list[int]  # source index of each prescribed column
+    C: np.ndarray  # the configuration's modal damping over the layer's coordinates (see partition)
 
 
 def partition(mechanism: Mechanism, mask: int) -> Partition:
-    """Layer of the closed internal clearances; closed external ones prescribe their ahead end."""
+    """Layer of the closed rigid internal clearances; closed rigid external ones prescribe their ahead end.
+
+    Modal damping belongs to the contact state, not to the contact law: with
+    closed compliant internal contacts the configuration keeps the damping
+    C_t of the layer in which those pairs are tied (the preset's
+    ``damping.layers`` entry that names them), spread over each pair: with
+    R the map from the tied layer's coordinates to this layer's (q = R q_t)
+    and G = RᵀR, C = R G⁻¹ C_t G⁻¹ Rᵀ, so that Rᵀ C R = C_t. As the contact
+    stiffness grows the run so approaches the rigid run's.
+    """
     spec = mechanism.spec
     closed = closed_names(spec, mask)
-    layer = mechanism.layer(frozenset(n for n in closed if spec.clearance(n).kind == INTERNAL))
+    layer = mechanism.layer(frozenset(n for n in closed if spec.clearance(n).ties))
+    damping = layer.C
+    soft = frozenset(n for n in closed if spec.clearance(n).kind == INTERNAL and not spec.clearance(n).rigid)
+    if soft:
+        tied = mechanism.tied_layer(frozenset(n for n in closed if spec.clearance(n).kind == INTERNAL))
+        R = np.linalg.solve(layer.T.T @ layer.T, layer.T.T @ tied.T)
+        spread = R @ np.linalg.inv(R.T @ R)
+        damping = spread @ tied.C @ spread.T
     group = np.argmax(layer.T, axis=1)
     source_of = {number: s for s, (number, _, _) in enumerate(sources(spec))}
     prescribed: dict[int, int] = {}
     for c in spec.clearances:
-        if c.kind == EXTERNAL and c.name in closed:
+        if c.kind == EXTERNAL and c.rigid and c.name in closed:
             prescribed[int(group[c.ahead - 1])] = source_of[c.behind]
     pres = sorted(prescribed)
     free = [j for j in range(layer.size) if j not in prescribed]
-    return Partition(layer, group, free, pres, [prescribed[j] for j in pres])
+    return Partition(layer, group, free, pres, [prescribed[j] for j in pres], damping)
 
 
 def internal_force_coefficients(
     mechanism: Mechanism, mask: int, ahead: int, behind: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[int, float]]:
     """Coefficients of an internal clearance's contact force while it is closed in ``mask``.
 
     The force is the pair force (+λ on ahead, -λ on behind) that keeps the
@@ -142,7 +159,9 @@ def internal_force_coefficients(
     a_F = M_FF⁻¹ (f_F - C_FF v_F - K_FF x_F - M_FP a_P - C_FP v_P - K_FP x_P)
     and w selecting ahead minus behind, λ = -(wᵀ a)|_(λ=0) / (w_Fᵀ M_FF⁻¹ w_F).
     This is linear in the full state and the sources, so it is returned as
-    (fx[n], fv[n], fs[ns, 3]) with λ = fx·q + fv·q̇ + Σ_s fs[s]·(q_s, q̇_s, q̈_s).
+    (fx[n], fv[n], fs[ns, 3]) with λ = fx·q + fv·q̇ + Σ_s fs[s]·(q_s, q̇_s, q̈_s),
+    and a coefficient per closed Hertz contact j (its force F_j w_j adds
+    scale · rowᵀ w_j F_j).
     """
     spec = mechanism.spec
     bit = next(clearance_bit(spec, i) for i, c in enumerate(spec.clearances)
@@ -152,7 +171,9 @@ def internal_force_coefficients(
     g = np.zeros(spec.n_coordinates)
     g[ahead - 1], g[behind - 1] = 1.0, -1.0
     w = layer.T.T @ g  # selection over the open layer's coordinates
-    M, C, K = layer.M, layer.C, layer.K
+    springs = compliant_terms(mechanism, mask & ~bit)
+    M, C, K = layer.M, part.C + springs.layer_C(layer.T), layer.K + springs.layer_K(layer.T)
+    S = layer.T.T @ springs.S
     row = np.linalg.solve(M[np.ix_(free, free)], w[free])  # M_FF⁻¹ w_F (M symmetric)
     scale = -1.0 / float(w[free] @ row)  # λ = scale * (relative acceleration with λ = 0)
     fx = np.zeros(spec.n_coordinates)
@@ -168,92 +189,101 @@ def internal_force_coefficients(
         fs[source, 0] += scale * -(row @ K[free, j])
         fs[source, 1] += scale * -(row @ C[free, j])
         fs[source, 2] += scale * (w[j] - row @ M[free, j])
-    return fx, fv, fs
+    fs -= scale * (row @ S[free]).reshape(fs.shape)
+    fh = {j: float(scale * (row @ (layer.T.T @ w)[free])) for j, w in springs.hertz.items()}
+    return fx, fv, fs, fh
 
 
-@dataclass
-class ConfigurationTables:
-    """Padded per-configuration arrays for the kernel, filled in lazily by :meth:`build`."""
+@dataclass(frozen=True)
+class CompliantTerms:
+    """The springs and dashpots of the closed compliant clearances of one configuration.
 
-    built: np.ndarray
-    m: np.ndarray
-    kept: np.ndarray
-    group: np.ndarray
-    nf: np.ndarray
-    free: np.ndarray
-    npres: np.ndarray
-    pres: np.ndarray
-    pres_src: np.ndarray
-    ML: np.ndarray
-    CL: np.ndarray
-    KL: np.ndarray
-    Sinv: np.ndarray
-    SinvFine: np.ndarray  # the same for the refined step after events
-    MinvFF: np.ndarray
-    Frow: np.ndarray  # [mask, clearance, 3n + 3ns]: contact force on (q, q̇, q̈, sources)
+    Over the full coordinates q and the sources' (x, v, a) vector src (the
+    kernel's layout, s-major), the contact forces of the closed linear
+    clearances add to the equations of motion
 
-    @classmethod
-    def empty(cls, n_configurations: int, n: int, n_clearances: int, n_sources: int) -> ConfigurationTables:
-        def ints() -> np.ndarray:
-            return np.zeros((n_configurations, n), dtype=np.int64)
+        M q̈ + C q̇ + K q + (ΔC q̇ + ΔK q + S src) = 0
 
-        def mats() -> np.ndarray:
-            return np.zeros((n_configurations, n, n))
+    with, per clearance, ΔK = k w wᵀ, ΔC = c w wᵀ (w = e_ahead - e_behind),
+    and for an external one (behind = source s) w = e_ahead and S[ahead, 3s] =
+    -k, S[ahead, 3s + 1] = -c. Its contact force, positive in compression, is
+    F = k δ + c δ̇ with the overlap δ = -(q_ahead - q_behind): the row
+    ``force[k]`` on (q, q̇, q̈, src, 1) of the monitor layout.
+    """
 
-        counts = [np.zeros(n_configurations, dtype=np.int64) for _ in range(3)]
-        return cls(
-            built=np.zeros(n_configurations, dtype=np.int64),
-            m=counts[0], kept=ints(), group=ints(), nf=counts[1], free=ints(),
-            npres=counts[2], pres=ints(), pres_src=ints(),
-            ML=mats(), CL=mats(), KL=mats(), Sinv=mats(), SinvFine=mats(), MinvFF=mats(),
-            Frow=np.zeros((n_configurations, n_clearances, 3 * n + 3 * n_sources)),
-        )
+    K: np.ndarray  # n x n
+    C: np.ndarray
+    S: np.ndarray  # n x 3 ns
+    force: dict[int, np.ndarray]  # clearance index -> row on (q, q̇, q̈, src)
+    hertz: dict[int, np.ndarray]  # closed Hertz clearance -> w over the full coordinates (its force acts as F w)
 
-    def build(self, mechanism: Mechanism, mask: int, dt: float, beta: float, gamma: float,
-              fine_dt: float | None = None) -> None:
-        """Partition configuration ``mask`` and precompute its matrices (BMIV for dt and for fine_dt)."""
-        spec = mechanism.spec
-        part = partition(mechanism, mask)
-        layer, free, pres = part.layer, part.free, part.prescribed
-        m = layer.size
-        M_L, C_L, K_L = layer.M, layer.C, layer.K
-        M_FF = M_L[np.ix_(free, free)]
+    def layer_K(self, T: np.ndarray) -> np.ndarray:
+        return T.T @ self.K @ T
 
-        def effective(h: float) -> np.ndarray:
-            return M_FF + gamma * h * C_L[np.ix_(free, free)] + beta * h * h * K_L[np.ix_(free, free)]
+    def layer_C(self, T: np.ndarray) -> np.ndarray:
+        return T.T @ self.C @ T
 
-        nf, npres = len(free), len(pres)
-        self.m[mask], self.nf[mask], self.npres[mask] = m, nf, npres
-        kept_full = [k - 1 for k in layer.kept]
-        self.kept[mask, :m] = kept_full
-        self.group[mask, :] = part.group
-        self.free[mask, :nf] = free
-        self.pres[mask, :npres] = pres
-        self.pres_src[mask, :npres] = part.sources
-        self.ML[mask, :m, :m] = M_L
-        self.CL[mask, :m, :m] = C_L
-        self.KL[mask, :m, :m] = K_L
-        if nf:
-            self.Sinv[mask, :nf, :nf] = np.linalg.inv(effective(dt))
-            self.SinvFine[mask, :nf, :nf] = np.linalg.inv(effective(fine_dt or dt))
-            self.MinvFF[mask, :nf, :nf] = np.linalg.inv(M_FF)
-        n = spec.n_coordinates
-        MT = mechanism.M @ layer.T
-        row_x, row_v, row_a = mechanism.K @ layer.T, MT @ np.linalg.solve(M_L, C_L), MT
-        for index, c in enumerate(spec.clearances):
-            if not mask & clearance_bit(spec, index):
-                continue
-            frow = self.Frow[mask, index]
-            if c.kind == INTERNAL and c.state == ENABLED:
-                fx, fv, fs = internal_force_coefficients(mechanism, mask, c.ahead, c.behind)
-                frow[:n], frow[n:2 * n], frow[3 * n:] = fx, fv, fs.ravel()
-            else:  # the row force r at the ahead coordinate, on layer values = full values at kept
-                i = c.ahead - 1
-                for j, full in enumerate(kept_full):
-                    frow[full] += row_x[i, j]
-                    frow[n + full] += row_v[i, j]
-                    frow[2 * n + full] += row_a[i, j]
-        self.built[mask] = 1
 
-    def configurations_built(self) -> list[int]:
-        return [int(c) for c in np.flatnonzero(self.built)]
+def contact_damping(mechanism: Mechanism, index: int) -> float:
+    """Dashpot c of a linear clearance: its own, or 2 ζ √(k m) on the local masses (see ClearanceSpec)."""
+    c = mechanism.spec.clearances[index]
+    if c.contact_damping is not None:
+        return float(c.contact_damping)
+    ratio = c.contact_damping_ratio or 0.0
+    m = mechanism.M[c.ahead - 1, c.ahead - 1]
+    if c.kind == INTERNAL:
+        mb = mechanism.M[c.behind - 1, c.behind - 1]
+        m = m * mb / (m + mb)
+    return float(2.0 * ratio * np.sqrt(c.contact_stiffness * m))
+
+
+def compliant_terms(mechanism: Mechanism, mask: int) -> CompliantTerms:
+    """:class:`CompliantTerms` of the compliant clearances closed in ``mask`` (a Hertz one is nonlinear:
+    only its direction w, see :func:`hertz_row`)."""
+    spec = mechanism.spec
+    n, ns = spec.n_coordinates, len(sources(spec))
+    K, C, S = np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, 3 * ns))
+    force: dict[int, np.ndarray] = {}
+    hertz: dict[int, np.ndarray] = {}
+    source_of = {number: s for s, (number, _, _) in enumerate(sources(spec))}
+    for index, c in enumerate(spec.clearances):
+        if c.rigid or not mask & clearance_bit(spec, index):
+            continue
+        if c.contact == HERTZ:
+            w = np.zeros(n)
+            w[c.ahead - 1] = 1.0
+            if c.kind == INTERNAL:
+                w[c.behind - 1] = -1.0
+            hertz[index] = w
+            continue
+        k, d = c.contact_stiffness, contact_damping(mechanism, index)
+        w = np.zeros(n)
+        w[c.ahead - 1] = 1.0
+        row = np.zeros(3 * n + 3 * ns)
+        if c.kind == INTERNAL:
+            w[c.behind - 1] = -1.0
+        else:
+            s = source_of[c.behind]
+            S[c.ahead - 1, 3 * s], S[c.ahead - 1, 3 * s + 1] = -k, -d
+            row[3 * n + 3 * s], row[3 * n + 3 * s + 1] = k, d
+        K += k * np.outer(w, w)
+        C += d * np.outer(w, w)
+        row[:n], row[n:2 * n] = -k * w, -d * w
+        force[index] = row
+    return CompliantTerms(K, C, S, force, hertz)
+
+
+def hertz_row(mechanism: Mechanism, index: int) -> np.ndarray:
+    """The monitor row of a closed Hertz clearance: -w on q and on q̇, +1 on its source's x and v, so that
+    the row's q part gives the overlap δ and its q̇ part δ̇ (the kernel's ``overlap_and_rate``)."""
+    spec = mechanism.spec
+    n, ns = spec.n_coordinates, len(sources(spec))
+    c = spec.clearances[index]
+    row = np.zeros(3 * n + 3 * ns)
+    row[c.ahead - 1] = row[n + c.ahead - 1] = -1.0
+    if c.kind == INTERNAL:
+        row[c.behind - 1] = row[n + c.behind - 1] = 1.0
+    else:
+        s = next(s for s, (number, _, _) in enumerate(sources(spec)) if number == c.behind)
+        row[3 * n + 3 * s] = row[3 * n + 3 * s + 1] = 1.0
+    return row

@@ -35,7 +35,9 @@ import numpy as np
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.configurations import (
     clearance_bit,
+    compliant_terms,
     configuration_label,
+    hertz_row,
     internal_force_coefficients,
     mask_of,
     partition,
@@ -43,10 +45,21 @@ from vtool.solvers.configurations import (
 )
 from vtool.solvers.model import Mechanism
 from vtool.solvers.sources import SourceSeries
-from vtool.solvers.spec import ENABLED, INTERNAL, LOCAL, MOMENTUM, PINNED, THESIS
+from vtool.solvers.spec import (
+    ENABLED,
+    HERTZ,
+    INTERNAL,
+    LINEAR,
+    LOCAL,
+    MOMENTUM,
+    PINNED,
+    RIGID,
+    THESIS,
+)
 from vtool.solvers.trace import CLOSED, OPENED, RELEASED
 
 LAW_CODES = {MOMENTUM: kernel.LAW_MOMENTUM, LOCAL: kernel.LAW_LOCAL, THESIS: kernel.LAW_THESIS}
+SOFT_CODES = {RIGID: 0, LINEAR: kernel.SOFT_LINEAR, HERTZ: kernel.SOFT_HERTZ}
 EVENT_KINDS = {kernel.EV_OPENED: OPENED, kernel.EV_CLOSED: CLOSED, kernel.EV_RELEASED: RELEASED}
 
 
@@ -88,6 +101,7 @@ class OrderedLayer:
     kept: np.ndarray  # full coordinate (0-based) of each z index
     group: np.ndarray  # z index of each full coordinate
     source: np.ndarray  # source index of each prescribed z index (nf..m-1)
+    S: np.ndarray  # m x 3 ns: the sources' (x, v, a) pull on each z index through closed compliant contacts
 
     @property
     def m(self) -> int:
@@ -105,9 +119,9 @@ class ConfigurationTables:
         count = 2**ncl
         self.ci = np.zeros((count, kernel.CI_HEAD + 3 * n), dtype=np.int64)
         self.cm = np.zeros((count, kernel.CM_SIZE, n, n))
-        self.cp = np.zeros((count, n, 3 * n))
-        self.mk = np.zeros((count, ncl, 3), dtype=np.int64)
-        self.mon = np.zeros((count, ncl, 3 * n + 3 * ns + 1))
+        self.cp = np.zeros((count, n, 3 * n + 3 * ns))
+        self.mk = np.zeros((count, ncl, kernel.MK_SIZE), dtype=np.int64)
+        self.mon = np.zeros((count, ncl, 3 * n + 3 * ns + 1 + ncl))
         self.layers: dict[int, OrderedLayer] = {}
         self.step: tuple[float, float, float, float] | None = None  # (dt, beta, gamma, fine) of the inverses
 
@@ -147,7 +161,11 @@ class ConfigurationTables:
         kept = np.array([layer.kept[col] - 1 for col in order], dtype=np.int64)
         source = np.array(part.sources, dtype=np.int64)
         ix = np.ix_(order, order)
-        M_o, C_o, K_o = layer.M[ix], layer.C[ix], layer.K[ix]
+        springs = compliant_terms(mechanism, mask)
+        M_o = layer.M[ix]
+        C_o = (part.C + springs.layer_C(layer.T))[ix]
+        K_o = (layer.K + springs.layer_K(layer.T))[ix]
+        S_o = (layer.T.T @ springs.S)[order]
         ci = self.ci[mask]
         ci[kernel.CI_M], ci[kernel.CI_NF] = m, nf
         head = kernel.CI_HEAD
@@ -164,42 +182,63 @@ class ConfigurationTables:
             self.cp[mask, :nf, 3 * p] = M_o[:nf, nf + p]
             self.cp[mask, :nf, 3 * p + 1] = C_o[:nf, nf + p]
             self.cp[mask, :nf, 3 * p + 2] = K_o[:nf, nf + p]
-        self._monitors(mask, part, group, m)
-        ordered = OrderedLayer(mask, M_o, C_o, K_o, nf, kept, group, source)
+        self.cp[mask, :nf, 3 * n:] = S_o[:nf]
+        ci[kernel.CI_SRC] = int(bool(S_o[:nf].any()))
+        ci[kernel.CI_HERTZ] = int(bool(springs.hertz))
+        self._monitors(mask, part, group, m, springs)
+        ordered = OrderedLayer(mask, M_o, C_o, K_o, nf, kept, group, source, S_o)
         self.layers[mask] = ordered
         self._inverses(mask)
         ci[kernel.CI_BUILT] = 1
         return ordered
 
-    def _monitors(self, mask: int, part, group: np.ndarray, m: int) -> None:  # type: ignore[no-untyped-def]
-        """Force rows of the closed clearances, gap references of the open monitored ones."""
+    def _monitors(self, mask: int, part, group: np.ndarray, m: int, springs) -> None:  # type: ignore[no-untyped-def]
+        """Force rows of the closed clearances, gap references of the open monitored ones.
+
+        A rigid external contact's force is the row force r at its ahead
+        coordinate less the compliant contacts' forces on that coordinate; a
+        compliant contact's force is its spring and dashpot (``springs``), and
+        its monitor is the overlap of the pair."""
         mechanism, spec, n, ns = self.mechanism, self.mechanism.spec, self.n, self.ns
         layer = part.layer
         kept_full = [k - 1 for k in layer.kept]
         MT = mechanism.M @ layer.T
-        row_x, row_v, row_a = mechanism.K @ layer.T, MT @ np.linalg.solve(layer.M, layer.C), MT
+        row_x, row_v, row_a = mechanism.K @ layer.T, MT @ np.linalg.solve(layer.M, part.C), MT
         source_of = {number: s for s, (number, _, _) in enumerate(sources(spec))}
         for index, c in enumerate(spec.clearances):
             mk, mon = self.mk[mask, index], self.mon[mask, index]
+            behind = int(group[c.behind - 1]) if c.kind == INTERNAL else -1 - source_of[c.behind]
             if mask & clearance_bit(spec, index):
                 frow = np.zeros(3 * n + 3 * ns)
-                if c.kind == INTERNAL and c.state == ENABLED:
-                    fx, fv, fs = internal_force_coefficients(mechanism, mask, c.ahead, c.behind)
+                hertz = mon[3 * n + 3 * ns + 1:]  # per unit force of each closed Hertz contact
+                if c.contact == LINEAR:
+                    frow[:] = springs.force[index]
+                elif c.contact == HERTZ:
+                    frow[:] = hertz_row(mechanism, index)
+                elif c.kind == INTERNAL and c.state == ENABLED:
+                    fx, fv, fs, fh = internal_force_coefficients(mechanism, mask, c.ahead, c.behind)
                     frow[:n], frow[n:2 * n], frow[3 * n:] = fx, fv, fs.ravel()
+                    for j, coefficient in fh.items():
+                        hertz[j] = coefficient
                 else:  # the row force r at the ahead coordinate (see vtool.solvers.configurations)
                     i = c.ahead - 1
                     for j, full in enumerate(kept_full):
                         frow[full] += row_x[i, j]
                         frow[n + full] += row_v[i, j]
                         frow[2 * n + full] += row_a[i, j]
+                    frow[:n] += springs.K[i]
+                    frow[n:2 * n] += springs.C[i]
+                    frow[3 * n:] += springs.S[i]
+                    for j, w in springs.hertz.items():  # less the Hertz forces F_j w_j on this coordinate
+                        hertz[j] = -w[i]
                 for part_index in range(3):  # fold full coordinates onto the z indices
                     np.add.at(mon[part_index * n:(part_index + 1) * n], group,
                               frow[part_index * n:(part_index + 1) * n])
                 mon[3 * n:3 * n + 3 * ns] = frow[3 * n:]
-                mk[:] = (kernel.MK_FORCE, m, 0)
+                kind = kernel.MK_FORCE if c.rigid else kernel.MK_OVERLAP
+                mk[:] = (kind, int(group[c.ahead - 1]), behind, m)
             elif c.state == ENABLED:
-                behind = int(group[c.behind - 1]) if c.kind == INTERNAL else -1 - source_of[c.behind]
-                mk[:] = (kernel.MK_GAP, int(group[c.ahead - 1]), behind)
+                mk[:] = (kernel.MK_GAP, int(group[c.ahead - 1]), behind, m)
 
 
 @dataclass(frozen=True)
@@ -226,13 +265,14 @@ class ContactProblem:
         self.ns, self.nh = self.series.n_sources, self.series.n_harmonics
         self.source_numbers = self.series.numbers
         cl = np.zeros((self.ncl, kernel.CL_SIZE), dtype=np.int64)
-        clf = np.zeros((self.ncl, 2))
+        clf = np.zeros((self.ncl, kernel.CLF_SIZE))
         for k, c in enumerate(spec.clearances):
             cl[k] = (c.ahead - 1, c.behind - 1 if c.behind <= self.n else -1,
                      self.series.index(c.behind) if c.behind > self.n else -1,
                      int(c.state == ENABLED), int(c.state == PINNED), clearance_bit(spec, k),
-                     LAW_CODES[spec.impact_law(c)])
-            clf[k] = (c.restitution, spec.contact.rocker_scale)
+                     LAW_CODES[spec.impact_law(c)], SOFT_CODES[c.contact])
+            clf[k, :kernel.CLF_HV] = (c.restitution, spec.contact.rocker_scale, c.contact_stiffness,
+                                      c.contact_exponent)
         self.cl, self.clf = cl, clf
         self.mass = np.stack([mechanism.M, np.linalg.inv(mechanism.M)])
         self.omega = mechanism.omega
@@ -240,6 +280,7 @@ class ContactProblem:
         x_scale = max(spec.cam.amplitude + abs(mechanism.start.cam_offset), 1e-9)
         self.x_scale = x_scale
         self.rest_velocity = rules.rest_velocity or 1e-5 * self.velocity_scale()
+        self.clf[:, kernel.CLF_HV] = self.rest_velocity  # a Hertz contact's approach velocity, set at closing
         self.gap_noise = 1e-13 * x_scale
         self.zeno_window = 1e-3 * 2 * math.pi / self.omega_max
         self.start_mask = mask_of(spec, spec.initial.closed)

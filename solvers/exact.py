@@ -45,7 +45,7 @@ from scipy.optimize import brentq
 from vtool.errors import InputError, RunError
 from vtool.solvers.contact import ContactProblem
 from vtool.solvers.model import Mechanism
-from vtool.solvers.piecewise import PiecewiseBackend, PiecewiseRun
+from vtool.solvers.piecewise import PiecewiseBackend, PiecewiseRun, refuse_hertz
 from vtool.solvers.spec import RunSpec
 from vtool.solvers.statespace import Propagator, StateSpace, shift_coefficients
 from vtool.solvers.trace import TraceBuilder
@@ -79,6 +79,7 @@ class ExactBackend(PiecewiseBackend):
     def check(self, mechanism: Mechanism, options: ExactOptions) -> None:
         if not 0.0 < options.time_tolerance < 1e-3:
             raise InputError("time_tolerance", options.time_tolerance, "> 0 and < 1e-3", "s")
+        refuse_hertz(mechanism, self.name)
 
     def settings(self, options: ExactOptions) -> dict:
         return {"time_tolerance_s": options.time_tolerance}
@@ -121,6 +122,10 @@ class _Config:
     Qm: np.ndarray  # output rows' forced part, on u(t)
     closed: np.ndarray  # bool per clearance
     grid_basis: np.ndarray  # u(τ) at τ = delta * (1..BLOCK)
+    GFV: np.ndarray  # contact forces from h (the monitors themselves unless a compliant contact is closed)
+    GFAV: np.ndarray
+    HFm: np.ndarray
+    soft: bool  # a compliant contact is closed: forces differ from monitors
 
 
 class _ExactRun(PiecewiseRun):
@@ -148,8 +153,12 @@ class _ExactRun(PiecewiseRun):
             GV = ss.G @ prop.V
             closed = (ss.mask & self.closed_bit) != 0
             PV, Qm = self.output_maps(ss, prop)
-            ss.cache[key] = _Config(delta, prop, GV, ss.G @ ss.A @ prop.V, ss.G @ ss.Y + ss.H, PV, Qm, closed,
-                                    ss.basis(delta * np.arange(1, BLOCK + 1)))
+            GAV, Hm = ss.G @ ss.A @ prop.V, ss.G @ ss.Y + ss.H
+            soft = bool(ss.compliant is not None and ss.compliant.any())
+            GFV, GFAV, HFm = ((ss.GF @ prop.V, ss.GF @ ss.A @ prop.V, ss.GF @ ss.Y + ss.HF) if soft
+                              else (GV, GAV, Hm))
+            ss.cache[key] = _Config(delta, prop, GV, GAV, Hm, PV, Qm, closed,
+                                    ss.basis(delta * np.arange(1, BLOCK + 1)), GFV, GFAV, HFm, soft)
         self.configs[ss.mask] = cfg = ss.cache[key]
         return cfg
 
@@ -203,7 +212,14 @@ class _ExactRun(PiecewiseRun):
             negative = values[monitored] < 0.0
             last = int(np.argmax(negative.any(axis=0))) if negative.any() else count
             if last:
-                self.peaks(ss, cfg, t, h, base_v, taus[:last], values[:, :last])
+                if cfg.soft:
+                    self.overlap_peaks(ss, cfg, t, h, base_v, taus[:last], values[:, :last])
+                    forces = (cfg.GFV @ states(slice(0, last))).real + (
+                        shift_coefficients(cfg.HFm, ss.omega, ss.n_harmonics, t) @ ss.basis(taus[:last]))
+                    base_f = (cfg.GFV @ h).real + cfg.HFm @ ss.basis(t)
+                    self.peaks(ss, cfg, t, h, base_f, taus[:last], forces)
+                else:
+                    self.peaks(ss, cfg, t, h, base_v, taus[:last], values[:, :last])
             start_tau, start_h = (float(taus[last - 1]), states(last - 1)) if last else (0.0, h)
             self.outputs(ss, cfg, t, h, self.output_times(t, t + start_tau))
             if self.every_step and last:
@@ -219,22 +235,24 @@ class _ExactRun(PiecewiseRun):
                 self.steps += 1
                 h_event = prop.at(start_h, tau)
                 y_event = prop.real(h_event) + ss.particular(start_t + tau)
-                self.track_peaks(ss, (cfg.GV @ h_event).real + cfg.Hm @ ss.basis(start_t + tau), start_t + tau)
+                self.track_peaks(ss, (cfg.GFV @ h_event).real + cfg.HFm @ ss.basis(start_t + tau), start_t + tau)
                 return start_t + tau, y_event, [k for k, r in roots.items() if r <= tau + tol]
             t, h, base_v = float(times[-1]), states(count - 1), values[:, -1]
         y = prop.real(h) + ss.particular(t)
         self._carry = (ss.mask, t, h, y)
         return t, y, []
 
-    def monitor(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, k: int):  # noqa: ANN202
-        """Monitor k at t + τ as a function of τ (and its rate), on the exact solution."""
-        forced, prop = cfg.Hm[k], cfg.prop
+    def monitor(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, k: int,  # noqa: ANN202
+                force: bool = False):
+        """Monitor k (or its contact force) at t + τ as a function of τ (and its rate), on the exact solution."""
+        GV, GAV, Hm = (cfg.GFV, cfg.GFAV, cfg.HFm) if force else (cfg.GV, cfg.GAV, cfg.Hm)
+        forced, prop = Hm[k], cfg.prop
         if prop.modal:  # Re Σ c_j e^{λ_j τ} (+ the rigid-body drift, linear in τ) + forced part
             lam = prop.lam
-            c, c_rate = cfg.GV[k] * h, cfg.GAV[k] * h
+            c, c_rate = GV[k] * h, GAV[k] * h
             drift = prop.drift * h[prop.drift_v]
-            slope = float((cfg.GV[k, prop.drift_x] @ drift).real) if drift.size else 0.0
-            slope_rate = float((cfg.GAV[k, prop.drift_x] @ drift).real) if drift.size else 0.0
+            slope = float((GV[k, prop.drift_x] @ drift).real) if drift.size else 0.0
+            slope_rate = float((GAV[k, prop.drift_x] @ drift).real) if drift.size else 0.0
 
             def value(tau: float) -> float:
                 return float((c @ np.exp(lam * tau)).real + slope * tau + forced @ ss.basis(t + tau))
@@ -246,10 +264,10 @@ class _ExactRun(PiecewiseRun):
             return value, rate
 
         def value(tau: float) -> float:
-            return float((cfg.GV[k] @ prop.at(h, tau)).real + forced @ ss.basis(t + tau))
+            return float((GV[k] @ prop.at(h, tau)).real + forced @ ss.basis(t + tau))
 
         def rate(tau: float) -> float:
-            return float((cfg.GAV[k] @ prop.at(h, tau)).real + forced @ ss.basis_rate(t + tau))
+            return float((GAV[k] @ prop.at(h, tau)).real + forced @ ss.basis_rate(t + tau))
 
         return value, rate
 
@@ -275,13 +293,26 @@ class _ExactRun(PiecewiseRun):
         taus = np.concatenate([[0.0], taus])
         values = np.concatenate([base_v[:, None], values], axis=1)
         for k, first, last in peak_brackets(values, cfg.closed, self.peak):
-            value, rate = self.monitor(ss, cfg, t, h, k)
+            value, rate = self.monitor(ss, cfg, t, h, k, force=True)
             low, high = float(taus[first]), float(taus[last])
             if rate(low) > 0.0 > rate(high):
                 tau = brentq(rate, low, high, xtol=self.options.time_tolerance, rtol=4 * np.finfo(float).eps)
                 self.peak[k] = max(self.peak[k], value(tau))
                 if t + tau >= self.t_rev:
                     self.peak_late[k] = max(self.peak_late[k], value(tau))
+
+    def overlap_peaks(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, base_v: np.ndarray,
+                      taus: np.ndarray, values: np.ndarray) -> None:
+        """Peak overlaps of the closed compliant contacts: samples, local maxima refined where δ' = 0."""
+        self.track_overlap(ss, np.concatenate([base_v[:, None], values], axis=1))
+        taus = np.concatenate([[0.0], taus])
+        values = np.concatenate([base_v[:, None], values], axis=1) - self.problem.gap_noise
+        for k, first, last in peak_brackets(values, ss.compliant, self.peak_overlap):
+            value, rate = self.monitor(ss, cfg, t, h, k)
+            low, high = float(taus[first]), float(taus[last])
+            if rate(low) > 0.0 > rate(high):
+                tau = brentq(rate, low, high, xtol=self.options.time_tolerance, rtol=4 * np.finfo(float).eps)
+                self.peak_overlap[k] = max(self.peak_overlap[k], value(tau) - self.problem.gap_noise)
 
     def outputs(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, times: list[float]) -> None:
         if times:
@@ -292,7 +323,7 @@ class _ExactRun(PiecewiseRun):
         """Output rows at ``times`` from the homogeneous states ``hs`` (columns)."""
         basis = ss.basis(times)
         z = ((cfg.PV @ hs).real + cfg.Qm @ basis).T
-        forces = np.where(cfg.closed[:, None], (cfg.GV @ hs).real + cfg.Hm @ basis, 0.0)
+        forces = np.where(cfg.closed[:, None], (cfg.GFV @ hs).real + cfg.HFm @ basis, 0.0)
         self.peak = np.maximum(self.peak, forces.max(axis=1))
         late = times >= self.t_rev
         if late.any():

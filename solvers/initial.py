@@ -34,6 +34,12 @@ a preset choice (``initial.velocities``):
 
 The accelerations are the consistent ones of the starting configuration
 (computed by the back end before the first step).
+
+Compliant contacts closed at the start (``contact = "linear"``): an internal
+one adds its spring to K_L; a compliant cam contact is a spring k_c in
+series with the mechanism, so k_eff above becomes 1 / (1/k_eff + 1/k_c) (the
+force per unit cam displacement), the follower sits F/k_eff from its
+unloaded place and the contact overlaps by F/k_c.
 """
 
 from __future__ import annotations
@@ -44,7 +50,7 @@ import numpy as np
 
 from vtool.errors import InputError
 from vtool.solvers.layers import Layer
-from vtool.solvers.spec import ENABLED, QUASI_STATIC_START, MechanismSpec
+from vtool.solvers.spec import ENABLED, INTERNAL, QUASI_STATIC_START, MechanismSpec
 
 
 @dataclass(frozen=True)
@@ -84,24 +90,49 @@ def check_open_gaps(spec: MechanismSpec, q: np.ndarray) -> None:
                              f"{ahead - q[c.behind - 1]:.3g} {length})")
 
 
+def start_stiffness(spec: MechanismSpec, layer: Layer) -> np.ndarray:
+    """K_L of the starting layer with the springs of the compliant internal contacts closed at the start."""
+    K = layer.K.copy()
+    for c in spec.clearances:
+        if c.rigid or c.name not in spec.initial.closed:
+            continue
+        if c.kind != INTERNAL and c.behind != spec.cam.coordinate:
+            raise InputError("initial.closed", list(spec.initial.closed),
+                             f"clearances closed at the start that are rigid, internal or the cam's "
+                             f"({c.name} is a compliant contact with a fixed source)")
+        if c.kind == INTERNAL:
+            w = layer.T[c.ahead - 1] - layer.T[c.behind - 1]
+            K += c.contact_stiffness * np.outer(w, w)
+    return K
+
+
 def static_start(spec: MechanismSpec, layer: Layer, omega: float) -> StaticStart:
     """Apply the thesis' static-start rule in the starting layer (see module doc)."""
-    follower = cam_clearance(spec).ahead
+    cam = cam_clearance(spec)
+    follower = cam.ahead
     f = int(np.argmax(layer.T[follower - 1]))  # the follower's column in the layer
     try:
-        flexibility = np.linalg.solve(layer.K, np.eye(layer.size)[:, f])
+        flexibility = np.linalg.solve(start_stiffness(spec, layer), np.eye(layer.size)[:, f])
     except np.linalg.LinAlgError:
         raise InputError(
             "members", "no spring to ground", "a mechanism that is statically stable with the cam released"
         ) from None
     follower_stiffness = 1.0 / flexibility[f]
+    structure_stiffness = follower_stiffness
+    follower_share = 1.0  # follower displacement per unit cam displacement
+    if not cam.rigid and cam.name in spec.initial.closed:
+        series = 1.0 / (1.0 / follower_stiffness + 1.0 / cam.contact_stiffness)
+        follower_share = series / follower_stiffness
+        follower_stiffness = series
     amplitude = spec.cam.amplitude
     if spec.cam.offset is None:
         cam_offset = amplitude + spec.initial.spring_preload * spec.initial.lever_ratio / follower_stiffness
     else:
         cam_offset = spec.cam.offset
     follower_force = follower_stiffness * cam_offset
-    shape = layer.T @ (flexibility * follower_stiffness)  # q per unit follower displacement
+    shape = layer.T @ (flexibility * structure_stiffness)  # q per unit follower displacement
+    if follower_share != 1.0:
+        shape = shape * follower_share  # per unit cam displacement
     cam_velocity = amplitude * omega  # d/dt (A sin wt) at t = 0
     cam_acceleration = 0.0  # -A w² sin(0)
     check_open_gaps(spec, shape * cam_offset)

@@ -75,9 +75,12 @@ def tie_matrix(n: int, pairs: list[tuple[int, int]]) -> tuple[np.ndarray, tuple[
 
 
 def internal_layer_names(spec: MechanismSpec) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """(enabled internal clearance names, pinned internal clearance names)."""
-    enabled = tuple(c.name for c in spec.clearances if c.kind == INTERNAL and c.state == ENABLED)
-    pinned = tuple(c.name for c in spec.clearances if c.kind == INTERNAL and c.state == PINNED)
+    """(enabled, pinned) names of the rigid internal clearances: the ones that tie a pair.
+
+    A compliant internal clearance never ties its pair: its spring joins the
+    configuration's matrices instead (:mod:`vtool.solvers.contact`)."""
+    enabled = tuple(c.name for c in spec.clearances if c.ties and c.state == ENABLED)
+    pinned = tuple(c.name for c in spec.clearances if c.ties and c.state == PINNED)
     return enabled, pinned
 
 
@@ -92,7 +95,10 @@ def possible_layers(spec: MechanismSpec) -> list[frozenset[str]]:
 
 
 def build_layer(spec: MechanismSpec, M: np.ndarray, K: np.ndarray, closed: frozenset[str]) -> Layer:
-    """Reduce the full (M, K) to one layer and compute its modes and modal damping."""
+    """Reduce the full (M, K) to one layer and compute its modes and modal damping.
+
+    Every internal clearance named in ``closed`` ties its pair (the caller
+    passes only the rigid ones, except for :meth:`Mechanism.tied_layer`)."""
     pairs = [(c.ahead, c.behind) for c in spec.clearances if c.kind == INTERNAL and c.name in closed]
     T, kept = tie_matrix(spec.n_coordinates, pairs)
     M_L = T.T @ M @ T

@@ -18,7 +18,7 @@ from vtool.solvers.assembly import assemble_full
 from vtool.solvers.damping import undamped_modes
 from vtool.solvers.initial import StaticStart, static_start
 from vtool.solvers.layers import Layer, build_layer, internal_layer_names, possible_layers
-from vtool.solvers.spec import INTERNAL, MechanismSpec, RunSpec
+from vtool.solvers.spec import INTERNAL, LINEAR, MechanismSpec, RunSpec
 
 
 class Mechanism:
@@ -49,8 +49,17 @@ class Mechanism:
 
     @cached_property
     def highest_frequency(self) -> float:
-        """omega_max of the unconstrained system (rad/s): no configuration is stiffer."""
-        return float(undamped_modes(self.M, self.K).omega.max())
+        """omega_max of the unconstrained system with every linear contact closed (rad/s): no
+        configuration is stiffer (a Hertz contact's stiffness grows with its overlap: not counted)."""
+        K = self.K.copy()
+        for c in self.spec.clearances:
+            if c.contact == LINEAR:
+                w = np.zeros(len(K))
+                w[c.ahead - 1] = 1.0
+                if c.behind <= len(K):
+                    w[c.behind - 1] = -1.0
+                K += c.contact_stiffness * np.outer(w, w)
+        return float(undamped_modes(self.M, K).omega.max())
 
     @property
     def omega(self) -> float:
@@ -61,7 +70,17 @@ class Mechanism:
         """The layer with these internal clearances closed (pinned ones always are)."""
         _, pinned = internal_layer_names(self.spec)
         key = frozenset(closed) | frozenset(pinned)
-        key = frozenset(n for n in key if self.spec.clearance(n).kind == INTERNAL)
+        key = frozenset(n for n in key if self.spec.clearance(n).ties)
+        if key not in self._layers:
+            self._layers[key] = build_layer(self.spec, self.M, self.K, key)
+        return self._layers[key]
+
+    def tied_layer(self, closed: frozenset[str]) -> Layer:
+        """The layer with these internal clearances tied, compliant ones included: the layer whose modal
+        damping a configuration with closed compliant internal contacts keeps (see
+        :func:`vtool.solvers.configurations.partition`)."""
+        _, pinned = internal_layer_names(self.spec)
+        key = frozenset(n for n in frozenset(closed) | frozenset(pinned) if self.spec.clearance(n).kind == INTERNAL)
         if key not in self._layers:
             self._layers[key] = build_layer(self.spec, self.M, self.K, key)
         return self._layers[key]

@@ -163,7 +163,8 @@ class NewmarkBackend(Backend):
         run = KernelRun(problem, options, builder)
         run.execute(progress, cancel)
         o = options
-        return {"steps": int(run.ist[kernel.I_STEPS]), "peak": run.peak[0].copy(), "peak_late": run.peak[1].copy(),
+        return {"steps": int(run.ist[kernel.I_STEPS]), "peak": run.peak[kernel.PEAK_ALL].copy(),
+                "peak_late": run.peak[kernel.PEAK_LATE].copy(), "peak_overlap": run.peak[kernel.PEAK_OVERLAP].copy(),
                 "compile_time": run.compile_time,
                 "settings": {"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
                              "refine_after_events": o.refine}}
@@ -194,7 +195,7 @@ class KernelRun:
         self.out_c = np.zeros(ROW_BUFFER, dtype=np.int64)
         self.ev_f = np.zeros((EVENT_BUFFER, 2))
         self.ev_i = np.zeros((EVENT_BUFFER, 4), dtype=np.int64)
-        self.peak = np.zeros((2, ncl))
+        self.peak = np.zeros((3, ncl))
         start = mechanism.start
         self.x, self.v, self.a = start.q.copy(), start.qd.copy(), start.qdd.copy()
         self.ist = np.zeros(kernel.I_SIZE, dtype=np.int64)

@@ -69,21 +69,28 @@ IP_SIZE = 8
  FP_GAPNOISE, FP_REFINE, FP_REFWIN, FP_FTOL, FP_TREV) = range(15)
 FP_SIZE = 16
 # clearance table columns (int) and float columns
-CL_AHEAD, CL_BEHIND, CL_SRC, CL_MON, CL_PIN, CL_BIT, CL_LAW = range(7)
-CL_SIZE = 7
-CLF_E, CLF_SCALE = range(2)
+CL_AHEAD, CL_BEHIND, CL_SRC, CL_MON, CL_PIN, CL_BIT, CL_LAW, CL_SOFT = range(8)
+CL_SIZE = 8  # CL_SOFT: SOFT_LINEAR or SOFT_HERTZ for a compliant clearance (no impact, no tie), else 0
+SOFT_LINEAR, SOFT_HERTZ = 1, 2
+# float columns: restitution, SCALE; Hertz stiffness and exponent; approach velocity of the contact
+CLF_E, CLF_SCALE, CLF_HK, CLF_HN, CLF_HV = range(5)
+CLF_SIZE = 5
 # impact laws
 LAW_MOMENTUM, LAW_LOCAL, LAW_THESIS = range(3)
 # event kinds
 EV_OPENED, EV_CLOSED, EV_RELEASED = range(3)
-# configuration integer table: built, m, nf, then kept[n], group[n], source of each z index[n]
-CI_BUILT, CI_M, CI_NF = range(3)
-CI_HEAD = 3
+# configuration integer table: built, m, nf, source coupling, then kept[n], group[n], source of each z index[n]
+CI_BUILT, CI_M, CI_NF, CI_SRC, CI_HERTZ = range(5)
+CI_HEAD = 5
 # configuration matrices
 CM_MFF, CM_CFF, CM_KFF, CM_SINV, CM_SINVF, CM_MINVFF = range(6)
 CM_SIZE = 6
-# monitor kind per (configuration, clearance): (type, ahead z index, behind z index or -1 - source)
-MK_NONE, MK_GAP, MK_FORCE = range(3)
+# monitor per (configuration, clearance): (kind, ahead z index, behind z index or -1 - source, m)
+MK_KIND, MK_AHEAD, MK_BEHIND, MK_M = range(4)
+MK_SIZE = 4
+MK_NONE, MK_GAP, MK_FORCE, MK_OVERLAP = range(4)  # MK_OVERLAP: a closed compliant clearance
+# peak rows: contact force over the run, after the first revolution, overlap of compliant contacts
+PEAK_ALL, PEAK_LATE, PEAK_OVERLAP = range(3)
 # run status
 FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED, CHATTER = range(1, 7)
 # integer and float state slots
@@ -160,10 +167,12 @@ def set_prescribed(ci, c, n, src, z, zd, zdd):
 
 
 @jit
-def free_rhs(ci, cm, cp, c, z, zd, zdd, rhs):
-    """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P): the thesis' ΔP on the right."""
+def free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
+    """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
+    right, and the sources' pull through closed compliant contacts (``cp[c, f, 3n:]``)."""
     nf = ci[c, CI_NF]
     m = ci[c, CI_M]
+    coupled = ci[c, CI_SRC]
     for f in range(nf):
         s = 0.0
         for g in range(nf):
@@ -171,6 +180,9 @@ def free_rhs(ci, cm, cp, c, z, zd, zdd, rhs):
         for p in range(m - nf):
             j = nf + p
             s -= cp[c, f, 3 * p] * zdd[j] + cp[c, f, 3 * p + 1] * zd[j] + cp[c, f, 3 * p + 2] * z[j]
+        if coupled:
+            for j in range(src.shape[0]):
+                s -= cp[c, f, 3 * n + j] * src[j]
         rhs[f] = s
 
 
@@ -204,11 +216,142 @@ def cholesky_solve(nf, L, rhs, out):
 
 
 @jit
-def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol):
+def effective_solve(cm, c, which, L, nf, b, out):
+    """out = S⁻¹ b: the stored inverse of the standard (``which`` 0) or refined (1) step, or the
+    Cholesky factor in L (2)."""
+    if which == 2:
+        cholesky_solve(nf, L, b, out)
+        return
+    slot = CM_SINV if which == 0 else CM_SINVF
+    for f in range(nf):
+        acc = 0.0
+        for g in range(nf):
+            acc += cm[c, slot, f, g] * b[g]
+        out[f] = acc
+
+
+# ----- Hertz contacts (Hunt-Crossley) -----
+@jit
+def hertz_law(clf, k, delta, rate):
+    """(F, dF/dδ, dF/dδ̇) of Hertz contact k: F = K δⁿ (1 + 3(1 - e)/2 · δ̇/v⁻), never pulling.
+
+    v⁻ is the approach velocity of the contact's closing (Hunt and Crossley
+    1975: the damping that gives restitution e at an impact at v⁻)."""
+    if delta <= 0.0:
+        return 0.0, 0.0, 0.0
+    stiffness = clf[k, CLF_HK]
+    exponent = clf[k, CLF_HN]
+    lam = 1.5 * (1.0 - clf[k, CLF_E]) / clf[k, CLF_HV]
+    power = stiffness * delta**exponent
+    force = power * (1.0 + lam * rate)
+    if force <= 0.0:
+        return 0.0, 0.0, 0.0
+    return force, exponent * power / delta * (1.0 + lam * rate), power * lam
+
+
+@jit
+def overlap_and_rate(mon, c, k, n, ns, z, zd, src):
+    """(δ, δ̇) of a closed Hertz contact: its monitor row holds -w on z and on ż, +1 on its source."""
+    delta = 0.0
+    rate = 0.0
+    for j in range(n):
+        delta += mon[c, k, j] * z[j]
+        rate += mon[c, k, n + j] * zd[j]
+    for s in range(ns):
+        delta += mon[c, k, 3 * n + 3 * s] * src[3 * s]
+        rate += mon[c, k, 3 * n + 3 * s + 1] * src[3 * s + 1]
+    return delta, rate
+
+
+@jit
+def compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src):
+    """Contact force of closed compliant clearance k: the Hertz law, or its linear row."""
+    if cl[k, CL_SOFT] == SOFT_HERTZ:
+        delta, rate = overlap_and_rate(mon, c, k, n, ns, z, zd, src)
+        return hertz_law(clf, k, delta, rate)[0]
+    return contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src)
+
+
+@jit
+def hertz_correction(ci, cm, cl, clf, mk, mon, c, beta, gamma, h, which, L, n, ns, src1, z1, zd1, zdd1, sol):
+    """Add the closed Hertz contacts' forces to a Newmark step whose linear part is done.
+
+    With the linear accelerations u (in z̈1) and V_j = S⁻¹ w_j (w_j: contact
+    j's direction on the free rows), z̈_F = u + Σ V_j F_j, and each overlap is
+    affine in the forces: δ_k = δ_k⁰ - βh² Σ w_kᵀV_j F_j, δ̇_k = δ̇_k⁰ - γh
+    Σ w_kᵀV_j F_j. Newton on F_k = H_k(δ_k(F), δ̇_k(F)) (a system of the
+    closed Hertz contacts' size); then the state takes the forces.
+    """
+    nf = ci[c, CI_NF]
+    ncl = cl.shape[0]
+    idx = np.empty(ncl, dtype=np.int64)
+    nc = 0
+    for k in range(ncl):
+        if mk[c, k, MK_KIND] == MK_OVERLAP and cl[k, CL_SOFT] == SOFT_HERTZ:
+            idx[nc] = k
+            nc += 1
+    if nc == 0:
+        return
+    V = np.zeros((nf, nc))
+    w = np.zeros(nf)
+    col = np.zeros(nf)
+    for j in range(nc):
+        for f in range(nf):
+            w[f] = -mon[c, idx[j], f]
+        effective_solve(cm, c, which, L, nf, w, col)
+        for f in range(nf):
+            V[f, j] = col[f]
+    A = np.zeros((nc, nc))  # δ_k per unit F_j, before the βh² and γh factors: -w_kᵀ V_j
+    d0 = np.zeros(nc)
+    r0 = np.zeros(nc)
+    for i in range(nc):
+        d0[i], r0[i] = overlap_and_rate(mon, c, idx[i], n, ns, z1, zd1, src1)
+        for j in range(nc):
+            acc = 0.0
+            for f in range(nf):
+                acc += mon[c, idx[i], f] * V[f, j]
+            A[i, j] = acc
+    F = np.zeros(nc)
+    R = np.zeros(nc)
+    J = np.zeros((nc, nc))
+    dF = np.zeros(nc)
+    scale = 0.0
+    for _ in range(60):
+        for i in range(nc):
+            delta = d0[i]
+            rate = r0[i]
+            for j in range(nc):
+                delta += beta * h * h * A[i, j] * F[j]
+                rate += gamma * h * A[i, j] * F[j]
+            value, d_delta, d_rate = hertz_law(clf, idx[i], delta, rate)
+            R[i] = value - F[i]
+            for j in range(nc):
+                J[i, j] = (d_delta * beta * h * h + d_rate * gamma * h) * A[i, j] - (1.0 if i == j else 0.0)
+            scale = max(scale, abs(value))
+        solve_dense(J, R, dF, nc)
+        change = 0.0
+        for i in range(nc):
+            F[i] = max(F[i] - dF[i], 0.0)
+            change = max(change, abs(dF[i]))
+        if change <= 1e-12 * scale + 1e-300:
+            break
+    for f in range(nf):
+        acc = 0.0
+        for j in range(nc):
+            acc += V[f, j] * F[j]
+        zdd1[f] += acc
+        z1[f] += beta * h * h * acc
+        zd1[f] += gamma * h * acc
+
+
+@jit
+def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
+               cl, clf, mk, mon):
     """One Newmark step of length h from layer state (z, ż, z̈) into (z1, ż1, z̈1).
 
     ``which``: 0 the stored S⁻¹ of the standard step, 1 of the refined step,
     2 a Cholesky factor already in ``L``. ``src1`` holds the sources at t + h.
+    Closed Hertz contacts are added by Newton iteration (:func:`hertz_correction`).
     """
     m = ci[c, CI_M]
     nf = ci[c, CI_NF]
@@ -216,28 +359,30 @@ def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1,
         z1[j] = z[j] + h * zd[j] + h * h * (0.5 - beta) * zdd[j]
         zd1[j] = zd[j] + h * (1.0 - gamma) * zdd[j]
     set_prescribed(ci, c, n, src1, z1, zd1, zdd1)
-    free_rhs(ci, cm, cp, c, z1, zd1, zdd1, rhs)
-    if which == 2:
-        cholesky_solve(nf, L, rhs, sol)
-    else:
-        slot = CM_SINV if which == 0 else CM_SINVF
-        for f in range(nf):
-            s = 0.0
-            for g in range(nf):
-                s += cm[c, slot, f, g] * rhs[g]
-            sol[f] = s
+    free_rhs(ci, cm, cp, c, n, src1, z1, zd1, zdd1, rhs)
+    effective_solve(cm, c, which, L, nf, rhs, sol)
     for f in range(nf):
         zdd1[f] = sol[f]
         z1[f] += beta * h * h * sol[f]
         zd1[f] += gamma * h * sol[f]
+    if ci[c, CI_HERTZ]:
+        hertz_correction(ci, cm, cl, clf, mk, mon, c, beta, gamma, h, which, L, n, src1.shape[0] // 3, src1,
+                         z1, zd1, zdd1, sol)
 
 
 @jit
-def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
+def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk, mon):
     """Free accelerations of configuration c from its equations of motion (prescribed set from src)."""
     set_prescribed(ci, c, n, src, z, zd, zdd)
-    free_rhs(ci, cm, cp, c, z, zd, zdd, rhs)
+    free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs)
     nf = ci[c, CI_NF]
+    if ci[c, CI_HERTZ]:  # the Hertz forces of the present overlaps, on the free rows (w = -mon row)
+        for k in range(cl.shape[0]):
+            if mk[c, k, MK_KIND] == MK_OVERLAP and cl[k, CL_SOFT] == SOFT_HERTZ:
+                delta, rate = overlap_and_rate(mon, c, k, n, src.shape[0] // 3, z, zd, src)
+                force = hertz_law(clf, k, delta, rate)[0]
+                for f in range(nf):
+                    rhs[f] -= mon[c, k, f] * force
     for f in range(nf):
         s = 0.0
         for g in range(nf):
@@ -246,26 +391,51 @@ def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
 
 
 @jit
-def monitor_value(mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src):
-    """Contact force (closed) or gap + allowance (open) of clearance k; 0 when not monitored."""
-    kind = mk[c, k, 0]
-    if kind == MK_GAP:
-        behind = mk[c, k, 2]
+def contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src):
+    """Contact force of closed clearance k: its row on (z, ż, z̈, sources, 1)."""
+    f = mon[c, k, 3 * n + 3 * ns]
+    for j in range(mk[c, k, MK_M]):
+        f += mon[c, k, j] * z[j] + mon[c, k, n + j] * zd[j] + mon[c, k, 2 * n + j] * zdd[j]
+    for j in range(3 * ns):
+        f += mon[c, k, 3 * n + j] * src[j]
+    return f
+
+
+@jit
+def rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src):
+    """Contact force of closed rigid clearance k: its linear row, plus the closed Hertz contacts' pull
+    on it (``mon[c, k, 3n + 3ns + 1 + j]`` per unit Hertz force F_j)."""
+    f = contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src)
+    head = 3 * n + 3 * ns + 1
+    for j in range(cl.shape[0]):
+        if mon[c, k, head + j] != 0.0:
+            delta, rate = overlap_and_rate(mon, c, j, n, ns, z, zd, src)
+            f += mon[c, k, head + j] * hertz_law(clf, j, delta, rate)[0]
+    return f
+
+
+@jit
+def monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src):
+    """What changes sign at clearance k's next event; 0 when not monitored.
+
+    Open: gap + allowance. Closed rigid: the contact force. Closed compliant:
+    the overlap δ = -gap + allowance (the contact ends when the parts part).
+    """
+    kind = mk[c, k, MK_KIND]
+    if kind == MK_GAP or kind == MK_OVERLAP:
+        behind = mk[c, k, MK_BEHIND]
         other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
-        return z[mk[c, k, 1]] - other + gap_noise
+        gap = z[mk[c, k, MK_AHEAD]] - other
+        return (gap if kind == MK_GAP else -gap) + gap_noise
     if kind == MK_FORCE:
-        f = mon[c, k, 3 * n + 3 * ns]
-        for j in range(mk[c, k, 1]):  # mk[c, k, 1] holds m for force rows
-            f += mon[c, k, j] * z[j] + mon[c, k, n + j] * zd[j] + mon[c, k, 2 * n + j] * zdd[j]
-        for j in range(3 * ns):
-            f += mon[c, k, 3 * n + j] * src[j]
-        return f
+        return rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src)
     return 0.0
 
 
 # ----- output -----
 @jit
-def record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src, out_t, out_q, out_F, out_c, row):
+def record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src, out_t, out_q, out_F, out_c,
+               row):
     out_t[row] = t
     out_c[row] = c
     for i in range(n):
@@ -278,8 +448,10 @@ def record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src, out_t,
         out_q[row, 1, n + s] = src[3 * s + 1]
         out_q[row, 2, n + s] = src[3 * s + 2]
     for k in range(ncl):
-        if mk[c, k, 0] == MK_FORCE:
-            out_F[row, k] = monitor_value(mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src)
+        if mk[c, k, MK_KIND] == MK_FORCE:
+            out_F[row, k] = rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src)
+        elif mk[c, k, MK_KIND] == MK_OVERLAP:
+            out_F[row, k] = compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src)
         else:
             out_F[row, k] = 0.0
 
@@ -391,7 +563,7 @@ def impact_momentum(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, e
     idx = np.empty(ncl, dtype=np.int64)
     nc = 0
     for k in range(ncl):
-        if (c & cl[k, CL_BIT]) or closing[k]:
+        if ((c & cl[k, CL_BIT]) and not cl[k, CL_SOFT]) or closing[k]:
             idx[nc] = k
             nc += 1
     G = np.zeros((nc, n))
@@ -467,7 +639,7 @@ def impact_momentum(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, e
 def prescribed_velocity(cl, c, ncl, coordinate, src):
     """Velocity of the source a coordinate is tied to in configuration c, or nan if it is free."""
     for k in range(ncl):
-        if (c & cl[k, CL_BIT]) and cl[k, CL_BEHIND] < 0 and cl[k, CL_AHEAD] == coordinate:
+        if (c & cl[k, CL_BIT]) and not cl[k, CL_SOFT] and cl[k, CL_BEHIND] < 0 and cl[k, CL_AHEAD] == coordinate:
             return src[3 * cl[k, CL_SRC] + 1]
     return np.nan
 
@@ -521,13 +693,27 @@ def impact_local(ip, fp, cl, clf, mass, c, k, src, v, stick, ev_f, ev_i, ist, t)
 
 
 @jit
+def snap_shut(cl, k, x, src):
+    """Clearance k's gap (or overlap) set to exactly zero: it is within the time tolerance of zero."""
+    x[cl[k, CL_AHEAD]] = x[cl[k, CL_BEHIND]] if cl[k, CL_BEHIND] >= 0 else src[3 * cl[k, CL_SRC]]
+
+
+@jit
+def relative_velocity(cl, k, v, src):
+    """Velocity of clearance k's gap: v_ahead - v_behind (or the source's)."""
+    behind = cl[k, CL_BEHIND]
+    return v[cl[k, CL_AHEAD]] - (v[behind] if behind >= 0 else src[3 * cl[k, CL_SRC] + 1])
+
+
+@jit
 def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t):
     """Apply the impact law of every closing clearance at t; returns the new configuration mask.
 
     Local-law closings are applied one after the other (each changes only its
     own coordinates); momentum-law closings are solved together with every
     closed contact (:func:`impact_momentum`). Gaps are snapped shut (they are
-    within the time tolerance).
+    within the time tolerance). A compliant clearance closes with no jump: its
+    spring and dashpot take over (the event records its approach velocity).
     """
     ncl = ip[IP_NCL]
     mask = c
@@ -536,9 +722,13 @@ def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist,
     for k in range(ncl):
         if not closing[k]:
             continue
-        a = cl[k, CL_AHEAD]
-        x[a] = x[cl[k, CL_BEHIND]] if cl[k, CL_BEHIND] >= 0 else src[3 * cl[k, CL_SRC]]
-        if cl[k, CL_LAW] == LAW_MOMENTUM:
+        snap_shut(cl, k, x, src)
+        if cl[k, CL_SOFT]:
+            mask |= cl[k, CL_BIT]
+            u = relative_velocity(cl, k, v, src)
+            clf[k, CLF_HV] = max(-u, fp[FP_VREST], 1e-300)  # the Hertz contact's approach velocity
+            add_event(ev_f, ev_i, ist, t, k, EV_CLOSED, u, c, mask)
+        elif cl[k, CL_LAW] == LAW_MOMENTUM:
             momentum[k] = 1
             any_momentum = True
         else:
@@ -549,7 +739,7 @@ def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist,
 
 
 @jit
-def settle(ip, fp, cl, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist, rhs, z, zd, zdd):
+def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist, rhs, z, zd, zdd):
     """Consistent accelerations of configuration c; release at once every contact that would pull.
 
     Returns the settled configuration, or -1 - c2 when configuration c2 must
@@ -564,13 +754,13 @@ def settle(ip, fp, cl, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist,
         if not ci[c, CI_BUILT]:
             return -1 - c
         gather(ci, c, n, x, v, a, z, zd, zdd)
-        consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs)
+        consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk, mon)
         scatter(ci, c, n, z, zd, zdd, x, v, a)
         worst = -1
         worst_f = -fp[FP_FTOL]
         for k in range(ncl):
-            if mk[c, k, 0] == MK_FORCE and cl[k, CL_MON]:
-                f = monitor_value(mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z, zd, zdd, src)
+            if mk[c, k, MK_KIND] == MK_FORCE and cl[k, CL_MON]:
+                f = monitor_value(cl, clf, mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z, zd, zdd, src)
                 if f < worst_f:
                     worst = k
                     worst_f = f
@@ -584,7 +774,7 @@ def settle(ip, fp, cl, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist,
 
 # ----- event location -----
 @jit
-def locate_event(ci, cm, cp, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi_lo, phi_hi,
+def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi_lo, phi_hi,
                  z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L):
     """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from (z, ż, z̈) at t.
 
@@ -614,8 +804,9 @@ def locate_event(ci, cm, cp, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi
         tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
         fill_sources(ns, nh, fp[FP_OMEGA], sc, sa, sb, t + tau, src1)
         factor_effective(ci, cm, c, beta, gamma, tau, L)
-        layer_step(ci, cm, cp, c, beta, gamma, tau, 2, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol)
-        f = monitor_value(mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z1, zd1, zdd1, src1)
+        layer_step(ci, cm, cp, c, beta, gamma, tau, 2, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
+                   cl, clf, mk, mon)
+        f = monitor_value(cl, clf, mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z1, zd1, zdd1, src1)
         if f < 0.0:
             hi, fhi = tau, f
             if side == -1:
@@ -627,6 +818,22 @@ def locate_event(ci, cm, cp, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi
                 fhi *= 0.5
             side = 1
     return lo
+
+
+@jit
+def track_peaks(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, after, phi, z, zd, zdd, src, peak):
+    """Raise the peak contact forces (and compliant overlaps) with the monitors ``phi`` at a step's end."""
+    for k in range(ncl):
+        kind = mk[c, k, MK_KIND]
+        force = phi[k]
+        if kind == MK_OVERLAP:
+            force = compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src)
+            peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
+        elif kind != MK_FORCE:
+            continue
+        peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], force)
+        if after:
+            peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], force)
 
 
 # ----- the hot loop -----
@@ -647,13 +854,14 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
     handling.
     """
     n, ncl, ns, nh = ip[IP_N], ip[IP_NCL], ip[IP_NS], ip[IP_NH]
-    if ip[IP_EVERY]:
+    if ip[IP_EVERY] or ci[c, CI_HERTZ]:  # Hertz contacts: every step through layer_step's iteration
         return fst[F_T]
     beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
     omega, gap_noise, x_limit, t_rev = fp[FP_OMEGA], fp[FP_GAPNOISE], fp[FP_XLIM], fp[FP_TREV]
     fine = dt / fp[FP_REFINE]
     m = ci[c, CI_M]
     nf = ci[c, CI_NF]
+    coupled = ci[c, CI_SRC]
     rows = out_t.shape[0]
     t = fst[F_T]
     while True:
@@ -705,6 +913,9 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             for p in range(m - nf):
                 j = nf + p
                 acc -= cp[c, f, 3 * p] * zdd1[j] + cp[c, f, 3 * p + 1] * zd1[j] + cp[c, f, 3 * p + 2] * z1[j]
+            if coupled:
+                for j in range(3 * ns):
+                    acc -= cp[c, f, 3 * n + j] * src1[j]
             rhs[f] = acc
         for f in range(nf):
             acc = 0.0
@@ -715,12 +926,13 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             zd1[f] += gamma * h * acc
         # monitors (see monitor_value): stop before a sign change
         for k in range(ncl):
-            kind = mk[c, k, 0]
+            kind = mk[c, k, MK_KIND]
             value = 0.0
-            if kind == MK_GAP:
-                behind = mk[c, k, 2]
+            if kind == MK_GAP or kind == MK_OVERLAP:
+                behind = mk[c, k, MK_BEHIND]
                 other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
-                value = z1[mk[c, k, 1]] - other + gap_noise
+                value = z1[mk[c, k, MK_AHEAD]] - other
+                value = (value if kind == MK_GAP else -value) + gap_noise
                 if value < 0.0:
                     return t
             elif kind == MK_FORCE:
@@ -786,7 +998,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
                 out_q[row, 2, n + s] = srco[3 * s + 2]
             for k in range(ncl):
                 force = 0.0
-                if mk[c, k, 0] == MK_FORCE:
+                if mk[c, k, MK_KIND] == MK_FORCE or mk[c, k, MK_KIND] == MK_OVERLAP:
                     force = mon[c, k, 3 * n + 3 * ns]
                     for j in range(m):
                         force += mon[c, k, j] * zo[j] + mon[c, k, n + j] * zdo[j] + mon[c, k, 2 * n + j] * zddo[j]
@@ -798,11 +1010,24 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
         # accept: peaks, state, time
         after = t1 >= t_rev
         for k in range(ncl):
-            if mk[c, k, 0] == MK_FORCE:
-                if phi[k] > peak[0, k]:
-                    peak[0, k] = phi[k]
-                if after and phi[k] > peak[1, k]:
-                    peak[1, k] = phi[k]
+            kind = mk[c, k, MK_KIND]
+            if kind == MK_FORCE:
+                if phi[k] > peak[PEAK_ALL, k]:
+                    peak[PEAK_ALL, k] = phi[k]
+                if after and phi[k] > peak[PEAK_LATE, k]:
+                    peak[PEAK_LATE, k] = phi[k]
+            elif kind == MK_OVERLAP:
+                force = mon[c, k, 3 * n + 3 * ns]
+                for j in range(m):
+                    force += mon[c, k, j] * z1[j] + mon[c, k, n + j] * zd1[j]
+                for j in range(3 * ns):
+                    force += mon[c, k, 3 * n + j] * src1[j]
+                if force > peak[PEAK_ALL, k]:
+                    peak[PEAK_ALL, k] = force
+                if after and force > peak[PEAK_LATE, k]:
+                    peak[PEAK_LATE, k] = force
+                if phi[k] - gap_noise > peak[PEAK_OVERLAP, k]:
+                    peak[PEAK_OVERLAP, k] = phi[k] - gap_noise
         for j in range(m):
             z[j] = z1[j]
             zd[j] = zd1[j]
@@ -830,9 +1055,10 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
     ist[I_CFG]; everything needed to resume is in the arguments, so Python may
     build a configuration or empty a buffer and call again. Output rows at the
     output instants are interpolated inside the step by the linear-acceleration
-    interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); ``peak[0]`` holds
-    the peak contact forces over every step, ``peak[1]`` those after the first
-    cam revolution.
+    interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); ``peak[PEAK_ALL]``
+    holds the peak contact forces over every step, ``peak[PEAK_LATE]`` those
+    after the first cam revolution, ``peak[PEAK_OVERLAP]`` the largest overlap
+    of each compliant contact.
     """
     n, ncl, ns, nh = ip[IP_N], ip[IP_NCL], ip[IP_NS], ip[IP_NH]
     every = ip[IP_EVERY]
@@ -869,7 +1095,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
             return OUTPUT_FULL
         fill_sources(ns, nh, omega, sc, sa, sb, t, src0)
         if ist[I_NEED_SETTLE]:
-            settled = settle(ip, fp, cl, ci, cm, cp, mk, mon, c, t, x, v, a, src0, ev_f, ev_i, ist,
+            settled = settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src0, ev_f, ev_i, ist,
                              rhs, z, zd, zdd)
             if settled < 0:
                 ist[I_CFG] = -1 - settled
@@ -882,10 +1108,10 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 if ist[I_NOUT] >= rows:
                     return OUTPUT_FULL
                 gather(ci, c, n, x, v, a, z, zd, zdd)
-                record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src0,
+                record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src0,
                            out_t, out_q, out_F, out_c, ist[I_NOUT])
                 for k in range(ncl):
-                    peak[0, k] = max(peak[0, k], out_F[ist[I_NOUT], k])
+                    peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], out_F[ist[I_NOUT], k])
                 ist[I_NOUT] += 1
                 ist[I_NEXT_OUT] = 1
                 ist[I_STARTED] = 1
@@ -921,15 +1147,18 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 continue
             fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
             if h == dt:
-                layer_step(ci, cm, cp, c, beta, gamma, h, 0, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol)
+                layer_step(ci, cm, cp, c, beta, gamma, h, 0, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
+                           cl, clf, mk, mon)
             elif h == fine:
-                layer_step(ci, cm, cp, c, beta, gamma, h, 1, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol)
+                layer_step(ci, cm, cp, c, beta, gamma, h, 1, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
+                           cl, clf, mk, mon)
             else:
                 factor_effective(ci, cm, c, beta, gamma, h, L)
-                layer_step(ci, cm, cp, c, beta, gamma, h, 2, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol)
+                layer_step(ci, cm, cp, c, beta, gamma, h, 2, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
+                           cl, clf, mk, mon)
             fired = False
             for k in range(ncl):
-                phi[k] = monitor_value(mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1)
+                phi[k] = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1)
                 if cl[k, CL_MON] and phi[k] < 0.0:
                     fired = True
             if fired:  # locate every sign change; the earliest is taken
@@ -937,11 +1166,11 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 for k in range(ncl):
                     tau[k] = 2.0 * h
                     if cl[k, CL_MON] and phi[k] < 0.0:
-                        phi0 = monitor_value(mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src0)
+                        phi0 = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src0)
                         if phi0 < 0.0:
                             tau[k] = 0.0
                         else:
-                            tau[k] = locate_event(ci, cm, cp, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h,
+                            tau[k] = locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h,
                                                   phi0, phi[k], z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L)
                         tau_min = min(tau_min, tau[k])
                 h = tau_min
@@ -949,10 +1178,10 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                     fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
                     factor_effective(ci, cm, c, beta, gamma, h, L)
                     layer_step(ci, cm, cp, c, beta, gamma, h, 2, L, n, src1, z, zd, zdd,
-                               z1, zd1, zdd1, rhs, sol)
+                               z1, zd1, zdd1, rhs, sol, cl, clf, mk, mon)
                     for k in range(ncl):
-                        if mk[c, k, 0] == MK_FORCE:
-                            phi[k] = monitor_value(mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1)
+                        if mk[c, k, MK_KIND] == MK_FORCE or mk[c, k, MK_KIND] == MK_OVERLAP:
+                            phi[k] = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1)
                 else:
                     for j in range(n):
                         z1[j] = z[j]
@@ -974,7 +1203,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                     if ist[I_NOUT] >= rows:
                         status = OUTPUT_FULL
                         break
-                    record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t + h, z1, zd1, zdd1, src1,
+                    record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t + h, z1, zd1, zdd1, src1,
                                out_t, out_q, out_F, out_c, ist[I_NOUT])
                     ist[I_NOUT] += 1
                 else:
@@ -996,7 +1225,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                             zo[j] = z[j] + zd[j] * s_out + zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
                         fill_sources(ns, nh, omega, sc, sa, sb, t_out, srco)
                         set_prescribed(ci, c, n, srco, zo, zdo, zddo)
-                        record_row(ci, mk, mon, c, n, ns, ncl, gap_noise, t_out, zo, zdo, zddo, srco,
+                        record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t_out, zo, zdo, zddo, srco,
                                    out_t, out_q, out_F, out_c, ist[I_NOUT])
                         ist[I_NOUT] += 1
                         ist[I_NEXT_OUT] = j_out + 1
@@ -1004,13 +1233,8 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                         status = OUTPUT_FULL
                         break
                 # peaks at the step's end
-                after = t + h >= t_rev
-                for k in range(ncl):
-                    if mk[c, k, 0] == MK_FORCE:
-                        if phi[k] > peak[0, k]:
-                            peak[0, k] = phi[k]
-                        if after and phi[k] > peak[1, k]:
-                            peak[1, k] = phi[k]
+                track_peaks(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t + h >= t_rev, phi, z1, zd1, zdd1, src1,
+                            peak)
                 ist[I_STEPS] += 1
                 for j in range(n):
                     z[j] = z1[j]
@@ -1048,7 +1272,11 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
         stick = ist[I_RAPID] >= ip[IP_ZSTICK]
         for k in range(ncl):
             if (c & cl[k, CL_BIT]) and not (new_c & cl[k, CL_BIT]):
-                add_event(ev_f, ev_i, ist, t, k, EV_OPENED, 0.0, c, new_c)
+                u = 0.0
+                if cl[k, CL_SOFT]:  # the parts leave with their relative velocity; the overlap is shut
+                    snap_shut(cl, k, x, src0)
+                    u = relative_velocity(cl, k, v, src0)
+                add_event(ev_f, ev_i, ist, t, k, EV_OPENED, u, c, new_c)
         if any_closing:
             new_c = impact(ip, fp, cl, clf, mass, new_c, closing, src0, x, v, stick, ev_f, ev_i, ist, t)
         ist[I_CFG] = new_c

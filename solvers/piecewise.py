@@ -30,11 +30,13 @@ from typing import Any
 
 import numpy as np
 
-from vtool.errors import RunError
+from vtool.errors import InputError, RunError
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.backends import Backend, Cancel, Progress
 from vtool.solvers.contact import EVENT_KINDS, ContactProblem, OrderedLayer
+from vtool.solvers.model import Mechanism
 from vtool.solvers.sources import SourceSeries
+from vtool.solvers.spec import HERTZ
 from vtool.solvers.statespace import StateSpace, from_layer
 from vtool.solvers.trace import TraceBuilder
 
@@ -84,28 +86,41 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
     src = np.zeros((3 * ns, nb))  # the sources (x, v, a), s-major as the kernel's src vector
     for s in range(ns):
         src[3 * s:3 * s + 3] = source_coefficients(series, s)
-    G = np.zeros((ncl, n2))
-    H = np.zeros((ncl, nb))
+    G, H = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # monitors (kernel.monitor_value)
+    GF, HF = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # contact forces (kernel.contact_force)
     for k in range(ncl):
-        kind, ahead, behind = (int(v) for v in tables.mk[mask, k])
-        if kind == kernel.MK_GAP:
-            G[k] += Zy[0, ahead]
-            H[k] += Zb[0, ahead]
-            H[k, 0] += problem.gap_noise
+        kind, ahead, behind, _ = (int(v) for v in tables.mk[mask, k])
+        if kind in (kernel.MK_GAP, kernel.MK_OVERLAP):
+            sign = 1.0 if kind == kernel.MK_GAP else -1.0
+            G[k] += sign * Zy[0, ahead]
+            H[k] += sign * Zb[0, ahead]
             if behind >= 0:
-                G[k] -= Zy[0, behind]
-                H[k] -= Zb[0, behind]
+                G[k] -= sign * Zy[0, behind]
+                H[k] -= sign * Zb[0, behind]
             else:
-                H[k] -= src[3 * (-1 - behind)]
-        elif kind == kernel.MK_FORCE:
+                H[k] -= sign * src[3 * (-1 - behind)]
+            H[k, 0] += problem.gap_noise
+        if kind in (kernel.MK_FORCE, kernel.MK_OVERLAP):
             row = tables.mon[mask, k]
             for i in range(3):
                 coefficients = row[i * n:i * n + m]
-                G[k] += coefficients @ Zy[i]
-                H[k] += coefficients @ Zb[i]
-            H[k] += row[3 * n:3 * n + 3 * ns] @ src
-            H[k, 0] += row[3 * n + 3 * ns]
-    ss.P, ss.Q, ss.G, ss.H = P, Q, G, H
+                GF[k] += coefficients @ Zy[i]
+                HF[k] += coefficients @ Zb[i]
+            HF[k] += row[3 * n:3 * n + 3 * ns] @ src
+            HF[k, 0] += row[3 * n + 3 * ns]
+        if kind == kernel.MK_FORCE:
+            G[k], H[k] = GF[k], HF[k]
+    ss.compliant = tables.mk[mask, :, kernel.MK_KIND] == kernel.MK_OVERLAP
+    hertz = np.flatnonzero(ss.compliant & (problem.cl[:, kernel.CL_SOFT] == kernel.SOFT_HERTZ))
+    ss.hertz = hertz
+    if hertz.size:  # F_j acts as F_j w_j: on ÿ through M_FF⁻¹ w_F, on the rigid forces through their rows
+        GF[hertz], HF[hertz] = 0.0, 0.0
+        w = -tables.mon[mask][hertz][:, :nf].T  # (nf, nh): the Hertz rows hold -w
+        ss.hertz_rate = np.vstack([np.zeros((nf, hertz.size)), np.linalg.solve(layer.M[:nf, :nf], w)])
+        head = 3 * n + 3 * ns + 1
+        ss.hertz_force = tables.mon[mask][:, head + hertz].copy()
+        ss.hertz_force[hertz, np.arange(hertz.size)] = 1.0
+    ss.P, ss.Q, ss.G, ss.H, ss.GF, ss.HF = P, Q, G, H, GF, HF
     return ss
 
 
@@ -137,6 +152,7 @@ class PiecewiseRun(ABC):
         self.rows: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self.peak = np.zeros(self.ncl)
         self.peak_late = np.zeros(self.ncl)
+        self.peak_overlap = np.zeros(self.ncl)
         self.t_rev = 2 * math.pi / problem.omega
         self.steps = 0
         self.next_out = 0
@@ -168,8 +184,42 @@ class PiecewiseRun(ABC):
         return z[:self.n], z[self.n:2 * self.n], z[2 * self.n:]
 
     def monitors(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
-        """Monitor values (contact force if closed, gap if open) at t; columns for arrays of t."""
-        return ss.G @ y + ss.harmonic(ss.H, t)
+        """Monitor values (rigid contact force or compliant overlap if closed, gap if open) at t;
+        columns for arrays of t."""
+        linear = ss.G @ y + ss.harmonic(ss.H, t)
+        if ss.hertz is None or not ss.hertz.size or ss.hertz_force is None:
+            return linear
+        coupling = ss.hertz_force.copy()  # the rigid contacts' forces include the Hertz forces' pull
+        coupling[~(ss.mask & self.closed_bit != 0) | ss.compliant] = 0.0
+        return linear + coupling @ self.hertz_forces(ss, t, y)
+
+    def forces(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Contact forces (0 for an open clearance) at t; columns for arrays of t."""
+        linear = ss.GF @ y + ss.harmonic(ss.HF, t)
+        if ss.hertz is None or not ss.hertz.size or ss.hertz_force is None:
+            return linear
+        return linear + ss.hertz_force @ self.hertz_forces(ss, t, y)
+
+    def hertz_forces(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Forces of the closed Hertz contacts (the kernel's ``hertz_law``) at t; columns for arrays of t."""
+        rows = ss.hertz
+        assert ss.G is not None and ss.H is not None
+        nf = ss.size // 2
+        delta = ss.G[rows] @ y + ss.harmonic(ss.H[rows], t) - self.problem.gap_noise
+        rate = ss.G[rows, :nf] @ y[nf:] + ss.H[rows] @ ss.basis_rate(t)
+        out = np.zeros(np.shape(delta))
+        for i, k in enumerate(rows):
+            for index in np.ndindex(np.shape(delta)[1:]):
+                at = (i, *index)
+                out[at] = kernel.hertz_law(self.problem.clf, int(k), float(delta[at]), float(rate[at]))[0]
+        return out
+
+    def track_overlap(self, ss: StateSpace, values: np.ndarray) -> None:
+        """Raise the peak overlaps of the closed compliant contacts with monitor values (columns or one)."""
+        if ss.compliant is not None and ss.compliant.any():
+            top = values.max(axis=1) if values.ndim == 2 else values
+            self.peak_overlap = np.where(ss.compliant, np.maximum(self.peak_overlap, top - self.problem.gap_noise),
+                                         self.peak_overlap)
 
     def state_of(self, ss: StateSpace, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         layer = self.problem.tables.layers[ss.mask]
@@ -199,9 +249,9 @@ class PiecewiseRun(ABC):
 
     def emit(self, ss: StateSpace, t: float, y: np.ndarray) -> None:
         x, v, a = self.full_state(ss, t, y)
-        values = self.monitors(ss, t, y)
-        F = np.where((ss.mask & self.closed_bit) != 0, values, 0.0)
+        F = self.forces(ss, t, y)
         self.track_peaks(ss, F, t)
+        self.track_overlap(ss, self.monitors(ss, t, y))
         src = self.sources(t).reshape(-1, 3)
         q3 = np.stack([np.concatenate([x, src[:, 0]]), np.concatenate([v, src[:, 1]]),
                        np.concatenate([a, src[:, 2]])])
@@ -263,7 +313,8 @@ class PiecewiseRun(ABC):
         m = problem.n
         while True:
             self.ist[kernel.I_NEV] = 0
-            result = int(kernel.settle(self.ip, self.fp, problem.cl, tables.ci, tables.cm, tables.cp, tables.mk,
+            result = int(kernel.settle(self.ip, self.fp, problem.cl, problem.clf, tables.ci, tables.cm, tables.cp,
+                                       tables.mk,
                                        tables.mon, mask, t, x, v, a, self.sources(t), self.ev_f, self.ev_i,
                                        self.ist, np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m)))
             self._take_events()
@@ -295,9 +346,14 @@ class PiecewiseRun(ABC):
         self.last_event = t
         if self.rapid >= self.problem.rules.zeno_stop:
             raise RunError(f"chattering contact at t = {t:.6g} s in configuration {self.problem.label(c)}")
+        src = self.sources(t)
         for k in range(self.ncl):
             if (c & self.closed_bit[k]) and not (new_c & self.closed_bit[k]):
-                self.builder.add_event(t, k, EVENT_KINDS[kernel.EV_OPENED], 0.0, c, new_c)
+                u = 0.0
+                if self.problem.cl[k, kernel.CL_SOFT]:  # the parts leave with their relative velocity
+                    kernel.snap_shut(self.problem.cl, k, x, src)
+                    u = float(kernel.relative_velocity(self.problem.cl, k, v, src))
+                self.builder.add_event(t, k, EVENT_KINDS[kernel.EV_OPENED], u, c, new_c)
         if closing.any():
             stick = self.rapid >= self.problem.rules.zeno_stick
             problem = self.problem
@@ -310,8 +366,16 @@ class PiecewiseRun(ABC):
 
     def statistics(self, settings: dict[str, Any]) -> dict[str, Any]:
         self.flush_rows()
-        return {"steps": self.steps, "peak": self.peak, "peak_late": self.peak_late,
+        return {"steps": self.steps, "peak": self.peak, "peak_late": self.peak_late, "peak_overlap": self.peak_overlap,
                 "configurations": tuple(sorted(self.spaces)), "settings": settings}
+
+
+def refuse_hertz(mechanism: Mechanism, backend: str) -> None:
+    """One line for a back end that integrates linear configurations only, given a Hertz contact."""
+    for c in mechanism.spec.clearances:
+        if c.contact == HERTZ:
+            raise InputError("run.backend", backend, f"newmark or scipy for a preset with a hertz contact "
+                             f"({c.name}: nonlinear between events, so the exact solution does not apply)")
 
 
 class PiecewiseBackend(Backend):

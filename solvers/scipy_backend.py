@@ -87,8 +87,14 @@ class _ScipyRun(PiecewiseRun):
         if atol is None:
             atol = np.concatenate([np.full(nf, self.x_scale), np.full(nf, self.v_scale)]) * self.options.rtol
 
-        def rhs(t: float, y: np.ndarray) -> np.ndarray:
-            return ss.A @ y + ss.forcing(t)
+        if ss.hertz is not None and ss.hertz.size:
+
+            def rhs(t: float, y: np.ndarray) -> np.ndarray:
+                return ss.A @ y + ss.forcing(t) + ss.hertz_rate @ self.hertz_forces(ss, t, y)
+        else:
+
+            def rhs(t: float, y: np.ndarray) -> np.ndarray:
+                return ss.A @ y + ss.forcing(t)
 
         events = []
         monitored = [int(k) for k in np.flatnonzero(self.monitored)]
@@ -127,7 +133,8 @@ class _ScipyRun(PiecewiseRun):
     def refine_peaks(self, ss: StateSpace, solution) -> None:  # noqa: ANN001 (an OdeResult)
         """Peak contact forces: at the steps, and each local maximum between steps refined on the
         dense output (bounded Brent), so a peak between two steps is not missed."""
-        values = self.monitors(ss, solution.t, solution.y)
+        values = self.forces(ss, solution.t, solution.y)
+        self.track_overlap(ss, self.monitors(ss, solution.t, solution.y))
         closed = (ss.mask & self.closed_bit) != 0
         for i, t_sample in enumerate(solution.t):
             self.raise_peaks(closed, values[:, i], float(t_sample))
@@ -137,13 +144,26 @@ class _ScipyRun(PiecewiseRun):
                 continue
 
             def force(t: float, k: int = k) -> float:
-                return -float(self.monitors(ss, t, solution.sol(t))[k])
+                return -float(self.forces(ss, t, solution.sol(t))[k])
 
             best = minimize_scalar(force, bounds=(low, high), method="bounded",
                                    options={"xatol": 1e-9 * (high - low)})
             self.peak[k] = max(self.peak[k], -float(best.fun))
             if best.x >= self.t_rev:
                 self.peak_late[k] = max(self.peak_late[k], -float(best.fun))
+        if ss.compliant is not None and ss.compliant.any():  # the peak overlaps, refined the same way
+            overlaps = self.monitors(ss, solution.t, solution.y) - self.problem.gap_noise
+            for k, first, last in peak_brackets(overlaps, ss.compliant, self.peak_overlap):
+                low, high = float(solution.t[first]), float(solution.t[last])
+                if high <= low:
+                    continue
+
+                def overlap(t: float, k: int = k) -> float:
+                    return -float(self.monitors(ss, t, solution.sol(t))[k]) + self.problem.gap_noise
+
+                best = minimize_scalar(overlap, bounds=(low, high), method="bounded",
+                                       options={"xatol": 1e-9 * (high - low)})
+                self.peak_overlap[k] = max(self.peak_overlap[k], -float(best.fun))
 
 
 ScipyBackend.run_class = _ScipyRun

@@ -36,6 +36,14 @@ THESIS = "thesis"
 MOMENTUM = "momentum"
 IMPACT_LAWS = (LOCAL, THESIS, MOMENTUM)
 
+#: Contact laws of a clearance (see :mod:`vtool.solvers.contact`): rigid (impact laws, ties and
+#: prescribed coordinates), a linear spring-dashpot acting while the parts overlap, or Hertz's
+#: k delta^n with Hunt-Crossley damping (Newmark and scipy back ends).
+RIGID = "rigid"
+LINEAR = "linear"
+HERTZ = "hertz"
+CONTACT_LAWS = (RIGID, LINEAR, HERTZ)
+
 #: Start velocities (see :mod:`vtool.solvers.initial`).
 THESIS_START = "thesis"
 QUASI_STATIC_START = "quasi-static"
@@ -97,6 +105,21 @@ class ClearanceSpec:
     where the contact force acts equal and opposite on the pair. ``state``:
     ``enabled`` (opens and closes), ``pinned`` (always closed: the pair is one
     coordinate) or ``removed`` (never closes, not monitored).
+
+    ``contact``: ``rigid`` (a closed clearance ties its pair or prescribes its
+    ahead coordinate; closing is an impact) or ``linear`` (while the parts
+    overlap, δ = -gap > 0, a spring ``contact_stiffness`` k and a dashpot c act
+    between them: F = k δ + c δ̇; piecewise linear, so every back end applies).
+    The dashpot is ``contact_damping`` c, or ``contact_damping_ratio`` ζ with
+    c = 2 ζ √(k m), m the diagonal mass of the ahead coordinate (internal:
+    the two diagonal masses in series), the masses the local impact law uses.
+    A linear contact acts while the parts overlap (Kelvin–Voigt): near the
+    end of a contact its dashpot may pull (F < 0), a known property of the
+    model; the overlap, not the force, decides when the contact ends.
+    ``hertz``: F = k δⁿ (1 + 3(1 - e)/2 · δ̇/v⁻), n = ``contact_exponent``,
+    with the Hunt–Crossley damping of the clearance's restitution e at the
+    approach velocity v⁻ of the contact's closing; it never pulls. Nonlinear:
+    the Newmark back end iterates, scipy integrates it, exact refuses it.
     """
 
     name: str
@@ -106,6 +129,20 @@ class ClearanceSpec:
     state: str = ENABLED
     restitution: float = 0.0
     impact: str | None = None  # impact law; None: the mechanism's default (ContactSpec.impact)
+    contact: str = RIGID
+    contact_stiffness: float = 0.0  # force/length
+    contact_damping: float | None = None  # force*time/length
+    contact_damping_ratio: float | None = None  # of critical, on the local masses
+    contact_exponent: float = 1.5  # hertz
+
+    @property
+    def rigid(self) -> bool:
+        return self.contact == RIGID
+
+    @property
+    def ties(self) -> bool:
+        """A closed rigid internal clearance: its pair is one coordinate of the layer."""
+        return self.kind == INTERNAL and self.contact == RIGID
 
 
 @dataclass(frozen=True)

@@ -81,6 +81,14 @@ class StateSpace:
     Q: np.ndarray | None = None  # (3n, 2K+1)
     G: np.ndarray | None = None  # (ncl, 2nf): monitors from y
     H: np.ndarray | None = None  # (ncl, 2K+1)
+    GF: np.ndarray | None = None  # (ncl, 2nf): contact forces from y (0 for an open clearance)
+    HF: np.ndarray | None = None  # (ncl, 2K+1)
+    compliant: np.ndarray | None = None  # bool per clearance: closed compliant (monitor = overlap)
+    # closed Hertz contacts (nonlinear, scipy only): their clearances, their forces' effect on y' and on
+    # the contact forces, per unit force
+    hertz: np.ndarray | None = None  # clearance indices
+    hertz_rate: np.ndarray | None = None  # (2nf, nh)
+    hertz_force: np.ndarray | None = None  # (ncl, nh)
     cache: dict = field(default_factory=dict, repr=False)  # per-back-end derived data
 
     @property
@@ -360,7 +368,21 @@ def _diagonalise(Az: np.ndarray, xs: list[int], vs: list[int]):  # noqa: ANN202
 
 
 def from_layer(problem, layer) -> StateSpace:  # noqa: ANN001 (a ContactProblem and its OrderedLayer)
-    """State space of one configuration from the contact problem's ordered layer (free first)."""
+    """State space of one configuration from the contact problem's ordered layer (free first).
+
+    The sources' pull through closed compliant contacts (``layer.S``, on the
+    sources' x, v, a) enters as one more prescribed column per source, with
+    those couplings as its K, C and M entries.
+    """
     nf, m = layer.nf, layer.m
-    return state_space(layer.mask, np.arange(nf), np.arange(nf, m), layer.source, layer.M, layer.C, layer.K,
+    M, C, K, source = layer.M, layer.C, layer.K, layer.source
+    ns = layer.S.shape[1] // 3
+    if layer.S[:nf].any():
+        size = m + ns
+        M, C, K = (np.pad(X, ((0, ns), (0, ns))) for X in (M, C, K))
+        for s in range(ns):
+            K[:m, m + s], C[:m, m + s], M[:m, m + s] = layer.S[:, 3 * s], layer.S[:, 3 * s + 1], layer.S[:, 3 * s + 2]
+        source = np.concatenate([source, np.arange(ns)])
+        m = size
+    return state_space(layer.mask, np.arange(nf), np.arange(nf, m), source, M, C, K,
                        problem.series, problem.label(layer.mask))

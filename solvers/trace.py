@@ -99,6 +99,7 @@ class Trace:
     success: bool = True
     message: str = ""
     peak_force_after_first_revolution: np.ndarray | None = None  # per clearance, over every step
+    peak_overlap: np.ndarray | None = None  # per clearance, largest overlap of a compliant contact
 
     # ----- columns by the engineer's names -----
     def coordinate(self, number: int, rows: slice = slice(None)) -> np.ndarray:
@@ -275,7 +276,7 @@ class Trace:
                 "clearance": c.name,
                 "force": self.force_label(i),
                 "state": c.state,
-                "impact_law": self.spec.impact_law(c),
+                "impact_law": self.spec.impact_law(c) if c.rigid else None,  # compliant: see "contact"
                 "events": sum(e.clearance == c.name for e in self.events),
                 "separations": len(self.events_at(c.name, (OPENED, RELEASED))),
                 "impacts": len(impacts),
@@ -284,7 +285,11 @@ class Trace:
                 "peak_force": float(self.peak_force[i]),
                 "peak_force_after_first_revolution": None if late is None else float(late[i]),
                 "peak_force_unit": units.force,
+                "contact": c.contact,
             }
+            if not c.rigid and self.peak_overlap is not None:
+                entry["peak_overlap"] = float(self.peak_overlap[i])
+                entry["peak_overlap_unit"] = units.length
             if c.kind == EXTERNAL and c.behind != self.spec.cam.coordinate:
                 entry["seating_velocities"] = [-e.relative_velocity for e in impacts]
                 entry["seating_velocity_unit"] = units.velocity
@@ -335,8 +340,12 @@ class Trace:
         lines.append(f"{'clearance':<10} {'force':<6} {'state':<8} {'law':<8} {'separations':>11} {'impacts':>8} "
                      f"{'peak force (' + units.force + ')':>18}")
         for c in s["clearances"]:
-            lines.append(f"{c['clearance']:<10} {c['force']:<6} {c['state']:<8} {c['impact_law']:<8} "
+            lines.append(f"{c['clearance']:<10} {c['force']:<6} {c['state']:<8} {c['impact_law'] or c['contact']:<8} "
                          f"{c['separations']:>11} {c['impacts']:>8} {c['peak_force']:>18.6g}")
+        for c in s["clearances"]:
+            if "peak_overlap" in c:
+                lines.append(f"  {c['clearance']}: {c['contact']} contact, peak overlap "
+                             f"{c['peak_overlap']:.6g} {c['peak_overlap_unit']}")
         lines.append("")
         lines.append(f"episodes (events at one clearance within {s['episode_window_deg']:g} deg are one):")
         for c in s["clearances"]:
@@ -493,7 +502,7 @@ class TraceBuilder:
                                  int(before), int(after)))
 
     def build(self, peak: np.ndarray, statistics: RunStatistics, peak_late: np.ndarray | None = None,
-              sort: bool = False) -> Trace:
+              sort: bool = False, peak_overlap: np.ndarray | None = None) -> Trace:
         n = self.spec.n_coordinates + len(self.source_numbers)
         ncl = len(self.spec.clearances)
         rows = sum(len(b[0]) for b in self.blocks)
@@ -517,4 +526,5 @@ class TraceBuilder:
             self.stream.write(self.block_trace(t, np.zeros((0, 3, n)), F, cfg))
         return Trace(self.spec, t, cam_angle_deg(t, self.omega), self.numbers, q, qd, qdd, F, cfg,
                      tuple(self.events), np.array(peak, dtype=float), statistics,
-                     peak_force_after_first_revolution=None if peak_late is None else np.array(peak_late))
+                     peak_force_after_first_revolution=None if peak_late is None else np.array(peak_late),
+                     peak_overlap=None if peak_overlap is None else np.array(peak_overlap, dtype=float))

@@ -1,0 +1,276 @@
+"""Compliant (linear spring-dashpot) contacts: a drop test against its closed form, every back end.
+
+The drop test: one mass m on a soft spring k_s (tests.valvetrain_cases.sdof_doc),
+released from rest 0.01 in above a seat at 0 whose contact is a spring k_c
+and a dashpot c. While the mass overlaps the seat (x < 0),
+
+    m ẍ + c ẋ + (k_s + k_c) x = 0,   x(0) = 0,  ẋ(0) = -v0
+
+so x(t) = -(v0/ω_d) e^{-ζ ω_n t} sin ω_d t with ω_n² = (k_s + k_c)/m,
+ζ = c / (2 m ω_n), ω_d = ω_n √(1 - ζ²): the contact lasts π/ω_d and the
+mass leaves with v0 · exp(-ζ ω_n π/ω_d) (the rebound velocity).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tests.valvetrain_cases import SDOF_MASS, SDOF_STIFFNESS, sdof_doc, spec_from
+from vtool.errors import InputError
+from vtool.solvers import backends
+from vtool.solvers.model import assemble
+from vtool.solvers.trace import CLOSED, OPENED
+
+K_CONTACT = 1.0e6  # lbf/in
+RATIO = 0.2  # of critical, on the seat's local mass (the mass itself here)
+TOLERANCE = {"exact": 1e-8, "scipy": 1e-5, "newmark": 1e-4}
+
+
+def drop_doc(ratio: float = RATIO) -> dict:
+    doc = sdof_doc(seat=0.0, time_step=1e-7, degrees=5e-5)
+    doc["clearances"][1].update(contact="linear", contact_stiffness=K_CONTACT, contact_damping_ratio=ratio)
+    return doc
+
+
+def closed_form(ratio: float) -> tuple[float, float]:
+    """(contact duration s, rebound velocity / approach velocity)."""
+    m = SDOF_MASS / 3.0
+    c = 2.0 * ratio * math.sqrt(K_CONTACT * m)
+    omega_n = math.sqrt((SDOF_STIFFNESS + K_CONTACT) / m)
+    zeta = c / (2.0 * m * omega_n)
+    omega_d = omega_n * math.sqrt(1.0 - zeta**2)
+    return math.pi / omega_d, math.exp(-zeta * omega_n * math.pi / omega_d)
+
+
+def first_contact(name: str, ratio: float = RATIO):  # noqa: ANN201
+    spec = spec_from(drop_doc(ratio))
+    backend = backends.get(name)()
+    options = backend.options_from_run(spec.run)
+    if name == "scipy":
+        options = type(options)(**{**options.__dict__, "rtol": 1e-10})
+    trace = backend.simulate(assemble(spec), options)
+    seat = [e for e in trace.events if e.clearance == "seat"]
+    closing = next(e for e in seat if e.kind == CLOSED)
+    opening = next(e for e in seat if e.kind == OPENED and e.time > closing.time)
+    return trace, closing, opening
+
+
+@pytest.mark.parametrize("name", backends.available())
+def test_drop_test_matches_the_closed_form(name: str) -> None:
+    trace, closing, opening = first_contact(name)
+    duration, rebound = closed_form(RATIO)
+    tolerance = TOLERANCE.get(name, 1e-4)
+    assert opening.time - closing.time == pytest.approx(duration, rel=tolerance)
+    assert opening.relative_velocity / -closing.relative_velocity == pytest.approx(rebound, rel=tolerance)
+    # the approach velocity is the free fall on the soft spring: v0 = ω_s · 0.01 in
+    assert -closing.relative_velocity == pytest.approx(0.01 * math.sqrt(SDOF_STIFFNESS / (SDOF_MASS / 3)),
+                                                       rel=1e-3)
+    # peak force and overlap: the largest of k x + c ẋ and of x over the closed form's contact
+    m = SDOF_MASS / 3.0
+    c = 2.0 * RATIO * math.sqrt(K_CONTACT * m)
+    omega_n = math.sqrt((SDOF_STIFFNESS + K_CONTACT) / m)
+    zeta = c / (2.0 * m * omega_n)
+    omega_d = omega_n * math.sqrt(1.0 - zeta**2)
+    t = np.linspace(0.0, duration, 200001)
+    v0 = -closing.relative_velocity
+    overlap = v0 / omega_d * np.exp(-zeta * omega_n * t) * np.sin(omega_d * t)
+    rate = np.gradient(overlap, t)
+    summary = {c["clearance"]: c for c in trace.summary()["clearances"]}["seat"]
+    assert summary["contact"] == "linear"
+    assert summary["peak_overlap"] == pytest.approx(overlap.max(), rel=max(tolerance, 1e-6) * 10)
+    assert summary["peak_force"] == pytest.approx((K_CONTACT * overlap + c * rate).max(), rel=max(tolerance, 2e-5) * 10)
+
+
+def test_an_undamped_contact_returns_the_approach_velocity() -> None:
+    _, closing, opening = first_contact("exact", ratio=0.0)
+    assert opening.relative_velocity == pytest.approx(-closing.relative_velocity, rel=1e-9)
+
+
+def test_contact_keys_are_checked_in_one_line() -> None:
+    doc = drop_doc()
+    doc["clearances"][1]["contact_stiffness"] = -1.0
+    with pytest.raises(InputError, match="contact_stiffness"):
+        spec_from(doc)
+    doc = drop_doc()
+    doc["clearances"][1]["contact_damping"] = 3.0
+    with pytest.raises(InputError, match="not both"):
+        spec_from(doc)
+    doc = drop_doc()
+    doc["clearances"][1].update(contact="rigid")
+    with pytest.raises(InputError, match="rigid contact"):
+        spec_from(doc)
+    doc = drop_doc()
+    doc["clearances"][1].update(contact="hertz")
+    with pytest.raises(InputError, match="hertz contact"):  # its damping comes from the restitution
+        spec_from(doc)
+    doc = drop_doc()
+    doc["clearances"][1].update(contact="plastic")
+    with pytest.raises(InputError, match="rigid, linear, hertz"):
+        spec_from(doc)
+
+
+# ----- gnilka-1a with every clearance linear (vtool.solvers.compliance; docs/contact.md) -----
+def test_stiffer_contacts_approach_the_rigid_momentum_run() -> None:
+    from vtool.presets import load_preset
+    from vtool.solvers.compliance import figures, with_contacts
+
+    spec = load_preset("gnilka-1a")
+    rigid = figures(with_contacts(spec, None, impact="momentum"))
+    errors = []
+    for k in (1e6, 1e7, 1e8):
+        f = figures(with_contacts(spec, k, 1.0))
+        errors.append((abs(f.throw_off - rigid.throw_off), abs(f.seating_velocity / rigid.seating_velocity - 1),
+                       abs(f.impulse / rigid.impulse - 1), abs(f.seating_angle - rigid.seating_angle)))
+    throw_off, velocity, impulse, seating = zip(*errors, strict=True)
+    assert throw_off[0] > throw_off[1] > throw_off[2] and throw_off[2] < 0.25  # deg
+    assert impulse[0] > impulse[1] > impulse[2] and impulse[2] < 0.01
+    assert velocity[2] < min(velocity[:2]) and velocity[2] < 0.001
+    assert seating[2] < min(seating[:2]) and seating[2] < 0.05  # deg
+
+
+def test_exact_and_newmark_agree_on_a_compliant_run() -> None:
+    """Same event sequence; Newmark's event angles converge on the exact ones at second order (the
+    largest difference is a grazing cam re-contact, 0.49 deg at 0.5 us)."""
+    import dataclasses
+
+    from vtool.presets import load_preset
+    from vtool.solvers.compliance import with_contacts
+    from vtool.solvers.run import simulate
+
+    spec = with_contacts(load_preset("gnilka-1a"), 1e7, 1.0)
+    exact = simulate(dataclasses.replace(spec, run=dataclasses.replace(spec.run, backend="exact")))
+    worst = []
+    for dt in (0.5e-6, 0.25e-6, 0.125e-6):
+        newmark = simulate(dataclasses.replace(spec, run=dataclasses.replace(spec.run, time_step=dt)))
+        assert [(e.clearance, e.kind) for e in newmark.events] == [(e.clearance, e.kind) for e in exact.events]
+        worst.append(max(abs(a.cam_angle - b.cam_angle) for a, b in zip(newmark.events, exact.events, strict=True)))
+    assert worst[2] < 0.05  # deg
+    assert 3.0 < worst[0] / worst[1] < 5.0 and 3.0 < worst[1] / worst[2] < 5.0
+    for a, b in zip(newmark.summary()["clearances"], exact.summary()["clearances"], strict=True):
+        assert a["peak_overlap"] == pytest.approx(b["peak_overlap"], rel=0.01)
+
+
+@pytest.mark.slow
+def test_generated_stiffness_study_is_current() -> None:
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+    import tables_compliant
+
+    assert tables_compliant.main(check=True) == 0, "run python3 benchmarks/tables_compliant.py"
+
+
+def test_vtool_solve_reports_the_peak_overlap(tmp_path) -> None:  # noqa: ANN001
+    import json
+
+    import tomli_w
+    from click.testing import CliRunner
+
+    from tests.valvetrain_cases import thesis_doc
+    from vtool.app.cli.main import cli
+
+    doc = thesis_doc("gnilka-1a")
+    for c in doc["clearances"]:
+        if c["name"] == "seat":
+            c.update(contact="linear", contact_stiffness=1e7, contact_damping_ratio=1.0)
+    preset = tmp_path / "soft-seat.toml"
+    preset.write_text(tomli_w.dumps(doc))
+    result = CliRunner().invoke(cli, ["solve", str(preset)])
+    assert result.exit_code == 0, result.output
+    assert "seat: linear contact, peak overlap" in result.output
+    result = CliRunner().invoke(cli, ["solve", str(preset), "--json"])
+    seat = next(c for c in json.loads(result.output)["clearances"] if c["clearance"] == "seat")
+    assert seat["contact"] == "linear" and seat["peak_overlap_unit"] == "in" and 0 < seat["peak_overlap"] < 0.01
+
+
+# ----- Hertz contacts: F = k δ^n (1 + 3(1 - e)/2 · δ̇/v⁻), Newmark with iteration and scipy -----
+def hertz_doc(restitution: float = 1.0, backend: str = "newmark") -> dict:
+    """The drop test on a Hertz seat, the mass on a 1 lbf/in spring (its share of the contact force,
+    k_s δ / F, is 1.5e-5 at the peak): it reaches the seat at v0 = 0.316 in/s."""
+    doc = sdof_doc(seat=0.0, time_step=1e-6, degrees=4e-4)
+    doc["members"]["spring"]["stiffness"] = 1.0
+    doc["clearances"][1].update(contact="hertz", contact_stiffness=1e7, contact_exponent=1.5,
+                                restitution=restitution)
+    doc["run"]["backend"] = backend
+    return doc
+
+
+def hertz_contact(restitution: float, backend: str):  # noqa: ANN201
+    from vtool.solvers.run import simulate
+
+    trace = simulate(spec_from(hertz_doc(restitution, backend)))
+    seat = [e for e in trace.events if e.clearance == "seat"]
+    return trace, seat[0], seat[1]
+
+
+@pytest.mark.parametrize("backend", ["newmark", "scipy"])
+def test_hertz_drop_matches_its_closed_form(backend: str) -> None:
+    """Elastic Hertz impact (n = 3/2): δ_max = (5 m v0² / 4k)^(2/5), F_max = k δ_max^(3/2), the contact
+    lasts 2 δ_max/v0 ∫₀¹ (1 - x^(5/2))^(-1/2) dx = 2 δ_max/v0 · (2/5) B(2/5, 1/2), the mass leaves at v0."""
+    from scipy.special import beta
+
+    trace, closing, opening = hertz_contact(1.0, backend)
+    m, k, v0 = SDOF_MASS / 3.0, 1e7, -closing.relative_velocity
+    delta = (5.0 * m * v0**2 / (4.0 * k)) ** 0.4
+    duration = 2.0 * delta / v0 * 0.4 * beta(0.4, 0.5)
+    seat = trace.summary()["clearances"][1]
+    assert opening.kind == OPENED and closing.kind == CLOSED
+    assert opening.time - closing.time == pytest.approx(duration, rel=5e-5)
+    assert seat["peak_overlap"] == pytest.approx(delta, rel=5e-5)
+    assert seat["peak_force"] == pytest.approx(k * delta**1.5, rel=5e-5)
+    assert opening.relative_velocity == pytest.approx(v0, rel=1e-4)
+
+
+def test_hunt_crossley_damping_lowers_the_rebound() -> None:
+    ratios = []
+    for restitution in (1.0, 0.8, 0.5):
+        _, closing, opening = hertz_contact(restitution, "newmark")
+        ratios.append(opening.relative_velocity / -closing.relative_velocity)
+    assert ratios[0] > ratios[1] > ratios[2] > 0.0
+
+
+def test_hertz_seat_on_1a_newmark_and_scipy_agree() -> None:
+    import dataclasses
+
+    from tests.valvetrain_cases import thesis_doc
+    from vtool.solvers.run import simulate
+
+    doc = thesis_doc("gnilka-1a")
+    doc["run"]["degrees"] = 400.0
+    for c in doc["clearances"]:
+        if c["name"] == "seat":
+            c.update(contact="hertz", contact_stiffness=1e8, restitution=0.0)
+    spec = spec_from(doc)
+    newmark = simulate(dataclasses.replace(spec, run=dataclasses.replace(spec.run, time_step=2.5e-7)))
+    scipy = simulate(dataclasses.replace(spec, run=dataclasses.replace(spec.run, backend="scipy")))
+    assert [(e.clearance, e.kind) for e in newmark.events] == [(e.clearance, e.kind) for e in scipy.events]
+    assert max(abs(a.cam_angle - b.cam_angle) for a, b in zip(newmark.events, scipy.events, strict=True)) < 0.1
+    a, b = newmark.summary()["clearances"][2], scipy.summary()["clearances"][2]
+    assert a["peak_force"] == pytest.approx(b["peak_force"], rel=1e-3)
+    assert a["peak_overlap"] == pytest.approx(b["peak_overlap"], rel=1e-3)
+
+
+def test_exact_refuses_a_hertz_contact_in_one_line(tmp_path) -> None:  # noqa: ANN001
+    import tomli_w
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    preset = tmp_path / "hertz.toml"
+    preset.write_text(tomli_w.dumps(hertz_doc()))
+    result = CliRunner().invoke(cli, ["solve", str(preset), "--backend", "exact"])
+    assert result.exit_code == 2
+    assert result.output.count("\n") == 1 and "hertz contact" in result.output
+
+
+def test_a_hertz_contact_starts_open() -> None:
+    doc = hertz_doc()
+    doc["clearances"][0]["state"] = "enabled"
+    doc["clearances"][0].update(contact="hertz", contact_stiffness=1e7)
+    doc["initial"]["closed"] = ["cam"]
+    with pytest.raises(InputError, match="starts open"):
+        spec_from(doc)
