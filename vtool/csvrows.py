@@ -134,23 +134,35 @@ def put_value(x, bits, powers, out, pos):  # noqa: ANN001, ANN201 (a numba kerne
 
 
 @jit
-def put_rows(values, bits, powers, label_text, label_start, label_of_row, out, offsets, fallback):  # noqa: ANN001, ANN201
+def put_rows(values, bits, same, powers, label_text, label_start, label_of_row, out, offsets,  # noqa: ANN001, ANN201
+             fallback):
     """Rows of ``values`` with their labels into ``out`` (see the module doc); returns the bytes written.
 
     ``label_text[label_start[i]:label_start[i + 1]]`` is label i (UTF-8);
     row r ends with label ``label_of_row[r]``. ``offsets[r]`` is where row r
     starts (``offsets[rows]`` the end); ``fallback[r]`` is set for a row that
-    Python must write (its bytes here are incomplete).
+    Python must write (its bytes here are incomplete). A column c with
+    ``same[c] = j >= 0`` holds the values of the earlier column j: its text is
+    copied, not formatted again.
     """
     rows, cols = values.shape
+    starts = np.zeros(cols, dtype=np.int64)
+    ends = np.zeros(cols, dtype=np.int64)
     pos = 0
     for r in range(rows):
         offsets[r] = pos
         for c in range(cols):
-            end = put_value(values[r, c], bits[r, c], powers, out, pos)
-            if end < 0:
-                fallback[r] = True
-                end = pos
+            j = same[c]
+            if j >= 0:
+                end = pos + ends[j] - starts[j]
+                out[pos:end] = out[starts[j]:ends[j]]
+            else:
+                end = put_value(values[r, c], bits[r, c], powers, out, pos)
+                if end < 0:
+                    fallback[r] = True
+                    end = pos
+            starts[c] = pos
+            ends[c] = end
             out[end] = COMMA
             pos = end + 1
         label = label_of_row[r]
@@ -170,6 +182,26 @@ POWERS = np.array([float(f"1e{k}") for k in range(-MAX_SHIFT, MAX_SHIFT + 1)])
 def python_row(values: np.ndarray, label: str) -> str:
     """One row as Python formats it (the reference, and the fallback)."""
     return ",".join("%.10g" % value for value in values.tolist()) + "," + label + "\n"  # noqa: UP031
+
+
+def repeated_columns(values: np.ndarray) -> np.ndarray:
+    """For each column, the first earlier column with the same values (bit for bit), or -1.
+
+    A trace's CSV repeats some columns (the preset's quantities ``q9``, ``F1``
+    ... beside the coordinates and forces): their text is copied."""
+    same = np.full(values.shape[1], -1, dtype=np.int64)
+    first: dict[bytes, list[int]] = {}
+    for c in range(values.shape[1]):
+        column = np.ascontiguousarray(values[:, c])
+        with np.errstate(all="ignore"):  # inf - inf in the sum is only a key
+            key = column.tobytes()[:64] + column.sum(dtype=np.float64).tobytes()
+        for j in first.get(key, []):
+            if np.array_equal(column.view(np.int64), values[:, j].view(np.int64)):
+                same[c] = j
+                break
+        else:
+            first.setdefault(key, []).append(c)
+    return same
 
 
 def ready() -> bool:
@@ -208,7 +240,8 @@ def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
     out = np.empty(rows * (values.shape[1] * VALUE_WIDTH + width + 2), dtype=np.uint8)
     offsets = np.zeros(rows + 1, dtype=np.int64)
     fallback = np.zeros(rows, dtype=np.bool_)
-    end = put_rows(values, values.view(np.int64), POWERS, label_text, label_start, label_of_row, out, offsets, fallback)
+    end = put_rows(values, values.view(np.int64), repeated_columns(values), POWERS, label_text, label_start,
+                   label_of_row, out, offsets, fallback)
     pieces, done = [], 0
     for r in np.flatnonzero(fallback).tolist():
         pieces.append(out[offsets[done]:offsets[r]])
