@@ -94,8 +94,8 @@ PEAK_ALL, PEAK_LATE, PEAK_OVERLAP = range(3)
 # run status
 FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED, CHATTER = range(1, 7)
 # integer and float state slots
-I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_SETTLE, I_WANT_CFG, I_STARTED = range(10)
-I_SIZE = 10
+I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_SETTLE, I_WANT_CFG, I_STARTED, I_SUB = range(11)
+I_SIZE = 11  # I_SUB: refined steps taken since the grid point I_GRID (the refined steps' own grid)
 F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
 F_SIZE = 4
 
@@ -858,7 +858,8 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
         return fst[F_T]
     beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
     omega, gap_noise, x_limit, t_rev = fp[FP_OMEGA], fp[FP_GAPNOISE], fp[FP_XLIM], fp[FP_TREV]
-    fine = dt / fp[FP_REFINE]
+    refine = int(fp[FP_REFINE] + 0.5)
+    fine = dt / refine
     m = ci[c, CI_M]
     nf = ci[c, CI_NF]
     coupled = ci[c, CI_SRC]
@@ -866,20 +867,22 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
     t = fst[F_T]
     while True:
         k_grid = ist[I_GRID]
-        if t < fst[F_FINE_UNTIL]:
+        sub = ist[I_SUB]
+        if sub > 0 or t < fst[F_FINE_UNTIL]:  # refined steps on their grid, on to the next grid point
+            if t != k_grid * dt + sub * fine:
+                return t
             h = fine
             slot = CM_SINVF
-            if t + h >= (k_grid + 1) * dt:
-                return t
+            t1 = (k_grid + 1) * dt if sub + 1 == refine else k_grid * dt + (sub + 1) * fine
         elif t == k_grid * dt:
             h = dt
             slot = CM_SINV
+            t1 = (k_grid + 1) * dt
         else:
             return t
-        if t + h > t_end or t >= fst[F_CHUNK_END]:
+        if t1 > t_end or t >= fst[F_CHUNK_END]:
             return t
         # the sources at t + h
-        t1 = t + h
         c1 = np.cos(omega * t1)
         s1 = np.sin(omega * t1)
         for s in range(ns):
@@ -1033,15 +1036,14 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             zd[j] = zd1[j]
             zdd[j] = zdd1[j]
         ist[I_STEPS] += 1
-        if h == dt:
+        if slot == CM_SINV or sub + 1 == refine:
             ist[I_GRID] = k_grid + 1
-            t = (k_grid + 1) * dt
+            ist[I_SUB] = 0
         else:
-            t = t1
-            if abs(t - (k_grid + 1) * dt) <= 1e-9 * dt:
-                ist[I_GRID] = k_grid + 1
-                t = (k_grid + 1) * dt
+            ist[I_SUB] = sub + 1
+        t = t1
         fst[F_T] = t
+
 
 
 # ----- the run loop -----
@@ -1064,7 +1066,8 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
     every = ip[IP_EVERY]
     beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
     omega, tol, gap_noise, x_limit = fp[FP_OMEGA], fp[FP_TTOL], fp[FP_GAPNOISE], fp[FP_XLIM]
-    fine = dt / fp[FP_REFINE]
+    refine = int(fp[FP_REFINE] + 0.5)
+    fine = dt / refine
     t_rev = fp[FP_TREV]
     z = np.zeros(n)
     zd = np.zeros(n)
@@ -1134,15 +1137,29 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 continue
             k_grid = ist[I_GRID]
             grid_next = (k_grid + 1) * dt
-            if t == k_grid * dt:
+            sub = ist[I_SUB]
+            j_target = -1  # refined steps: the index of the refined grid point this step reaches
+            target = grid_next
+            if sub > 0 or t < fst[F_FINE_UNTIL]:
+                if t == k_grid * dt + sub * fine:
+                    j_target = sub + 1
+                else:  # after an event, between the refined grid's points: on to the next one
+                    j_target = int((t - k_grid * dt) / fine) + 1
+                target = grid_next if j_target >= refine else k_grid * dt + j_target * fine
+                h = min(target, t_end) - t
+                if t == k_grid * dt + sub * fine and target <= t_end:
+                    h = fine
+            elif t == k_grid * dt:
                 h = min(dt, t_end - t)
             else:
                 h = min(grid_next, t_end) - t
-            if t < fst[F_FINE_UNTIL]:
-                h = min(h, fine)
-            if h <= 1e-9 * dt:
-                ist[I_GRID] = k_grid + 1
-                t = grid_next
+            if h <= 1e-9 * dt:  # at a grid point but for round-off
+                t = target
+                if target == grid_next:
+                    ist[I_GRID] = k_grid + 1
+                    ist[I_SUB] = 0
+                else:
+                    ist[I_SUB] = j_target
                 fst[F_T] = t
                 continue
             fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
@@ -1243,9 +1260,13 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 for j in range(3 * ns):
                     src0[j] = src1[j]
                 t = t + h
-                if abs(t - grid_next) <= 1e-9 * dt:
-                    ist[I_GRID] = k_grid + 1
-                    t = grid_next
+                if abs(t - target) <= 1e-9 * dt:
+                    t = target
+                    if target == grid_next:
+                        ist[I_GRID] = k_grid + 1
+                        ist[I_SUB] = 0
+                    else:
+                        ist[I_SUB] = j_target
                 fst[F_T] = t
             if fired:
                 event = True

@@ -11,18 +11,22 @@ non-finite result) is a :class:`vtool.errors.RunError` naming what failed.
 
 from __future__ import annotations
 
+import dataclasses
+import threading
 import warnings
+from collections import OrderedDict
 from collections.abc import Callable
 
 import numpy as np
 
 from vtool.errors import PresetWarning, RunError
 from vtool.solvers import backends, cost
-from vtool.solvers.damping import undamped_modes
 from vtool.solvers.model import Mechanism, assemble
 from vtool.solvers.preflight import seat_reach_warning
-from vtool.solvers.spec import MechanismSpec
+from vtool.solvers.spec import MechanismSpec, RunSpec
 from vtool.solvers.trace import CsvStream, Trace
+
+CANONICAL_RUN = RunSpec(rpm=1.0, degrees=1.0, time_step=1.0)  # the run settings of a kept mechanism's key
 
 #: Numerical failures turned into a RunError (the input is valid but the numbers are not).
 NUMERICAL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError)
@@ -32,7 +36,7 @@ def run_cost(mechanism: Mechanism, every_step: bool = False) -> cost.Estimate:
     """The estimated steps and memory of the spec's run on this mechanism."""
     spec = mechanism.spec
     r = spec.run
-    omega_max = float(undamped_modes(mechanism.M, mechanism.K).omega.max())
+    omega_max = mechanism.highest_frequency
     n_sources = 1 + (spec.seat is not None)
     return cost.estimate(backend=r.backend, rpm=r.rpm, degrees=r.degrees, time_step=r.time_step,
                          output_interval=r.output_interval, every_step=every_step, omega_max=omega_max,
@@ -40,12 +44,36 @@ def run_cost(mechanism: Mechanism, every_step: bool = False) -> cost.Estimate:
                          n_clearances=len(spec.clearances), n_quantities=len(r.quantities))
 
 
+#: Assembled mechanisms kept per thread (the last few specs, run settings aside): a second run of
+#: the same mechanism (another speed, step or back end; the TUI's reruns) reuses its layers and
+#: built configurations. Per thread, because a mechanism's tables hold the step's effective
+#: inverses (ConfigurationTables.use_step), which two threads must not share.
+ASSEMBLED_KEPT = 4
+_kept = threading.local()
+
+
 def _assemble(spec: MechanismSpec) -> Mechanism:
+    key = dataclasses.replace(spec, run=CANONICAL_RUN)
+    kept: OrderedDict = _kept.__dict__.setdefault("mechanisms", OrderedDict())
     try:
-        return assemble(spec)
-    except NUMERICAL_FAILURES as exc:
-        raise RunError(f"assembling the mechanism failed ({type(exc).__name__}: {str(exc)[:80]}); "
-                       "check the members' sections, moduli and masses") from None
+        base = kept.get(key)
+        keep = True
+    except TypeError:  # an unhashable spec (built by hand with lists): assemble it afresh
+        base, keep = None, False
+    if base is None:
+        try:
+            base = assemble(key)
+        except NUMERICAL_FAILURES as exc:
+            raise RunError(f"assembling the mechanism failed ({type(exc).__name__}: {str(exc)[:80]}); "
+                           "check the members' sections, moduli and masses") from None
+        base.highest_frequency  # noqa: B018 (computed once: every run of the mechanism shares it)
+        if keep:
+            kept[key] = base
+            while len(kept) > ASSEMBLED_KEPT:
+                kept.popitem(last=False)
+    else:
+        kept.move_to_end(key)
+    return base.with_run(spec.run)
 
 
 def _check_finite(trace: Trace) -> Trace:
