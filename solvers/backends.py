@@ -27,7 +27,9 @@ The contract every back end follows (subclass :class:`Backend`)
 
 :meth:`Backend.simulate` is the template every back end shares: options,
 checks, the contact problem, timing, single-threaded small linear algebra,
-and the :class:`~vtool.solvers.trace.Trace`.
+and the :class:`~vtool.solvers.trace.Trace` (with a
+:class:`~vtool.solvers.trace.CsvStream`, the rows also go to a CSV file as
+they are added, so a back end hands them to the builder in time order).
 """
 
 from __future__ import annotations
@@ -45,7 +47,7 @@ if TYPE_CHECKING:
     from vtool.solvers.contact import ContactProblem
     from vtool.solvers.model import Mechanism
     from vtool.solvers.spec import RunSpec
-    from vtool.solvers.trace import Trace, TraceBuilder
+    from vtool.solvers.trace import CsvStream, Trace, TraceBuilder
 
 ENTRY_POINT_GROUP = "vtool.backends"
 
@@ -96,7 +98,7 @@ class Backend(ABC):
         """Run the contact problem into the builder; return the statistics (see the contract)."""
 
     def simulate(self, mechanism: Mechanism, options: Any = None, progress: Progress | None = None,
-                 cancel: Cancel | None = None) -> Trace:
+                 cancel: Cancel | None = None, stream: CsvStream | None = None) -> Trace:
         from vtool.solvers.contact import ContactProblem, EventRules
         from vtool.solvers.trace import RunStatistics, TraceBuilder
         from vtool.threads import limited
@@ -109,10 +111,11 @@ class Backend(ABC):
         with limited():
             started = wallclock.perf_counter()
             problem = ContactProblem(mechanism, rules)
-            builder = TraceBuilder(mechanism.spec, problem.source_numbers, problem.omega)
+            builder = TraceBuilder(mechanism.spec, problem.source_numbers, problem.omega, stream)
             stats = self.integrate(problem, options, builder, progress, cancel)
             compile_time = float(stats.get("compile_time", 0.0))
-            wall = wallclock.perf_counter() - started - compile_time
+            writing = stream.seconds if stream is not None else 0.0  # the CSV's share, not the solver's
+            wall = wallclock.perf_counter() - started - compile_time - writing
         spec = mechanism.spec
         settings = dict(stats.get("settings", {}))
         settings.update(rpm=spec.run.rpm, degrees=spec.run.degrees,

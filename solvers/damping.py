@@ -16,7 +16,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 from vtool.errors import RunError
 
@@ -48,6 +47,8 @@ def undamped_modes(M: np.ndarray, K: np.ndarray) -> Modes:
     if not (np.all(np.isfinite(M)) and np.all(np.isfinite(K))):
         raise RunError("natural modes: the mass or stiffness matrix has non-finite entries; "
                        "check the members' section, modulus, density and gravity")
+    import scipy.linalg  # here, not at import: loading the model alone needs no scipy (~0.2 s)
+
     try:
         eigenvalues, shapes = scipy.linalg.eigh(K, M)
     except (np.linalg.LinAlgError, ValueError) as exc:

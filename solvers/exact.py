@@ -51,7 +51,7 @@ from vtool.solvers.statespace import Propagator, StateSpace, shift_coefficients
 from vtool.solvers.trace import TraceBuilder
 
 SCAN_FRACTION = 1.0 / 16.0  # scan grid as a fraction of the shortest period
-BLOCK = 256  # samples evaluated together
+BLOCK = 1024  # samples evaluated together
 PEAK_MARGIN = 1e-2  # local maxima of sampled forces within this fraction of the peak are refined
 
 
@@ -130,6 +130,7 @@ class _Config:
 
 class _ExactRun(PiecewiseRun):
     backend = "exact"
+    progress_steps = 40  # a call scans about one block of samples (850 degrees of 1A: 37,000 samples)
 
     def __init__(self, problem: ContactProblem, options: ExactOptions, builder: TraceBuilder) -> None:
         super().__init__(problem, options.output_interval, options.every_step, builder)
@@ -137,11 +138,17 @@ class _ExactRun(PiecewiseRun):
         self.series = problem.series
         self.monitored_index = np.flatnonzero(self.monitored)
         self._carry: tuple | None = None  # (mask, t, h, y) where the last advance stopped without an event
+        self.configs: dict[int, _Config] = {}
 
     def config(self, ss: StateSpace) -> _Config:
-        if "exact" not in ss.cache:
-            period = 2 * math.pi / ss.omega_max if ss.omega_max > 0 else self.t_end
-            delta = min(self.options.scan_fraction * period, self.out_dt)
+        """What this back end derives from a configuration, once per scan interval (kept with ``ss``)."""
+        cfg = self.configs.get(ss.mask)
+        if cfg is not None:
+            return cfg
+        period = 2 * math.pi / ss.omega_max if ss.omega_max > 0 else self.t_end
+        delta = min(self.options.scan_fraction * period, self.out_dt)
+        key = ("exact", delta)
+        if key not in ss.cache:
             prop = Propagator(ss.A, delta, ss.T, ss.Tinv)
             GV = ss.G @ prop.V
             closed = (ss.mask & self.closed_bit) != 0
@@ -150,9 +157,10 @@ class _ExactRun(PiecewiseRun):
             soft = bool(ss.compliant is not None and ss.compliant.any())
             GFV, GFAV, HFm = ((ss.GF @ prop.V, ss.GF @ ss.A @ prop.V, ss.GF @ ss.Y + ss.HF) if soft
                               else (GV, GAV, Hm))
-            ss.cache["exact"] = _Config(delta, prop, GV, GAV, Hm, PV, Qm, closed,
-                                        ss.basis(delta * np.arange(1, BLOCK + 1)), GFV, GFAV, HFm, soft)
-        return ss.cache["exact"]
+            ss.cache[key] = _Config(delta, prop, GV, GAV, Hm, PV, Qm, closed,
+                                    ss.basis(delta * np.arange(1, BLOCK + 1)), GFV, GFAV, HFm, soft)
+        self.configs[ss.mask] = cfg = ss.cache[key]
+        return cfg
 
     def output_maps(self, ss: StateSpace, prop: Propagator) -> tuple[np.ndarray, np.ndarray]:
         """Output rows z = Re(PV h) + Qm u(t): the coordinates' (x, v, a) and the sources' after them."""
@@ -320,10 +328,8 @@ class _ExactRun(PiecewiseRun):
         late = times >= self.t_rev
         if late.any():
             self.peak_late = np.maximum(self.peak_late, forces[:, late].max(axis=1))
-        width = self.n + self.series.n_sources
-        x, v, a, forces = z[:, :width], z[:, width:2 * width], z[:, 2 * width:], forces.T
-        self.rows.extend((float(t_out), np.stack([x[i], v[i], a[i]]), forces[i], ss.mask)
-                         for i, t_out in enumerate(times))
+        self.rows.append((np.asarray(times, dtype=float), z.reshape(len(times), 3, -1), forces.T,
+                          np.full(len(times), ss.mask, dtype=np.int64)))
 
 
 ExactBackend.run_class = _ExactRun

@@ -24,6 +24,7 @@ contact problem's (:mod:`vtool.solvers.contact`, the kernel's ``impact`` and
 from __future__ import annotations
 
 import math
+import weakref
 from abc import ABC, abstractmethod
 from typing import Any
 
@@ -38,6 +39,11 @@ from vtool.solvers.sources import SourceSeries
 from vtool.solvers.spec import HERTZ
 from vtool.solvers.statespace import StateSpace, from_layer
 from vtool.solvers.trace import TraceBuilder
+
+#: The state spaces of a mechanism's configurations, kept as long as its configuration tables: a
+#: second run of the same mechanism (a sweep, a benchmark, the TUI) reuses them and what the back
+#: ends derived from them (``StateSpace.cache``: eigendecompositions, scan powers).
+_SPACES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def source_coefficients(series: SourceSeries, s: int) -> np.ndarray:
@@ -127,6 +133,8 @@ class PiecewiseRun(ABC):
     """
 
     backend = "piecewise"
+    #: advance() returns at least this many times over a run (progress, cancel, rows to the builder)
+    progress_steps = 200
 
     def __init__(self, problem: ContactProblem, output_interval: float, every_step: bool,
                  builder: TraceBuilder) -> None:
@@ -140,7 +148,8 @@ class PiecewiseRun(ABC):
         self.every_step = every_step
         self.ip, self.fp = problem.parameters(t_end=self.t_end)
         self.spaces: dict[int, StateSpace] = {}
-        self.rows: list[tuple[float, np.ndarray, np.ndarray, int]] = []
+        # output rows not yet handed to the builder: blocks (t, q3, F, cfg), flushed in time order
+        self.rows: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self.peak = np.zeros(self.ncl)
         self.peak_late = np.zeros(self.ncl)
         self.peak_overlap = np.zeros(self.ncl)
@@ -157,8 +166,17 @@ class PiecewiseRun(ABC):
 
     # ----- configuration data -----
     def space(self, mask: int) -> StateSpace:
+        """Configuration ``mask``'s state space: built once per mechanism and cam motion (see _SPACES)."""
         if mask not in self.spaces:
-            self.spaces[mask] = state_space(self.problem, self.problem.build(mask))
+            problem = self.problem
+            layer = problem.build(mask)
+            series = problem.series
+            key = (mask, float(series.omega), problem.gap_noise, series.const.tobytes(), series.cos.tobytes(),
+                   series.sin.tobytes())
+            shared = _SPACES.setdefault(problem.tables, {})
+            if key not in shared:
+                shared[key] = state_space(problem, layer)
+            self.spaces[mask] = shared[key]
         return self.spaces[mask]
 
     def full_state(self, ss: StateSpace, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -237,7 +255,21 @@ class PiecewiseRun(ABC):
         src = self.sources(t).reshape(-1, 3)
         q3 = np.stack([np.concatenate([x, src[:, 0]]), np.concatenate([v, src[:, 1]]),
                        np.concatenate([a, src[:, 2]])])
-        self.rows.append((t, q3, F, ss.mask))
+        self.rows.append((np.array([t]), q3[None], F[None], np.array([ss.mask], dtype=np.int64)))
+
+    def flush_rows(self) -> None:
+        """Hand the rows emitted so far to the builder, in time order (stable: ties keep their order).
+
+        Called after every :meth:`advance`: a call's rows may interleave (outputs at the requested
+        angles and every-step samples) but all come before the next call's."""
+        if not self.rows:
+            return
+        blocks, self.rows = self.rows, []
+        t, q3, F, cfg = (np.concatenate(parts) for parts in zip(*blocks, strict=True))
+        if np.any(np.diff(t) < 0.0):
+            order = np.argsort(t, kind="stable")
+            t, q3, F, cfg = t[order], q3[order], F[order], cfg[order]
+        self.builder.add_rows(t, q3, F, cfg)
 
     def output_times(self, t0: float, t1: float) -> list[float]:
         """Requested output instants in (t0, t1] not yet written (and t = 0 at the start)."""
@@ -262,9 +294,10 @@ class PiecewiseRun(ABC):
         t, y = 0.0, self.state_of(ss, x, v)
         for t_out in self.output_times(-1.0, 0.0):
             self.emit(ss, t_out, y)
-        chunk = max(self.t_end / 200.0, 1e-12)
+        chunk = max(self.t_end / self.progress_steps, 1e-12)
         while t < self.t_end * (1 - 1e-14):
             t, y, fired = self.advance(ss, t, y, min(t + chunk, self.t_end))
+            self.flush_rows()
             if fired:
                 mask, x, v, a = self.apply_events(ss, t, y, fired)
                 ss = self.space(mask)
@@ -332,11 +365,7 @@ class PiecewiseRun(ABC):
         return new_c, x, v, a
 
     def statistics(self, settings: dict[str, Any]) -> dict[str, Any]:
-        self.rows.sort(key=lambda row: row[0])
-        if self.rows:
-            self.builder.add_rows(np.array([r[0] for r in self.rows]), np.array([r[1] for r in self.rows]),
-                                  np.array([r[2] for r in self.rows]),
-                                  np.array([r[3] for r in self.rows], dtype=np.int64))
+        self.flush_rows()
         return {"steps": self.steps, "peak": self.peak, "peak_late": self.peak_late, "peak_overlap": self.peak_overlap,
                 "configurations": tuple(sorted(self.spaces)), "settings": settings}
 

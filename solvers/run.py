@@ -24,7 +24,7 @@ from vtool.solvers import backends, cost
 from vtool.solvers.model import Mechanism, assemble
 from vtool.solvers.preflight import seat_reach_warning
 from vtool.solvers.spec import MechanismSpec, RunSpec
-from vtool.solvers.trace import Trace
+from vtool.solvers.trace import CsvStream, Trace
 
 CANONICAL_RUN = RunSpec(rpm=1.0, degrees=1.0, time_step=1.0)  # the run settings of a kept mechanism's key
 
@@ -97,15 +97,20 @@ def simulate(
     options: object | None = None,
     max_steps: float | None = None,
     max_bytes: float | None = None,
+    stream: CsvStream | None = None,
 ) -> Trace:
     """Run the preset's back end (``spec.run.backend``) on the assembled mechanism.
 
     ``max_steps`` and ``max_bytes`` override the cost limits
     (:data:`vtool.solvers.cost.MAX_STEPS`, :data:`vtool.solvers.cost.MAX_BYTES`).
+    With a ``stream`` the rows are written to its CSV as the run goes; a
+    thinning stream keeps the memory of an every-step run to that of a run at
+    the output interval (the memory limit counts it so).
     """
     backend = backends.get(spec.run.backend)()
     mechanism = _assemble(spec)
-    cost.check(run_cost(mechanism, every_step), max_steps, max_bytes)
+    in_memory_every_step = every_step and not (stream is not None and stream.thin)
+    cost.check(run_cost(mechanism, in_memory_every_step), max_steps, max_bytes)
     reach = seat_reach_warning(mechanism)
     if reach is not None:
         warnings.warn(PresetWarning(reach), stacklevel=2)
@@ -118,6 +123,7 @@ def simulate(
                 options,
                 progress=progress if backend.supports_progress else None,
                 cancel=cancel if backend.supports_cancel else None,
+                stream=stream,
             )
     except NUMERICAL_FAILURES as exc:
         raise RunError(f"{spec.run.backend} run failed ({type(exc).__name__}: {str(exc)[:80]}); likely "

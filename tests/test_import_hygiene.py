@@ -51,7 +51,21 @@ def test_cli_help_imports_no_numerics() -> None:
         "from vtool.app.cli.main import cli\n"
         "r = CliRunner().invoke(cli, ['--help'])\n"
         "assert r.exit_code == 0, r.output\n"
-        "print(','.join(m for m in ('numba', 'scipy', 'textual') if m in sys.modules))\n"
+        "print(','.join(m for m in ('numpy', 'numba', 'scipy', 'textual') if m in sys.modules))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == ""
+
+
+def test_solve_imports_no_ui_and_no_study_tools() -> None:
+    """`vtool solve PRESET` (newmark) never imports the TUI, plotting, cluster, TOML-writing or test tools."""
+    code = (
+        "import sys\nfrom click.testing import CliRunner\n"
+        "from vtool.app.cli.main import cli\n"
+        "r = CliRunner().invoke(cli, ['solve', 'gnilka-1a'])\n"
+        "assert r.exit_code == 0, r.output\n"
+        "print(','.join(m for m in ('textual', 'plotext', 'dask', 'distributed', 'tomlkit', 'tomli_w',"
+        " 'hypothesis', 'pytest', 'scipy.optimize', 'scipy.integrate') if m in sys.modules))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""

@@ -105,14 +105,21 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
     from vtool.solvers.run import simulate
 
     spec = with_run_overrides(spec, backend=backend, time_step=dt, rpm=rpm, degrees=degrees)
-    announce_compile(spec.run.backend)
+    announce_compile(spec.run.backend, csv=csv_path is not None and every_step)
     progress = DelayedProgress(f"{spec.run.backend} {spec.run.degrees:g} deg")
     try:
-        trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps)
+        if csv_path is None:
+            trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps)
+        else:  # rows go to the temporary file as the run makes them; renamed over the target at the end
+            from vtool.files import open_atomic
+            from vtool.solvers.trace import CsvStream
+
+            with open_atomic(csv_path, "--csv") as handle:
+                stream = CsvStream(handle, spec.run.quantities, thin=every_step)
+                trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps,
+                                 stream=stream)
     finally:
         progress.close()
-    if csv_path is not None:
-        trace.write_csv(str(csv_path), field="--csv")
     if as_json:
         click.echo(json_text(trace.summary()))
     else:
@@ -121,17 +128,24 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
             click.echo("")
             click.echo(trace.event_table())
         if csv_path is not None:
-            click.echo(f"wrote {len(trace.time)} rows to {csv_path}")
+            click.echo(f"wrote {stream.rows} rows to {csv_path} ({stream.seconds:.1f} s formatting and writing)")
     if plot:
         from vtool.app.valvetrain_charts import all_charts
 
         click.echo(all_charts(trace))
 
 
-def announce_compile(backend: str) -> None:
-    """One line on stderr before a run that must first compile the solver (a new install's first run)."""
+def announce_compile(backend: str, csv: bool = False) -> None:
+    """One line on stderr before a run that must first compile the solver (a new install's first run),
+    and one before the first every-step CSV compiles its number formatter (a few seconds, once)."""
     from vtool.solvers.newmark import compile_notice
 
     notice = compile_notice(backend)
     if notice:
         click.echo(notice, err=True)
+    if csv:
+        from vtool.csvrows import compile_notice as csv_notice
+
+        notice = csv_notice()
+        if notice:
+            click.echo(notice, err=True)
