@@ -238,16 +238,17 @@ class KernelRun:
         chunk = self.options.chunk_steps * self.options.time_step
         self.compile()
         args = self.arguments()
+        self.fst[kernel.F_CHUNK_END] = self.fst[kernel.F_T] + chunk
         while True:
-            self.fst[kernel.F_CHUNK_END] = self.fst[kernel.F_T] + chunk
             status = kernel.run_chunk(*args)
             t = float(self.fst[kernel.F_T])
             if status == kernel.NEED_CONFIG:
                 problem.build(int(self.ist[kernel.I_WANT_CFG]))
                 continue
-            if status == kernel.OUTPUT_FULL:
+            if status == kernel.OUTPUT_FULL:  # the chunk goes on (its end stays: progress and cancel keep coming)
                 self.flush()
                 continue
+            self.fst[kernel.F_CHUNK_END] = t + chunk
             if status == kernel.DIVERGED:
                 raise RunError(self._where("diverged", t))
             if status == kernel.CHATTER:

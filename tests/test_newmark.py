@@ -205,3 +205,15 @@ def test_chattering_is_stopped_by_sticking_when_resting_is_disabled() -> None:
     too_strict = NewmarkOptions(1e-6, beta=0.25, rest_velocity=1e-300, zeno_stick=10_000, zeno_stop=30)
     with pytest.raises(RunError, match="chattering contact"):
         NewmarkBackend().simulate(mechanism, too_strict)
+
+
+def test_an_every_step_run_reports_progress_and_can_be_cancelled() -> None:
+    """Every-step output fills the row buffer before a chunk ends: the chunk must still end (progress, cancel)."""
+    from vtool.solvers.run import simulate
+
+    spec = load_preset("gnilka-1a")
+    seen: list[float] = []
+    simulate(spec, every_step=True, progress=seen.append)
+    assert len(seen) >= 3 and seen[-1] == 1.0
+    with pytest.raises(RunError, match="cancelled"):
+        simulate(spec, every_step=True, cancel=lambda: True)
