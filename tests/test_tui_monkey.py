@@ -25,6 +25,7 @@ import time
 from dataclasses import dataclass, field
 
 import pytest
+from textual import _wait as textual_wait
 from textual import events
 from textual.pilot import OutOfBounds
 
@@ -115,6 +116,17 @@ async def one_sequence(seed: int, found: Found, tmp_path) -> None:  # type: igno
 
 
 async def test_monkey_finds_no_crash(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    # Textual's pilot waits after every key until the *process* is idle (process CPU time
+    # standing still, at most 1 s per wait). A run computing in a worker thread keeps the
+    # process busy, so every event sent during a run waited the full second: that was most
+    # of a sequence's time. The pilot's idle now means the event loop's thread is idle; the
+    # runs still go on in their threads while the monkey keeps pressing (events race runs,
+    # as a user's do).
+    monkeypatch.setattr(textual_wait, "process_time", time.thread_time)
+    # and it looks for idle in 20 ms slices (at least two per key): 5 ms slices, same 1/10
+    # busy threshold... cuts a sequence's idle waiting by about half
+    monkeypatch.setattr(textual_wait, "SLEEP_GRANULARITY", 0.005)
+    monkeypatch.setattr(textual_wait, "SLEEP_IDLE", 0.0005)
     monkeypatch.chdir(tmp_path)  # saves and exports land here
     monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path))
     found = Found()
