@@ -8,9 +8,9 @@ pasted text (long digit runs, ``1e999``, ``nan``, control characters,
 paths that cannot be written). The app must never hit an uncaught
 exception; an error dialog is the expected answer to bad input.
 
-CI runs one sequence of 30 events (30 to 60 s on the shared, loaded 2-core
-machine, where a Textual event costs 1 to 2 s); ``VTOOL_MONKEY=1000`` runs
-1,000 sequences of 50 events and prints what it found::
+CI runs one sequence of 30 events (about 11 s; docs/tui.md, "Monkey test",
+says where a sequence's time goes); ``VTOOL_MONKEY=1000`` runs 1,000
+sequences of 50 events and prints what it found::
 
     VTOOL_MONKEY=1000 .venv/bin/python -m pytest -q -s tests/test_tui_monkey.py
 
