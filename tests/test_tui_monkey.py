@@ -22,6 +22,7 @@ from __future__ import annotations
 import os
 import random
 import time
+import traceback
 from dataclasses import dataclass, field
 
 import pytest
@@ -110,7 +111,8 @@ async def one_sequence(seed: int, found: Found, tmp_path) -> None:  # type: igno
             app.workers.cancel_all()
             await pilot.pause()
     except Exception as exc:  # the monkey's one job: record what escaped the app
-        found.crashes.append(f"seed {seed}: {type(exc).__name__}: {exc} after {done[-5:]}")
+        where = " | ".join(line.strip().replace("\n", " ") for line in traceback.format_tb(exc.__traceback__)[-4:])
+        found.crashes.append(f"seed {seed}: {type(exc).__name__}: {exc} after {done[-5:]} at {where}")
         return
     found.internal += [f"seed {seed}: {t}" for t in internal_errors(app, 0)]
 
@@ -132,8 +134,11 @@ async def test_monkey_finds_no_crash(tmp_path, monkeypatch) -> None:  # type: ig
     found = Found()
     started = time.perf_counter()
     for seed in range(FIRST_SEED, FIRST_SEED + SEQUENCES):
+        crashes = len(found.crashes)
         await one_sequence(seed, found, tmp_path)
-        if SEQUENCES > 10:  # a long run reports as it goes (pytest -s)
+        if SEQUENCES > 10:  # a long run reports as it goes (pytest -s), a crash at once
+            for line in found.crashes[crashes:]:
+                print("  ", line[:2000], flush=True)
             print(f"seed {seed}: {len(found.crashes)} crashes so far, "
                   f"{time.perf_counter() - started:.0f} s", flush=True)
     elapsed = time.perf_counter() - started
