@@ -17,7 +17,7 @@ from vtool.assessments.plate.constraints import free_dofs
 from vtool.assessments.plate.elements import ELEMENTS
 from vtool.assessments.plate.masters import NAMED_SETS, MasterSetError, labelled_set, named_set
 from vtool.assessments.plate.model import METHODS, Case, MasterSelection
-from vtool.assessments.plate.spec import UNIT_SYSTEMS, PlateSpec, PlateUnits
+from vtool.assessments.plate.spec import UNIT_SYSTEMS, PlateSpec
 from vtool.assessments.plate.study import (
     DEFAULT_PERIODS,
     MAX_EXACT_MODES,
@@ -30,8 +30,9 @@ from vtool.assessments.plate.transient import LOADS, MIN_OMEGA_MAX_H, RK4_LIMIT_
 from vtool.errors import InputError
 from vtool.presets.boom import short_error
 from vtool.presets.fields import Table
+from vtool.units import UnitSystem
 
-__all__ = ["UNIT_SYSTEMS", "PlateSpec", "PlateUnits", "dump", "load"]  # specs live in assessments.plate.spec
+__all__ = ["UNIT_SYSTEMS", "PlateSpec", "dump", "load"]  # specs live in assessments.plate.spec
 
 MAX_MESH = 64
 #: Physical bounds in SI, checked before any numerics (docs/plate.md, "Limits").
@@ -47,10 +48,11 @@ MAX_ASPECT = 100.0  # a/b and b/a
 MAX_CASES = 50
 
 
-def _si_scale(units: PlateUnits, key: str) -> float:
+def _si_scale(units: UnitSystem, key: str) -> float:
     """SI value per preset unit of ``key``."""
-    return {"a": units.metres, "b": units.metres, "thickness": units.metres,
-            "youngs_modulus": units.pascals, "density": units.kg_per_m3}[key]
+    return {"a": units.metres_per_length, "b": units.metres_per_length,
+            "thickness": units.metres_per_length, "youngs_modulus": units.pascals_per_pressure,
+            "density": units.kg_per_m3}[key]
 
 
 def _mesh(t: Table, key: str, default: tuple[int, int] | None) -> tuple[int, int]:
@@ -67,7 +69,7 @@ def _mesh(t: Table, key: str, default: tuple[int, int] | None) -> tuple[int, int
     return int(value[0]), int(value[1])
 
 
-def _plate(t: Table, units: PlateUnits) -> Plate:
+def _plate(t: Table, units: UnitSystem) -> Plate:
     unit = {"a": units.length, "b": units.length, "thickness": units.length,
             "youngs_modulus": units.pressure, "density": units.density}
     values = {}

@@ -275,7 +275,7 @@ def _cam(t: Table, n: int, units: UnitSystem, folder: Path | None = None) -> Cam
 
 def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """A lift table (file or inline arrays) and its fit setting; see solvers/cam.py."""
-    from vtool.solvers.cam import fit_table, normalize_table
+    from vtool.solvers.cam import fit_table, junction_warning, normalize_table
 
     lift_table = t.string("lift_table", default="") or None
     if lift_table is not None:
@@ -293,6 +293,9 @@ def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, An
     if (harmonics is None) == (tolerance is None):
         raise InputError(t.field("harmonics"), harmonics, "either harmonics (>= 1) or tolerance, not both")
     fit_table(theta, lift, harmonics, tolerance, t.path, units.length)  # refuse a table that cannot be fitted
+    jumps = junction_warning(theta, lift, t.path)
+    if jumps is not None:
+        warnings.warn(PresetWarning(jumps), stacklevel=3)
     return dict(angles=tuple(theta.tolist()), lifts=tuple(lift.tolist()), harmonics=harmonics,
                 tolerance=tolerance, lift_table=lift_table)
 

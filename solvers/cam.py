@@ -294,6 +294,25 @@ def acceleration_jumps(angles_deg: np.ndarray, lifts: np.ndarray) -> list[Juncti
     return sorted(junctions, key=lambda j: j.angle_deg)
 
 
+MAX_NAMED = 6  # junction angles a warning names before "and N more"
+
+
+def junction_warning(angles_deg: np.ndarray, lifts: np.ndarray, field: str = "cam") -> str | None:
+    """One line naming the angles where a lift table's acceleration jumps, or None.
+
+    Loading a preset with such a table warns with it (``vtool solve``, the
+    TUI, every command), not only ``vtool cam show``, which prints the sizes.
+    """
+    junctions = acceleration_jumps(np.asarray(angles_deg, dtype=float), np.asarray(lifts, dtype=float))
+    if not junctions:
+        return None
+    named = [f"{j.angle_deg:g} deg" + ("" if j.kind == "acceleration" else " (velocity kink)")
+             for j in junctions[:MAX_NAMED]]
+    more = f" and {len(junctions) - MAX_NAMED} more" if len(junctions) > MAX_NAMED else ""
+    return (f"{field}: the lift table's acceleration jumps at {', '.join(named)}{more} (a ramp/flank "
+            f"junction?): its Fourier series rings there; `vtool cam show` gives the sizes")
+
+
 MATTERS = 0.01  # a harmonic matters when its acceleration amplitude is >= 1 % of the largest
 
 

@@ -136,4 +136,6 @@ def test_cli_refuses_a_non_valvetrain_preset() -> None:
 
     result = CliRunner().invoke(cli, ["accuracy", "plate-table2"])
     assert result.exit_code == 2
-    assert "valvetrain" in result.output
+    # the shared wrong-kind check (presets/kinds.py require_kind): one house line, as `vtool modes`
+    assert result.output.strip().splitlines() == [
+        "error: preset: got 'plate', expected a valvetrain preset for `vtool accuracy`"]

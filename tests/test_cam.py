@@ -168,3 +168,46 @@ def test_table_of_the_harmonic_cam_reproduces_the_harmonic_run() -> None:
     a, b = simulate(thesis), simulate(table)
     assert [(e.clearance, e.kind) for e in a.events] == [(e.clearance, e.kind) for e in b.events]
     assert max(abs(x.cam_angle - y.cam_angle) for x, y in zip(a.events, b.events, strict=True)) < 1e-6
+
+
+def test_loading_a_table_with_a_ramp_junction_warns_naming_the_angle() -> None:
+    """Issue 15: not only `vtool cam show`: loading (hence `vtool solve`) warns where the table jumps."""
+    from vtool.errors import PresetWarning
+
+    angles, lift = ramp_flank_table(40.0)
+    doc = table_doc(angles=angles.tolist(), lifts=lift.tolist(), harmonics=40)
+    with pytest.warns(PresetWarning) as caught:
+        load(doc)
+    messages = [str(w.message) for w in caught if issubclass(w.category, PresetWarning)]
+    assert len(messages) == 1
+    assert messages[0].startswith("cam: the lift table's acceleration jumps at 20 deg (velocity kink), 40 deg,")
+    assert "320 deg, 340 deg (velocity kink)" in messages[0]
+
+
+def test_a_smooth_table_loads_without_a_junction_warning() -> None:
+    import warnings
+
+    from vtool.errors import PresetWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PresetWarning)
+        load_preset("ramped-cam")
+        angles = np.arange(0.0, 360.0, 5.0)
+        load(table_doc(angles=angles.tolist(), lifts=harmonic_table(angles).tolist(), harmonics=4))
+
+
+def test_vtool_solve_prints_one_warning_line_naming_the_junction(tmp_path: Path) -> None:
+    import tomli_w
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    angles, lift = ramp_flank_table(63.0)
+    doc = table_doc(angles=angles.tolist(), lifts=lift.tolist(), harmonics=40)
+    doc["seat"]["position"] = 0.56  # in: below where this cam's static start puts the valve
+    (tmp_path / "ramp.toml").write_text(tomli_w.dumps(doc))
+    result = CliRunner().invoke(cli, ["solve", str(tmp_path / "ramp.toml"), "--degrees", "5"])
+    assert result.exit_code == 0, result.output
+    warned = [line for line in result.stderr.splitlines() if "lift table" in line]
+    assert len(warned) == 1
+    assert warned[0].startswith("warning: cam: the lift table's acceleration jumps at 20 deg (velocity kink), 63 deg")

@@ -180,3 +180,29 @@ async def test_plate_invalid_step_blocks_and_auto_masters_round_trip(tmp_path) -
         await pilot.pause()
         assert isinstance(app.screen, ErrorDialog)
         assert app.errors_shown[-1].startswith("units: got 'furlongs'")
+
+
+async def test_boom_form_offers_the_envelope_family_and_pseudo_height_rule_of_the_preset() -> None:
+    """The form's choices write the preset keys the loader reads; the default stays unwritten."""
+    app = create_app("boom-brick-wall", remember=False, chart_color=False)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        family = screen.form.row("boom.envelope.family")
+        rule = screen.form.row("walls[0].pseudo_height_rule")
+        assert family.text == "thesis" and rule.text == "whole-unit"  # default / the preset's value
+        assert "family" not in screen.current_document()["boom"]["envelope"]  # absent stays absent
+        assert not family.has_class("-changed")
+        family.editor.value = "equal-rise"
+        rule.editor.value = "exact"
+        await pilot.pause()
+        assert family.has_class("-changed") and rule.has_class("-changed")
+        await run_and_wait(pilot, app)
+        doc = boom.dump(load_preset("boom-brick-wall"))
+        doc["boom"]["envelope"]["family"] = "equal-rise"
+        doc["walls"][0]["pseudo_height_rule"] = "exact"
+        expected = assess(boom.load(doc))
+        assert screen.results.rows == expected.rows
+        assert "P r2=r1" in screen.results.source  # the equal-rise family
+        left = next(s for s in screen.results.structures if s.name == "left")
+        assert left.details["pseudo_height"] == pytest.approx(31565.0 / 207.0)  # 152.49 in, not 152

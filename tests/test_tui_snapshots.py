@@ -94,3 +94,30 @@ async def test_wide_terminal_adds_the_summary_beside_the_charts() -> None:
         header = next(line for line in lines if "clearance" in line and "separations" in line)
         assert header.index("clearance") > header.index("▕") + 40  # right of the form and the charts
         assert "contact forces (lbf)" in text and "events" in text
+
+
+async def boom_limits_shot(size: tuple[int, int]) -> tuple[str, object]:
+    app = create_app("boom-brick-wall", remember=False, chart_color=False)
+    async with app.run_test(size=size) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        await app.workers.wait_for_complete()
+        text = await shot(app, pilot, size[0])
+        return text, app.screen.results
+
+
+@pytest.mark.parametrize("size", [(80, 24), (120, 40)])
+async def test_boom_limits_show_the_answer_column_without_scrolling(size: tuple[int, int]) -> None:
+    """The allowable p+ (the answer) is on screen right after the criterion, in both units."""
+    text, results = await boom_limits_shot(size)
+    lines = text.splitlines()
+    assert len(lines) == size[1]
+    header = next(line for line in lines if "criterion" in line and "structure" in line)
+    assert "p+ [psi]" in header and "p+ [lb/ft^2]" in header
+    assert header.index("p+ [psi]") > header.index("criterion")
+    if size[0] >= 120:
+        assert "SONIC BOOM" in text  # wide enough: the form stays beside the table
+    for r in results.rows:  # every row's answer, in both units, on screen
+        row = next(line for line in lines if r.criterion in line and f"{r.pressure:.4g}" in line)
+        assert f"{r.pressure_alt:.4g}" in row

@@ -17,13 +17,12 @@ def accuracy(preset: str, degrees: float | None, csv_path: Path | None, markdown
     and scipy (rtol 1e-4 to 1e-11) against the exact back end: wall time, steps, events, and errors in
     event angles, peak contact forces, valve seating velocity and valve lift."""
     from vtool.presets import load_preset
+    from vtool.presets.kinds import require_kind
     from vtool.presets.valvetrain import with_run_overrides
     from vtool.solvers.accuracy import accuracy_study, table_markdown, table_text, write_table_csv
 
     spec = load_preset(preset)
-    if spec.kind != "valvetrain":
-        raise click.BadParameter(f"{preset} is a {spec.kind} preset; `vtool accuracy` needs a valvetrain preset",
-                                 param_hint="PRESET")
+    require_kind(spec, "valvetrain", "`vtool accuracy`")
     spec = with_run_overrides(spec, degrees=degrees)
     _, rows = accuracy_study(spec)
     unit = spec.unit_system.length

@@ -40,12 +40,13 @@ from textual.app import ComposeResult
 from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
-from textual.widgets import Footer, ProgressBar, Static, TabbedContent
+from textual.widgets import ProgressBar, Static, TabbedContent
 from textual.worker import Worker, WorkerState, get_current_worker
 
 from vtool.app.tui.dialogs import PathDialog
 from vtool.app.tui.form import Field, ParamForm
 from vtool.app.tui.messages import FieldEdited, RunProgressed
+from vtool.app.tui.widgets import KeyFooter
 from vtool.errors import InputError
 
 PROGRESS_INTERVAL = 0.05  # s between progress messages: the bar needs no more
@@ -120,7 +121,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         with Horizontal(id="status-bar"):
             yield ProgressBar(total=1.0, show_eta=False, id="progress")
             yield Static("ready", id="status", markup=False)
-        yield Footer(show_command_palette=False, compact=True)
+        yield KeyFooter(show_command_palette=False, compact=True)
 
     @abstractmethod
     def compose_results(self) -> ComposeResult:

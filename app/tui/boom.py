@@ -21,6 +21,8 @@ from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, INTEGER, NUMBERS, TEXT, Field, dotted
 from vtool.app.tui.messages import AssessmentFinished
 from vtool.app.tui.widgets import ChartView, TextPanel
+from vtool.assessments.sonic_boom.spec import PSEUDO_HEIGHT_RULES
+from vtool.assessments.sonic_boom.spectra import FAMILIES
 
 PULSES = ("envelope", "N", "P", "Q", "R", "T", "csv")
 IDEALIZED_KEYS = ("s", "r1", "r2", "alpha", "beta")
@@ -44,6 +46,8 @@ def boom_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
             Field(("boom", "envelope", "r1"), "env. r1", "first,last,step", kind=NUMBERS, group=g),
             Field(("boom", "envelope", "alpha"), "env. alpha", optional=True, group=g),
             Field(("boom", "envelope", "beta"), "env. beta", optional=True, group=g),
+            Field(("boom", "envelope", "family"), "env. family", kind=CHOICE, choices=tuple(FAMILIES),
+                  default="thesis", group=g),
         ]
     elif pulse == "csv":
         fields.append(Field(("boom", "csv"), "pulse CSV file", kind=TEXT, group=g))
@@ -72,6 +76,8 @@ def boom_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
             Field(("walls", i, "net_area"), "net area", f"{u.length}^2", optional=True, group=grp),
             Field(("walls", i, "height"), "height b", u.length, optional=True, group=grp),
             Field(("walls", i, "measured_frequency"), "measured f", "Hz", optional=True, group=grp),
+            Field(("walls", i, "pseudo_height_rule"), "pseudo-height", kind=CHOICE,
+                  choices=PSEUDO_HEIGHT_RULES, default="exact", group=grp),
         ]
     for i, floor in enumerate(doc.get("floors", [])):
         grp = f"Floor {floor.get('name', i)}"
@@ -242,7 +248,7 @@ class BoomScreen(DomainScreen):
 
         a, daf = message.assessment, message.daf
         self.results = a
-        self.limits_panel.set_text(report.limits_text(a))
+        self.limits_panel.set_text(report.limits_text(a, answer_first=True))
         self.daf_chart.plot(lambda w, h, c: line_chart(daf["ratio"], daf["series"], title="overall DAF",
                                                        xlabel="tau/T", ylabel="DAF", width=w, height=h,
                                                        color=c))

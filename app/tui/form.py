@@ -42,6 +42,9 @@ class Field:
     choices: tuple[str, ...] = ()
     optional: bool = False  # empty text removes the key from the document
     group: str = ""
+    #: what the loader takes when the key is absent: the row shows it, and while the
+    #: row still shows it an absent key stays absent (the saved file does not grow)
+    default: Any = None
 
     @property
     def name(self) -> str:
@@ -151,7 +154,7 @@ class FieldRow(Widget):
     def __init__(self, field: Field, value: Any) -> None:
         super().__init__(id=field.widget_id)
         self.field = field
-        self.initial = value
+        self.initial = field.default if value is None else value
         self.error: str | None = None
 
     def compose(self) -> ComposeResult:
@@ -200,8 +203,13 @@ class FieldRow(Widget):
         self.query_one(".field-error", Static).update(message or "")
 
 
-class ParamForm(VerticalScroll):
-    """Grouped fields of one preset document; posts :class:`FieldEdited` on every edit."""
+class ParamForm(VerticalScroll, can_focus=False):
+    """Grouped fields of one preset document; posts :class:`FieldEdited` on every edit.
+
+    The form itself takes no focus (its fields do; page keys and the wheel still
+    scroll it): a click on a label would otherwise focus the container, and a focus
+    change of the container restyles every row (about 0.3 s per click at 60 rows).
+    """
 
     DEFAULT_CSS = """
     ParamForm { height: 1fr; }
@@ -260,7 +268,9 @@ class ParamForm(VerticalScroll):
         for row in self.query(FieldRow):
             f = row.field
             text = row.text
-            if not text.strip():
+            kept_default = (f.default is not None and get_path(doc, f.path) is None
+                            and text.strip() == format_value(f.default))
+            if not text.strip() or kept_default:
                 set_path(out, f.path, None, remove=True)
             else:
                 set_path(out, f.path, parse_value(f, text))
@@ -269,7 +279,10 @@ class ParamForm(VerticalScroll):
     def mark_changed(self, loaded: dict[str, Any]) -> None:
         """Mark the rows whose text differs from the loaded document's value."""
         for row in self.query(FieldRow):
-            before = format_value(get_path(loaded, row.field.path))
+            value = get_path(loaded, row.field.path)
+            if value is None:
+                value = row.field.default  # absent: the default the row shows
+            before = format_value(value)
             row.mark_changed(row.text.strip() != before and
                              parse_value(row.field, row.text) != parse_value(row.field, before))
 

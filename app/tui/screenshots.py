@@ -64,6 +64,7 @@ SHOTS = (
     ("valvetrain-configuration-wide", "valvetrain", "gnilka-1a", (170, 40), ("ctrl+t", "ctrl+t")),
     ("valvetrain-animation", "valvetrain", "gnilka-1a", (80, 24), ("ctrl+t",) * 5),
     ("boom-limits", "boom", "boom-brick-wall", (80, 24), ()),
+    ("boom-form", "boom", "boom-brick-wall", (120, 40), ()),
     ("boom-daf", "boom", "boom-brick-wall", (80, 24), ("ctrl+t",)),
     ("plate-transient", "plate", "plate-table2", (120, 32), ("ctrl+t",)),
 )

@@ -6,7 +6,8 @@ from collections.abc import Callable
 
 from rich.text import Text
 from textual.containers import ScrollableContainer
-from textual.widgets import Static
+from textual.screen import Screen
+from textual.widgets import Footer, Static
 
 ChartFunction = Callable[[int, int, bool], str]  # (width, height, color) -> chart text
 
@@ -76,3 +77,24 @@ class TextPanel(ScrollableContainer):
     def set_text(self, text: str) -> None:
         self.text = text
         self.query_one(Static).update(Text(text, no_wrap=True))
+
+
+class KeyFooter(Footer):
+    """Textual's footer, rebuilt only when the keys it shows change.
+
+    Textual rebuilds the footer (a widget per key) on every focus change, and a
+    rebuild lays out the whole screen: about half of what a ``tab`` costs on the
+    valve-train form. The keys shown rarely change with focus, so an unchanged
+    set is not rebuilt.
+    """
+
+    _shown: tuple[object, ...] | None = None
+
+    def bindings_changed(self, screen: Screen[object]) -> None:
+        shown = tuple((b.key, b.description, b.action, b.group, enabled, tooltip)
+                      for (_, b, enabled, tooltip) in screen.active_bindings.values() if b.show)
+        if self._bindings_ready and shown == self._shown:
+            return
+        if screen.app.app_focus and self.is_attached and screen is self.screen:
+            self._shown = shown  # what the rebuild below will show
+        super().bindings_changed(screen)

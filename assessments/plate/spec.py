@@ -9,27 +9,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from vtool.assessments.plate.study import Study
+from vtool.units import PLATE_UNIT_SYSTEMS, UnitSystem
 
-
-@dataclass(frozen=True)
-class PlateUnits:
-    """Unit names of one consistent system, as a plate preset uses them, and their SI factors."""
-
-    length: str
-    pressure: str
-    density: str
-    force: str
-    metres: float = 1.0  # per length unit
-    pascals: float = 1.0  # per pressure unit
-    kg_per_m3: float = 1.0  # per density unit
-
-
-#: Same system names as the valve-train presets.
-UNIT_SYSTEMS: dict[str, PlateUnits] = {
-    "in-lbf-s": PlateUnits("in", "lbf/in^2", "lbf*s^2/in^4", "lbf", 0.0254, 6894.757293168361,
-                           4.4482216152605 / 0.0254**4),
-    "SI": PlateUnits("m", "Pa", "kg/m^3", "N"),
-}
+#: the plate's unit systems (same names as the valve-train presets): one class, :mod:`vtool.units`
+UNIT_SYSTEMS: dict[str, UnitSystem] = PLATE_UNIT_SYSTEMS
 
 
 @dataclass(frozen=True)
@@ -46,5 +29,5 @@ class PlateSpec:
     kind: str = "plate"
 
     @property
-    def unit_system(self) -> PlateUnits:
+    def unit_system(self) -> UnitSystem:
         return UNIT_SYSTEMS[self.units]

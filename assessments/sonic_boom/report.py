@@ -59,16 +59,22 @@ def structure_line(s: Structure, u: UnitSystem) -> str:
     return f"  {s.name}: {'; '.join(parts)}; f: {freqs}"
 
 
-def limits_text(a: Assessment) -> str:
-    """The assessment as a table: DAF source, criteria, structures, allowable pressures."""
+def limits_text(a: Assessment, answer_first: bool = False) -> str:
+    """The assessment as a table: DAF source, criteria, structures, allowable pressures.
+
+    ``answer_first`` (the TUI, whose panel is often 80 columns wide) puts the
+    allowable-pressure table right under the title, with its columns ordered
+    structure, criterion, p+ in both units, then how it was found; the CLI
+    keeps the order of the CSV.
+    """
     u = a.units
-    lines = [a.title, f"DAF source: {a.source}",
-             f"units: {u.name} (pressure {u.pressure}, also {u.alt_pressure}; g = {u.gravity:g} "
-             f"{u.length}/s^2)", "criteria:"]
-    lines += [f"  {c.describe()}" for c in a.criteria]
-    lines.append("structures:")
-    lines += [structure_line(s, u) for s in a.structures]
-    lines.append("allowable peak overpressure:")
+    head = [a.title]
+    details = [f"DAF source: {a.source}",
+               f"units: {u.name} (pressure {u.pressure}, also {u.alt_pressure}; g = {u.gravity:g} "
+               f"{u.length}/s^2)", "criteria:"]
+    details += [f"  {c.describe()}" for c in a.criteria]
+    details.append("structures:")
+    details += [structure_line(s, u) for s in a.structures]
     header = (*ROW_HEADER, f"limit/DAF [{u.length}/s | {u.length}]", f"p+ [{u.pressure}]",
               f"p+ [{u.alt_pressure}]", "note")
     table = [header]
@@ -78,7 +84,11 @@ def limits_text(a: Assessment) -> str:
         table.append((r.structure, r.frequency_source, f"{r.frequency:.3f}", f"{r.tau:g}",
                       f"{r.ratio:.4f}", r.criterion, r.response, f"{r.daf:.4f}", fmt(r.normalized),
                       fmt(r.pressure), fmt(r.pressure_alt), note))
-    return "\n".join(lines + _columns(table))
+    if not answer_first:
+        return "\n".join(head + details + ["allowable peak overpressure:"] + _columns(table))
+    order = (0, 5, 9, 10, 1, 2, 3, 4, 6, 7, 8, 11)  # structure, criterion, p+ (both units), the rest
+    table = [tuple(row[i] for i in order) for row in table]
+    return "\n".join(head + ["allowable peak overpressure:"] + _columns(table) + details)
 
 
 def limits_csv(a: Assessment) -> str:

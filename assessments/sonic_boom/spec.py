@@ -1,7 +1,7 @@
 """Frozen specs of a sonic-boom study (what a ``boom_wall`` / ``boom_floor`` preset holds).
 
 Validation happens in :mod:`vtool.presets.boom`; these classes only carry
-the values, with their units named by :class:`UnitSystem`.
+the values, with their units named by :class:`vtool.units.UnitSystem`.
 """
 
 from __future__ import annotations
@@ -11,6 +11,10 @@ from dataclasses import dataclass, field
 from vtool.assessments.sonic_boom.criteria import Criterion
 from vtool.assessments.sonic_boom.pulses import PulseParams
 from vtool.assessments.sonic_boom.spectra import EnvelopeSpec
+from vtool.units import BOOM_UNIT_SYSTEMS, UnitSystem
+
+__all__ = ["DURATION_LIMITS", "FREQUENCY_LIMITS", "PSEUDO_HEIGHT_RULES", "UNIT_SYSTEMS", "BoomFloorSpec",
+           "BoomLoading", "BoomWallSpec", "DesignRange", "FloorSpec", "UnitSystem", "WallSpec"]
 
 #: Structure frequencies (Hz) accepted: measured, from the plate formula or the
 #: column model, and the design-curve range.
@@ -19,33 +23,8 @@ FREQUENCY_LIMITS: tuple[float, float] = (1e-2, 1e3)
 DURATION_LIMITS: tuple[float, float] = (1e-4, 10.0)
 
 
-@dataclass(frozen=True)
-class UnitSystem:
-    """A consistent unit system: lengths, forces, pressures, and g."""
-
-    name: str
-    length: str
-    force: str
-    pressure: str
-    surface_weight: str
-    gravity: float
-    metres_per_length: float
-    alt_pressure: str  # a second pressure unit engineers quote booms in
-    alt_per_pressure: float
-    pascals_per_pressure: float = 1.0
-    newtons_per_force: float = 1.0
-
-    @property
-    def mass(self) -> str:
-        return f"{self.force} s^2/{self.length}"
-
-
-UNIT_SYSTEMS: dict[str, UnitSystem] = {
-    # the thesis' system; g = 386.4 in/s^2 as in its arithmetic (section 1.5.2)
-    "in-lbf-s": UnitSystem("in-lbf-s", "in", "lbf", "psi", "lbf/in^2", 386.4, 0.0254,
-                           "lb/ft^2", 144.0, 6894.757293168361, 4.4482216152605),
-    "m-N-s": UnitSystem("m-N-s", "m", "N", "Pa", "N/m^2", 9.80665, 1.0, "kPa", 1e-3),
-}
+#: the boom's unit systems (thesis 001's g = 386.4 in/s^2): :data:`vtool.units.BOOM_UNIT_SYSTEMS`
+UNIT_SYSTEMS: dict[str, UnitSystem] = BOOM_UNIT_SYSTEMS
 
 
 @dataclass(frozen=True)
