@@ -1,7 +1,7 @@
 """Preset fuzzer: any valve-train preset gives a run, one clean line (exit 2 or 1), never a traceback.
 
 A seeded hypothesis fuzzer mutates the shipped valve-train presets (delete or
-add keys, numbers scaled by 1e-8 to 1e8, wrong types, 0, negatives, NaN, +-inf, 1e+-300, ints too large for
+add keys, a contact made compliant (linear or hertz), numbers scaled by 1e-8 to 1e8, wrong types, 0, negatives, NaN, +-inf, 1e+-300, ints too large for
 a float, huge arrays and strings, duplicated entries, invalid UTF-8, tables
 and arrays nested 5,000 deep) and runs each through ``vtool solve`` in
 process. Every case must end with exit code 0, 1 or 2; a non-zero exit prints
@@ -75,6 +75,13 @@ def at(doc: Any, path: tuple[Any, ...]) -> Any:
 def mutated_text(draw: st.DrawFn) -> bytes:
     """A shipped valve-train preset with one to three mutations, as file bytes."""
     doc = base_doc(draw(st.sampled_from(VALVETRAIN)))
+    if draw(st.integers(0, 3)) == 0:  # a compliant contact (docs/contact.md), then mutated like the rest
+        clearance = draw(st.sampled_from(doc["clearances"]))
+        law = draw(st.sampled_from(["linear", "hertz"]))
+        clearance["contact"] = law
+        clearance["contact_stiffness"] = draw(st.sampled_from([1e3, 1e6, 1e8, 1e12, 1e13]))
+        if law == "linear":
+            clearance["contact_damping_ratio"] = draw(st.sampled_from([0.0, 0.5, 1.0, 5.0]))
     for _ in range(draw(st.integers(1, 3))):
         target = at(doc, draw(st.sampled_from(containers(doc))))
         keys = list(target) if isinstance(target, dict) else list(range(len(target)))
