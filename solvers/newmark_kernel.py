@@ -98,6 +98,10 @@ I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_SETTLE, I_WAN
 I_SIZE = 11  # I_SUB: refined steps taken since the grid point I_GRID (the refined steps' own grid)
 F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
 F_SIZE = 4
+# how a step solves S z̈ = rhs (layer_step's ``which``): stored inverses of the standard and refined
+# steps, or a Cholesky factor. np.int64 values, not int literals: numba compiles a function once per
+# literal argument value, and layer_step (with the Hertz iteration) is the kernel's largest callee.
+STANDARD, REFINED, CHOLESKY = np.int64(0), np.int64(1), np.int64(2)
 
 
 ENTRY_POINTS = ("run_chunk", "impact", "settle", "fill_sources")  # what the back ends call from Python
@@ -804,7 +808,7 @@ def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, 
         tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
         fill_sources(ns, nh, fp[FP_OMEGA], sc, sa, sb, t + tau, src1)
         factor_effective(ci, cm, c, beta, gamma, tau, L)
-        layer_step(ci, cm, cp, c, beta, gamma, tau, 2, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
+        layer_step(ci, cm, cp, c, beta, gamma, tau, CHOLESKY, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
                    cl, clf, mk, mon)
         f = monitor_value(cl, clf, mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z1, zd1, zdd1, src1)
         if f < 0.0:
@@ -1170,14 +1174,14 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 continue
             fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
             if h == dt:
-                layer_step(ci, cm, cp, c, beta, gamma, h, 0, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
+                layer_step(ci, cm, cp, c, beta, gamma, h, STANDARD, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
                            cl, clf, mk, mon)
             elif h == fine:
-                layer_step(ci, cm, cp, c, beta, gamma, h, 1, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
+                layer_step(ci, cm, cp, c, beta, gamma, h, REFINED, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
                            cl, clf, mk, mon)
             else:
                 factor_effective(ci, cm, c, beta, gamma, h, L)
-                layer_step(ci, cm, cp, c, beta, gamma, h, 2, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
+                layer_step(ci, cm, cp, c, beta, gamma, h, CHOLESKY, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
                            cl, clf, mk, mon)
             fired = False
             for k in range(ncl):
@@ -1200,7 +1204,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 if h > 0.0:
                     fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
                     factor_effective(ci, cm, c, beta, gamma, h, L)
-                    layer_step(ci, cm, cp, c, beta, gamma, h, 2, L, n, src1, z, zd, zdd,
+                    layer_step(ci, cm, cp, c, beta, gamma, h, CHOLESKY, L, n, src1, z, zd, zdd,
                                z1, zd1, zdd1, rhs, sol, cl, clf, mk, mon)
                     for k in range(ncl):
                         if mk[c, k, MK_KIND] == MK_FORCE or mk[c, k, MK_KIND] == MK_OVERLAP:
