@@ -78,7 +78,7 @@ CLF_SIZE = 5
 # impact laws
 LAW_MOMENTUM, LAW_LOCAL, LAW_THESIS = range(3)
 # event kinds
-EV_OPENED, EV_CLOSED, EV_RELEASED = range(3)
+EV_OPENED, EV_CLOSED, EV_RELEASED = np.int64(0), np.int64(1), np.int64(2)  # np.int64: add_event compiles once
 # configuration integer table: built, m, nf, source coupling, then kept[n], group[n], source of each z index[n]
 CI_BUILT, CI_M, CI_NF, CI_SRC, CI_HERTZ = range(5)
 CI_HEAD = 5
