@@ -146,3 +146,11 @@ def test_compare_runs_for_every_valvetrain_preset(tmp_path: Path, name: str) -> 
     assert [(r["impact"], r["start"]) for r in rows] == [(law, start) for law in ("local", "thesis", "momentum")
                                                          for start in ("thesis", "quasi-static")]
     assert len(out.read_text().splitlines()) == 1 + len(rows)
+
+
+@pytest.mark.parametrize("command", [["size", "--rpm-max", "12000"], ["compare"], ["cam", "show"], ["accuracy"]])
+def test_valvetrain_only_commands_refuse_another_kind_in_one_line(command: list[str]) -> None:
+    result = run(*command, "plate-table2")
+    assert result.exit_code == 2
+    assert result.output.strip().count("\n") == 0
+    assert "expected a valvetrain preset" in result.output

@@ -23,9 +23,9 @@ def show(preset: str, plot: bool, as_json: bool) -> None:
     from vtool.solvers.cam import cam_report, report_text
 
     spec = load_preset(preset)
-    if spec.kind != "valvetrain":
-        raise click.BadParameter(f"{preset} is a {spec.kind} preset; `vtool cam` needs a valvetrain preset",
-                                 param_hint="PRESET")
+    from vtool.presets.kinds import require_kind
+
+    require_kind(spec, "valvetrain", "`vtool cam`")
     report = cam_report(spec)
     if spec.seat is not None:
         from vtool.solvers.lash import lash_of

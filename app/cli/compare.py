@@ -33,9 +33,9 @@ def compare(preset: str, impacts: tuple[str, ...], starts: tuple[str, ...] | Non
     from vtool.solvers.compare import compare as run_compare
 
     spec = load_preset(preset)
-    if spec.kind != "valvetrain":
-        raise click.BadParameter(f"{preset} is a {spec.kind} preset; `vtool compare` needs a valvetrain preset",
-                                 param_hint="PRESET")
+    from vtool.presets.kinds import require_kind
+
+    require_kind(spec, "valvetrain", "`vtool compare`")
     if degrees is not None:
         from vtool.errors import InputError
 

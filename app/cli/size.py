@@ -21,9 +21,9 @@ def size(preset: str, rpm_max: float, tolerance: float, max_elements: int) -> No
     from vtool.solvers.size import size_study, study_text
 
     spec = load_preset(preset)
-    if spec.kind != "valvetrain":
-        raise click.BadParameter(f"{preset} is a {spec.kind} preset; `vtool size` needs a valvetrain preset",
-                                 param_hint="PRESET")
+    from vtool.presets.kinds import require_kind
+
+    require_kind(spec, "valvetrain", "`vtool size`")
     if not rpm_max > 0 or rpm_max > 1e6:
         raise InputError("--rpm-max", rpm_max, "> 0 and <= 1e6", "rev/min")
     if not 0 < tolerance < 1:
