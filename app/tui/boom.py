@@ -8,7 +8,6 @@ assessment used (pulse or envelope).
 
 from __future__ import annotations
 
-import threading
 from typing import Any
 
 from textual import work
@@ -149,8 +148,6 @@ def daf_curves(spec: Any, assessment: Any, cancel: Any = None) -> dict[str, Any]
 
 class BoomScreen(DomainScreen):
     MODE = "boom"
-    #: held by the running assessment; a new run waits for the cancelled one
-    run_lock = threading.Lock()
     KINDS = ("boom_wall", "boom_floor")
     DEFAULT_PRESET = "boom-brick-wall"
     TITLE_TEXT = "SONIC BOOM"
@@ -228,9 +225,11 @@ class BoomScreen(DomainScreen):
         def cancel() -> bool:
             return worker.is_cancelled
 
-        # the previous run (cancelled by this one: exclusive) releases the lock
-        # when it has stopped: only one run's arrays exist at a time
-        with self.run_lock:
+        # the previous run (cancelled by this one: exclusive) leaves the slot when it has
+        # stopped: only one run's arrays exist at a time (the base's cancellable wait)
+        with self.run_slot() as go:
+            if not go:
+                return
             try:
                 assessment = assess(spec, cancel)
                 daf = daf_curves(spec, assessment, cancel)

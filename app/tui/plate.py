@@ -8,7 +8,6 @@ scheme, against the exact (Navier) reference.
 
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass
 from typing import Any
 
@@ -195,8 +194,6 @@ def case_text(run: PlateRun) -> str:
 
 class PlateScreen(DomainScreen):
     MODE = "plate"
-    #: held by the running study; a new run waits for the cancelled one
-    run_lock = threading.Lock()
     KINDS = ("plate",)
     DEFAULT_PRESET = "plate-table2"
     TITLE_TEXT = "PLATE (condensation)"
@@ -289,9 +286,11 @@ class PlateScreen(DomainScreen):
         def cancel() -> bool:
             return worker.is_cancelled
 
-        # the previous run (cancelled by this one: exclusive) releases the lock
-        # when it has stopped: only one run's arrays exist at a time
-        with self.run_lock:
+        # the previous run (cancelled by this one: exclusive) leaves the slot when it has
+        # stopped: only one run's arrays exist at a time (the base's cancellable wait)
+        with self.run_slot() as go:
+            if not go:
+                return
             try:
                 result = run_plate(spec, options, cancel)
             except Cancelled:
