@@ -60,7 +60,8 @@ from vtool.solvers.trace import CLOSED, OPENED, RELEASED
 
 LAW_CODES = {MOMENTUM: kernel.LAW_MOMENTUM, LOCAL: kernel.LAW_LOCAL, THESIS: kernel.LAW_THESIS}
 SOFT_CODES = {RIGID: 0, LINEAR: kernel.SOFT_LINEAR, HERTZ: kernel.SOFT_HERTZ}
-EVENT_KINDS = {kernel.EV_OPENED: OPENED, kernel.EV_CLOSED: CLOSED, kernel.EV_RELEASED: RELEASED}
+EVENT_KINDS: dict[int, str] = {int(kernel.EV_OPENED): OPENED, int(kernel.EV_CLOSED): CLOSED,
+                              int(kernel.EV_RELEASED): RELEASED}
 
 
 def source_series(mechanism: Mechanism) -> SourceSeries:

@@ -353,7 +353,7 @@ class PiecewiseRun(ABC):
                 if self.problem.cl[k, kernel.CL_SOFT]:  # the parts leave with their relative velocity
                     kernel.snap_shut(self.problem.cl, k, x, src)
                     u = float(kernel.relative_velocity(self.problem.cl, k, v, src))
-                self.builder.add_event(t, k, EVENT_KINDS[kernel.EV_OPENED], u, c, new_c)
+                self.builder.add_event(t, k, EVENT_KINDS[int(kernel.EV_OPENED)], u, c, new_c)
         if closing.any():
             stick = self.rapid >= self.problem.rules.zeno_stick
             problem = self.problem
