@@ -147,3 +147,37 @@ async def test_monkey_finds_no_crash(tmp_path, monkeypatch) -> None:  # type: ig
     for line in found.crashes + found.internal:
         print("  ", line[:300])
     assert not found.crashes, "\n".join(found.crashes)
+
+
+async def test_paging_a_choice_list_before_it_is_laid_out_is_harmless() -> None:
+    """Seed 812: ``down`` opened a choice field's list and ``pageup`` reached it before its
+    first layout; Textual's OptionList indexed its empty line table (KeyError: 0). The
+    reproducer pages the list directly while it has no size; every choice field and the sweep
+    metric use ``ChoiceSelect``."""
+    from textual.app import App, ComposeResult
+    from textual.widgets import Select
+    from textual.widgets._select import SelectOverlay
+
+    from vtool.app.tui.form import FieldRow
+    from vtool.app.tui.widgets import ChoiceSelect
+
+    class OneChoice(App[None]):
+        def compose(self) -> ComposeResult:
+            yield ChoiceSelect([("a", "a"), ("b", "b")], value="a", allow_blank=False)
+
+    app = OneChoice()
+    async with app.run_test(size=(80, 24)) as pilot:
+        overlay = app.query_one(SelectOverlay)
+        assert not overlay.scrollable_content_region  # not laid out: Textual's own list raises here
+        overlay.highlighted = 0
+        overlay.action_page_up()
+        overlay.action_page_down()
+        await pilot.pause()
+    assert app._exception is None
+    # the app's choice fields are this widget, not a bare Select
+    tui = create_app("gnilka-1a", remember=False, chart_color=False)
+    async with tui.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        selects = list(tui.screen.query(Select))
+        assert selects and all(isinstance(s, ChoiceSelect) for s in selects)
+        assert any(isinstance(s.parent, FieldRow) for s in selects)

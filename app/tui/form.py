@@ -21,6 +21,7 @@ from textual.widget import Widget
 from textual.widgets import Input, Label, Select, Static
 
 from vtool.app.tui.messages import FieldEdited
+from vtool.app.tui.widgets import ChoiceSelect
 
 Path = tuple[str | int, ...]
 
@@ -163,7 +164,7 @@ class FieldRow(Widget):
         if f.kind == CHOICE:
             options = [(c, c) for c in f.choices]
             value = self.initial if self.initial in f.choices else f.choices[0]
-            yield Select(options, value=value, allow_blank=False, compact=True, id=f"{f.widget_id}-editor")
+            yield ChoiceSelect(options, value=value, allow_blank=False, compact=True, id=f"{f.widget_id}-editor")
         else:
             yield Input(format_value(self.initial), compact=True, id=f"{f.widget_id}-editor",
                         select_on_focus=False)

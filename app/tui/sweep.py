@@ -23,7 +23,7 @@ from textual.widget import Widget
 from textual.widgets import Button, Input, ProgressBar, Select, Static
 from textual.worker import Worker, WorkerState, get_current_worker
 
-from vtool.app.tui.widgets import ChartView, TextPanel
+from vtool.app.tui.widgets import ChartView, ChoiceSelect, TextPanel
 
 DEFAULT_METRICS = ("spring_margin", "cam_separation_duration", "cam_separations", "lift_loss",
                    "seating_velocity_max", "seat_bounces", "bounce_height", "peak_F1", "peak_F2", "peak_F7",
@@ -84,7 +84,7 @@ class SweepPane(Widget):
                 yield Input(values, placeholder="start:stop:step or a,b,c", id="sweep-values")
                 yield Input(fixed, placeholder="fixed settings, e.g. run.degrees=460", id="sweep-fixed")
                 names = self._metric_names()
-                yield Select([(m, m) for m in names], value=metric if metric in names else names[0],
+                yield ChoiceSelect([(m, m) for m in names], value=metric if metric in names else names[0],
                              allow_blank=False, id="sweep-metric")
             with Horizontal():
                 yield Button("Run", id="sweep-run", variant="primary")

@@ -1,4 +1,4 @@
-"""Reusable widgets: a chart that redraws to its size, and a plain-text panel."""
+"""Reusable widgets: a chart that redraws to its size, a plain-text panel, a Select safe to page."""
 
 from __future__ import annotations
 
@@ -6,8 +6,10 @@ from collections.abc import Callable
 
 from rich.text import Text
 from textual.containers import ScrollableContainer
+from textual.app import ComposeResult
 from textual.screen import Screen
-from textual.widgets import Footer, Static
+from textual.widgets import Footer, Select, Static
+from textual.widgets._select import SelectCurrent, SelectOverlay
 
 ChartFunction = Callable[[int, int, bool], str]  # (width, height, color) -> chart text
 
@@ -98,3 +100,27 @@ class KeyFooter(Footer):
         if screen.app.app_focus and self.is_attached and screen is self.screen:
             self._shown = shown  # what the rebuild below will show
         super().bindings_changed(screen)
+
+
+class _PagingOverlay(SelectOverlay):
+    """Select's drop-down list, safe to page before it has been laid out.
+
+    Textual 8.2's ``OptionList._move_page`` indexes its line table, which is
+    empty until the list has a size: page-up pressed in the same frame as the
+    key that opens the list raised ``KeyError: 0`` (TUI monkey, seed 812:
+    ``down`` then ``pageup`` on a choice field). Paging an unlaid list does
+    nothing here.
+    """
+
+    def _move_page(self, direction: int) -> None:
+        if (self.highlighted or 0) not in self._index_to_line:
+            return
+        super()._move_page(direction)
+
+
+class ChoiceSelect(Select[str]):
+    """A ``Select`` whose drop-down is the paging-safe overlay above."""
+
+    def compose(self) -> ComposeResult:
+        yield SelectCurrent(self.prompt)
+        yield _PagingOverlay(type_to_search=self._type_to_search).data_bind(compact=Select.compact)
