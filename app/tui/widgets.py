@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from rich.text import Text
-from textual.containers import ScrollableContainer
 from textual.app import ComposeResult
+from textual.containers import ScrollableContainer
 from textual.screen import Screen
 from textual.widgets import Footer, Select, Static
 from textual.widgets._select import SelectCurrent, SelectOverlay
