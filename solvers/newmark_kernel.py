@@ -868,6 +868,14 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
     nf = ci[c, CI_NF]
     coupled = ci[c, CI_SRC]
     rows = out_t.shape[0]
+    # this configuration's 2-D tables, taken once (inner loops then index two dimensions, not four)
+    Cff = cm[c, CM_CFF]
+    Kff = cm[c, CM_KFF]
+    Sstd = cm[c, CM_SINV]
+    Sfine = cm[c, CM_SINVF]
+    P = cp[c]
+    W = mon[c]
+    kinds = mk[c]
     t = fst[F_T]
     while True:
         k_grid = ist[I_GRID]
@@ -877,10 +885,12 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
                 return t
             h = fine
             slot = CM_SINVF
+            S = Sfine
             t1 = (k_grid + 1) * dt if sub + 1 == refine else k_grid * dt + (sub + 1) * fine
         elif t == k_grid * dt:
             h = dt
             slot = CM_SINV
+            S = Sstd
             t1 = (k_grid + 1) * dt
         else:
             return t
@@ -905,9 +915,13 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
                 src1[3 * s + 1] += wk * (cb * ck - ca * sk)
                 src1[3 * s + 2] -= wk * wk * (ca * ck + cb * sk)
         # the Newmark step (see layer_step)
+        hx = h * h * (0.5 - beta)
+        hv = h * (1.0 - gamma)
+        bx = beta * h * h
+        gv = gamma * h
         for j in range(m):
-            z1[j] = z[j] + h * zd[j] + h * h * (0.5 - beta) * zdd[j]
-            zd1[j] = zd[j] + h * (1.0 - gamma) * zdd[j]
+            z1[j] = z[j] + h * zd[j] + hx * zdd[j]
+            zd1[j] = zd[j] + hv * zdd[j]
         for j in range(nf, m):
             sidx = ci[c, CI_HEAD + 2 * n + j]
             z1[j] = src1[3 * sidx]
@@ -916,38 +930,38 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
         for f in range(nf):
             acc = 0.0
             for g in range(nf):
-                acc -= cm[c, CM_CFF, f, g] * zd1[g] + cm[c, CM_KFF, f, g] * z1[g]
+                acc -= Cff[f, g] * zd1[g] + Kff[f, g] * z1[g]
             for p in range(m - nf):
                 j = nf + p
-                acc -= cp[c, f, 3 * p] * zdd1[j] + cp[c, f, 3 * p + 1] * zd1[j] + cp[c, f, 3 * p + 2] * z1[j]
+                acc -= P[f, 3 * p] * zdd1[j] + P[f, 3 * p + 1] * zd1[j] + P[f, 3 * p + 2] * z1[j]
             if coupled:
                 for j in range(3 * ns):
-                    acc -= cp[c, f, 3 * n + j] * src1[j]
+                    acc -= P[f, 3 * n + j] * src1[j]
             rhs[f] = acc
         for f in range(nf):
             acc = 0.0
             for g in range(nf):
-                acc += cm[c, slot, f, g] * rhs[g]
+                acc += S[f, g] * rhs[g]
             zdd1[f] = acc
-            z1[f] += beta * h * h * acc
-            zd1[f] += gamma * h * acc
+            z1[f] += bx * acc
+            zd1[f] += gv * acc
         # monitors (see monitor_value): stop before a sign change
         for k in range(ncl):
-            kind = mk[c, k, MK_KIND]
+            kind = kinds[k, MK_KIND]
             value = 0.0
             if kind == MK_GAP or kind == MK_OVERLAP:
-                behind = mk[c, k, MK_BEHIND]
+                behind = kinds[k, MK_BEHIND]
                 other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
-                value = z1[mk[c, k, MK_AHEAD]] - other
+                value = z1[kinds[k, MK_AHEAD]] - other
                 value = (value if kind == MK_GAP else -value) + gap_noise
                 if value < 0.0:
                     return t
             elif kind == MK_FORCE:
-                value = mon[c, k, 3 * n + 3 * ns]
+                value = W[k, 3 * n + 3 * ns]
                 for j in range(m):
-                    value += mon[c, k, j] * z1[j] + mon[c, k, n + j] * zd1[j] + mon[c, k, 2 * n + j] * zdd1[j]
+                    value += W[k, j] * z1[j] + W[k, n + j] * zd1[j] + W[k, 2 * n + j] * zdd1[j]
                 for j in range(3 * ns):
-                    value += mon[c, k, 3 * n + j] * src1[j]
+                    value += W[k, 3 * n + j] * src1[j]
                 if value < 0.0 and cl[k, CL_MON]:
                     return t
             phi[k] = value
@@ -1017,18 +1031,18 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
         # accept: peaks, state, time
         after = t1 >= t_rev
         for k in range(ncl):
-            kind = mk[c, k, MK_KIND]
+            kind = kinds[k, MK_KIND]
             if kind == MK_FORCE:
                 if phi[k] > peak[PEAK_ALL, k]:
                     peak[PEAK_ALL, k] = phi[k]
                 if after and phi[k] > peak[PEAK_LATE, k]:
                     peak[PEAK_LATE, k] = phi[k]
             elif kind == MK_OVERLAP:
-                force = mon[c, k, 3 * n + 3 * ns]
+                force = W[k, 3 * n + 3 * ns]
                 for j in range(m):
-                    force += mon[c, k, j] * z1[j] + mon[c, k, n + j] * zd1[j]
+                    force += W[k, j] * z1[j] + W[k, n + j] * zd1[j]
                 for j in range(3 * ns):
-                    force += mon[c, k, 3 * n + j] * src1[j]
+                    force += W[k, 3 * n + j] * src1[j]
                 if force > peak[PEAK_ALL, k]:
                     peak[PEAK_ALL, k] = force
                 if after and force > peak[PEAK_LATE, k]:

@@ -338,7 +338,12 @@ def test_damping_extremes_make_a_restless_or_a_quiet_valve_train() -> None:
     most once per revolution (with the local law and the quasi-static start it floats clear of the seat:
     the follower leaves the cam at 90 degrees and lands at 305) and little else happens. (A plain 1 µs Newmark run showed six seat bounces per revolution undamped: its
     high-mode error after impacts, which the refinement after events removes.)"""
-    undamped, mechanism = run(variant(damping=0.0))
+    # Undamped, the run is chaotic: a round-off change (every-step output against 1-degree output
+    # already differs by 1e-12 s at event 43) gives another, equally valid sequence. The invariants
+    # are checked at every step, where the method defines the contact forces; 1-degree rows inside a
+    # step are its cubic interpolant, which in one such sequence dipped to -10 lbf (0.1 % of the
+    # peak) between two positive step ends (docs/limits.md).
+    undamped, mechanism = run(variant(damping=0.0), every_step=True)
     assert_sane(undamped, mechanism)
     damped, mechanism = run(variant(damping=1.0))
     assert_sane(damped, mechanism)

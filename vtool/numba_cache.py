@@ -14,10 +14,13 @@ is imported (the kernel module calls it first) and:
 4. and when none is writable, disables caching (``NUMBA_DISABLE_CACHE``-like:
    :data:`CACHE_ENABLED` is False, the kernel module passes it as ``cache=``)
    with a one-line warning on stderr: every run then compiles again.
+
+It also answers numba's start-up BLAS probe (:func:`decline_blas_probe`).
 """
 
 from __future__ import annotations
 
+import importlib.abc
 import os
 import sys
 import tempfile
@@ -57,6 +60,7 @@ def configure(package_dir: str | os.PathLike[str] | None = None) -> str:
     global CACHE_ENABLED, _configured
     if _configured is not None:
         return _configured
+    decline_blas_probe()
     if os.environ.get("NUMBA_CACHE_DIR"):
         _configured = f"NUMBA_CACHE_DIR={os.environ['NUMBA_CACHE_DIR']} (set by the user)"
         return _configured
@@ -84,3 +88,33 @@ def _reload_numba_config() -> None:
         from numba.core import config
 
         config.reload_config()
+
+
+class _BlasProbe(importlib.abc.MetaPathFinder):
+    """Refuses ``scipy.linalg`` to numba's start-up probe ``numba.np.arraymath._check_blas`` only."""
+
+    def find_spec(self, name, path=None, target=None):  # type: ignore[no-untyped-def]  # noqa: ANN001, ANN201
+        if name != "scipy.linalg":
+            return None
+        frame = sys._getframe(1)
+        while frame is not None:
+            if frame.f_code.co_name == "_check_blas" and frame.f_globals.get("__name__") == "numba.np.arraymath":
+                raise ImportError("vtool: numba's BLAS probe declined (vtool's kernels use no BLAS)")
+            frame = frame.f_back
+        return None
+
+
+def decline_blas_probe() -> None:
+    """Keep numba's start-up from importing ``scipy.linalg`` (0.15-0.25 s of every process).
+
+    When numba first loads a compiled function it imports ``numba.np.arraymath``,
+    whose module code probes for BLAS by importing ``scipy.linalg.cython_blas``
+    and keeps the answer only to choose between BLAS and a plain loop in
+    ``np.correlate``/``np.convolve``, which vtool's kernels do not call. This
+    finder makes that one probe fail, so a ``vtool solve`` that needs no scipy
+    loads none of ``scipy.linalg``. Every other import of ``scipy.linalg`` (the
+    exact and scipy back ends, numba typing ``np.linalg`` or ``np.dot``, which
+    call ``ensure_blas`` themselves) goes through unchanged. Idempotent.
+    """
+    if not any(isinstance(finder, _BlasProbe) for finder in sys.meta_path):
+        sys.meta_path.insert(0, _BlasProbe())
