@@ -50,10 +50,15 @@ def undamped_modes(M: np.ndarray, K: np.ndarray) -> Modes:
     # K φ = ω² M φ reduced with M = L Lᵀ to the standard problem (L⁻¹ K L⁻ᵀ) y = ω² y, φ = L⁻ᵀ y,
     # as LAPACK's sygvd does, with NumPy alone: `vtool solve` imports no scipy.linalg (issue 12)
     try:
-        L = np.linalg.cholesky(M)
-        Linv = np.linalg.solve(L, np.eye(M.shape[0]))
-        A = Linv @ K @ Linv.T
-        eigenvalues, vectors = np.linalg.eigh(0.5 * (A + A.T))
+        with np.errstate(all="ignore"):
+            L = np.linalg.cholesky(M)
+            Linv = np.linalg.solve(L, np.eye(M.shape[0]))
+            A = Linv @ K @ Linv.T
+            A = 0.5 * (A + A.T)
+        if not np.all(np.isfinite(A)):
+            raise RunError("natural modes: K and M of very different scale overflow the reduced problem "
+                           "(M^-1/2 K M^-1/2); check the members' modulus, section, mass and gravity")
+        eigenvalues, vectors = np.linalg.eigh(A)
         shapes = Linv.T @ vectors
     except (np.linalg.LinAlgError, ValueError) as exc:
         raise RunError(f"natural modes could not be computed ({str(exc).splitlines()[0][:80]}): the mass "

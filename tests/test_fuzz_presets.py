@@ -246,6 +246,19 @@ def test_an_ill_conditioned_mass_matrix_is_a_run_error_not_a_linalg_error() -> N
         undamped_modes(__import__("numpy").diag([1.0, -1.0]), __import__("numpy").eye(2))
 
 
+def test_stiffness_and_mass_that_overflow_the_reduced_problem_are_a_run_error_not_nan_modes() -> None:
+    """The NumPy reduction M^-1/2 K M^-1/2 overflows where LAPACK's generalized solver refused
+    infinities: one line, never NaN frequencies passed on to the run."""
+    import numpy as np
+
+    from vtool.solvers.damping import undamped_modes
+
+    for M, K in [(np.eye(2), 1e308 * np.array([[1.0, -1.0], [-1.0, 1.0]])),
+                 (np.diag([1e300, 1e-300]), 1e300 * np.eye(2))]:
+        with pytest.raises(RunError, match="overflow the reduced problem"):
+            undamped_modes(M, K)
+
+
 @pytest.mark.parametrize("changes", [{"rpm": 0.001}, {"degrees": 3.6e6}])
 def test_runs_that_would_hang_are_refused_with_the_estimate(changes: dict[str, float]) -> None:
     from vtool.solvers.cost import CostError
