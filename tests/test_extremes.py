@@ -342,7 +342,7 @@ def test_damping_extremes_make_a_restless_or_a_quiet_valve_train() -> None:
     # already differs by 1e-12 s at event 43) gives another, equally valid sequence. The invariants
     # are checked at every step, where the method defines the contact forces; 1-degree rows inside a
     # step are its cubic interpolant, which in one such sequence dipped to -10 lbf (0.1 % of the
-    # peak) between two positive step ends (docs/limits.md).
+    # peak) between two positive step ends (docs/limits.md, "what every run must satisfy").
     undamped, mechanism = run(variant(damping=0.0), every_step=True)
     assert_sane(undamped, mechanism)
     damped, mechanism = run(variant(damping=1.0))
