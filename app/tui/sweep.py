@@ -85,7 +85,7 @@ class SweepPane(Widget):
                 yield Input(fixed, placeholder="fixed settings, e.g. run.degrees=460", id="sweep-fixed")
                 names = self._metric_names()
                 yield ChoiceSelect([(m, m) for m in names], value=metric if metric in names else names[0],
-                             allow_blank=False, id="sweep-metric")
+                                   allow_blank=False, id="sweep-metric")
             with Horizontal():
                 yield Button("Run", id="sweep-run", variant="primary")
                 yield Button("Cancel", id="sweep-cancel")
