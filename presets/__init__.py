@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from vtool.errors import InputError, one_line
-from vtool.files import write_atomic
+from vtool.files import is_file, write_atomic
 from vtool.presets.kinds import KINDS, kind_named
 
 PRESET_DIR = Path(__file__).resolve().parent
@@ -49,10 +49,10 @@ def shipped_names() -> list[str]:
 def find_preset(name_or_path: str | os.PathLike[str]) -> Path:
     """Resolve a preset given as a path or a shipped name."""
     candidate = Path(name_or_path)
-    if candidate.is_file():
+    if is_file(candidate):  # a name the system cannot look up (too long, a NUL) is no file
         return candidate
     shipped = PRESET_DIR / f"{Path(str(name_or_path)).stem}.toml"
-    if candidate.suffix in ("", ".toml") and shipped.is_file() and candidate.parent == Path("."):
+    if candidate.suffix in ("", ".toml") and is_file(shipped) and candidate.parent == Path("."):
         return shipped
     raise InputError(
         "preset", str(name_or_path),

@@ -13,6 +13,7 @@ import re
 from pathlib import Path
 
 from vtool.errors import InputError
+from vtool.files import is_file
 
 MAX_BYTES = 4_000_000
 _SPLIT = re.compile(r"[,;\t ]+")
@@ -21,7 +22,7 @@ _SPLIT = re.compile(r"[,;\t ]+")
 def read_lift_table(field: str, name: str, folder: Path | None, unit: str) -> tuple[list[float], list[float]]:
     """(angles_deg, lifts) from the CSV ``name`` (relative to ``folder``)."""
     path = Path(name) if Path(name).is_absolute() or folder is None else Path(folder) / name
-    if not path.is_file():
+    if not is_file(path):
         raise InputError(field, str(path), "an existing regular file (relative to the preset's folder)")
     if path.stat().st_size > MAX_BYTES:
         raise InputError(field, str(path), f"a file of at most {MAX_BYTES} bytes")

@@ -42,7 +42,7 @@ from pathlib import Path
 from typing import Any
 
 from vtool.errors import InputError, RunError
-from vtool.files import write_atomic
+from vtool.files import exists, write_atomic
 from vtool.solvers import backends
 from vtool.solvers.metrics import TIMING_METRICS, failed_metrics, metric_columns, run_metrics
 from vtool.solvers.model import Mechanism, assemble
@@ -404,7 +404,7 @@ class SweepFile:
         self.header = csv_header(fields, spec, timing)
         self.keys: dict[tuple[str, ...], int] = {}
         self.rows: list[list[str]] = []
-        if resume and self.path.exists():
+        if resume and exists(self.path):
             self._read_partial()
         elif resume:
             raise InputError("--resume", str(self.path), "an existing partial sweep file (none found)")

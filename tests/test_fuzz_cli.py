@@ -178,6 +178,26 @@ def test_bad_output_paths_are_one_line_and_write_nothing(tmp_path: Path, where: 
     assert list(tmp_path.iterdir()) == []
 
 
+LONG = "1" * 300  # a file name over the system's 255-byte limit: ENAMETOOLONG on any lookup (monkey seed 366)
+
+
+@pytest.mark.parametrize("arguments, text", [
+    (["solve", LONG], "preset: got '111"),
+    (["solve", "gnilka-1a", "--degrees", "10", "--csv", LONG + ".csv"], "(File name too long)"),
+    (["solve", "gnilka-1a", "--degrees", "10", "--csv", f"{LONG}/x.csv"], "a file in an existing folder"),
+    (["presets", "copy", "gnilka-1a", LONG], "(File name too long)"),
+    (["presets", "show", LONG], "preset: got '111"),
+])
+def test_names_too_long_for_the_system_are_one_line(tmp_path: Path, monkeypatch, arguments: list[str],  # type: ignore[no-untyped-def]
+                                                    text: str) -> None:
+    """Path.is_file and friends raise OSError (ENAMETOOLONG) instead of answering False: every probe
+    of a typed path goes through vtool.files' safe ones."""
+    monkeypatch.chdir(tmp_path)
+    result = run(*arguments)
+    assert result.exit_code == 2 and text in one_error_line(result)
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
 def test_a_read_only_folder_is_one_line(tmp_path: Path) -> None:
     tmp_path.chmod(0o500)

@@ -181,3 +181,17 @@ async def test_paging_a_choice_list_before_it_is_laid_out_is_harmless() -> None:
         selects = list(tui.screen.query(Select))
         assert selects and all(isinstance(s, ChoiceSelect) for s in selects)
         assert any(isinstance(s.parent, FieldRow) for s in selects)
+
+
+async def test_opening_a_name_too_long_for_the_system_shows_the_error_dialog() -> None:
+    """Seed 366: a pasted 400-digit name in the open dialog reached Path.is_file, which raises
+    ENAMETOOLONG; now it is "no such preset" in the error dialog and the app lives on."""
+    from vtool.app.tui.dialogs import ErrorDialog
+
+    app = create_app("gnilka-1d", remember=False, chart_color=False)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        assert await app.open_preset("1" * 400) is False
+        await pilot.pause()
+        assert isinstance(app.screen, ErrorDialog)
+    assert app._exception is None

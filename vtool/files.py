@@ -8,6 +8,10 @@ write to the same path removes). It refuses, in one line
 a device node at the output path, and an empty path; a symlink is written
 through to its target (the link itself is kept). A failure while writing (a
 full disk) is a :class:`vtool.errors.RunError`; nothing partial is left.
+
+:func:`is_file`, :func:`is_dir` and :func:`is_symlink` probe a path a user
+typed: a path the system cannot even look up (a name over 255 bytes, a NUL,
+a component that is a file) is simply not there, never an ``OSError``.
 """
 
 from __future__ import annotations
@@ -24,6 +28,34 @@ from pathlib import Path
 from typing import TextIO
 
 from vtool.errors import InputError, RunError
+
+
+def _probe(path: str | os.PathLike[str], test: str) -> bool:
+    try:
+        return bool(getattr(Path(path), test)())
+    except (OSError, ValueError):  # ENAMETOOLONG, EACCES, an embedded NUL ...: not a usable path
+        return False
+
+
+def is_file(path: str | os.PathLike[str]) -> bool:
+    """``Path.is_file`` that answers False where the system cannot look the path up."""
+    return _probe(path, "is_file")
+
+
+def is_dir(path: str | os.PathLike[str]) -> bool:
+    """``Path.is_dir`` that answers False where the system cannot look the path up."""
+    return _probe(path, "is_dir")
+
+
+def exists(path: str | os.PathLike[str]) -> bool:
+    """``Path.exists`` that answers False where the system cannot look the path up."""
+    return _probe(path, "exists")
+
+
+def is_symlink(path: str | os.PathLike[str]) -> bool:
+    """``Path.is_symlink`` that answers False where the system cannot look the path up."""
+    return _probe(path, "is_symlink")
+
 
 #: Temporaries of a dead process (or older than this, in s, when it cannot be told) are removed.
 STALE_AFTER = 3600.0
@@ -69,9 +101,9 @@ def check_output_path(path: str | os.PathLike[str], field: str = "output") -> Pa
     if str(path) == "":
         raise InputError(field, "", "a file path")
     path = Path(path)
-    target = Path(os.path.realpath(path)) if path.is_symlink() else path
+    target = Path(os.path.realpath(path)) if is_symlink(path) else path
     directory = target.parent if str(target.parent) else Path(".")
-    if not directory.is_dir():
+    if not is_dir(directory):
         raise InputError(field, str(path), f"a file in an existing folder ({directory} does not exist)")
     if not os.access(directory, os.W_OK | os.X_OK):
         raise InputError(field, str(path), f"a file in a writable folder ({directory} is read-only)")

@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from vtool.errors import InputError
-from vtool.files import write_atomic
+from vtool.files import exists, is_dir, write_atomic
 from vtool.presets import find_preset, list_presets
 
 
@@ -39,8 +39,8 @@ def show_command(name: str) -> None:
 def copy_command(name: str, dest: Path, force: bool) -> None:
     """Copy a preset to DEST (a file, or a folder to copy into) to edit it."""
     source = find_preset(name)
-    target = dest / source.name if dest.is_dir() else dest
-    if target.exists() and not force:
+    target = dest / source.name if is_dir(dest) else dest
+    if exists(target) and not force:
         raise InputError("dest", str(target), "a path that does not exist yet (or --force)")
     write_atomic(target, source.read_text(encoding="utf-8"), "DEST")
     click.echo(f"copied {source.stem} to {target}")

@@ -21,6 +21,7 @@ from vtool.app.tui.plate import PlateScreen
 from vtool.app.tui.recent import RecentFiles, default_path
 from vtool.app.tui.valvetrain import ValveTrainScreen
 from vtool.errors import InputError, RunError
+from vtool.files import is_file
 
 SCREENS_BY_MODE = {screen.MODE: screen for screen in (ValveTrainScreen, BoomScreen, PlateScreen)}
 
@@ -130,7 +131,7 @@ class VtoolApp(App[None]):
         except InputError as exc:
             self.report_error("Cannot open preset", exc)
             return False
-        item = name if not Path(name).is_file() else str(Path(name).resolve())
+        item = name if not is_file(name) else str(Path(name).resolve())
         if mode in self.mounted_modes:
             await self.switch_mode(mode)
             screen = self.domain_screen()
