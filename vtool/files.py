@@ -9,7 +9,7 @@ a device node at the output path, and an empty path; a symlink is written
 through to its target (the link itself is kept). A failure while writing (a
 full disk) is a :class:`vtool.errors.RunError`; nothing partial is left.
 
-:func:`is_file`, :func:`is_dir` and :func:`is_symlink` probe a path a user
+:func:`is_file`, :func:`is_dir`, :func:`exists` and :func:`is_symlink` probe a path a user
 typed: a path the system cannot even look up (a name over 255 bytes, a NUL,
 a component that is a file) is simply not there, never an ``OSError``.
 """
