@@ -3,6 +3,11 @@
 Run: ``python3 benchmarks/tables_compliant.py`` (``--check`` compares instead of writing and
 exits 1 when the committed table differs). Every number comes from
 :func:`vtool.solvers.compliance.study` (exact back end; the Newmark step search against it).
+
+The check allows ``CHECK_REL`` relative on each number: at k = 1e8 and 1e9 the
+seat chatters for thousands of events, and the event count follows the last
+bits of LAPACK's results, which differ between CPUs (1757 events on one
+machine, 1755 on another, the same code).
 """
 
 from __future__ import annotations
@@ -10,7 +15,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from vtool.markdown import read_block, replace_block, table
+from vtool.markdown import read_block, replace_block, table, table_differences
 from vtool.presets import load_preset
 from vtool.solvers.compliance import study
 
@@ -19,6 +24,7 @@ PRESET = "gnilka-1a"
 STIFFNESSES = (1e5, 1e6, 1e7, 1e8, 1e9)  # lbf/in
 RATIO = 1.0
 BLOCK = "stiffness-study"
+CHECK_REL = 5e-3  # see the module doc
 
 
 def block() -> str:
@@ -43,10 +49,10 @@ def block() -> str:
 def main(check: bool = False) -> int:
     text = block()
     if check:
-        if read_block(DOC, BLOCK) != text:
-            print(f"{DOC.name}: block {BLOCK} differs from `python3 benchmarks/tables_compliant.py`")
-            return 1
-        return 0
+        differences = table_differences(read_block(DOC, BLOCK), text, CHECK_REL)
+        for line in differences:
+            print(f"{DOC.name}: block {BLOCK}: {line} (`python3 benchmarks/tables_compliant.py` rewrites it)")
+        return 1 if differences else 0
     replace_block(DOC, BLOCK, text)
     return 0
 

@@ -18,7 +18,8 @@ Newmark runs use its default refinement after events (steps of
 dt / ``NewmarkOptions.refine`` for ``refine_periods`` periods of the highest
 mode); one extra row shows the plain thesis scheme at 1 µs. Settings a back end refuses (a Newmark step beyond its stability
 limit) are listed with the reason instead of figures. scipy rows depend on
-the scipy and numpy versions, which :func:`library_versions` names.
+the scipy and numpy versions and the CPU's BLAS kernels, which
+:func:`library_versions` names.
 """
 
 from __future__ import annotations
@@ -64,10 +65,20 @@ class AccuracyRow:
 
 
 def library_versions() -> str:
-    """The numpy and scipy versions the scipy rows depend on, e.g. ``scipy 1.14.1, numpy 2.1.3``."""
-    import scipy
+    """What the scipy rows' last bits depend on: the numpy and scipy versions and the BLAS kernels
+    chosen for this CPU, e.g. ``scipy 1.17.1, numpy 2.4.6, openblas Haswell``.
 
-    return f"scipy {scipy.__version__}, numpy {np.__version__}"
+    A chattering run at a loose tolerance follows the last bits of its matrix
+    products, which the BLAS kernels (AVX2 or AVX-512, picked at load time)
+    set: the same versions on another CPU give another event sequence.
+    """
+    import scipy
+    import scipy.linalg  # noqa: F401 (loads scipy's BLAS, so that threadpoolctl sees it)
+    from threadpoolctl import threadpool_info
+
+    kernels = sorted({f"{lib.get('internal_api')} {lib.get('architecture')}" for lib in threadpool_info()
+                      if lib.get("user_api") == "blas"})
+    return ", ".join([f"scipy {scipy.__version__}", f"numpy {np.__version__}", *kernels])
 
 
 def with_run(spec: MechanismSpec, **changes: object) -> MechanismSpec:

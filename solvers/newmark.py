@@ -64,7 +64,7 @@ from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.backends import Backend, Cancel, Progress
 from vtool.solvers.contact import EVENT_KINDS, ContactProblem
 from vtool.solvers.model import Mechanism
-from vtool.solvers.spec import RunSpec
+from vtool.solvers.spec import HERTZ, MOMENTUM, RIGID, RunSpec
 from vtool.solvers.trace import TraceBuilder
 
 COMPILE_ESTIMATE_S = 30.0  # first compile of the kernel on a 2-core machine (benchmarks/bench_newmark.py)
@@ -95,14 +95,24 @@ class NewmarkOptions:
         return cls(run.time_step, run.beta, run.gamma, run.output_interval, every_step)
 
 
-def compile_notice(backend: str = "newmark") -> str | None:
+def kernel_laws(spec: Any, impacts: tuple[str, ...] = ()) -> tuple[bool | None, bool | None]:
+    """The kernel's (hertz, momentum) switches (:func:`vtool.solvers.newmark_kernel.laws`) for a
+    valve-train spec, and for its runs under the impact laws ``impacts`` besides (``vtool compare``)."""
+    hertz = any(c.contact == HERTZ for c in spec.clearances)
+    momentum = MOMENTUM in impacts or any(c.contact == RIGID and spec.impact_law(c) == MOMENTUM
+                                          for c in spec.clearances)
+    return (True if hertz else None), (True if momentum else None)
+
+
+def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | None] = (None, None)) -> str | None:
     """The line to show before a run that must first compile the kernel, or None when it is cached.
 
     The newmark back end runs ``run_chunk``; the piecewise back ends call the
-    event rules (``impact``, ``settle``, ``fill_sources``) from Python.
+    event rules (``impact``, ``settle``, ``fill_sources``) from Python. ``laws``:
+    see :func:`kernel_laws` (a kernel is compiled and cached per switch pair).
     """
     names = ("run_chunk",) if backend == "newmark" else ("impact", "settle", "fill_sources")
-    if kernel.is_cached(names):
+    if kernel.is_cached(names, *laws):
         return None
     return (f"compiling the solver, once (about {COMPILE_ESTIMATE_S:.0f} s on two cores); "
             "later runs load it from the cache")
@@ -221,7 +231,7 @@ class KernelRun:
         return (self.ip, self.fp, problem.cl, problem.clf, problem.series.const, problem.series.cos,
                 problem.series.sin, problem.mass, tables.ci, tables.cm, tables.cp, tables.mk, tables.mon,
                 self.out_t, self.out_q, self.out_F, self.out_c, self.ev_f, self.ev_i, self.peak,
-                self.x, self.v, self.a, self.ist, self.fst)
+                self.x, self.v, self.a, self.ist, self.fst, *kernel.laws(problem.cl))
 
     def compile(self) -> None:
         """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""

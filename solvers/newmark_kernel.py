@@ -51,6 +51,7 @@ pull (an impact so released is a bounce: two events at one instant).
 from __future__ import annotations
 
 import os
+from typing import Any
 
 import numpy as np
 
@@ -60,7 +61,13 @@ numba_cache.configure(os.path.dirname(os.path.abspath(__file__)))  # before numb
 
 from numba import njit  # noqa: E402 (after the cache folder is chosen)
 
-jit = njit(cache=numba_cache.CACHE_ENABLED, nogil=True, error_model="numpy")
+_OPTIONS: dict[str, Any] = {"cache": numba_cache.CACHE_ENABLED, "nogil": True, "error_model": "numpy"}
+_INNER: dict[str, Any] = {**_OPTIONS, "no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+jit = njit(**_OPTIONS)  # entry points, callable from Python
+# Called only from compiled code: no CPython or C wrapper to build (about 0.07 s of compile each).
+inner = njit(**_INNER)
+# A few lines each: their code is copied into the caller (numba IR), with no compile of their own.
+tiny = njit(**_INNER, inline="always")
 
 # ----- slots of the integer and float parameter vectors -----
 IP_N, IP_NCL, IP_NS, IP_NH, IP_EVERY, IP_ZSTICK, IP_ZSTOP = range(7)
@@ -107,16 +114,43 @@ STANDARD, REFINED, CHOLESKY = np.int64(0), np.int64(1), np.int64(2)
 ENTRY_POINTS = ("run_chunk", "impact", "settle", "fill_sources")  # what the back ends call from Python
 
 
-def is_cached(names: tuple[str, ...] = ENTRY_POINTS) -> bool:
-    """True when these entry points' compiled code is in the numba cache (no compile needed).
+def is_cached(names: tuple[str, ...] = ENTRY_POINTS, hertz: bool | None = None,
+              momentum: bool | None = None) -> bool:
+    """True when these entry points' compiled code for these law switches (see :func:`laws`) is in the
+    numba cache (no compile needed).
 
     Reads the cache's index (numba keeps one per function, stamped with this
-    file's modification time and size); any doubt counts as not cached.
+    file's modification time and size, its keys led by the argument types);
+    any doubt counts as not cached.
     """
+    trailing = {"run_chunk": (hertz, momentum), "settle": (hertz,), "impact": (momentum,), "fill_sources": ()}
     try:
-        return all(globals()[name]._cache._cache_file._load_index() for name in names)
+        import numba
+
+        for name in names:
+            index = globals()[name]._cache._cache_file._load_index()
+            switches = tuple(numba.typeof(value) for value in trailing[name])
+            if not any(tuple(getattr(key[0], "args", key[0]))[len(key[0]) - len(switches):] == switches
+                       for key in index):
+                return False
+        return True
     except Exception:  # noqa: BLE001 (numba internals: a missing or unreadable index means "compile")
         return False
+
+
+def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:
+    """The ``hertz`` and ``momentum`` switches of the kernel's entry points for clearance table ``cl``.
+
+    Each is True when some clearance uses that law and None when none does.
+    numba prunes the branches under ``if hertz is not None`` (``momentum``)
+    before typing when the switch is None, so a mechanism without Hertz
+    contacts (momentum-law impacts) compiles and caches a kernel without
+    that code, and one with them compiles its own. The plain-Python
+    reference takes the same branches.
+    """
+    hertz = bool(np.any(cl[:, CL_SOFT] == SOFT_HERTZ))
+    momentum = bool(np.any((cl[:, CL_LAW] == LAW_MOMENTUM) & (cl[:, CL_SOFT] == 0)))
+    return (True if hertz else None), (True if momentum else None)
 
 
 # ----- sources -----
@@ -143,7 +177,7 @@ def fill_sources(ns, nh, omega, sc, sa, sb, t, src):
 
 
 # ----- layer values of a configuration -----
-@jit
+@tiny
 def gather(ci, c, n, x, v, a, z, zd, zdd):
     for j in range(ci[c, CI_M]):
         i = ci[c, CI_HEAD + j]
@@ -152,7 +186,7 @@ def gather(ci, c, n, x, v, a, z, zd, zdd):
         zdd[j] = a[i]
 
 
-@jit
+@tiny
 def scatter(ci, c, n, z, zd, zdd, x, v, a):
     for i in range(n):
         j = ci[c, CI_HEAD + n + i]
@@ -161,7 +195,7 @@ def scatter(ci, c, n, z, zd, zdd, x, v, a):
         a[i] = zdd[j]
 
 
-@jit
+@tiny
 def set_prescribed(ci, c, n, src, z, zd, zdd):
     for j in range(ci[c, CI_NF], ci[c, CI_M]):
         s = ci[c, CI_HEAD + 2 * n + j]
@@ -170,7 +204,7 @@ def set_prescribed(ci, c, n, src, z, zd, zdd):
         zdd[j] = src[3 * s + 2]
 
 
-@jit
+@inner
 def free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
     right, and the sources' pull through closed compliant contacts (``cp[c, f, 3n:]``)."""
@@ -190,7 +224,7 @@ def free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
         rhs[f] = s
 
 
-@jit
+@inner
 def factor_effective(ci, cm, c, beta, gamma, h, L):
     """Cholesky factor (lower, in place in L) of S = M_FF + gamma h C_FF + beta h² K_FF."""
     nf = ci[c, CI_NF]
@@ -205,7 +239,7 @@ def factor_effective(ci, cm, c, beta, gamma, h, L):
                 L[f, g] = s / L[g, g]
 
 
-@jit
+@tiny
 def cholesky_solve(nf, L, rhs, out):
     for f in range(nf):
         s = rhs[f]
@@ -219,7 +253,7 @@ def cholesky_solve(nf, L, rhs, out):
         out[f] = s / L[f, f]
 
 
-@jit
+@inner
 def effective_solve(cm, c, which, L, nf, b, out):
     """out = S⁻¹ b: the stored inverse of the standard (``which`` 0) or refined (1) step, or the
     Cholesky factor in L (2)."""
@@ -253,7 +287,7 @@ def hertz_law(clf, k, delta, rate):
     return force, exponent * power / delta * (1.0 + lam * rate), power * lam
 
 
-@jit
+@tiny
 def overlap_and_rate(mon, c, k, n, ns, z, zd, src):
     """(δ, δ̇) of a closed Hertz contact: its monitor row holds -w on z and on ż, +1 on its source."""
     delta = 0.0
@@ -267,16 +301,17 @@ def overlap_and_rate(mon, c, k, n, ns, z, zd, src):
     return delta, rate
 
 
-@jit
-def compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src):
+@inner
+def compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz):
     """Contact force of closed compliant clearance k: the Hertz law, or its linear row."""
-    if cl[k, CL_SOFT] == SOFT_HERTZ:
-        delta, rate = overlap_and_rate(mon, c, k, n, ns, z, zd, src)
-        return hertz_law(clf, k, delta, rate)[0]
+    if hertz is not None:
+        if cl[k, CL_SOFT] == SOFT_HERTZ:
+            delta, rate = overlap_and_rate(mon, c, k, n, ns, z, zd, src)
+            return hertz_law(clf, k, delta, rate)[0]
     return contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src)
 
 
-@jit
+@inner
 def hertz_correction(ci, cm, cl, clf, mk, mon, c, beta, gamma, h, which, L, n, ns, src1, z1, zd1, zdd1, sol):
     """Add the closed Hertz contacts' forces to a Newmark step whose linear part is done.
 
@@ -348,9 +383,9 @@ def hertz_correction(ci, cm, cl, clf, mk, mon, c, beta, gamma, h, which, L, n, n
         zd1[f] += gamma * h * acc
 
 
-@jit
+@inner
 def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
-               cl, clf, mk, mon):
+               cl, clf, mk, mon, hertz):
     """One Newmark step of length h from layer state (z, ż, z̈) into (z1, ż1, z̈1).
 
     ``which``: 0 the stored S⁻¹ of the standard step, 1 of the refined step,
@@ -369,24 +404,26 @@ def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1,
         zdd1[f] = sol[f]
         z1[f] += beta * h * h * sol[f]
         zd1[f] += gamma * h * sol[f]
-    if ci[c, CI_HERTZ]:
-        hertz_correction(ci, cm, cl, clf, mk, mon, c, beta, gamma, h, which, L, n, src1.shape[0] // 3, src1,
-                         z1, zd1, zdd1, sol)
+    if hertz is not None:
+        if ci[c, CI_HERTZ]:
+            hertz_correction(ci, cm, cl, clf, mk, mon, c, beta, gamma, h, which, L, n, src1.shape[0] // 3, src1,
+                             z1, zd1, zdd1, sol)
 
 
-@jit
-def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk, mon):
+@inner
+def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk, mon, hertz):
     """Free accelerations of configuration c from its equations of motion (prescribed set from src)."""
     set_prescribed(ci, c, n, src, z, zd, zdd)
     free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs)
     nf = ci[c, CI_NF]
-    if ci[c, CI_HERTZ]:  # the Hertz forces of the present overlaps, on the free rows (w = -mon row)
-        for k in range(cl.shape[0]):
-            if mk[c, k, MK_KIND] == MK_OVERLAP and cl[k, CL_SOFT] == SOFT_HERTZ:
-                delta, rate = overlap_and_rate(mon, c, k, n, src.shape[0] // 3, z, zd, src)
-                force = hertz_law(clf, k, delta, rate)[0]
-                for f in range(nf):
-                    rhs[f] -= mon[c, k, f] * force
+    if hertz is not None:
+        if ci[c, CI_HERTZ]:  # the Hertz forces of the present overlaps, on the free rows (w = -mon row)
+            for k in range(cl.shape[0]):
+                if mk[c, k, MK_KIND] == MK_OVERLAP and cl[k, CL_SOFT] == SOFT_HERTZ:
+                    delta, rate = overlap_and_rate(mon, c, k, n, src.shape[0] // 3, z, zd, src)
+                    force = hertz_law(clf, k, delta, rate)[0]
+                    for f in range(nf):
+                        rhs[f] -= mon[c, k, f] * force
     for f in range(nf):
         s = 0.0
         for g in range(nf):
@@ -394,7 +431,7 @@ def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk,
         zdd[f] = s
 
 
-@jit
+@tiny
 def contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src):
     """Contact force of closed clearance k: its row on (z, ż, z̈, sources, 1)."""
     f = mon[c, k, 3 * n + 3 * ns]
@@ -405,21 +442,22 @@ def contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src):
     return f
 
 
-@jit
-def rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src):
+@inner
+def rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz):
     """Contact force of closed rigid clearance k: its linear row, plus the closed Hertz contacts' pull
     on it (``mon[c, k, 3n + 3ns + 1 + j]`` per unit Hertz force F_j)."""
     f = contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src)
-    head = 3 * n + 3 * ns + 1
-    for j in range(cl.shape[0]):
-        if mon[c, k, head + j] != 0.0:
-            delta, rate = overlap_and_rate(mon, c, j, n, ns, z, zd, src)
-            f += mon[c, k, head + j] * hertz_law(clf, j, delta, rate)[0]
+    if hertz is not None:
+        head = 3 * n + 3 * ns + 1
+        for j in range(cl.shape[0]):
+            if mon[c, k, head + j] != 0.0:
+                delta, rate = overlap_and_rate(mon, c, j, n, ns, z, zd, src)
+                f += mon[c, k, head + j] * hertz_law(clf, j, delta, rate)[0]
     return f
 
 
-@jit
-def monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src):
+@inner
+def monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src, hertz):
     """What changes sign at clearance k's next event; 0 when not monitored.
 
     Open: gap + allowance. Closed rigid: the contact force. Closed compliant:
@@ -432,14 +470,14 @@ def monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src):
         gap = z[mk[c, k, MK_AHEAD]] - other
         return (gap if kind == MK_GAP else -gap) + gap_noise
     if kind == MK_FORCE:
-        return rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src)
+        return rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz)
     return 0.0
 
 
 # ----- output -----
-@jit
+@inner
 def record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src, out_t, out_q, out_F, out_c,
-               row):
+               row, hertz):
     out_t[row] = t
     out_c[row] = c
     for i in range(n):
@@ -453,15 +491,15 @@ def record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, sr
         out_q[row, 2, n + s] = src[3 * s + 2]
     for k in range(ncl):
         if mk[c, k, MK_KIND] == MK_FORCE:
-            out_F[row, k] = rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src)
+            out_F[row, k] = rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz)
         elif mk[c, k, MK_KIND] == MK_OVERLAP:
-            out_F[row, k] = compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src)
+            out_F[row, k] = compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz)
         else:
             out_F[row, k] = 0.0
 
 
 # ----- impacts -----
-@jit
+@tiny
 def add_event(ev_f, ev_i, ist, t, k, kind, u, c_from, c_to):
     row = ist[I_NEV]
     if row < ev_f.shape[0]:
@@ -474,7 +512,7 @@ def add_event(ev_f, ev_i, ist, t, k, kind, u, c_from, c_to):
     ist[I_NEV] = row + 1
 
 
-@jit
+@inner
 def solve_dense(A, b, out, na):
     """out[:na] = A[:na, :na]⁻¹ b[:na] by Gaussian elimination with partial pivoting (A, b overwritten)."""
     for col in range(na):
@@ -500,7 +538,7 @@ def solve_dense(A, b, out, na):
         out[r] = s / d
 
 
-@jit
+@inner
 def solve_impulse_lcp(W, u, b, eq, scale, P, uplus):
     """Impulses P >= 0 with u + W P - b >= 0 and complementarity (equalities: = b).
 
@@ -542,7 +580,7 @@ def solve_impulse_lcp(W, u, b, eq, scale, P, uplus):
         uplus[r] = u[r]
 
 
-@jit
+@inner
 def impact_momentum(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t):
     """Newton impact with restitution, impulses of all contacts together on the consistent mass matrix.
 
@@ -639,7 +677,7 @@ def impact_momentum(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, e
     return mask
 
 
-@jit
+@tiny
 def prescribed_velocity(cl, c, ncl, coordinate, src):
     """Velocity of the source a coordinate is tied to in configuration c, or nan if it is free."""
     for k in range(ncl):
@@ -648,7 +686,7 @@ def prescribed_velocity(cl, c, ncl, coordinate, src):
     return np.nan
 
 
-@jit
+@inner
 def impact_local(ip, fp, cl, clf, mass, c, k, src, v, stick, ev_f, ev_i, ist, t):
     """The thesis' local law at one closing clearance k (see the module doc); returns the new mask.
 
@@ -710,7 +748,7 @@ def relative_velocity(cl, k, v, src):
 
 
 @jit
-def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t):
+def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t, momentum):
     """Apply the impact law of every closing clearance at t; returns the new configuration mask.
 
     Local-law closings are applied one after the other (each changes only its
@@ -721,7 +759,7 @@ def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist,
     """
     ncl = ip[IP_NCL]
     mask = c
-    momentum = np.zeros(ncl, dtype=np.int64)
+    joint = np.zeros(ncl, dtype=np.int64)  # the momentum-law closings, solved together
     any_momentum = False
     for k in range(ncl):
         if not closing[k]:
@@ -733,17 +771,18 @@ def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist,
             clf[k, CLF_HV] = max(-u, fp[FP_VREST], 1e-300)  # the Hertz contact's approach velocity
             add_event(ev_f, ev_i, ist, t, k, EV_CLOSED, u, c, mask)
         elif cl[k, CL_LAW] == LAW_MOMENTUM:
-            momentum[k] = 1
+            joint[k] = 1
             any_momentum = True
         else:
             mask = impact_local(ip, fp, cl, clf, mass, mask, k, src, v, stick, ev_f, ev_i, ist, t)
-    if any_momentum:
-        mask = impact_momentum(ip, fp, cl, clf, mass, mask, momentum, src, x, v, stick, ev_f, ev_i, ist, t)
+    if momentum is not None:  # None: no clearance has the momentum law (see laws)
+        if any_momentum:
+            mask = impact_momentum(ip, fp, cl, clf, mass, mask, joint, src, x, v, stick, ev_f, ev_i, ist, t)
     return mask
 
 
 @jit
-def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist, rhs, z, zd, zdd):
+def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist, rhs, z, zd, zdd, hertz):
     """Consistent accelerations of configuration c; release at once every contact that would pull.
 
     Returns the settled configuration, or -1 - c2 when configuration c2 must
@@ -758,13 +797,13 @@ def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i,
         if not ci[c, CI_BUILT]:
             return -1 - c
         gather(ci, c, n, x, v, a, z, zd, zdd)
-        consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk, mon)
+        consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk, mon, hertz)
         scatter(ci, c, n, z, zd, zdd, x, v, a)
         worst = -1
         worst_f = -fp[FP_FTOL]
         for k in range(ncl):
             if mk[c, k, MK_KIND] == MK_FORCE and cl[k, CL_MON]:
-                f = monitor_value(cl, clf, mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z, zd, zdd, src)
+                f = monitor_value(cl, clf, mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z, zd, zdd, src, hertz)
                 if f < worst_f:
                     worst = k
                     worst_f = f
@@ -777,9 +816,9 @@ def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i,
 
 
 # ----- event location -----
-@jit
+@inner
 def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi_lo, phi_hi,
-                 z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L):
+                 z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L, hertz):
     """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from (z, ż, z̈) at t.
 
     Illinois (modified regula falsi) on phi(tau) = monitor after a Newmark
@@ -809,8 +848,8 @@ def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, 
         fill_sources(ns, nh, fp[FP_OMEGA], sc, sa, sb, t + tau, src1)
         factor_effective(ci, cm, c, beta, gamma, tau, L)
         layer_step(ci, cm, cp, c, beta, gamma, tau, CHOLESKY, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
-                   cl, clf, mk, mon)
-        f = monitor_value(cl, clf, mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z1, zd1, zdd1, src1)
+                   cl, clf, mk, mon, hertz)
+        f = monitor_value(cl, clf, mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z1, zd1, zdd1, src1, hertz)
         if f < 0.0:
             hi, fhi = tau, f
             if side == -1:
@@ -824,14 +863,14 @@ def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, 
     return lo
 
 
-@jit
-def track_peaks(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, after, phi, z, zd, zdd, src, peak):
+@inner
+def track_peaks(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, after, phi, z, zd, zdd, src, peak, hertz):
     """Raise the peak contact forces (and compliant overlaps) with the monitors ``phi`` at a step's end."""
     for k in range(ncl):
         kind = mk[c, k, MK_KIND]
         force = phi[k]
         if kind == MK_OVERLAP:
-            force = compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src)
+            force = compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz)
             peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
         elif kind != MK_FORCE:
             continue
@@ -841,7 +880,7 @@ def track_peaks(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, after, phi, z, zd, z
 
 
 # ----- the hot loop -----
-@jit
+@inner
 def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist, fst, c,
             z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi):
     """Standard and refined steps in configuration c while nothing happens; returns the time reached.
@@ -1064,7 +1103,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
 
 
 
-@jit
+@tiny
 def arrive(ist, fst, target, grid_next, k_grid, j_target):
     """Now at ``target``: the next standard grid point, or point ``j_target`` of the refined grid."""
     if target == grid_next:
@@ -1079,7 +1118,7 @@ def arrive(ist, fst, target, grid_next, k_grid, j_target):
 # ----- the run loop -----
 @jit
 def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
-              out_t, out_q, out_F, out_c, ev_f, ev_i, peak, x, v, a, ist, fst):
+              out_t, out_q, out_F, out_c, ev_f, ev_i, peak, x, v, a, ist, fst, hertz, momentum):
     """Integrate from fst[F_T] until t_end, the chunk end, or something Python must do.
 
     Returns a status (FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED,
@@ -1129,7 +1168,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
         fill_sources(ns, nh, omega, sc, sa, sb, t, src0)
         if ist[I_NEED_SETTLE]:
             settled = settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src0, ev_f, ev_i, ist,
-                             rhs, z, zd, zdd)
+                             rhs, z, zd, zdd, hertz)
             if settled < 0:
                 ist[I_CFG] = -1 - settled
                 ist[I_WANT_CFG] = -1 - settled
@@ -1142,7 +1181,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                     return OUTPUT_FULL
                 gather(ci, c, n, x, v, a, z, zd, zdd)
                 record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, src0,
-                           out_t, out_q, out_F, out_c, ist[I_NOUT])
+                           out_t, out_q, out_F, out_c, ist[I_NOUT], hertz)
                 for k in range(ncl):
                     peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], out_F[ist[I_NOUT], k])
                 ist[I_NOUT] += 1
@@ -1187,19 +1226,18 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 t = arrive(ist, fst, target, grid_next, k_grid, j_target)
                 continue
             fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
-            if h == dt:
-                layer_step(ci, cm, cp, c, beta, gamma, h, STANDARD, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
-                           cl, clf, mk, mon)
-            elif h == fine:
-                layer_step(ci, cm, cp, c, beta, gamma, h, REFINED, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
-                           cl, clf, mk, mon)
-            else:
-                factor_effective(ci, cm, c, beta, gamma, h, L)
-                layer_step(ci, cm, cp, c, beta, gamma, h, CHOLESKY, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
-                           cl, clf, mk, mon)
+            which = STANDARD
+            if h != dt:
+                if h == fine:
+                    which = REFINED
+                else:
+                    which = CHOLESKY
+                    factor_effective(ci, cm, c, beta, gamma, h, L)
+            layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
+                       cl, clf, mk, mon, hertz)
             fired = False
             for k in range(ncl):
-                phi[k] = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1)
+                phi[k] = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1, hertz)
                 if cl[k, CL_MON] and phi[k] < 0.0:
                     fired = True
             if fired:  # locate every sign change; the earliest is taken
@@ -1207,22 +1245,22 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                 for k in range(ncl):
                     tau[k] = 2.0 * h
                     if cl[k, CL_MON] and phi[k] < 0.0:
-                        phi0 = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src0)
+                        phi0 = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src0, hertz)
                         if phi0 < 0.0:
                             tau[k] = 0.0
                         else:
                             tau[k] = locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h,
-                                                  phi0, phi[k], z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L)
+                                                  phi0, phi[k], z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L, hertz)
                         tau_min = min(tau_min, tau[k])
                 h = tau_min
                 if h > 0.0:
                     fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
                     factor_effective(ci, cm, c, beta, gamma, h, L)
                     layer_step(ci, cm, cp, c, beta, gamma, h, CHOLESKY, L, n, src1, z, zd, zdd,
-                               z1, zd1, zdd1, rhs, sol, cl, clf, mk, mon)
+                               z1, zd1, zdd1, rhs, sol, cl, clf, mk, mon, hertz)
                     for k in range(ncl):
                         if mk[c, k, MK_KIND] == MK_FORCE or mk[c, k, MK_KIND] == MK_OVERLAP:
-                            phi[k] = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1)
+                            phi[k] = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1, hertz)
                 else:
                     for j in range(n):
                         z1[j] = z[j]
@@ -1245,7 +1283,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                         status = OUTPUT_FULL
                         break
                     record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t + h, z1, zd1, zdd1, src1,
-                               out_t, out_q, out_F, out_c, ist[I_NOUT])
+                               out_t, out_q, out_F, out_c, ist[I_NOUT], hertz)
                     ist[I_NOUT] += 1
                 else:
                     full = False
@@ -1267,7 +1305,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                         fill_sources(ns, nh, omega, sc, sa, sb, t_out, srco)
                         set_prescribed(ci, c, n, srco, zo, zdo, zddo)
                         record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t_out, zo, zdo, zddo, srco,
-                                   out_t, out_q, out_F, out_c, ist[I_NOUT])
+                                   out_t, out_q, out_F, out_c, ist[I_NOUT], hertz)
                         ist[I_NOUT] += 1
                         ist[I_NEXT_OUT] = j_out + 1
                     if full:
@@ -1275,7 +1313,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                         break
                 # peaks at the step's end
                 track_peaks(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t + h >= t_rev, phi, z1, zd1, zdd1, src1,
-                            peak)
+                            peak, hertz)
                 ist[I_STEPS] += 1
                 for j in range(n):
                     z[j] = z1[j]
@@ -1318,7 +1356,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                     u = relative_velocity(cl, k, v, src0)
                 add_event(ev_f, ev_i, ist, t, k, EV_OPENED, u, c, new_c)
         if any_closing:
-            new_c = impact(ip, fp, cl, clf, mass, new_c, closing, src0, x, v, stick, ev_f, ev_i, ist, t)
+            new_c = impact(ip, fp, cl, clf, mass, new_c, closing, src0, x, v, stick, ev_f, ev_i, ist, t, momentum)
         ist[I_CFG] = new_c
         ist[I_NEED_SETTLE] = 1
         fst[F_FINE_UNTIL] = t + fp[FP_REFWIN]

@@ -316,7 +316,8 @@ class PiecewiseRun(ABC):
             result = int(kernel.settle(self.ip, self.fp, problem.cl, problem.clf, tables.ci, tables.cm, tables.cp,
                                        tables.mk,
                                        tables.mon, mask, t, x, v, a, self.sources(t), self.ev_f, self.ev_i,
-                                       self.ist, np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m)))
+                                       self.ist, np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m),
+                                       kernel.laws(problem.cl)[0]))
             self._take_events()
             if result >= 0:
                 return result
@@ -359,7 +360,8 @@ class PiecewiseRun(ABC):
             problem = self.problem
             self.ist[kernel.I_NEV] = 0
             new_c = int(kernel.impact(self.ip, self.fp, problem.cl, problem.clf, problem.mass, new_c, closing,
-                                      self.sources(t), x, v, stick, self.ev_f, self.ev_i, self.ist, t))
+                                      self.sources(t), x, v, stick, self.ev_f, self.ev_i, self.ist, t,
+                                      kernel.laws(problem.cl)[1]))
             self._take_events()
         new_c = self.settle(new_c, t, x, v, a)
         return new_c, x, v, a

@@ -164,6 +164,28 @@ def test_generated_stiffness_study_is_current() -> None:
     assert tables_compliant.main(check=True) == 0, "run python3 benchmarks/tables_compliant.py"
 
 
+def test_table_differences_allow_the_last_digits_and_nothing_more() -> None:
+    from vtool.markdown import table, table_differences
+
+    committed = table(["contact", "events", "J"], [["k = 1e8", "1757", "0.03560"], ["rigid", "79", "-"]])
+    assert table_differences(committed, committed, 5e-3) == []
+    near = table(["contact", "events", "J"], [["k = 1e8", "1755", "0.03561"], ["rigid", "79", "-"]])
+    assert table_differences(committed, near, 5e-3) == []
+    assert table_differences(committed, near, 0.0) == ["line 3, column 2: committed 1757, generated 1755",
+                                                       "line 3, column 3: committed 0.03560, generated 0.03561"]
+    far = table(["contact", "events", "J"], [["k = 1e8", "1700", "0.03560"], ["rigid", "79", "0"]])
+    assert table_differences(committed, far, 5e-3) == ["line 3, column 2: committed 1757, generated 1700",
+                                                       "line 4, column 3: committed -, generated 0"]
+    assert table_differences(committed, committed + "| one | more | row |\n", 5e-3) == [
+        "4 lines committed, 5 generated"]
+    bounds = table(["back end", "largest difference"], [["newmark", "< 1e-6"]])
+    assert table_differences(bounds, bounds.replace("1e-6", "1e-7"), 0.0, decades=1) == []
+    assert table_differences(bounds, bounds.replace("1e-6", "1e-8"), 0.0, decades=1) == [
+        "line 3, column 2: committed < 1e-6, generated < 1e-8"]
+    assert table_differences(bounds, bounds.replace("1e-6", "1e-7"), 0.0) == [
+        "line 3, column 2: committed < 1e-6, generated < 1e-7"]
+
+
 def test_vtool_solve_reports_the_peak_overlap(tmp_path) -> None:  # noqa: ANN001
     import json
 

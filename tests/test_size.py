@@ -17,7 +17,7 @@ import scipy.linalg
 from click.testing import CliRunner
 
 from vtool.app.cli.main import cli
-from vtool.markdown import read_block
+from vtool.markdown import read_block, table_differences
 from vtool.presets import load_preset
 from vtool.solvers.assembly import unsplit_members
 from vtool.solvers.model import assemble
@@ -85,6 +85,11 @@ def test_size_command_prints_its_table_and_refuses_bad_input() -> None:
     assert CliRunner().invoke(cli, ["size", "plate-table2", "--rpm-max", "100"]).exit_code == 2
 
 
+def rows_text(rows: list[list[str]]) -> str:
+    """Rows from :func:`deterministic` as Markdown table lines again."""
+    return "\n".join(" | ".join(row) + ("" if row[-1].endswith("|") else " |") for row in rows) + "\n"
+
+
 def deterministic(block: str) -> list[list[str]]:
     """Table rows without the wall-time columns."""
     rows = [line.split(" | ") for line in block.splitlines() if line.startswith("| ")]
@@ -103,7 +108,10 @@ def test_generated_size_block_for_the_thesis_mechanism_is_current() -> None:
     name, rpm = bench_size.SIZE_CASES["size-1a"]
     fresh = bench_size.size_block(bench_size.size_study_for(name, rpm))
     committed = read_block(bench_size.DOCS, "size-1a")
-    assert deterministic(committed.split("\n\n")[0]) == deterministic(fresh.split("\n\n")[0])
+    # numbers to 1e-3 relative: a refined run's step count follows its event times, whose last bits follow
+    # LAPACK's (the modes), which differ between CPUs (114074 steps on one, 114076 on another)
+    assert table_differences(rows_text(deterministic(committed.split("\n\n")[0])),
+                             rows_text(deterministic(fresh.split("\n\n")[0])), 1e-3) == []
     assert committed.splitlines()[-3:] == fresh.splitlines()[-3:]
 
 
@@ -112,5 +120,8 @@ def test_generated_table_versus_harmonic_block_is_current() -> None:
     from vtool.markdown import table
 
     fresh = bench_size.table_vs_harmonic_rows()
-    assert read_block(bench_size.DOCS, "table-vs-harmonic") == table(*fresh)
+    committed = read_block(bench_size.DOCS, "table-vs-harmonic")
+    # the bounds to a decade: scipy's and Newmark's worst differences sit near a power of ten, and their
+    # last bits follow the CPU's BLAS kernels
+    assert table_differences(committed, table(*fresh), 0.0, decades=1) == []
     assert all(row[2] == "yes" and float(row[3].lstrip("< ")) <= 1e-5 for row in fresh[1])

@@ -10,10 +10,15 @@ The text after the name in the opening comment says which command writes the
 block. :func:`replace_block` rewrites the lines between the markers,
 :func:`read_block` returns them, so a test can regenerate a table's
 deterministic columns and compare them with the committed file.
+:func:`table_differences` compares two tables cell by cell with a relative
+tolerance on numbers, for tables whose last digits depend on the machine
+(a chattering contact's event count follows LAPACK's last bits, which differ
+between CPUs).
 """
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Sequence
 from pathlib import Path
@@ -55,3 +60,46 @@ def replace_block(path: str | Path, name: str, content: str) -> bool:
     if new != text:
         write_atomic(str(path), new)
     return new != text
+
+
+def _number(cell: str) -> float | None:
+    try:
+        return float(cell)
+    except ValueError:
+        return None
+
+
+def _within_decades(a: str, b: str, decades: int) -> bool:
+    """Both cells bounds ``< x`` (x > 0) whose x differ by at most ``decades`` powers of ten."""
+    if not (a.startswith("< ") and b.startswith("< ")):
+        return False
+    x, y = _number(a[2:]), _number(b[2:])
+    return x is not None and y is not None and x > 0 and y > 0 and abs(math.log10(x / y)) <= decades + 1e-9
+
+
+def table_differences(committed: str, fresh: str, rel: float, decades: int = 0) -> list[str]:
+    """The cells where two Markdown tables differ: text exactly, numbers beyond ``rel`` relative,
+    bounds ``< 1e-7`` by more than ``decades`` powers of ten.
+
+    Returns one line per differing cell (line, column, both values), or a line
+    naming a difference in shape; an empty list when the tables agree.
+    """
+    rows_a = [line.strip().strip("|").split("|") for line in committed.strip().splitlines()]
+    rows_b = [line.strip().strip("|").split("|") for line in fresh.strip().splitlines()]
+    if len(rows_a) != len(rows_b):
+        return [f"{len(rows_a)} lines committed, {len(rows_b)} generated"]
+    out = []
+    for r, (row_a, row_b) in enumerate(zip(rows_a, rows_b, strict=True)):
+        if len(row_a) != len(row_b):
+            out.append(f"line {r + 1}: {len(row_a)} cells committed, {len(row_b)} generated")
+            continue
+        for col, (a, b) in enumerate(zip(row_a, row_b, strict=True)):
+            a, b = a.strip(), b.strip()
+            x, y = _number(a), _number(b)
+            if x is not None and y is not None:
+                if abs(x - y) <= rel * max(abs(x), abs(y)):
+                    continue
+            elif a == b or _within_decades(a, b, decades):
+                continue
+            out.append(f"line {r + 1}, column {col + 1}: committed {a}, generated {b}")
+    return out

@@ -105,7 +105,7 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
     from vtool.solvers.run import simulate
 
     spec = with_run_overrides(spec, backend=backend, time_step=dt, rpm=rpm, degrees=degrees)
-    announce_compile(spec.run.backend, csv=csv_path is not None and every_step)
+    announce_compile(spec, csv=csv_path is not None and every_step)
     progress = DelayedProgress(f"{spec.run.backend} {spec.run.degrees:g} deg")
     try:
         if csv_path is None:
@@ -135,12 +135,13 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
         click.echo(all_charts(trace))
 
 
-def announce_compile(backend: str, csv: bool = False) -> None:
-    """One line on stderr before a run that must first compile the solver (a new install's first run),
-    and one before the first every-step CSV compiles its number formatter (a few seconds, once)."""
-    from vtool.solvers.newmark import compile_notice
+def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()) -> None:
+    """One line on stderr before a run that must first compile the solver (a new install's first run, or
+    the first with Hertz contacts or momentum-law impacts), and one before the first every-step CSV
+    compiles its number formatter (a few seconds, once). ``impacts``: further impact laws to be run."""
+    from vtool.solvers.newmark import compile_notice, kernel_laws
 
-    notice = compile_notice(backend)
+    notice = compile_notice(spec.run.backend, kernel_laws(spec, impacts))
     if notice:
         click.echo(notice, err=True)
     if csv:
