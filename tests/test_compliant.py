@@ -296,3 +296,36 @@ def test_a_hertz_contact_starts_open() -> None:
     doc["initial"]["closed"] = ["cam"]
     with pytest.raises(InputError, match="starts open"):
         spec_from(doc)
+
+
+def test_kernel_law_switches_follow_the_clearances() -> None:
+    """The kernel is compiled without the Hertz iteration (momentum-law LCP) for a mechanism that has no
+    Hertz contact (momentum-law clearance): the switches say which, from the spec and from the table."""
+    import dataclasses
+
+    from vtool.presets import load_preset
+    from vtool.solvers import newmark_kernel as kernel
+    from vtool.solvers.contact import ContactProblem
+    from vtool.solvers.newmark import kernel_laws
+
+    thesis = load_preset("gnilka-1a")
+    momentum = dataclasses.replace(thesis, contact=dataclasses.replace(thesis.contact, impact="momentum"))
+    hertz = spec_from(hertz_doc())
+    for spec, expected in ((thesis, (None, None)), (momentum, (None, True)), (hertz, (True, None))):
+        assert kernel_laws(spec) == expected
+        assert kernel.laws(ContactProblem(assemble(spec)).cl) == expected
+    assert kernel_laws(thesis, impacts=("local", "momentum")) == (None, True)  # vtool compare's runs
+
+
+def test_a_kernel_is_cached_per_law_switch_pair() -> None:
+    from vtool.presets import load_preset
+    from vtool.solvers import newmark_kernel as kernel
+    from vtool.solvers.run import simulate
+
+    if not hasattr(kernel.run_chunk, "signatures"):
+        pytest.skip("NUMBA_DISABLE_JIT: nothing is compiled")
+    simulate(load_preset("gnilka-1a"))
+    if not kernel.numba_cache.CACHE_ENABLED:
+        pytest.skip("no writable numba cache")
+    assert kernel.is_cached(("run_chunk",), None, None)
+    assert not kernel.is_cached(("run_chunk",), 1.0, None)  # no kernel takes a float switch
