@@ -114,7 +114,7 @@ def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | Non
     names = ("run_chunk",) if backend == "newmark" else ("impact", "settle", "fill_sources")
     if kernel.is_cached(names, *laws):
         return None
-    return (f"compiling the solver, once (about {COMPILE_ESTIMATE_S:.0f} s on two cores); "
+    return (f"compiling the solver for these contact laws, once (about {COMPILE_ESTIMATE_S:.0f} s on two cores); "
             "later runs load it from the cache")
 
 
