@@ -46,6 +46,16 @@ closing gives the tied pair SCALE times the ahead coordinate's velocity
 After every transition :func:`settle` computes the consistent accelerations
 of the new configuration and releases at once any contact whose force would
 pull (an impact so released is a bounce: two events at one instant).
+
+Compile time
+------------
+Entry points (``@jit``) get numba's CPython wrapper; functions only compiled
+code calls (``@inner``) get none; helpers of a few lines (``@tiny``) are
+copied into their callers as numba IR and never compiled on their own. The
+``hertz`` and ``momentum`` arguments (:func:`laws`) are None when no
+clearance uses that law: numba then prunes the branches under them before
+typing, so the Hertz iteration and the momentum-law LCP are compiled (and
+cached) only for mechanisms that use them.
 """
 
 from __future__ import annotations
@@ -130,8 +140,8 @@ def is_cached(names: tuple[str, ...] = ENTRY_POINTS, hertz: bool | None = None,
         for name in names:
             index = globals()[name]._cache._cache_file._load_index()
             switches = tuple(numba.typeof(value) for value in trailing[name])
-            if not any(tuple(getattr(key[0], "args", key[0]))[len(key[0]) - len(switches):] == switches
-                       for key in index):
+            signatures = (tuple(getattr(key[0], "args", key[0])) for key in index)
+            if not any(args[len(args) - len(switches):] == switches for args in signatures):
                 return False
         return True
     except Exception:  # noqa: BLE001 (numba internals: a missing or unreadable index means "compile")
