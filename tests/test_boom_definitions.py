@@ -89,7 +89,7 @@ def test_daf_json_parses_and_carries_units(tmp_path) -> None:
     runner = CliRunner()
     result = runner.invoke(cli, ["boom", "daf", "--type", "N", "--range", "0:1:0.1", "--json"])
     assert result.exit_code == 0, result.output
-    doc = json.loads(result.output)
+    doc = json.loads(result.stdout)
     assert doc["ratio_unit"].startswith("tau/T") and doc["time_unit"] == "t/tau"
     assert doc["tau_over_T"] == pytest.approx([0.1 * k for k in range(11)])
     v = doc["quantities"]["velocity"]
@@ -100,6 +100,6 @@ def test_daf_json_parses_and_carries_units(tmp_path) -> None:
     env = runner.invoke(cli, ["boom", "daf", "--envelope", "--family", "equal-rise",
                               "--range", "0:1:0.25", "--json"])
     assert env.exit_code == 0, env.output
-    doc = json.loads(env.output)
+    doc = json.loads(env.stdout)
     assert doc["family"] == "equal-rise" and "(equal-rise family)" in doc["source"]
     assert set(doc["quantities"]) == {"velocity", "displacement"}

@@ -29,7 +29,7 @@ def test_modes_prints_frequencies_and_static_start() -> None:
 def test_modes_json_has_the_thesis_frequencies() -> None:
     result = run("modes", "gnilka-1a", "--json")
     assert result.exit_code == 0
-    report = json.loads(result.output)
+    report = json.loads(result.stdout)
     open_layer, contact_layer = report["layers"]
     np.testing.assert_allclose(open_layer["omega_rad_s"][1:], thesis.FIG_6_1_OMEGA[1:], rtol=0.002)
     np.testing.assert_allclose(contact_layer["omega_rad_s"], thesis.FIG_6_2_OMEGA, rtol=0.002)

@@ -42,7 +42,7 @@ def test_every_step_csv_has_a_row_per_step(tmp_path: Path) -> None:
 def test_json_summary_has_events_and_statistics() -> None:
     result = run("solve", "gnilka-1a", "--degrees", "200", "--json")
     assert result.exit_code == 0
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     assert summary["backend"] == "newmark" and summary["steps"] > 3000
     assert summary["events_list"][0]["clearance"] == "cam"
     assert {c["clearance"] for c in summary["clearances"]} == {"cam", "rocker", "seat"}
@@ -57,7 +57,7 @@ def test_plot_draws_force_displacement_and_configuration_charts() -> None:
 
 def test_overrides_change_the_run() -> None:
     result = run("solve", "gnilka-1a", "--rpm", "9000", "--degrees", "90", "--dt", "2e-6", "--json")
-    settings = json.loads(result.output)["settings"]
+    settings = json.loads(result.stdout)["settings"]
     assert settings == {"time_step_s": 2e-6, "beta": 1 / 6, "gamma": 0.5, "refine_after_events": 10,
                         "rpm": 9000.0, "degrees": 90.0, "impact": ["local"], "rocker_scale": 1.0,
                         "start_velocities": "thesis"}
@@ -68,7 +68,7 @@ def test_impact_law_and_start_overrides_are_in_the_settings_and_the_events() -> 
     clearance, kind, relative velocity and the configurations before and after, and the law."""
     result = run("solve", "gnilka-1a", "--degrees", "400", "--impact", "momentum", "--start", "quasi-static",
                  "--events", "--json")
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     assert summary["settings"]["impact"] == ["momentum"]
     assert summary["settings"]["start_velocities"] == "quasi-static"
     assert {c["impact_law"] for c in summary["clearances"]} == {"momentum"}

@@ -205,7 +205,7 @@ def test_vtool_solve_reports_the_peak_overlap(tmp_path) -> None:  # noqa: ANN001
     assert result.exit_code == 0, result.output
     assert "seat: linear contact, peak overlap" in result.output
     result = CliRunner().invoke(cli, ["solve", str(preset), "--json"])
-    seat = next(c for c in json.loads(result.output)["clearances"] if c["clearance"] == "seat")
+    seat = next(c for c in json.loads(result.stdout)["clearances"] if c["clearance"] == "seat")
     assert seat["contact"] == "linear" and seat["peak_overlap_unit"] == "in" and 0 < seat["peak_overlap"] < 0.01
 
 

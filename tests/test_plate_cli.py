@@ -77,7 +77,7 @@ def test_modes_prints_errors_against_exact(tmp_path: Path) -> None:
 def test_modes_json_all_cases() -> None:
     result = run("modes", "plate-table3", "--json", "--count", "2")
     assert result.exit_code == 0
-    data = json.loads(result.output)
+    data = json.loads(result.stdout)
     assert [d["KS"] for d in data][:3] == [82, 44, 18]
 
 

@@ -1,0 +1,83 @@
+"""First compile of the Newmark kernel: this checkout against an earlier commit, interleaved.
+
+Run: ``python3 benchmarks/bench_compile_ab.py [REF] [--pairs N]`` (default REF ``79a928d``, the
+kernel before the compile-time work of 2026-11-24; N = 3 pairs, about 30 s a process on two
+cores). Each process compiles ``gnilka-1a``'s kernel with an empty numba cache, as
+``bench_newmark.py`` does; the two versions alternate, so that a machine whose speed drifts
+(this project's 2-core VMs drift by ±20 % within minutes) slows both alike, and the ratio of
+the medians is the figure to quote.
+
+The earlier commit is read with ``git archive`` into a temporary folder laid out as the
+installed package (``vtool/`` with ``app``, ``assessments``, ``presets`` and ``solvers``
+inside) and put first on ``PYTHONPATH``, ahead of the editable install's finder.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import statistics
+import subprocess
+import sys
+import tarfile
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SUBPACKAGES = ("app", "assessments", "presets", "solvers")  # folders the installed package maps into vtool
+COMPILE = """
+from vtool.presets import load_preset
+from vtool.solvers.run import simulate
+import vtool.solvers.newmark_kernel as kernel
+trace = simulate(load_preset("gnilka-1a"))
+assert kernel.__file__.startswith({prefix!r}), kernel.__file__
+print(trace.statistics.compile_time)
+"""
+
+
+def layout(ref: str, folder: Path) -> Path:
+    """``ref``'s sources as an importable ``vtool`` package under ``folder``; returns the path entry."""
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", ref], capture_output=True, check=True).stdout
+    tree = folder / "tree"
+    with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
+        tar.extractall(tree, filter="data")
+    package = folder / "path" / "vtool"
+    package.mkdir(parents=True)
+    for entry in (tree / "vtool").iterdir():
+        (package / entry.name).symlink_to(entry)
+    for name in SUBPACKAGES:
+        (package / name).symlink_to(tree / name)
+    return folder / "path"
+
+
+def compile_seconds(path_entry: Path | None, prefix: str) -> float:
+    env = dict(os.environ)
+    if path_entry is not None:
+        env["PYTHONPATH"] = os.pathsep.join([str(path_entry), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    with tempfile.TemporaryDirectory() as cache:
+        env["NUMBA_CACHE_DIR"] = cache
+        out = subprocess.run([sys.executable, "-c", COMPILE.format(prefix=prefix)], capture_output=True,
+                             text=True, env=env, cwd=tempfile.gettempdir())
+    if out.returncode != 0:
+        raise SystemExit(f"compile run failed:\n{out.stderr[-2000:]}")
+    return float(out.stdout.split()[-1])
+
+
+def main(argv: list[str]) -> None:
+    pairs = int(argv[argv.index("--pairs") + 1]) if "--pairs" in argv else 3
+    refs = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] != "--pairs")]
+    ref = refs[0] if refs else "79a928d"
+    old, new = [], []
+    with tempfile.TemporaryDirectory() as folder:
+        entry = layout(ref, Path(folder))
+        for _ in range(pairs):
+            old.append(compile_seconds(entry, str(entry)))
+            new.append(compile_seconds(None, str(ROOT)))
+            print(f"  {ref}: {old[-1]:.1f} s   this checkout: {new[-1]:.1f} s", flush=True)
+    a, b = statistics.median(old), statistics.median(new)
+    print(f"first compile of gnilka-1a's kernel, empty cache, median of {pairs} interleaved: {ref} {a:.1f} s, "
+          f"this checkout {b:.1f} s; ratio {b / a:.2f} (target 10 s: ratio {b / 10.0:.2f})")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
