@@ -60,6 +60,7 @@ cached) only for mechanisms that use them.
 
 from __future__ import annotations
 
+import math
 import os
 from typing import Any
 
@@ -167,8 +168,8 @@ def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:
 @jit
 def fill_sources(ns, nh, omega, sc, sa, sb, t, src):
     """src[3s : 3s + 3] = (x, v, a) of every source s at t (harmonics by angle addition)."""
-    c1 = np.cos(omega * t)
-    s1 = np.sin(omega * t)
+    c1 = math.cos(omega * t)
+    s1 = math.sin(omega * t)
     for s in range(ns):
         src[3 * s] = sc[s]
         src[3 * s + 1] = 0.0
@@ -244,7 +245,7 @@ def factor_effective(ci, cm, c, beta, gamma, h, L):
             for k in range(g):
                 s -= L[f, k] * L[g, k]
             if f == g:
-                L[f, f] = np.sqrt(s) if s > 0.0 else 1e-300
+                L[f, f] = math.sqrt(s) if s > 0.0 else 1e-300
             else:
                 L[f, g] = s / L[g, g]
 
@@ -693,7 +694,7 @@ def prescribed_velocity(cl, c, ncl, coordinate, src):
     for k in range(ncl):
         if (c & cl[k, CL_BIT]) and not cl[k, CL_SOFT] and cl[k, CL_BEHIND] < 0 and cl[k, CL_AHEAD] == coordinate:
             return src[3 * cl[k, CL_SRC] + 1]
-    return np.nan
+    return math.nan
 
 
 @inner
@@ -723,9 +724,9 @@ def impact_local(ip, fp, cl, clf, mass, c, k, src, v, stick, ev_f, ev_i, ist, t)
         e = 0.0 if (stick or abs(u) < fp[FP_VREST]) else clf[k, CLF_E]
         wa = prescribed_velocity(cl, c, ncl, a, src)
         wb = prescribed_velocity(cl, c, ncl, behind, src)
-        if not np.isnan(wa):  # a follows a source: b alone changes
+        if not math.isnan(wa):  # a follows a source: b alone changes
             v[behind] = wa + e * u
-        elif not np.isnan(wb):
+        elif not math.isnan(wb):
             v[a] = wb - e * u
         else:
             ma = mass[0, a, a]
@@ -946,8 +947,8 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
         if t1 > t_end or t >= fst[F_CHUNK_END]:
             return t
         # the sources at t + h
-        c1 = np.cos(omega * t1)
-        s1 = np.sin(omega * t1)
+        c1 = math.cos(omega * t1)
+        s1 = math.sin(omega * t1)
         for s in range(ns):
             src1[3 * s] = sc[s]
             src1[3 * s + 1] = 0.0
@@ -1033,8 +1034,8 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
                 zddo[j] = zdd[j] + da * r
                 zdo[j] = zd[j] + zdd[j] * s_out + da * s_out * r / 2.0
                 zo[j] = z[j] + zd[j] * s_out + zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
-            co = np.cos(omega * t_out)
-            so = np.sin(omega * t_out)
+            co = math.cos(omega * t_out)
+            so = math.sin(omega * t_out)
             for s in range(ns):
                 srco[3 * s] = sc[s]
                 srco[3 * s + 1] = 0.0
