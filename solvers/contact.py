@@ -275,6 +275,7 @@ class ContactProblem:
             clf[k, :kernel.CLF_HV] = (c.restitution, spec.contact.rocker_scale, c.contact_stiffness,
                                       c.contact_exponent)
         self.cl, self.clf = cl, clf
+        self.hertz, self.momentum = kernel.laws(cl)  # the kernel's law switches
         self.mass = np.stack([mechanism.M, np.linalg.inv(mechanism.M)])
         self.omega = mechanism.omega
         self.omega_max = mechanism.highest_frequency
@@ -339,7 +340,7 @@ class ContactProblem:
         ev_i = np.zeros((4 * self.ncl + 4, 4), dtype=np.int64)
         ist = np.zeros(kernel.I_SIZE, dtype=np.int64)
         new = int(kernel.impact(ip, fp, self.cl, self.clf, self.mass, mask, flags, self.sources_at(t), x, v,
-                                stick, ev_f, ev_i, ist, t, kernel.laws(self.cl)[1]))
+                                stick, ev_f, ev_i, ist, t, self.momentum))
         events = [(int(ev_i[r, 0]), EVENT_KINDS[int(ev_i[r, 1])], float(ev_f[r, 1]), int(ev_i[r, 2]),
                    int(ev_i[r, 3])) for r in range(int(ist[kernel.I_NEV]))]
         return new, events

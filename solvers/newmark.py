@@ -231,7 +231,7 @@ class KernelRun:
         return (self.ip, self.fp, problem.cl, problem.clf, problem.series.const, problem.series.cos,
                 problem.series.sin, problem.mass, tables.ci, tables.cm, tables.cp, tables.mk, tables.mon,
                 self.out_t, self.out_q, self.out_F, self.out_c, self.ev_f, self.ev_i, self.peak,
-                self.x, self.v, self.a, self.ist, self.fst, *kernel.laws(problem.cl))
+                self.x, self.v, self.a, self.ist, self.fst, problem.hertz, problem.momentum)
 
     def compile(self) -> None:
         """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""

@@ -317,7 +317,7 @@ class PiecewiseRun(ABC):
                                        tables.mk,
                                        tables.mon, mask, t, x, v, a, self.sources(t), self.ev_f, self.ev_i,
                                        self.ist, np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m),
-                                       kernel.laws(problem.cl)[0]))
+                                       problem.hertz))
             self._take_events()
             if result >= 0:
                 return result
@@ -361,7 +361,7 @@ class PiecewiseRun(ABC):
             self.ist[kernel.I_NEV] = 0
             new_c = int(kernel.impact(self.ip, self.fp, problem.cl, problem.clf, problem.mass, new_c, closing,
                                       self.sources(t), x, v, stick, self.ev_f, self.ev_i, self.ist, t,
-                                      kernel.laws(problem.cl)[1]))
+                                      problem.momentum))
             self._take_events()
         new_c = self.settle(new_c, t, x, v, a)
         return new_c, x, v, a
