@@ -44,6 +44,17 @@ Method (see the kernel's docstring for the equations):
   after the impact) came out as an extra separation; with four, all six
   thesis presets give the exact back end's event sequence (the accuracy
   tables give the figures). ``refine = 1`` is the plain thesis scheme.
+* First run: when numba's cache has no compiled kernel for this mechanism's
+  contact laws (a new install, or the first Hertz or momentum-law run), the
+  run does not wait for the compile. A child process compiles the kernel
+  into the cache (:mod:`vtool.solvers.kernel_build`) while the run starts at
+  once in the kernel's own source run as plain Python (:func:`plain_kernel`);
+  between chunks the run looks in the cache and, once the kernel is there,
+  loads it and goes on compiled. Both execute the same source, and their
+  results agree to the last bit on every thesis preset (a test compares
+  them to the reference tolerances). ``VTOOL_KERNEL`` chooses otherwise:
+  ``compiled`` compiles first, in this process (benchmarks, and the tests,
+  which need the compiled kernel), ``plain`` never compiles.
 * Stability: for gamma = 1/2 and beta < 1/4 the step must satisfy
   omega_max dt <= 1 / sqrt(gamma/2 - beta) (2 sqrt 3 for linear acceleration:
   dt <= sqrt(3)/pi T_min), with omega_max the highest natural frequency of
@@ -52,14 +63,19 @@ Method (see the kernel's docstring for the equations):
 
 from __future__ import annotations
 
+import importlib.util
 import math
+import os
 import time as wallclock
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
 import numpy as np
 
+from vtool import numba_cache
 from vtool.errors import InputError, RunError
+from vtool.solvers import kernel_build
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.backends import Backend, Cancel, Progress
 from vtool.solvers.contact import EVENT_KINDS, ContactProblem
@@ -67,7 +83,8 @@ from vtool.solvers.model import Mechanism
 from vtool.solvers.spec import HERTZ, MOMENTUM, RIGID, RunSpec
 from vtool.solvers.trace import TraceBuilder
 
-COMPILE_ESTIMATE_S = 30.0  # first compile of the kernel on a 2-core machine (benchmarks/bench_newmark.py)
+COMPILE_ESTIMATE_S = 15.0  # first compile of the kernel on a 2-core machine (benchmarks/bench_newmark.py)
+KERNEL_MODES = ("auto", "compiled", "plain")  # VTOOL_KERNEL (see "First run" in the module doc)
 ROW_BUFFER = 4096  # output rows between flushes: memory stays bounded for any run length
 EVENT_BUFFER = 4096
 
@@ -104,16 +121,54 @@ def kernel_laws(spec: Any, impacts: tuple[str, ...] = ()) -> tuple[bool | None, 
     return (True if hertz else None), (True if momentum else None)
 
 
+def kernel_mode() -> str:
+    """``VTOOL_KERNEL`` (default ``auto``): how a run gets its compiled kernel (see "First run" above)."""
+    mode = os.environ.get("VTOOL_KERNEL", "").strip() or "auto"
+    if mode not in KERNEL_MODES:
+        raise InputError("VTOOL_KERNEL", mode, "one of " + ", ".join(KERNEL_MODES))
+    return mode
+
+
+def jit_enabled() -> bool:
+    """False under ``NUMBA_DISABLE_JIT`` (the kernel module is plain Python already)."""
+    return hasattr(kernel.run_chunk, "signatures")
+
+
+_plain_module: list[ModuleType] = []
+
+
+def plain_kernel() -> ModuleType:
+    """The kernel's source loaded a second time as plain Python (``newmark_kernel_plain``; no numba)."""
+    if not jit_enabled():
+        return kernel
+    if not _plain_module:
+        spec = importlib.util.spec_from_file_location(kernel.__name__ + kernel.PLAIN_SUFFIX, kernel.__file__)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        _plain_module.append(module)
+    return _plain_module[0]
+
+
 def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | None] = (None, None)) -> str | None:
     """The line to show before a run that must first compile the kernel, or None when it is cached.
 
     The newmark back end runs ``run_chunk``; the piecewise back ends call the
     event rules (``impact``, ``settle``, ``fill_sources``) from Python. ``laws``:
     see :func:`kernel_laws` (a kernel is compiled and cached per switch pair).
+    A newmark run in the default ``auto`` mode does not wait for the compile.
     """
     names = ("run_chunk",) if backend == "newmark" else ("impact", "settle", "fill_sources")
-    if kernel.is_cached(names, *laws):
+    if not jit_enabled() or kernel.is_cached(names, *laws):
         return None
+    if backend == "newmark":
+        mode = kernel_mode()
+        if mode == "plain":
+            return None
+        if mode == "auto" and numba_cache.CACHE_ENABLED:
+            return (f"compiling the solver for these contact laws in the background, once (about "
+                    f"{COMPILE_ESTIMATE_S:.0f} s on two cores); this run starts now in plain Python and "
+                    "moves to the compiled solver when it is ready")
     return (f"compiling the solver for these contact laws, once (about {COMPILE_ESTIMATE_S:.0f} s on two cores); "
             "later runs load it from the cache")
 
@@ -175,7 +230,7 @@ class NewmarkBackend(Backend):
         o = options
         return {"steps": int(run.ist[kernel.I_STEPS]), "peak": run.peak[kernel.PEAK_ALL].copy(),
                 "peak_late": run.peak[kernel.PEAK_LATE].copy(), "peak_overlap": run.peak[kernel.PEAK_OVERLAP].copy(),
-                "compile_time": run.compile_time,
+                "compile_time": run.compile_time, "plain_steps": run.plain_steps,
                 "settings": {"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
                              "refine_after_events": o.refine}}
 
@@ -214,6 +269,7 @@ class KernelRun:
         self.fst = np.zeros(kernel.F_SIZE)
         self.fst[kernel.F_LAST_EVENT] = -1.0
         self.compile_time = 0.0
+        self.plain_steps = 0  # steps taken by the plain-Python kernel (before the compiled one was ready)
 
     def flush(self) -> None:
         """Move the filled rows and events out of the kernel's buffers."""
@@ -233,24 +289,54 @@ class KernelRun:
                 self.out_t, self.out_q, self.out_F, self.out_c, self.ev_f, self.ev_i, self.peak,
                 self.x, self.v, self.a, self.ist, self.fst, problem.hertz, problem.momentum)
 
-    def compile(self) -> None:
-        """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""
-        if not hasattr(kernel.run_chunk, "signatures") or kernel.run_chunk.signatures:
-            return  # NUMBA_DISABLE_JIT (the plain reference), or compiled already
+    def signature(self) -> tuple[Any, ...]:
+        """numba's types of :meth:`arguments` (what ``run_chunk`` is compiled for)."""
         import numba
 
+        return tuple(numba.typeof(value) for value in self.arguments())
+
+    def compile(self) -> None:
+        """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""
+        if not jit_enabled():
+            return  # NUMBA_DISABLE_JIT (the plain reference)
+        signature = self.signature()
+        if signature in kernel.run_chunk.signatures:
+            return  # compiled (or loaded) in this process already
         started = wallclock.perf_counter()
-        kernel.run_chunk.compile(tuple(numba.typeof(value) for value in self.arguments()))
-        self.compile_time = wallclock.perf_counter() - started
+        kernel.run_chunk.compile(signature)
+        self.compile_time += wallclock.perf_counter() - started
+
+    def ready(self) -> bool:
+        """True when ``run_chunk`` for these argument types is loaded in this process, or in numba's cache."""
+        return (self.signature() in kernel.run_chunk.signatures
+                or kernel.is_cached(("run_chunk",), self.problem.hertz, self.problem.momentum))
+
+    def first_kernel(self) -> tuple[ModuleType, bool]:
+        """The kernel module that takes the first chunk, and whether a compile is under way meanwhile
+        (see "First run" in the module doc)."""
+        if not jit_enabled():
+            return kernel, False
+        mode = kernel_mode()
+        if mode == "plain":
+            return plain_kernel(), False
+        if (mode == "compiled" or not numba_cache.CACHE_ENABLED or self.ready()
+                or not kernel_build.start(self.signature())):
+            self.compile()
+            return kernel, False
+        return plain_kernel(), True
 
     def execute(self, progress: Progress | None, cancel: Cancel | None) -> None:
         problem = self.problem
         chunk = self.options.chunk_steps * self.options.time_step
-        self.compile()
+        module, building = self.first_kernel()
         args = self.arguments()
         self.fst[kernel.F_CHUNK_END] = self.fst[kernel.F_T] + chunk
         while True:
-            status = kernel.run_chunk(*args)
+            if building and self.ready():  # the child's compile is in the cache: on with the compiled kernel
+                self.plain_steps = int(self.ist[kernel.I_STEPS])
+                self.compile()
+                module, building = kernel, False
+            status = module.run_chunk(*args)
             t = float(self.fst[kernel.F_T])
             if status == kernel.NEED_CONFIG:
                 problem.build(int(self.ist[kernel.I_WANT_CFG]))
@@ -269,6 +355,8 @@ class KernelRun:
                 progress(min(t / self.t_end, 1.0))
             if status == kernel.FINISHED:
                 self.flush()
+                if module is not kernel:
+                    self.plain_steps = int(self.ist[kernel.I_STEPS])
                 return
             if cancel is not None and cancel():
                 raise RunError(f"cancelled at t = {t:.6g} s")

@@ -56,6 +56,11 @@ copied into their callers as numba IR and never compiled on their own. The
 clearance uses that law: numba then prunes the branches under them before
 typing, so the Hertz iteration and the momentum-law LCP are compiled (and
 cached) only for mechanisms that use them.
+
+Loaded a second time under the module name ``…newmark_kernel_plain``
+(:data:`PLAIN`), the same source is plain Python, numba left out: a new
+install's first run goes on in it while a child process compiles the kernel
+into numba's cache (see :mod:`vtool.solvers.newmark`, "First run").
 """
 
 from __future__ import annotations
@@ -72,13 +77,22 @@ numba_cache.configure(os.path.dirname(os.path.abspath(__file__)))  # before numb
 
 from numba import njit  # noqa: E402 (after the cache folder is chosen)
 
+#: Module-name suffix of this source loaded a second time as plain Python (:func:`vtool.solvers.newmark.plain_kernel`).
+PLAIN_SUFFIX = "_plain"
+PLAIN = __name__.endswith(PLAIN_SUFFIX)
+
+
+def _plain(function: Any) -> Any:
+    return function
+
+
 _OPTIONS: dict[str, Any] = {"cache": numba_cache.CACHE_ENABLED, "nogil": True, "error_model": "numpy"}
 _INNER: dict[str, Any] = {**_OPTIONS, "no_cpython_wrapper": True, "no_cfunc_wrapper": True}
-jit = njit(**_OPTIONS)  # entry points, callable from Python
+jit = _plain if PLAIN else njit(**_OPTIONS)  # entry points, callable from Python
 # Called only from compiled code: no CPython or C wrapper to build (about 0.07 s of compile each).
-inner = njit(**_INNER)
+inner = _plain if PLAIN else njit(**_INNER)
 # A few lines each: their code is copied into the caller (numba IR), with no compile of their own.
-tiny = njit(**_INNER, inline="always")
+tiny = _plain if PLAIN else njit(**_INNER, inline="always")
 
 # ----- slots of the integer and float parameter vectors -----
 IP_N, IP_NCL, IP_NS, IP_NH, IP_EVERY, IP_ZSTICK, IP_ZSTOP = range(7)

@@ -78,6 +78,7 @@ class RunStatistics:
     settings: dict = field(default_factory=dict)
     error_estimate: float | None = None
     compile_time: float = 0.0  # s spent compiling (or loading) the kernel, not in wall_time
+    plain_steps: int = 0  # of ``steps``, those run as plain Python (before the compiled kernel was ready)
 
 
 @dataclass(frozen=True)
@@ -315,6 +316,7 @@ class Trace:
             "events": stats.events,
             "wall_time_s": stats.wall_time,
             "compile_time_s": stats.compile_time,
+            "plain_steps": stats.plain_steps,
             "episode_window_deg": EPISODE_WINDOW_DEG,
             "configurations_built": [configuration_label(self.spec, m) for m in stats.configurations_built],
             "events_list": [
@@ -332,8 +334,9 @@ class Trace:
         lines = [s["title"], f"back end {s['backend']}: " + ", ".join(f"{k} = {v}" for k, v in s["settings"].items())]
         compiling = (f" (+ {s['compile_time_s']:.1f} s compiling or loading the solver)"
                      if s["compile_time_s"] >= 0.5 else "")
+        plain = f" ({s['plain_steps']} of them as plain Python)" if s["plain_steps"] else ""
         lines.append(
-            f"steps {s['steps']}, events {s['events']}, wall time {s['wall_time_s']:.3f} s{compiling}, "
+            f"steps {s['steps']}{plain}, events {s['events']}, wall time {s['wall_time_s']:.3f} s{compiling}, "
             f"configurations built: {', '.join(s['configurations_built'])}"
         )
         lines.append("")

@@ -1,0 +1,139 @@
+"""A new install's first run: it does not wait for the kernel's compile (see newmark's "First run").
+
+The plain-Python copy of the kernel is the same source; a run may start in it
+and move to the compiled kernel between chunks, with the results of a run that
+was compiled throughout (to the reference tolerances of
+test_newmark.py::test_numba_kernel_equals_numpy_reference_on_example_1a).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from vtool.app.cli.main import cli
+from vtool.errors import InputError
+from vtool.presets import load_preset
+from vtool.solvers import kernel_build, newmark
+from vtool.solvers import newmark_kernel as kernel
+from vtool.solvers.run import simulate
+
+needs_jit = pytest.mark.skipif(not newmark.jit_enabled(), reason="NUMBA_DISABLE_JIT: nothing is compiled")
+
+
+def assert_same_run(a, b) -> None:  # noqa: ANN001 (two Traces)
+    assert [(e.clearance, e.kind) for e in a.events] == [(e.clearance, e.kind) for e in b.events]
+    np.testing.assert_allclose([e.time for e in a.events], [e.time for e in b.events], rtol=0, atol=1e-11)
+    np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a.contact_force, b.contact_force, rtol=0, atol=1e-6 * b.peak_force.max())
+
+
+def test_kernel_mode_comes_from_the_environment(monkeypatch) -> None:  # noqa: ANN001
+    monkeypatch.delenv("VTOOL_KERNEL", raising=False)
+    assert newmark.kernel_mode() == "auto"
+    for mode in newmark.KERNEL_MODES:
+        monkeypatch.setenv("VTOOL_KERNEL", mode)
+        assert newmark.kernel_mode() == mode
+    monkeypatch.setenv("VTOOL_KERNEL", "fast")
+    with pytest.raises(InputError, match="VTOOL_KERNEL: got 'fast', expected one of auto, compiled, plain"):
+        newmark.kernel_mode()
+
+
+def test_a_bad_kernel_mode_is_one_line_and_exit_2(monkeypatch) -> None:  # noqa: ANN001
+    monkeypatch.setenv("VTOOL_KERNEL", "fast")
+    result = CliRunner().invoke(cli, ["solve", "gnilka-1a"])
+    assert result.exit_code == 2
+    assert "VTOOL_KERNEL" in result.output and "Traceback" not in result.output
+    assert len(result.output.strip().splitlines()) == 1
+
+
+@needs_jit
+def test_the_plain_kernel_is_the_same_source_without_numba() -> None:
+    plain = newmark.plain_kernel()
+    assert plain is not kernel and plain.PLAIN and not kernel.PLAIN
+    assert plain.__file__ == kernel.__file__
+    assert not hasattr(plain.run_chunk, "signatures")  # a Python function, not a numba dispatcher
+    assert plain.run_chunk.__code__.co_code == kernel.run_chunk.py_func.__code__.co_code
+    assert (plain.FINISHED, plain.I_STEPS, plain.CL_SIZE) == (kernel.FINISHED, kernel.I_STEPS, kernel.CL_SIZE)
+
+
+@needs_jit
+def test_a_plain_run_equals_the_compiled_run(monkeypatch) -> None:  # noqa: ANN001
+    compiled = simulate(load_preset("gnilka-1a"))
+    monkeypatch.setenv("VTOOL_KERNEL", "plain")
+    plain = simulate(load_preset("gnilka-1a"))
+    assert compiled.statistics.plain_steps == 0
+    assert plain.statistics.plain_steps == plain.statistics.steps == compiled.statistics.steps
+    assert_same_run(plain, compiled)
+
+
+@needs_jit
+def test_a_run_moves_from_plain_to_compiled_between_chunks(monkeypatch) -> None:  # noqa: ANN001
+    """The compile "finishes" after the second chunk: the run goes on compiled from there."""
+    compiled = simulate(load_preset("gnilka-1a"))
+    started = []
+    answers = iter([False, False, False])  # first_kernel's question, then before chunks 1 and 2
+    monkeypatch.setenv("VTOOL_KERNEL", "auto")
+    monkeypatch.setattr(kernel_build, "start", lambda signature: started.append(signature) or True)
+    monkeypatch.setattr(newmark.KernelRun, "ready", lambda self: next(answers, True))
+    moved = simulate(load_preset("gnilka-1a"))
+    assert len(started) == 1
+    steps = moved.statistics.steps
+    assert steps == compiled.statistics.steps
+    assert 0 < moved.statistics.plain_steps < steps  # two chunks of 5000 steps, of 17,034
+    assert moved.statistics.plain_steps >= 2 * 5000
+    assert_same_run(moved, compiled)
+    summary = moved.summary_text()
+    assert f"({moved.statistics.plain_steps} of them as plain Python)" in summary
+
+
+@needs_jit
+def test_no_compile_is_started_when_the_kernel_is_loaded(monkeypatch) -> None:  # noqa: ANN001
+    simulate(load_preset("gnilka-1a"))
+    monkeypatch.setenv("VTOOL_KERNEL", "auto")
+    monkeypatch.setattr(kernel_build, "start", lambda signature: pytest.fail("a compile was started"))
+    assert simulate(load_preset("gnilka-1a")).statistics.plain_steps == 0
+
+
+def test_one_lock_per_compile(tmp_path, monkeypatch) -> None:  # noqa: ANN001
+    lock = tmp_path / "kernel.lock"
+    assert kernel_build._take(lock) is True
+    assert kernel_build._take(lock) is False  # a live compile holds it
+    old = time.time() - kernel_build.STALE_S - 1
+    os.utime(lock, (old, old))
+    assert kernel_build._take(lock) is True  # a dead child's lock is replaced
+    assert kernel_build._take(tmp_path / "missing" / "kernel.lock") is None  # no lock to be had
+
+
+@needs_jit
+@pytest.mark.slow
+def test_a_new_install_runs_at_once_and_compiles_in_the_background(tmp_path) -> None:
+    """Empty numba cache, the default mode: the first ``vtool solve`` announces the background compile
+    and runs as plain Python; the child fills the cache; the next run is compiled and silent."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("VTOOL_KERNEL")
+    command = [sys.executable, "-m", "vtool", "solve", "gnilka-1a", "--json"]
+    first = subprocess.run(command, env=env, capture_output=True, text=True, timeout=600)
+    assert first.returncode == 0, first.stderr
+    assert "in the background" in first.stderr
+    summary = json.loads(first.stdout)
+    assert summary["plain_steps"] > 0 and summary["compile_time_s"] < 5.0
+    probe = ("import sys; from vtool.solvers import newmark_kernel as k; "
+             "sys.exit(0 if k.is_cached(('run_chunk',), None, None) else 1)")
+    deadline = time.monotonic() + 600
+    while subprocess.run([sys.executable, "-c", probe], env=env).returncode != 0:
+        assert time.monotonic() < deadline, "the background compile did not reach the cache in 600 s"
+        time.sleep(2.0)
+    second = subprocess.run(command, env=env, capture_output=True, text=True, timeout=600)
+    assert second.returncode == 0, second.stderr
+    assert "compiling" not in second.stderr
+    again = json.loads(second.stdout)
+    assert again["plain_steps"] == 0
+    assert again["events_list"] == summary["events_list"]
