@@ -84,6 +84,7 @@ from vtool.solvers.spec import HERTZ, MOMENTUM, RIGID, RunSpec
 from vtool.solvers.trace import TraceBuilder
 
 COMPILE_ESTIMATE_S = 15.0  # first compile of the kernel on a 2-core machine (benchmarks/bench_newmark.py)
+RULES_COMPILE_ESTIMATE_S = 5.0  # of the event rules alone (impact, settle, fill_sources: the piecewise back ends)
 KERNEL_MODES = ("auto", "compiled", "plain")  # VTOOL_KERNEL (see "First run" in the module doc)
 ROW_BUFFER = 4096  # output rows between flushes: memory stays bounded for any run length
 EVENT_BUFFER = 4096
@@ -169,7 +170,8 @@ def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | Non
             return (f"compiling the solver for these contact laws in the background, once (about "
                     f"{COMPILE_ESTIMATE_S:.0f} s on two cores); this run starts now in plain Python and "
                     "moves to the compiled solver when it is ready")
-    return (f"compiling the solver for these contact laws, once (about {COMPILE_ESTIMATE_S:.0f} s on two cores); "
+    estimate = COMPILE_ESTIMATE_S if backend == "newmark" else RULES_COMPILE_ESTIMATE_S
+    return (f"compiling the solver for these contact laws, once (about {estimate:.0f} s on two cores); "
             "later runs load it from the cache")
 
 
