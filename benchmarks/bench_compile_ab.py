@@ -24,13 +24,13 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
+
 SUBPACKAGES = ("app", "assessments", "presets", "solvers")  # folders the installed package maps into vtool
 COMPILE = """
 from vtool.presets import load_preset
 from vtool.solvers.run import simulate
 import vtool.solvers.newmark_kernel as kernel
-
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 trace = simulate(load_preset("gnilka-1a"))
 assert kernel.__file__.startswith({prefix!r}), kernel.__file__
 print(trace.statistics.compile_time)

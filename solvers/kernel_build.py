@@ -12,11 +12,13 @@ numba's cache whether the kernel is there
 
 One compile at a time: the lock file (in the temporary folder, named by the
 kernel file's path, modification time and size, ``NUMBA_CACHE_DIR`` and the
-argument types) is
-created exclusively, so the workers of a sweep or several terminals started
-together launch one child between them. A lock older than :data:`STALE_S` is
-from a child that died and is replaced. The child's output goes nowhere; if it
-fails, the run simply finishes without it and the next run tries again.
+argument types) is created exclusively and holds the child's process id, so
+the workers of a sweep or several terminals started together launch one
+child between them, and each can tell whether it still runs
+(:func:`compiling`). A lock whose process is gone, or older than
+:data:`STALE_S`, is replaced. A child that fails leaves a ``.failed`` file
+beside the lock with its error; later runs then compile in their own process
+(where the error shows) instead of starting it again.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import traceback
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +51,36 @@ def lock_path(signature: tuple[Any, ...]) -> Path:
     return Path(tempfile.gettempdir()) / f"vtool-kernel-{uid}-{hashlib.sha1(key).hexdigest()[:16]}.lock"
 
 
+def failed_path(lock: Path) -> Path:
+    return lock.with_suffix(".failed")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # it exists, owned by someone else
+        return True
+    return True
+
+
+def holder_alive(lock: Path) -> bool:
+    """True when ``lock`` exists, is younger than :data:`STALE_S` and its process (if written yet) runs."""
+    for child in _children[:]:
+        if child.poll() is not None:
+            _children.remove(child)  # reaped
+    try:
+        if time.time() - lock.stat().st_mtime >= STALE_S:
+            return False
+        text = lock.read_text().strip()
+    except OSError:
+        return False
+    if not text:
+        return True  # just created: the process id follows
+    return text.isdigit() and _alive(int(text))
+
+
 def _take(lock: Path) -> bool | None:
     """Create the lock: True if taken, False if a live compile holds it, None if no lock can be made."""
     for _ in range(2):
@@ -55,9 +88,9 @@ def _take(lock: Path) -> bool | None:
             os.close(os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o600))
             return True
         except FileExistsError:
+            if holder_alive(lock):
+                return False
             try:
-                if time.time() - lock.stat().st_mtime < STALE_S:
-                    return False
                 lock.unlink()
             except FileNotFoundError:
                 continue  # the child just finished: take it
@@ -68,20 +101,16 @@ def _take(lock: Path) -> bool | None:
     return False
 
 
-def running() -> bool:
-    """True while a child this process started is still compiling."""
-    alive = [child for child in _children if child.poll() is None]
-    _children[:] = alive
-    return bool(alive)
-
-
 def start(signature: tuple[Any, ...]) -> bool:
     """Start the child compile of ``run_chunk`` for ``signature`` unless one is running already.
 
     Returns True when a compile is under way (this call's or another
-    process's), False when none could be started (the caller compiles itself).
+    process's), False when none could be started or an earlier one failed
+    (the caller compiles itself).
     """
     lock = lock_path(signature)
+    if failed_path(lock).exists():
+        return False
     taken = _take(lock)
     if taken is False:
         return True
@@ -97,7 +126,24 @@ def start(signature: tuple[Any, ...]) -> bool:
             lock.unlink(missing_ok=True)
         return False
     _children.append(child)
+    if taken:
+        try:  # not O_CREAT: a child that has finished already has removed the lock
+            descriptor = os.open(lock, os.O_WRONLY)
+            os.write(descriptor, str(child.pid).encode())
+            os.close(descriptor)
+        except OSError:
+            pass
     return True
+
+
+def compiling(signature: tuple[Any, ...]) -> bool:
+    """True while a child compile for ``signature`` (this process's or another's) is still running; a
+    lock left by one that was killed is removed."""
+    lock = lock_path(signature)
+    if holder_alive(lock):
+        return True
+    lock.unlink(missing_ok=True)
+    return False
 
 
 def main(argv: list[str]) -> int:
@@ -109,6 +155,13 @@ def main(argv: list[str]) -> int:
 
         kernel.run_chunk.compile(signature)
         return 0
+    except BaseException:
+        if lock is not None:
+            try:
+                failed_path(lock).write_text(traceback.format_exc())
+            except OSError:
+                pass
+        raise
     finally:
         if lock is not None:
             lock.unlink(missing_ok=True)

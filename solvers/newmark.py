@@ -50,7 +50,8 @@ Method (see the kernel's docstring for the equations):
   into the cache (:mod:`vtool.solvers.kernel_build`) while the run starts at
   once in the kernel's own source run as plain Python (:func:`plain_kernel`);
   between chunks the run looks in the cache and, once the kernel is there,
-  loads it and goes on compiled. Both execute the same source, and their
+  loads it and goes on compiled (should the child end without it, the run
+  compiles the kernel itself). Both execute the same source, and their
   results agree to the last bit on every thesis preset (a test compares
   them to the reference tolerances). ``VTOOL_KERNEL`` chooses otherwise:
   ``compiled`` compiles first, in this process (benchmarks, and the tests,
@@ -334,7 +335,8 @@ class KernelRun:
         args = self.arguments()
         self.fst[kernel.F_CHUNK_END] = self.fst[kernel.F_T] + chunk
         while True:
-            if building and self.ready():  # the child's compile is in the cache: on with the compiled kernel
+            # the child's compile is in the cache (or the child is gone without it: compile here): go on compiled
+            if building and (self.ready() or not kernel_build.compiling(self.signature())):
                 self.plain_steps = int(self.ist[kernel.I_STEPS])
                 self.compile()
                 module, building = kernel, False

@@ -82,6 +82,7 @@ def test_a_run_moves_from_plain_to_compiled_between_chunks(monkeypatch) -> None:
     answers = iter([False, False, False])  # first_kernel's question, then before chunks 1 and 2
     monkeypatch.setenv("VTOOL_KERNEL", "auto")
     monkeypatch.setattr(kernel_build, "start", lambda signature: started.append(signature) or True)
+    monkeypatch.setattr(kernel_build, "compiling", lambda signature: True)
     monkeypatch.setattr(newmark.KernelRun, "ready", lambda self: next(answers, True))
     moved = simulate(load_preset("gnilka-1a"))
     assert len(started) == 1
@@ -95,6 +96,19 @@ def test_a_run_moves_from_plain_to_compiled_between_chunks(monkeypatch) -> None:
 
 
 @needs_jit
+def test_a_run_compiles_itself_when_the_child_is_gone(monkeypatch) -> None:  # noqa: ANN001
+    """The child ended without putting the kernel in the cache: the run compiles it (no endless plain run)."""
+    compiled = simulate(load_preset("gnilka-1a"))
+    monkeypatch.setenv("VTOOL_KERNEL", "auto")
+    monkeypatch.setattr(kernel_build, "start", lambda signature: True)
+    monkeypatch.setattr(kernel_build, "compiling", lambda signature: False)
+    monkeypatch.setattr(newmark.KernelRun, "ready", lambda self: False)
+    alone = simulate(load_preset("gnilka-1a"))
+    assert alone.statistics.plain_steps == 0  # moved before the first chunk
+    assert_same_run(alone, compiled)
+
+
+@needs_jit
 def test_no_compile_is_started_when_the_kernel_is_loaded(monkeypatch) -> None:  # noqa: ANN001
     simulate(load_preset("gnilka-1a"))
     monkeypatch.setenv("VTOOL_KERNEL", "auto")
@@ -102,14 +116,36 @@ def test_no_compile_is_started_when_the_kernel_is_loaded(monkeypatch) -> None:  
     assert simulate(load_preset("gnilka-1a")).statistics.plain_steps == 0
 
 
-def test_one_lock_per_compile(tmp_path, monkeypatch) -> None:  # noqa: ANN001
+def test_one_lock_per_compile(tmp_path) -> None:  # noqa: ANN001
     lock = tmp_path / "kernel.lock"
     assert kernel_build._take(lock) is True
-    assert kernel_build._take(lock) is False  # a live compile holds it
+    assert kernel_build._take(lock) is False  # just made: its process id follows
+    lock.write_text(str(os.getpid()))
+    assert kernel_build._take(lock) is False  # a live process holds it
     old = time.time() - kernel_build.STALE_S - 1
     os.utime(lock, (old, old))
-    assert kernel_build._take(lock) is True  # a dead child's lock is replaced
+    assert kernel_build._take(lock) is True  # too old: replaced
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True, check=True).stdout.strip()
+    lock.write_text(gone)
+    assert not kernel_build.holder_alive(lock)
+    assert kernel_build._take(lock) is True  # its process is gone: replaced
+    lock.write_text("not a process id")
+    assert not kernel_build.holder_alive(lock)
     assert kernel_build._take(tmp_path / "missing" / "kernel.lock") is None  # no lock to be had
+
+
+def test_a_failed_child_leaves_its_error_and_no_lock(tmp_path, monkeypatch) -> None:  # noqa: ANN001
+    lock = tmp_path / "kernel.lock"
+    lock.write_text("")
+    child = subprocess.run([sys.executable, "-m", "vtool.solvers.kernel_build", str(lock)], input=b"not a pickle",
+                           capture_output=True)
+    assert child.returncode != 0
+    assert not lock.exists()
+    assert "UnpicklingError" in kernel_build.failed_path(lock).read_text()
+    monkeypatch.setattr(kernel_build, "lock_path", lambda signature: lock)
+    monkeypatch.setattr(subprocess, "Popen", lambda *a, **k: pytest.fail("a failed compile was started again"))
+    assert kernel_build.start(()) is False  # the caller compiles in its own process, where the error shows
 
 
 @needs_jit
