@@ -334,7 +334,8 @@ class Trace:
         lines = [s["title"], f"back end {s['backend']}: " + ", ".join(f"{k} = {v}" for k, v in s["settings"].items())]
         compiling = (f" (+ {s['compile_time_s']:.1f} s compiling or loading the solver)"
                      if s["compile_time_s"] >= 0.5 else "")
-        plain = f" ({s['plain_steps']} of them as plain Python)" if s["plain_steps"] else ""
+        plain = ("" if not s["plain_steps"] else " (all as plain Python)" if s["plain_steps"] == s["steps"]
+                 else f" ({s['plain_steps']} of them as plain Python)")
         lines.append(
             f"steps {s['steps']}{plain}, events {s['events']}, wall time {s['wall_time_s']:.3f} s{compiling}, "
             f"configurations built: {', '.join(s['configurations_built'])}"

@@ -72,6 +72,7 @@ def test_a_plain_run_equals_the_compiled_run(monkeypatch) -> None:  # noqa: ANN0
     assert compiled.statistics.plain_steps == 0
     assert plain.statistics.plain_steps == plain.statistics.steps == compiled.statistics.steps
     assert_same_run(plain, compiled)
+    assert f"steps {plain.statistics.steps} (all as plain Python)," in plain.summary_text()
 
 
 @needs_jit
