@@ -3,27 +3,38 @@
 A new install's first run would otherwise wait for the compile (about
 :data:`vtool.solvers.newmark.COMPILE_ESTIMATE_S` s on two cores) before its
 first step. Instead :func:`start` launches ``python -m
-vtool.solvers.kernel_build LOCK`` with the pickled argument types of
-``run_chunk`` on its standard input and returns at once; the child compiles
-``run_chunk`` for those types (numba writes its cache as it compiles), removes
-the lock and exits. The parent never waits for it: between chunks it asks
+vtool.solvers.kernel_build LOCK`` with the pickled jobs (here ``run_chunk`` and
+numba's types of its arguments) on its standard input and returns at once;
+the child compiles them (numba writes its cache as it compiles), removes the
+lock and exits. The parent never waits for it: between chunks it asks
 numba's cache whether the kernel is there
 (:func:`vtool.solvers.newmark_kernel.is_cached`) and then loads it.
 
 One compile at a time: the lock file (in the temporary folder, named by the
 kernel file's path, modification time and size, ``NUMBA_CACHE_DIR`` and the
-argument types) is created exclusively and holds the child's process id, so
+jobs) is created exclusively and holds the child's process id, so
 the workers of a sweep or several terminals started together launch one
 child between them, and each can tell whether it still runs
 (:func:`compiling`). A lock whose process is gone, or older than
 :data:`STALE_S`, is replaced. A child that fails leaves a ``.failed`` file
 beside the lock with its error; later runs then compile in their own process
 (where the error shows) instead of starting it again.
+
+Which kernel a run uses (``VTOOL_KERNEL``, :func:`kernel_mode`): ``auto``
+(the default) as above; ``compiled`` compiles in the run's own process
+before its first step, as numba does by default; ``plain`` never compiles.
+The piecewise back ends call only the event rules (``settle``, ``impact``,
+``fill_sources`` and, with compliant contacts, ``snap_shut``,
+``relative_velocity``, ``hertz_law``), a few hundred times a run: in
+``auto`` mode, until those are cached, a run calls them as plain Python
+(:class:`RecordingRules`, which notes the types they were called with) and
+then starts their compile the same way.
 """
 
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import os
 import pickle
 import subprocess
@@ -32,21 +43,91 @@ import tempfile
 import time
 import traceback
 from pathlib import Path
+from types import ModuleType
 from typing import Any
+
+from vtool.errors import InputError
+from vtool.solvers import newmark_kernel as kernel
 
 #: A lock older than this (s) is from a child that did not finish; a new compile replaces it.
 STALE_S = 600.0
+KERNEL_MODES = ("auto", "compiled", "plain")  # VTOOL_KERNEL
 _children: list[subprocess.Popen] = []  # type: ignore[type-arg]  # polled so that finished children are reaped
+_plain_module: list[ModuleType] = []
+
+#: A compile job: an entry point's name and numba's types of its arguments.
+Job = tuple[str, tuple[Any, ...]]
 
 
-def lock_path(signature: tuple[Any, ...]) -> Path:
-    """The lock file of a compile of ``run_chunk`` for these argument types (numba types)."""
-    from vtool.solvers import newmark_kernel as kernel
+def kernel_mode() -> str:
+    """``VTOOL_KERNEL`` (default ``auto``): how a run gets its compiled kernel (see the module doc)."""
+    mode = os.environ.get("VTOOL_KERNEL", "").strip() or "auto"
+    if mode not in KERNEL_MODES:
+        raise InputError("VTOOL_KERNEL", mode, "one of " + ", ".join(KERNEL_MODES))
+    return mode
 
+
+def jit_enabled() -> bool:
+    """False under ``NUMBA_DISABLE_JIT`` (the kernel module is plain Python already)."""
+    return hasattr(kernel.run_chunk, "signatures")
+
+
+def plain_kernel() -> ModuleType:
+    """The kernel's source loaded a second time as plain Python (``newmark_kernel_plain``; no numba)."""
+    if not jit_enabled():
+        return kernel
+    if not _plain_module:
+        spec = importlib.util.spec_from_file_location(kernel.__name__ + kernel.PLAIN_SUFFIX, kernel.__file__)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        _plain_module.append(module)
+    return _plain_module[0]
+
+
+class RecordingRules:
+    """The plain kernel's functions, noting numba's types of the first call of each (:attr:`jobs`)."""
+
+    def __init__(self) -> None:
+        self.plain = plain_kernel()
+        self.jobs: dict[str, tuple[Any, ...]] = {}
+
+    def __getattr__(self, name: str) -> Any:
+        function = getattr(self.plain, name)
+
+        def call(*args: Any) -> Any:
+            if name not in self.jobs:
+                import numba
+
+                self.jobs[name] = tuple(numba.typeof(value) for value in args)
+            return function(*args)
+
+        return call
+
+
+def rules(hertz: bool | None, momentum: bool | None) -> Any:
+    """The module whose event rules a piecewise run calls: the compiled kernel, or (``auto`` mode, not
+    cached yet; ``plain`` mode) a :class:`RecordingRules` on the plain one."""
+    mode = kernel_mode()
+    if not jit_enabled() or mode == "compiled":
+        return kernel
+    if mode == "auto" and kernel.is_cached(("impact", "settle", "fill_sources"), hertz, momentum):
+        return kernel
+    return RecordingRules()
+
+
+def compile_recorded(used: Any) -> None:
+    """After a piecewise run on :func:`rules`: start the compile of what it called as plain Python."""
+    if isinstance(used, RecordingRules) and used.jobs and kernel_mode() == "auto":
+        start(sorted(used.jobs.items()))
+
+
+def lock_path(jobs: list[Job]) -> Path:
+    """The lock file of a compile of these jobs."""
     source = Path(kernel.__file__).resolve()
     stamp = source.stat()
     cache = os.environ.get("NUMBA_CACHE_DIR", "")
-    key = f"{source}|{stamp.st_mtime_ns}|{stamp.st_size}|{cache}|{signature!r}".encode()
+    key = f"{source}|{stamp.st_mtime_ns}|{stamp.st_size}|{cache}|{jobs!r}".encode()
     uid = os.getuid() if hasattr(os, "getuid") else "user"
     return Path(tempfile.gettempdir()) / f"vtool-kernel-{uid}-{hashlib.sha1(key).hexdigest()[:16]}.lock"
 
@@ -101,14 +182,14 @@ def _take(lock: Path) -> bool | None:
     return False
 
 
-def start(signature: tuple[Any, ...]) -> bool:
-    """Start the child compile of ``run_chunk`` for ``signature`` unless one is running already.
+def start(jobs: list[Job]) -> bool:
+    """Start the child compile of ``jobs`` unless one is running already.
 
     Returns True when a compile is under way (this call's or another
     process's), False when none could be started or an earlier one failed
     (the caller compiles itself).
     """
-    lock = lock_path(signature)
+    lock = lock_path(jobs)
     if failed_path(lock).exists():
         return False
     taken = _take(lock)
@@ -119,7 +200,7 @@ def start(signature: tuple[Any, ...]) -> bool:
                                  stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                  close_fds=True)
         assert child.stdin is not None
-        child.stdin.write(pickle.dumps(signature))
+        child.stdin.write(pickle.dumps(jobs))
         child.stdin.close()
     except OSError:  # no process to be had (or it died at once): the caller compiles in-process
         if taken:
@@ -136,10 +217,10 @@ def start(signature: tuple[Any, ...]) -> bool:
     return True
 
 
-def compiling(signature: tuple[Any, ...]) -> bool:
-    """True while a child compile for ``signature`` (this process's or another's) is still running; a
-    lock left by one that was killed is removed."""
-    lock = lock_path(signature)
+def compiling(jobs: list[Job]) -> bool:
+    """True while a child compile of ``jobs`` (this process's or another's) is still running; a lock
+    left by one that was killed is removed."""
+    lock = lock_path(jobs)
     if holder_alive(lock):
         return True
     lock.unlink(missing_ok=True)
@@ -147,13 +228,12 @@ def compiling(signature: tuple[Any, ...]) -> bool:
 
 
 def main(argv: list[str]) -> int:
-    """The child: compile ``run_chunk`` for the pickled types on stdin; remove the lock ``argv[0]``."""
+    """The child: compile the pickled jobs on stdin (into numba's cache); remove the lock ``argv[0]``."""
     lock = Path(argv[0]) if argv else None
     try:
-        signature = pickle.loads(sys.stdin.buffer.read())
-        from vtool.solvers import newmark_kernel as kernel
-
-        kernel.run_chunk.compile(signature)
+        jobs = pickle.loads(sys.stdin.buffer.read())
+        for name, signature in jobs:
+            getattr(kernel, name).compile(signature)
         return 0
     except BaseException:
         if lock is not None:

@@ -48,8 +48,9 @@ Method (see the kernel's docstring for the equations):
   contact laws (a new install, or the first Hertz or momentum-law run), the
   run does not wait for the compile. A child process compiles the kernel
   into the cache (:mod:`vtool.solvers.kernel_build`) while the run starts at
-  once in the kernel's own source run as plain Python (:func:`plain_kernel`);
-  between chunks the run looks in the cache and, once the kernel is there,
+  once in the kernel's own source run as plain Python
+  (:func:`~vtool.solvers.kernel_build.plain_kernel`); between chunks the
+  run looks in the cache and, once the kernel is there,
   loads it and goes on compiled (should the child end without it, the run
   compiles the kernel itself). Both execute the same source, and their
   results agree to the last bit on every thesis preset (a test compares
@@ -64,9 +65,7 @@ Method (see the kernel's docstring for the equations):
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import os
 import time as wallclock
 from dataclasses import dataclass
 from types import ModuleType
@@ -86,7 +85,6 @@ from vtool.solvers.trace import TraceBuilder
 
 COMPILE_ESTIMATE_S = 15.0  # first compile of the kernel on a 2-core machine (benchmarks/bench_newmark.py)
 RULES_COMPILE_ESTIMATE_S = 5.0  # of the event rules alone (impact, settle, fill_sources: the piecewise back ends)
-KERNEL_MODES = ("auto", "compiled", "plain")  # VTOOL_KERNEL (see "First run" in the module doc)
 ROW_BUFFER = 4096  # output rows between flushes: memory stays bounded for any run length
 EVENT_BUFFER = 4096
 
@@ -123,54 +121,28 @@ def kernel_laws(spec: Any, impacts: tuple[str, ...] = ()) -> tuple[bool | None, 
     return (True if hertz else None), (True if momentum else None)
 
 
-def kernel_mode() -> str:
-    """``VTOOL_KERNEL`` (default ``auto``): how a run gets its compiled kernel (see "First run" above)."""
-    mode = os.environ.get("VTOOL_KERNEL", "").strip() or "auto"
-    if mode not in KERNEL_MODES:
-        raise InputError("VTOOL_KERNEL", mode, "one of " + ", ".join(KERNEL_MODES))
-    return mode
-
-
-def jit_enabled() -> bool:
-    """False under ``NUMBA_DISABLE_JIT`` (the kernel module is plain Python already)."""
-    return hasattr(kernel.run_chunk, "signatures")
-
-
-_plain_module: list[ModuleType] = []
-
-
-def plain_kernel() -> ModuleType:
-    """The kernel's source loaded a second time as plain Python (``newmark_kernel_plain``; no numba)."""
-    if not jit_enabled():
-        return kernel
-    if not _plain_module:
-        spec = importlib.util.spec_from_file_location(kernel.__name__ + kernel.PLAIN_SUFFIX, kernel.__file__)
-        assert spec is not None and spec.loader is not None
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        _plain_module.append(module)
-    return _plain_module[0]
-
-
 def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | None] = (None, None)) -> str | None:
     """The line to show before a run that must first compile the kernel, or None when it is cached.
 
     The newmark back end runs ``run_chunk``; the piecewise back ends call the
     event rules (``impact``, ``settle``, ``fill_sources``) from Python. ``laws``:
     see :func:`kernel_laws` (a kernel is compiled and cached per switch pair).
-    A newmark run in the default ``auto`` mode does not wait for the compile.
+    In the default ``auto`` mode no run waits for the compile: a newmark run
+    says so; a piecewise run calls the event rules as plain Python, a few
+    milliseconds more, and says nothing (:mod:`vtool.solvers.kernel_build`).
     """
     names = ("run_chunk",) if backend == "newmark" else ("impact", "settle", "fill_sources")
-    if not jit_enabled() or kernel.is_cached(names, *laws):
+    if not kernel_build.jit_enabled() or kernel.is_cached(names, *laws):
         return None
-    if backend == "newmark":
-        mode = kernel_mode()
-        if mode == "plain":
+    mode = kernel_build.kernel_mode()
+    if mode == "plain":
+        return None
+    if mode == "auto" and numba_cache.CACHE_ENABLED:
+        if backend != "newmark":
             return None
-        if mode == "auto" and numba_cache.CACHE_ENABLED:
-            return (f"compiling the solver for these contact laws in the background, once (about "
-                    f"{COMPILE_ESTIMATE_S:.0f} s on two cores); this run starts now in plain Python and "
-                    "moves to the compiled solver when it is ready")
+        return (f"compiling the solver for these contact laws in the background, once (about "
+                f"{COMPILE_ESTIMATE_S:.0f} s on two cores); this run starts now in plain Python and "
+                "moves to the compiled solver when it is ready")
     estimate = COMPILE_ESTIMATE_S if backend == "newmark" else RULES_COMPILE_ESTIMATE_S
     return (f"compiling the solver for these contact laws, once (about {estimate:.0f} s on two cores); "
             "later runs load it from the cache")
@@ -300,7 +272,7 @@ class KernelRun:
 
     def compile(self) -> None:
         """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""
-        if not jit_enabled():
+        if not kernel_build.jit_enabled():
             return  # NUMBA_DISABLE_JIT (the plain reference)
         signature = self.signature()
         if signature in kernel.run_chunk.signatures:
@@ -317,16 +289,16 @@ class KernelRun:
     def first_kernel(self) -> tuple[ModuleType, bool]:
         """The kernel module that takes the first chunk, and whether a compile is under way meanwhile
         (see "First run" in the module doc)."""
-        if not jit_enabled():
+        if not kernel_build.jit_enabled():
             return kernel, False
-        mode = kernel_mode()
+        mode = kernel_build.kernel_mode()
         if mode == "plain":
-            return plain_kernel(), False
+            return kernel_build.plain_kernel(), False
         if (mode == "compiled" or not numba_cache.CACHE_ENABLED or self.ready()
-                or not kernel_build.start(self.signature())):
+                or not kernel_build.start([("run_chunk", self.signature())])):
             self.compile()
             return kernel, False
-        return plain_kernel(), True
+        return kernel_build.plain_kernel(), True
 
     def execute(self, progress: Progress | None, cancel: Cancel | None) -> None:
         problem = self.problem
@@ -336,7 +308,7 @@ class KernelRun:
         self.fst[kernel.F_CHUNK_END] = self.fst[kernel.F_T] + chunk
         while True:
             # the child's compile is in the cache (or the child is gone without it: compile here): go on compiled
-            if building and (self.ready() or not kernel_build.compiling(self.signature())):
+            if building and (self.ready() or not kernel_build.compiling([("run_chunk", self.signature())])):
                 self.plain_steps = int(self.ist[kernel.I_STEPS])
                 self.compile()
                 module, building = kernel, False

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from vtool.errors import InputError, RunError
+from vtool.solvers import kernel_build
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.backends import Backend, Cancel, Progress
 from vtool.solvers.contact import EVENT_KINDS, ContactProblem, OrderedLayer
@@ -163,6 +164,7 @@ class PiecewiseRun(ABC):
         self.ev_f = np.zeros((4 * self.ncl + 4, 2))
         self.ev_i = np.zeros((4 * self.ncl + 4, 4), dtype=np.int64)
         self.ist = np.zeros(kernel.I_SIZE, dtype=np.int64)
+        self.rules = kernel_build.rules(problem.hertz, problem.momentum)  # compiled, or plain until cached
 
     # ----- configuration data -----
     def space(self, mask: int) -> StateSpace:
@@ -211,7 +213,7 @@ class PiecewiseRun(ABC):
         for i, k in enumerate(rows):
             for index in np.ndindex(np.shape(delta)[1:]):
                 at = (i, *index)
-                out[at] = kernel.hertz_law(self.problem.clf, int(k), float(delta[at]), float(rate[at]))[0]
+                out[at] = self.rules.hertz_law(self.problem.clf, int(k), float(delta[at]), float(rate[at]))[0]
         return out
 
     def track_overlap(self, ss: StateSpace, values: np.ndarray) -> None:
@@ -229,8 +231,8 @@ class PiecewiseRun(ABC):
     def sources(self, t: float) -> np.ndarray:
         src = np.zeros(3 * self.problem.ns)
         series = self.problem.series
-        kernel.fill_sources(self.problem.ns, self.problem.nh, series.omega, series.const, series.cos, series.sin,
-                            t, src)
+        self.rules.fill_sources(self.problem.ns, self.problem.nh, series.omega, series.const, series.cos,
+                                series.sin, t, src)
         return src
 
     # ----- output -----
@@ -306,6 +308,7 @@ class PiecewiseRun(ABC):
                 progress(min(t / self.t_end, 1.0))
             if cancel is not None and cancel():
                 raise RunError(f"cancelled at t = {t:.6g} s")
+        kernel_build.compile_recorded(self.rules)
 
     def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
         """The kernel's settle (release of pulling contacts), building configurations as it asks."""
@@ -313,11 +316,10 @@ class PiecewiseRun(ABC):
         m = problem.n
         while True:
             self.ist[kernel.I_NEV] = 0
-            result = int(kernel.settle(self.ip, self.fp, problem.cl, problem.clf, tables.ci, tables.cm, tables.cp,
-                                       tables.mk,
-                                       tables.mon, mask, t, x, v, a, self.sources(t), self.ev_f, self.ev_i,
-                                       self.ist, np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m),
-                                       problem.hertz))
+            result = int(self.rules.settle(self.ip, self.fp, problem.cl, problem.clf, tables.ci, tables.cm,
+                                           tables.cp, tables.mk, tables.mon, mask, t, x, v, a, self.sources(t),
+                                           self.ev_f, self.ev_i, self.ist, np.zeros(m), np.zeros(m), np.zeros(m),
+                                           np.zeros(m), problem.hertz))
             self._take_events()
             if result >= 0:
                 return result
@@ -352,16 +354,16 @@ class PiecewiseRun(ABC):
             if (c & self.closed_bit[k]) and not (new_c & self.closed_bit[k]):
                 u = 0.0
                 if self.problem.cl[k, kernel.CL_SOFT]:  # the parts leave with their relative velocity
-                    kernel.snap_shut(self.problem.cl, k, x, src)
-                    u = float(kernel.relative_velocity(self.problem.cl, k, v, src))
+                    self.rules.snap_shut(self.problem.cl, k, x, src)
+                    u = float(self.rules.relative_velocity(self.problem.cl, k, v, src))
                 self.builder.add_event(t, k, EVENT_KINDS[int(kernel.EV_OPENED)], u, c, new_c)
         if closing.any():
             stick = self.rapid >= self.problem.rules.zeno_stick
             problem = self.problem
             self.ist[kernel.I_NEV] = 0
-            new_c = int(kernel.impact(self.ip, self.fp, problem.cl, problem.clf, problem.mass, new_c, closing,
-                                      self.sources(t), x, v, stick, self.ev_f, self.ev_i, self.ist, t,
-                                      problem.momentum))
+            new_c = int(self.rules.impact(self.ip, self.fp, problem.cl, problem.clf, problem.mass, new_c, closing,
+                                          self.sources(t), x, v, stick, self.ev_f, self.ev_i, self.ist, t,
+                                          problem.momentum))
             self._take_events()
         new_c = self.settle(new_c, t, x, v, a)
         return new_c, x, v, a

@@ -21,11 +21,12 @@ from click.testing import CliRunner
 from vtool.app.cli.main import cli
 from vtool.errors import InputError
 from vtool.presets import load_preset
+from vtool.presets.valvetrain import with_run_overrides
 from vtool.solvers import kernel_build, newmark
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.run import simulate
 
-needs_jit = pytest.mark.skipif(not newmark.jit_enabled(), reason="NUMBA_DISABLE_JIT: nothing is compiled")
+needs_jit = pytest.mark.skipif(not kernel_build.jit_enabled(), reason="NUMBA_DISABLE_JIT: nothing is compiled")
 
 
 def assert_same_run(a, b) -> None:  # noqa: ANN001 (two Traces)
@@ -37,13 +38,13 @@ def assert_same_run(a, b) -> None:  # noqa: ANN001 (two Traces)
 
 def test_kernel_mode_comes_from_the_environment(monkeypatch) -> None:  # noqa: ANN001
     monkeypatch.delenv("VTOOL_KERNEL", raising=False)
-    assert newmark.kernel_mode() == "auto"
-    for mode in newmark.KERNEL_MODES:
+    assert kernel_build.kernel_mode() == "auto"
+    for mode in kernel_build.KERNEL_MODES:
         monkeypatch.setenv("VTOOL_KERNEL", mode)
-        assert newmark.kernel_mode() == mode
+        assert kernel_build.kernel_mode() == mode
     monkeypatch.setenv("VTOOL_KERNEL", "fast")
     with pytest.raises(InputError, match="VTOOL_KERNEL: got 'fast', expected one of auto, compiled, plain"):
-        newmark.kernel_mode()
+        kernel_build.kernel_mode()
 
 
 def test_a_bad_kernel_mode_is_one_line_and_exit_2(monkeypatch) -> None:  # noqa: ANN001
@@ -56,7 +57,7 @@ def test_a_bad_kernel_mode_is_one_line_and_exit_2(monkeypatch) -> None:  # noqa:
 
 @needs_jit
 def test_the_plain_kernel_is_the_same_source_without_numba() -> None:
-    plain = newmark.plain_kernel()
+    plain = kernel_build.plain_kernel()
     assert plain is not kernel and plain.PLAIN and not kernel.PLAIN
     assert plain.__file__ == kernel.__file__
     assert not hasattr(plain.run_chunk, "signatures")  # a Python function, not a numba dispatcher
@@ -82,8 +83,8 @@ def test_a_run_moves_from_plain_to_compiled_between_chunks(monkeypatch) -> None:
     started = []
     answers = iter([False, False, False])  # first_kernel's question, then before chunks 1 and 2
     monkeypatch.setenv("VTOOL_KERNEL", "auto")
-    monkeypatch.setattr(kernel_build, "start", lambda signature: started.append(signature) or True)
-    monkeypatch.setattr(kernel_build, "compiling", lambda signature: True)
+    monkeypatch.setattr(kernel_build, "start", lambda jobs: started.append(jobs) or True)
+    monkeypatch.setattr(kernel_build, "compiling", lambda jobs: True)
     monkeypatch.setattr(newmark.KernelRun, "ready", lambda self: next(answers, True))
     moved = simulate(load_preset("gnilka-1a"))
     assert len(started) == 1
@@ -101,8 +102,8 @@ def test_a_run_compiles_itself_when_the_child_is_gone(monkeypatch) -> None:  # n
     """The child ended without putting the kernel in the cache: the run compiles it (no endless plain run)."""
     compiled = simulate(load_preset("gnilka-1a"))
     monkeypatch.setenv("VTOOL_KERNEL", "auto")
-    monkeypatch.setattr(kernel_build, "start", lambda signature: True)
-    monkeypatch.setattr(kernel_build, "compiling", lambda signature: False)
+    monkeypatch.setattr(kernel_build, "start", lambda jobs: True)
+    monkeypatch.setattr(kernel_build, "compiling", lambda jobs: False)
     monkeypatch.setattr(newmark.KernelRun, "ready", lambda self: False)
     alone = simulate(load_preset("gnilka-1a"))
     assert alone.statistics.plain_steps == 0  # moved before the first chunk
@@ -113,7 +114,7 @@ def test_a_run_compiles_itself_when_the_child_is_gone(monkeypatch) -> None:  # n
 def test_no_compile_is_started_when_the_kernel_is_loaded(monkeypatch) -> None:  # noqa: ANN001
     simulate(load_preset("gnilka-1a"))
     monkeypatch.setenv("VTOOL_KERNEL", "auto")
-    monkeypatch.setattr(kernel_build, "start", lambda signature: pytest.fail("a compile was started"))
+    monkeypatch.setattr(kernel_build, "start", lambda jobs: pytest.fail("a compile was started"))
     assert simulate(load_preset("gnilka-1a")).statistics.plain_steps == 0
 
 
@@ -144,9 +145,9 @@ def test_a_failed_child_leaves_its_error_and_no_lock(tmp_path, monkeypatch) -> N
     assert child.returncode != 0
     assert not lock.exists()
     assert "UnpicklingError" in kernel_build.failed_path(lock).read_text()
-    monkeypatch.setattr(kernel_build, "lock_path", lambda signature: lock)
+    monkeypatch.setattr(kernel_build, "lock_path", lambda jobs: lock)
     monkeypatch.setattr(subprocess, "Popen", lambda *a, **k: pytest.fail("a failed compile was started again"))
-    assert kernel_build.start(()) is False  # the caller compiles in its own process, where the error shows
+    assert kernel_build.start([]) is False  # the caller compiles in its own process, where the error shows
 
 
 @needs_jit
@@ -174,3 +175,45 @@ def test_a_new_install_runs_at_once_and_compiles_in_the_background(tmp_path) -> 
     again = json.loads(second.stdout)
     assert again["plain_steps"] == 0
     assert again["events_list"] == summary["events_list"]
+
+
+@needs_jit
+def test_a_piecewise_run_calls_the_rules_as_plain_python_until_they_are_cached(monkeypatch) -> None:  # noqa: ANN001
+    """The exact back end before its event rules are cached: the same run, with the plain rules; the types
+    they were called with are those of the compiled rules' calls, and their compile is started after."""
+    spec = with_run_overrides(load_preset("gnilka-1a"), backend="exact")
+    compiled = simulate(spec)
+    started: list = []
+    monkeypatch.setenv("VTOOL_KERNEL", "auto")
+    monkeypatch.setattr(kernel, "is_cached", lambda names, hertz=None, momentum=None: False)
+    monkeypatch.setattr(kernel_build, "start", lambda jobs: started.append(jobs) or True)
+    plain = simulate(spec)
+    assert_same_run(plain, compiled)
+    assert len(started) == 1
+    jobs = dict(started[0])
+    assert set(jobs) == {"fill_sources", "settle", "impact"}
+    for name, signature in jobs.items():
+        assert signature in getattr(kernel, name).signatures  # what the compiled run compiled
+    assert kernel_build.rules(None, None).__class__ is kernel_build.RecordingRules
+    monkeypatch.setenv("VTOOL_KERNEL", "compiled")
+    assert kernel_build.rules(None, None) is kernel
+
+
+@needs_jit
+@pytest.mark.slow
+def test_a_new_install_runs_the_exact_back_end_without_waiting(tmp_path) -> None:
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("VTOOL_KERNEL")
+    command = [sys.executable, "-m", "vtool", "solve", "gnilka-1a", "--backend", "exact", "--json"]
+    first = subprocess.run(command, env=env, capture_output=True, text=True, timeout=600)
+    assert first.returncode == 0, first.stderr
+    assert "compiling" not in first.stderr
+    probe = ("import sys; from vtool.solvers import newmark_kernel as k; "
+             "sys.exit(0 if k.is_cached(('impact', 'settle', 'fill_sources'), None, None) else 1)")
+    deadline = time.monotonic() + 600
+    while subprocess.run([sys.executable, "-c", probe], env=env).returncode != 0:
+        assert time.monotonic() < deadline, "the background compile of the rules did not reach the cache"
+        time.sleep(1.0)
+    second = subprocess.run(command, env=env, capture_output=True, text=True, timeout=600)
+    assert second.returncode == 0, second.stderr
+    assert json.loads(second.stdout)["events_list"] == json.loads(first.stdout)["events_list"]
