@@ -36,6 +36,16 @@ def assert_same_run(a, b) -> None:  # noqa: ANN001 (two Traces)
     np.testing.assert_allclose(a.contact_force, b.contact_force, rtol=0, atol=1e-6 * b.peak_force.max())
 
 
+def wait_until_cached(env: dict, names: tuple[str, ...]) -> None:
+    """Poll (in fresh processes, with ``env``'s cache) until the background compile has cached ``names``."""
+    probe = ("import sys; from vtool.solvers import newmark_kernel as k; "
+             f"sys.exit(0 if k.is_cached({names!r}, None, None) else 1)")
+    deadline = time.monotonic() + 600
+    while subprocess.run([sys.executable, "-c", probe], env=env).returncode != 0:
+        assert time.monotonic() < deadline, f"the background compile of {names} did not reach the cache in 600 s"
+        time.sleep(1.0)
+
+
 def test_kernel_mode_comes_from_the_environment(monkeypatch) -> None:  # noqa: ANN001
     monkeypatch.delenv("VTOOL_KERNEL", raising=False)
     assert kernel_build.kernel_mode() == "auto"
@@ -163,12 +173,7 @@ def test_a_new_install_runs_at_once_and_compiles_in_the_background(tmp_path) -> 
     assert "in the background" in first.stderr
     summary = json.loads(first.stdout)
     assert summary["plain_steps"] > 0 and summary["compile_time_s"] < 5.0
-    probe = ("import sys; from vtool.solvers import newmark_kernel as k; "
-             "sys.exit(0 if k.is_cached(('run_chunk',), None, None) else 1)")
-    deadline = time.monotonic() + 600
-    while subprocess.run([sys.executable, "-c", probe], env=env).returncode != 0:
-        assert time.monotonic() < deadline, "the background compile did not reach the cache in 600 s"
-        time.sleep(2.0)
+    wait_until_cached(env, ("run_chunk",))
     second = subprocess.run(command, env=env, capture_output=True, text=True, timeout=600)
     assert second.returncode == 0, second.stderr
     assert "compiling" not in second.stderr
@@ -208,12 +213,7 @@ def test_a_new_install_runs_the_exact_back_end_without_waiting(tmp_path) -> None
     first = subprocess.run(command, env=env, capture_output=True, text=True, timeout=600)
     assert first.returncode == 0, first.stderr
     assert "compiling" not in first.stderr
-    probe = ("import sys; from vtool.solvers import newmark_kernel as k; "
-             "sys.exit(0 if k.is_cached(('impact', 'settle', 'fill_sources'), None, None) else 1)")
-    deadline = time.monotonic() + 600
-    while subprocess.run([sys.executable, "-c", probe], env=env).returncode != 0:
-        assert time.monotonic() < deadline, "the background compile of the rules did not reach the cache"
-        time.sleep(1.0)
+    wait_until_cached(env, ("impact", "settle", "fill_sources"))
     second = subprocess.run(command, env=env, capture_output=True, text=True, timeout=600)
     assert second.returncode == 0, second.stderr
     assert json.loads(second.stdout)["events_list"] == json.loads(first.stdout)["events_list"]
