@@ -118,8 +118,10 @@ def rules(hertz: bool | None, momentum: bool | None) -> Any:
 
 def compile_recorded(used: Any) -> None:
     """After a piecewise run on :func:`rules`: start the compile of what it called as plain Python."""
-    if isinstance(used, RecordingRules) and used.jobs and kernel_mode() == "auto":
-        start(sorted(used.jobs.items()))
+    from vtool import numba_cache
+
+    if isinstance(used, RecordingRules) and used.jobs and kernel_mode() == "auto" and numba_cache.CACHE_ENABLED:
+        start(sorted(used.jobs.items()))  # (with no cache to write, a compile would be lost: plain it stays)
 
 
 def lock_path(jobs: list[Job]) -> Path:
