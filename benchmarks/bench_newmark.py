@@ -1,7 +1,7 @@
 """Newmark back end benchmark: example 1A (850 degrees, dt = 1e-6 s), ratios measured in one run.
 
 Run: ``python3 benchmarks/bench_newmark.py`` (``--no-compile`` skips the empty-cache compile,
-which takes about half a minute). Prints figures, asserts nothing.
+and the first-run measure, about 30 s together). Prints figures, asserts nothing.
 
 1. Warm wall time of a whole run (``simulate``: assemble + contact problem + kernel), best of
    several, and its ratio to the 5 ms target; the kernel alone per step.
