@@ -77,7 +77,7 @@ numba_cache.configure(os.path.dirname(os.path.abspath(__file__)))  # before numb
 
 from numba import njit  # noqa: E402 (after the cache folder is chosen)
 
-#: Module-name suffix of this source loaded a second time as plain Python (:func:`vtool.solvers.newmark.plain_kernel`).
+#: Module-name suffix of this source loaded a second time as plain Python (:func:`vtool.solvers.kernel_build.plain_kernel`).
 PLAIN_SUFFIX = "_plain"
 PLAIN = __name__.endswith(PLAIN_SUFFIX)
 
