@@ -33,6 +33,7 @@ then starts their compile the same way.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.util
 import os
@@ -102,6 +103,7 @@ class RecordingRules:
                 self.jobs[name] = tuple(numba.typeof(value) for value in args)
             return function(*args)
 
+        setattr(self, name, call)  # found as an attribute from now on: __getattr__ runs once per name
         return call
 
 
@@ -143,16 +145,13 @@ def _alive(pid: int) -> bool:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except OSError:  # it exists, owned by someone else
-        return True
+    except PermissionError:  # it exists, owned by someone else
+        pass
     return True
 
 
 def holder_alive(lock: Path) -> bool:
     """True when ``lock`` exists, is younger than :data:`STALE_S` and its process (if written yet) runs."""
-    for child in _children[:]:
-        if child.poll() is not None:
-            _children.remove(child)  # reaped
     try:
         if time.time() - lock.stat().st_mtime >= STALE_S:
             return False
@@ -208,14 +207,12 @@ def start(jobs: list[Job]) -> bool:
         if taken:
             lock.unlink(missing_ok=True)
         return False
-    _children.append(child)
+    _children[:] = [*(c for c in _children if c.poll() is None), child]  # finished ones are reaped
     if taken:
-        try:  # not O_CREAT: a child that has finished already has removed the lock
+        with contextlib.suppress(OSError):  # not O_CREAT: a child that has finished has removed the lock
             descriptor = os.open(lock, os.O_WRONLY)
             os.write(descriptor, str(child.pid).encode())
             os.close(descriptor)
-        except OSError:
-            pass
     return True
 
 
@@ -239,10 +236,8 @@ def main(argv: list[str]) -> int:
         return 0
     except BaseException:
         if lock is not None:
-            try:
+            with contextlib.suppress(OSError):
                 failed_path(lock).write_text(traceback.format_exc())
-            except OSError:
-                pass
         raise
     finally:
         if lock is not None:

@@ -68,6 +68,7 @@ from __future__ import annotations
 import math
 import time as wallclock
 from dataclasses import dataclass
+from functools import cached_property
 from types import ModuleType
 from typing import Any
 
@@ -264,8 +265,9 @@ class KernelRun:
                 self.out_t, self.out_q, self.out_F, self.out_c, self.ev_f, self.ev_i, self.peak,
                 self.x, self.v, self.a, self.ist, self.fst, problem.hertz, problem.momentum)
 
+    @cached_property
     def signature(self) -> tuple[Any, ...]:
-        """numba's types of :meth:`arguments` (what ``run_chunk`` is compiled for)."""
+        """numba's types of :meth:`arguments` (what ``run_chunk`` is compiled for; fixed for the run)."""
         import numba
 
         return tuple(numba.typeof(value) for value in self.arguments())
@@ -274,7 +276,7 @@ class KernelRun:
         """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""
         if not kernel_build.jit_enabled():
             return  # NUMBA_DISABLE_JIT (the plain reference)
-        signature = self.signature()
+        signature = self.signature
         if signature in kernel.run_chunk.signatures:
             return  # compiled (or loaded) in this process already
         started = wallclock.perf_counter()
@@ -283,7 +285,7 @@ class KernelRun:
 
     def ready(self) -> bool:
         """True when ``run_chunk`` for these argument types is loaded in this process, or in numba's cache."""
-        return (self.signature() in kernel.run_chunk.signatures
+        return (self.signature in kernel.run_chunk.signatures
                 or kernel.is_cached(("run_chunk",), self.problem.hertz, self.problem.momentum))
 
     def first_kernel(self) -> tuple[ModuleType, bool]:
@@ -295,7 +297,7 @@ class KernelRun:
         if mode == "plain":
             return kernel_build.plain_kernel(), False
         if (mode == "compiled" or not numba_cache.CACHE_ENABLED or self.ready()
-                or not kernel_build.start([("run_chunk", self.signature())])):
+                or not kernel_build.start([("run_chunk", self.signature)])):
             self.compile()
             return kernel, False
         return kernel_build.plain_kernel(), True
@@ -308,7 +310,7 @@ class KernelRun:
         self.fst[kernel.F_CHUNK_END] = self.fst[kernel.F_T] + chunk
         while True:
             # the child's compile is in the cache (or the child is gone without it: compile here): go on compiled
-            if building and (self.ready() or not kernel_build.compiling([("run_chunk", self.signature())])):
+            if building and (self.ready() or not kernel_build.compiling([("run_chunk", self.signature)])):
                 self.plain_steps = int(self.ist[kernel.I_STEPS])
                 self.compile()
                 module, building = kernel, False
