@@ -120,7 +120,7 @@ class ConfigurationTables:
         count = 2**ncl
         self.ci = np.zeros((count, kernel.CI_HEAD + 3 * n), dtype=np.int64)
         self.cm = np.zeros((count, kernel.CM_SIZE, n, n))
-        self.cp = np.zeros((count, n, 3 * n + 3 * ns))
+        self.cp = np.zeros((count, kernel.CP_SIZE, kernel.PART_SIZE, n, 3 * max(n, ns)))  # kernel.CP_RAW
         self.mk = np.zeros((count, ncl, kernel.MK_SIZE), dtype=np.int64)
         self.mon = np.zeros((count, ncl, 3 * n + 3 * ns + 1 + ncl))
         self.layers: dict[int, OrderedLayer] = {}
@@ -146,6 +146,9 @@ class ConfigurationTables:
         M, C, K = cm[kernel.CM_MFF, :nf, :nf], cm[kernel.CM_CFF, :nf, :nf], cm[kernel.CM_KFF, :nf, :nf]
         cm[kernel.CM_SINV, :nf, :nf] = np.linalg.inv(M + gamma * dt * C + beta * dt * dt * K)
         cm[kernel.CM_SINVF, :nf, :nf] = np.linalg.inv(M + gamma * fine * C + beta * fine * fine * K)
+        cp = self.cp[mask]  # G = S⁻¹R, part by part (see kernel.CP_RAW)
+        cp[kernel.CP_STD, :, :nf] = cm[kernel.CM_SINV, :nf, :nf] @ cp[kernel.CP_RAW, :, :nf]
+        cp[kernel.CP_FINE, :, :nf] = cm[kernel.CM_SINVF, :nf, :nf] @ cp[kernel.CP_RAW, :, :nf]
 
     def build(self, mask: int) -> OrderedLayer:
         """Partition configuration ``mask`` and fill its rows (see the module doc)."""
@@ -179,11 +182,13 @@ class ConfigurationTables:
         cm[kernel.CM_KFF, :nf, :nf] = K_o[:nf, :nf]
         if nf:
             cm[kernel.CM_MINVFF, :nf, :nf] = np.linalg.inv(M_o[:nf, :nf])
-        for p in range(m - nf):
-            self.cp[mask, :nf, 3 * p] = M_o[:nf, nf + p]
-            self.cp[mask, :nf, 3 * p + 1] = C_o[:nf, nf + p]
-            self.cp[mask, :nf, 3 * p + 2] = K_o[:nf, nf + p]
-        self.cp[mask, :nf, 3 * n:] = S_o[:nf]
+        raw = self.cp[mask, kernel.CP_RAW]  # layout: see kernel.CP_RAW
+        raw[kernel.PART_C, :nf, :nf] = C_o[:nf, :nf]
+        raw[kernel.PART_K, :nf, :nf] = K_o[:nf, :nf]
+        raw[kernel.PART_P, :nf, 0:3 * (m - nf):3] = M_o[:nf, nf:]
+        raw[kernel.PART_P, :nf, 1:3 * (m - nf):3] = C_o[:nf, nf:]
+        raw[kernel.PART_P, :nf, 2:3 * (m - nf):3] = K_o[:nf, nf:]
+        raw[kernel.PART_S, :nf, :S_o.shape[1]] = S_o[:nf]
         ci[kernel.CI_SRC] = int(bool(S_o[:nf].any()))
         ci[kernel.CI_HERTZ] = int(bool(springs.hertz))
         self._monitors(mask, part, group, m, springs)

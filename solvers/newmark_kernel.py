@@ -27,8 +27,11 @@ Newmark step of length h in configuration c (general beta, gamma):
     z_F = z̃_F + beta h² z̈_F,   ż_F = ż̃_F + gamma h z̈_F
 
 with the prescribed values (z_P, ż_P, z̈_P) taken from the sources at t + h.
-Standard and refined steps use the stored S⁻¹; other step lengths (event
-location, the return to the step grid) factor S by Cholesky in place.
+Standard and refined steps use stored products G = S⁻¹[C_FF | K_FF | ΔP's
+other columns] (``CP_STD``, ``CP_FINE``): z̈_F = -G·(ż̃_F, z̃_F, …) is one
+product, with no right-hand side formed first; other step lengths (event
+location, the return to the step grid) form ΔP and factor S by Cholesky in
+place.
 
 Monitors: a closed clearance's contact force (a row of coefficients on
 (z, ż, z̈, sources) per configuration, positive in compression), an open
@@ -117,6 +120,16 @@ CI_HEAD = 5
 # configuration matrices
 CM_MFF, CM_CFF, CM_KFF, CM_SINV, CM_SINVF, CM_MINVFF = range(6)
 CM_SIZE = 6
+# step operators: cp[c, plane, part, f, :] for free z index f; plane CP_RAW holds R, whose parts are
+# C_FF, K_FF, the (M, C, K) columns of each prescribed z index p (at 3p, 3p + 1, 3p + 2) and the
+# sources' pull S (3 per source), so that the free rows' ΔP is R·(ż, z, (z̈, ż, z)_P, src); planes
+# CP_STD and CP_FINE hold G = S⁻¹R of the standard and the refined step, so that a step with a stored
+# inverse computes z̈_F = -G·(ż̃, z̃, …) in one product (see :func:`apply_operator`). Parts, not column
+# offsets: an index that is a loop counter needs no negative-index fix-up.
+CP_RAW, CP_STD, CP_FINE = range(3)
+CP_SIZE = 3
+PART_C, PART_K, PART_P, PART_S = range(4)
+PART_SIZE = 4
 # monitor per (configuration, clearance): (kind, ahead z index, behind z index or -1 - source, m)
 MK_KIND, MK_AHEAD, MK_BEHIND, MK_M = range(4)
 MK_SIZE = 4
@@ -229,24 +242,40 @@ def set_prescribed(ci, c, n, src, z, zd, zdd):
         zdd[j] = src[3 * s + 2]
 
 
+@tiny
+def apply_operator(cp, c, plane, nf, m, coupled, src, z, zd, zdd, out):
+    """out_F = -R·(ż_F, z_F, (z̈, ż, z)_P, src) for step operator R = cp[c, plane] (see ``CP_RAW``).
+
+    Two rows at a time (the second repeats the first when nf is odd), each summed in column order:
+    the two running sums are independent, so the processor overlaps them. Indexed in place: a view
+    of cp (an array rebound in the step loop) would cost a reference-count increment and decrement
+    per step."""
+    for f in range(0, nf, 2):
+        e = f + 1 if f + 1 < nf else f
+        s = 0.0
+        r = 0.0
+        for g in range(nf):
+            s -= cp[c, plane, PART_C, f, g] * zd[g] + cp[c, plane, PART_K, f, g] * z[g]
+            r -= cp[c, plane, PART_C, e, g] * zd[g] + cp[c, plane, PART_K, e, g] * z[g]
+        for p in range(m - nf):
+            j = nf + p
+            s -= (cp[c, plane, PART_P, f, 3 * p] * zdd[j] + cp[c, plane, PART_P, f, 3 * p + 1] * zd[j]
+                  + cp[c, plane, PART_P, f, 3 * p + 2] * z[j])
+            r -= (cp[c, plane, PART_P, e, 3 * p] * zdd[j] + cp[c, plane, PART_P, e, 3 * p + 1] * zd[j]
+                  + cp[c, plane, PART_P, e, 3 * p + 2] * z[j])
+        if coupled:
+            for j in range(src.shape[0]):
+                s -= cp[c, plane, PART_S, f, j] * src[j]
+                r -= cp[c, plane, PART_S, e, j] * src[j]
+        out[f] = s
+        out[e] = r
+
+
 @inner
 def free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
-    right, and the sources' pull through closed compliant contacts (``cp[c, f, 3n:]``)."""
-    nf = ci[c, CI_NF]
-    m = ci[c, CI_M]
-    coupled = ci[c, CI_SRC]
-    for f in range(nf):
-        s = 0.0
-        for g in range(nf):
-            s -= cm[c, CM_CFF, f, g] * zd[g] + cm[c, CM_KFF, f, g] * z[g]
-        for p in range(m - nf):
-            j = nf + p
-            s -= cp[c, f, 3 * p] * zdd[j] + cp[c, f, 3 * p + 1] * zd[j] + cp[c, f, 3 * p + 2] * z[j]
-        if coupled:
-            for j in range(src.shape[0]):
-                s -= cp[c, f, 3 * n + j] * src[j]
-        rhs[f] = s
+    right, and the sources' pull through closed compliant contacts (``CP_RAW``)."""
+    apply_operator(cp, c, CP_RAW, ci[c, CI_NF], ci[c, CI_M], ci[c, CI_SRC], src, z, zd, zdd, rhs)
 
 
 @inner
@@ -423,8 +452,12 @@ def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1,
         z1[j] = z[j] + h * zd[j] + h * h * (0.5 - beta) * zdd[j]
         zd1[j] = zd[j] + h * (1.0 - gamma) * zdd[j]
     set_prescribed(ci, c, n, src1, z1, zd1, zdd1)
-    free_rhs(ci, cm, cp, c, n, src1, z1, zd1, zdd1, rhs)
-    effective_solve(cm, c, which, L, nf, rhs, sol)
+    if which == CHOLESKY:
+        free_rhs(ci, cm, cp, c, n, src1, z1, zd1, zdd1, rhs)
+        cholesky_solve(nf, L, rhs, sol)
+    else:  # z̈_F = S⁻¹ ΔP as one product with the stored G = S⁻¹R
+        apply_operator(cp, c, CP_STD if which == STANDARD else CP_FINE, nf, m, ci[c, CI_SRC], src1, z1, zd1, zdd1,
+                       sol)
     for f in range(nf):
         zdd1[f] = sol[f]
         z1[f] += beta * h * h * sol[f]
@@ -932,12 +965,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
     nf = ci[c, CI_NF]
     coupled = ci[c, CI_SRC]
     rows = out_t.shape[0]
-    # this configuration's 2-D tables, taken once (inner loops then index two dimensions, not four)
-    Cff = cm[c, CM_CFF]
-    Kff = cm[c, CM_KFF]
-    Sstd = cm[c, CM_SINV]
-    Sfine = cm[c, CM_SINVF]
-    P = cp[c]
+    # this configuration's monitor tables, taken once (inner loops then index two dimensions, not three)
     W = mon[c]
     kinds = mk[c]
     t = fst[F_T]
@@ -948,13 +976,11 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             if t != k_grid * dt + sub * fine:
                 return t
             h = fine
-            slot = CM_SINVF
-            S = Sfine
+            plane = CP_FINE
             t1 = (k_grid + 1) * dt if sub + 1 == refine else k_grid * dt + (sub + 1) * fine
         elif t == k_grid * dt:
             h = dt
-            slot = CM_SINV
-            S = Sstd
+            plane = CP_STD
             t1 = (k_grid + 1) * dt
         else:
             return t
@@ -991,21 +1017,9 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             z1[j] = src1[3 * sidx]
             zd1[j] = src1[3 * sidx + 1]
             zdd1[j] = src1[3 * sidx + 2]
+        apply_operator(cp, c, plane, nf, m, coupled, src1, z1, zd1, zdd1, rhs)
         for f in range(nf):
-            acc = 0.0
-            for g in range(nf):
-                acc -= Cff[f, g] * zd1[g] + Kff[f, g] * z1[g]
-            for p in range(m - nf):
-                j = nf + p
-                acc -= P[f, 3 * p] * zdd1[j] + P[f, 3 * p + 1] * zd1[j] + P[f, 3 * p + 2] * z1[j]
-            if coupled:
-                for j in range(3 * ns):
-                    acc -= P[f, 3 * n + j] * src1[j]
-            rhs[f] = acc
-        for f in range(nf):
-            acc = 0.0
-            for g in range(nf):
-                acc += S[f, g] * rhs[g]
+            acc = rhs[f]
             zdd1[f] = acc
             z1[f] += bx * acc
             zd1[f] += gv * acc
@@ -1118,7 +1132,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             zd[j] = zd1[j]
             zdd[j] = zdd1[j]
         ist[I_STEPS] += 1
-        if slot == CM_SINV or sub + 1 == refine:
+        if plane == CP_STD or sub + 1 == refine:
             ist[I_GRID] = k_grid + 1
             ist[I_SUB] = 0
         else:
