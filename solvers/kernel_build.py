@@ -8,7 +8,10 @@ numba's types of its arguments) on its standard input and returns at once;
 the child compiles them (numba writes its cache as it compiles), removes the
 lock and exits. The parent never waits for it: between chunks it asks
 numba's cache whether the kernel is there
-(:func:`vtool.solvers.newmark_kernel.is_cached`) and then loads it.
+(:func:`vtool.solvers.newmark_kernel.is_cached`) and then loads it. The
+child compiles ``run_chunk`` on two processes (:func:`compile_kernel`: a
+helper, ``python -m vtool.solvers.kernel_build --part``, compiles part of its
+callees meanwhile); so does a ``compiled``-mode run in its own process.
 
 One compile at a time: the lock file (in the temporary folder, named by the
 kernel file's path, modification time and size, ``NUMBA_CACHE_DIR`` and the
@@ -226,13 +229,103 @@ def compiling(jobs: list[Job]) -> bool:
     return False
 
 
+def kernel_split(signature: tuple[Any, ...]) -> tuple[list[Job], list[Job]]:
+    """The callees of ``run_chunk`` compiled before it, for numba's types ``signature`` of its arguments:
+    (a helper process's share, the compiling process's share).
+
+    Each entry's types are those numba infers for the call inside
+    ``run_chunk`` (its arguments' types and its locals': ``np.zeros`` vectors,
+    ``int64`` indices, ``float64`` times), so that when ``run_chunk`` is
+    typed it finds each one in the cache (compiled by the helper) or in this
+    process; a mismatch would only cost a second compile of that callee.
+    ``tests/test_first_run.py`` checks them against the compiled kernel's. The
+    shares are balanced by their compile times (measured with numba's compile
+    events on the development machine).
+    """
+    from numba import types
+
+    (ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, ev_f, ev_i, peak,
+     x, v, a, ist, fst, hertz, momentum) = signature
+    i8, f8, b1 = types.int64, types.float64, types.boolean
+    vec, mat, ivec = types.Array(f8, 1, "C"), types.Array(f8, 2, "C"), types.Array(i8, 1, "C")
+    helper: list[Job] = [
+        ("settle", (ip, fp, cl, clf, ci, cm, cp, mk, mon, i8, f8, x, v, a, vec, ev_f, ev_i, ist, vec, vec, vec, vec,
+                    hertz)),
+        ("locate_event", (ci, cm, cp, cl, clf, mk, mon, i8, i8, i8, i8, i8, fp, sc, sa, sb, f8, f8, f8, f8,
+                          *(vec,) * 9, mat, hertz)),
+    ]
+    own: list[Job] = [
+        ("advance", (ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist, fst, i8,
+                     *(vec,) * 13)),
+        ("impact", (ip, fp, cl, clf, mass, i8, ivec, vec, x, v, b1, ev_f, ev_i, ist, f8, momentum)),
+        ("record_row", (ci, cl, clf, mk, mon, i8, i8, i8, i8, f8, f8, vec, vec, vec, vec, out_t, out_q, out_F, out_c,
+                        i8, hertz)),
+        ("track_peaks", (cl, clf, mk, mon, i8, i8, i8, i8, f8, b1, vec, vec, vec, vec, vec, peak, hertz)),
+    ]
+    return helper, own
+
+
+#: How long (s) a compile waits for its helper process before going on without it.
+HELPER_WAIT_S = 300.0
+
+
+def compile_kernel(signature: tuple[Any, ...]) -> None:
+    """Compile ``run_chunk`` for ``signature`` on two processes (numba compiles on one core).
+
+    A helper process compiles its share of the callees (:func:`kernel_split`)
+    into numba's cache while this one compiles the rest; then ``run_chunk``
+    is compiled here, loading the helper's from the cache: on two cores the
+    compile's wall time is that of the larger share and ``run_chunk`` itself
+    (``python3 benchmarks/bench_compile_ab.py REF`` measures it against an
+    earlier commit). Without a cache to share through, or
+    without a helper (it could not start, or failed: this process then
+    compiles what it left), the compile is the plain one.
+    """
+    from vtool import numba_cache
+
+    helper_jobs, own = kernel_split(signature)
+    helper = None
+    if numba_cache.CACHE_ENABLED:
+        with contextlib.suppress(OSError):
+            helper = subprocess.Popen([sys.executable, "-m", "vtool.solvers.kernel_build", "--part"],
+                                      stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                      close_fds=True)
+            assert helper.stdin is not None
+            helper.stdin.write(pickle.dumps(helper_jobs))
+            helper.stdin.close()
+    try:
+        if helper is not None:
+            for name, arg_types in own:
+                getattr(kernel, name).compile(arg_types)
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                helper.wait(HELPER_WAIT_S)
+        kernel.run_chunk.compile(signature)
+    finally:
+        if helper is not None and helper.poll() is None:
+            helper.kill()
+            helper.wait()
+
+
+def _compile(jobs: list[Job]) -> None:
+    for name, signature in jobs:
+        if name == "run_chunk":
+            compile_kernel(signature)
+        else:
+            getattr(kernel, name).compile(signature)
+
+
 def main(argv: list[str]) -> int:
-    """The child: compile the pickled jobs on stdin (into numba's cache); remove the lock ``argv[0]``."""
+    """The child: compile the pickled jobs on stdin (into numba's cache); remove the lock ``argv[0]``.
+
+    With ``--part`` (a helper of :func:`compile_kernel`): compile them, no lock, no ``run_chunk`` split.
+    """
+    if argv[:1] == ["--part"]:
+        for name, signature in pickle.loads(sys.stdin.buffer.read()):
+            getattr(kernel, name).compile(signature)
+        return 0
     lock = Path(argv[0]) if argv else None
     try:
-        jobs = pickle.loads(sys.stdin.buffer.read())
-        for name, signature in jobs:
-            getattr(kernel, name).compile(signature)
+        _compile(pickle.loads(sys.stdin.buffer.read()))
         return 0
     except BaseException:
         if lock is not None:

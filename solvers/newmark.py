@@ -280,7 +280,10 @@ class KernelRun:
         if signature in kernel.run_chunk.signatures:
             return  # compiled (or loaded) in this process already
         started = wallclock.perf_counter()
-        kernel.run_chunk.compile(signature)
+        if self.ready():
+            kernel.run_chunk.compile(signature)  # a load from the cache
+        else:
+            kernel_build.compile_kernel(signature)  # on two processes
         self.compile_time += wallclock.perf_counter() - started
 
     def ready(self) -> bool:

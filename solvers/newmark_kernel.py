@@ -152,6 +152,16 @@ STANDARD, REFINED, CHOLESKY = np.int64(0), np.int64(1), np.int64(2)
 ENTRY_POINTS = ("run_chunk", "impact", "settle", "fill_sources")  # what the back ends call from Python
 
 
+def cached_signatures(name: str) -> list[tuple[Any, ...]]:
+    """numba's argument types of each compiled version of function ``name`` in the cache (its index;
+    empty when there is none)."""
+    try:
+        index = globals()[name]._cache._cache_file._load_index()
+    except Exception:  # noqa: BLE001 (numba internals: no readable index)
+        return []
+    return [tuple(getattr(key[0], "args", key[0])) for key in index]
+
+
 def is_cached(names: tuple[str, ...] = ENTRY_POINTS, hertz: bool | None = None,
               momentum: bool | None = None) -> bool:
     """True when these entry points' compiled code for these law switches (see :func:`laws`) is in the
@@ -166,13 +176,11 @@ def is_cached(names: tuple[str, ...] = ENTRY_POINTS, hertz: bool | None = None,
         import numba
 
         for name in names:
-            index = globals()[name]._cache._cache_file._load_index()
             switches = tuple(numba.typeof(value) for value in trailing[name])
-            signatures = (tuple(getattr(key[0], "args", key[0])) for key in index)
-            if not any(args[len(args) - len(switches):] == switches for args in signatures):
+            if not any(args[len(args) - len(switches):] == switches for args in cached_signatures(name)):
                 return False
         return True
-    except Exception:  # noqa: BLE001 (numba internals: a missing or unreadable index means "compile")
+    except Exception:  # noqa: BLE001 (numba internals: anything unexpected means "compile")
         return False
 
 

@@ -183,6 +183,30 @@ def test_a_new_install_runs_at_once_and_compiles_in_the_background(tmp_path) -> 
 
 
 @needs_jit
+@pytest.mark.parametrize("name", ["gnilka-1a", "gnilka-2"])
+def test_the_split_compile_names_the_types_run_chunk_calls_its_callees_with(name: str, monkeypatch) -> None:  # noqa: ANN001
+    """kernel_split's types for each callee are those of the one version of it that run_chunk uses: the
+    cache holds no other version for the same law switches (a wrong guess, compiled by the split,
+    would be a second one beside the version run_chunk compiled for itself)."""
+    signatures: list = []
+    compile_run = newmark.KernelRun.compile
+
+    def noting(run) -> None:  # noqa: ANN001
+        signatures.append(run.signature)
+        compile_run(run)
+
+    monkeypatch.setattr(newmark.KernelRun, "compile", noting)
+    simulate(load_preset(name))  # run_chunk compiled (or loaded) for this preset, its callees cached
+    helper, own = kernel_build.kernel_split(signatures[0])
+    assert {job for job, _ in helper} & {job for job, _ in own} == set()
+    for job, types in helper + own:
+        getattr(kernel, job).compile(types)  # from the cache: the split's versions, if run_chunk's differ
+        switches = types[-1:]
+        versions = [args for args in kernel.cached_signatures(job) if args[-1:] == switches]
+        assert versions == [types], job
+
+
+@needs_jit
 def test_a_piecewise_run_calls_the_rules_as_plain_python_until_they_are_cached(monkeypatch) -> None:  # noqa: ANN001
     """The exact back end before its event rules are cached: the same run, with the plain rules; the types
     they were called with are those of the compiled rules' calls, and their compile is started after."""
