@@ -252,9 +252,9 @@ class KernelRun:
         nout = int(self.ist[kernel.I_NOUT])
         nev = int(min(self.ist[kernel.I_NEV], self.ev_f.shape[0]))
         self.builder.add_rows(self.out_t[:nout], self.out_q[:nout], self.out_F[:nout], self.out_c[:nout])
-        for row in range(nev):
-            k, kind, before, after = (int(value) for value in self.ev_i[row])
-            self.builder.add_event(self.ev_f[row, 0], k, EVENT_KINDS[kind], self.ev_f[row, 1], before, after)
+        events = zip(self.ev_f[:nev, :2].tolist(), self.ev_i[:nev].tolist(), strict=True)  # Python numbers
+        for (t, u), (k, kind, before, after) in events:
+            self.builder.add_event(t, k, EVENT_KINDS[kind], u, before, after)
         self.ist[kernel.I_NOUT] = 0
         self.ist[kernel.I_NEV] = 0
 
@@ -268,9 +268,7 @@ class KernelRun:
     @cached_property
     def signature(self) -> tuple[Any, ...]:
         """numba's types of :meth:`arguments` (what ``run_chunk`` is compiled for; fixed for the run)."""
-        import numba
-
-        return tuple(numba.typeof(value) for value in self.arguments())
+        return kernel_build.numba_types(self.arguments())
 
     def compile(self) -> None:
         """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""

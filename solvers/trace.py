@@ -501,7 +501,8 @@ class TraceBuilder:
                             np.array(F, dtype=float), np.array(cfg, dtype=np.int64)))
     def add_event(self, t: float, clearance: int, kind: str, relative_velocity: float, before: int,
                   after: int) -> None:
-        self.events.append(Event(float(t), float(cam_angle_deg(t, self.omega)),
+        t = float(t)
+        self.events.append(Event(t, t * self.omega * 180.0 / math.pi,  # cam_angle_deg, for one float
                                  self.spec.clearances[clearance].name, kind, float(relative_velocity),
                                  int(before), int(after)))
 

@@ -182,6 +182,18 @@ def test_a_new_install_runs_at_once_and_compiles_in_the_background(tmp_path) -> 
     assert again["events_list"] == summary["events_list"]
 
 
+def test_memoized_types_are_numbas() -> None:
+    import numba
+
+    base = np.zeros((4, 6))
+    readonly = np.ones(3)
+    readonly.flags.writeable = False
+    values = (base, base.T, base[:, ::2], base[0], np.zeros(5, dtype=np.int64), readonly, np.zeros((2, 2, 2)),
+              base.T.copy(order="F"), 3, 2.5, True, None, np.int64(4), base)
+    assert kernel_build.numba_types(values) == tuple(numba.typeof(value) for value in values)
+    assert kernel_build.numba_types(values) == tuple(numba.typeof(value) for value in values)  # memoized
+
+
 @needs_jit
 @pytest.mark.parametrize("name", ["gnilka-1a", "gnilka-2"])
 def test_the_split_compile_names_the_types_run_chunk_calls_its_callees_with(name: str, monkeypatch) -> None:  # noqa: ANN001
