@@ -182,6 +182,25 @@ def test_a_new_install_runs_at_once_and_compiles_in_the_background(tmp_path) -> 
     assert again["events_list"] == summary["events_list"]
 
 
+@needs_jit
+def test_the_split_compiles_helper_writes_its_jobs_into_the_cache(tmp_path) -> None:  # noqa: ANN001
+    """``python -m vtool.solvers.kernel_build --part`` (compile_kernel's helper) compiles the pickled
+    jobs into numba's cache and exits 0; another process then finds them there."""
+    import pickle
+
+    from numba import types
+
+    vec, mat = types.Array(types.float64, 1, "C"), types.Array(types.float64, 2, "C")
+    jobs = [("fill_sources", (types.int64, types.int64, types.float64, vec, mat, mat, types.float64, vec))]
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    helper = subprocess.run([sys.executable, "-m", "vtool.solvers.kernel_build", "--part"], input=pickle.dumps(jobs),
+                            env=env, capture_output=True, timeout=600)
+    assert helper.returncode == 0, helper.stderr.decode()
+    probe = ("import sys; from vtool.solvers import newmark_kernel as k; "
+             "sys.exit(0 if k.is_cached(('fill_sources',)) else 1)")
+    assert subprocess.run([sys.executable, "-c", probe], env=env, timeout=600).returncode == 0
+
+
 def test_memoized_types_are_numbas() -> None:
     import numba
 
