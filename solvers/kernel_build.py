@@ -278,11 +278,13 @@ def kernel_split(signature: tuple[Any, ...]) -> tuple[list[Job], list[Job]]:
                     hertz)),
         ("locate_event", (ci, cm, cp, cl, clf, mk, mon, i8, i8, i8, i8, i8, fp, sc, sa, sb, f8, f8, f8, f8,
                           *(vec,) * 9, mat, hertz)),
+        ("step_rows", (ci, cl, clf, mk, mon, i8, i8, i8, i8, i8, fp, sc, sa, sb, f8, f8, *(vec,) * 10, out_t, out_q,
+                       out_F, out_c, ist, hertz)),
     ]
     own: list[Job] = [
         ("advance", (ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist, fst, i8,
                      *(vec,) * 13)),
-        ("impact", (ip, fp, cl, clf, mass, i8, ivec, vec, x, v, b1, ev_f, ev_i, ist, f8, momentum)),
+        ("take_events", (ip, fp, cl, clf, mass, i8, f8, f8, vec, ivec, x, v, vec, ev_f, ev_i, ist, fst, momentum)),
         ("record_row", (ci, cl, clf, mk, mon, i8, i8, i8, i8, f8, f8, vec, vec, vec, vec, out_t, out_q, out_F, out_c,
                         i8, hertz)),
         ("track_peaks", (cl, clf, mk, mon, i8, i8, i8, i8, f8, b1, vec, vec, vec, vec, vec, peak, hertz)),

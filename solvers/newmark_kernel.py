@@ -1150,6 +1150,70 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
 
 
 
+@inner
+def step_rows(ci, cl, clf, mk, mon, c, n, ns, nh, ncl, fp, sc, sa, sb, t, h, z, zd, zdd, z1, zd1, zdd1, zo, zdo, zddo,
+              srco, out_t, out_q, out_F, out_c, ist, hertz):
+    """The output rows inside (t, t + h] of a step from (z, ż, z̈) to (z1, ż1, z̈1) taken by
+    :func:`run_chunk` (see there); False when the buffer filled first."""
+    dt, t_end, out_dt, omega, gap_noise = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_OMEGA], fp[FP_GAPNOISE]
+    rows = out_t.shape[0]
+    while True:
+        j_out = ist[I_NEXT_OUT]
+        t_out = j_out * out_dt
+        if t_out > t + h + 1e-9 * dt or t_out > t_end + 1e-9 * dt:
+            return True
+        if ist[I_NOUT] >= rows:
+            return False
+        s_out = t_out - t
+        r = s_out / h
+        for j in range(ci[c, CI_NF]):
+            da = zdd1[j] - zdd[j]
+            zddo[j] = zdd[j] + da * r
+            zdo[j] = zd[j] + zdd[j] * s_out + da * s_out * r / 2.0
+            zo[j] = z[j] + zd[j] * s_out + zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
+        fill_sources(ns, nh, omega, sc, sa, sb, t_out, srco)
+        set_prescribed(ci, c, n, srco, zo, zdo, zddo)
+        record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t_out, zo, zdo, zddo, srco,
+                   out_t, out_q, out_F, out_c, ist[I_NOUT], hertz)
+        ist[I_NOUT] += 1
+        ist[I_NEXT_OUT] = j_out + 1
+
+
+@inner
+def take_events(ip, fp, cl, clf, mass, c, t, h, tau, closing, x, v, src0, ev_f, ev_i, ist, fst, momentum):
+    """The events at t of configuration c: each monitor k that crossed within the time tolerance of
+    the located step h (``tau[k] <= h + tol``) opens its contact, or closes it by an impact. Returns
+    the configuration after them, or -1 when the contacts chatter (``IP_ZSTOP`` rapid events)."""
+    ncl = ip[IP_NCL]
+    tol = fp[FP_TTOL]
+    new_c = c
+    any_closing = False
+    for k in range(ncl):
+        closing[k] = 0
+        if cl[k, CL_MON] and tau[k] <= h + tol:
+            if c & cl[k, CL_BIT]:
+                new_c &= ~cl[k, CL_BIT]
+            else:
+                closing[k] = 1
+                any_closing = True
+    rapid = t - fst[F_LAST_EVENT] <= fp[FP_ZWIN]
+    ist[I_RAPID] = ist[I_RAPID] + 1 if rapid else 0
+    fst[F_LAST_EVENT] = t
+    if ist[I_RAPID] >= ip[IP_ZSTOP]:
+        return -1
+    stick = ist[I_RAPID] >= ip[IP_ZSTICK]
+    for k in range(ncl):
+        if (c & cl[k, CL_BIT]) and not (new_c & cl[k, CL_BIT]):
+            u = 0.0
+            if cl[k, CL_SOFT]:  # the parts leave with their relative velocity; the overlap is shut
+                snap_shut(cl, k, x, src0)
+                u = relative_velocity(cl, k, v, src0)
+            add_event(ev_f, ev_i, ist, t, k, EV_OPENED, u, c, new_c)
+    if any_closing:
+        new_c = impact(ip, fp, cl, clf, mass, new_c, closing, src0, x, v, stick, ev_f, ev_i, ist, t, momentum)
+    return new_c
+
+
 @tiny
 def arrive(ist, fst, target, grid_next, k_grid, j_target):
     """Now at ``target``: the next standard grid point, or point ``j_target`` of the refined grid."""
@@ -1181,7 +1245,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
     n, ncl, ns, nh = ip[IP_N], ip[IP_NCL], ip[IP_NS], ip[IP_NH]
     every = ip[IP_EVERY]
     beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
-    omega, tol, gap_noise, x_limit = fp[FP_OMEGA], fp[FP_TTOL], fp[FP_GAPNOISE], fp[FP_XLIM]
+    omega, gap_noise, x_limit = fp[FP_OMEGA], fp[FP_GAPNOISE], fp[FP_XLIM]
     refine = int(fp[FP_REFINE] + 0.5)
     fine = dt / refine
     t_rev = fp[FP_TREV]
@@ -1333,29 +1397,10 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                                out_t, out_q, out_F, out_c, ist[I_NOUT], hertz)
                     ist[I_NOUT] += 1
                 else:
-                    full = False
-                    while True:
-                        j_out = ist[I_NEXT_OUT]
-                        t_out = j_out * out_dt
-                        if t_out > t + h + 1e-9 * dt or t_out > t_end + 1e-9 * dt:
-                            break
-                        if ist[I_NOUT] >= rows:
-                            full = True
-                            break
-                        s_out = t_out - t
-                        r = s_out / h
-                        for j in range(ci[c, CI_NF]):
-                            da = zdd1[j] - zdd[j]
-                            zddo[j] = zdd[j] + da * r
-                            zdo[j] = zd[j] + zdd[j] * s_out + da * s_out * r / 2.0
-                            zo[j] = z[j] + zd[j] * s_out + zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
-                        fill_sources(ns, nh, omega, sc, sa, sb, t_out, srco)
-                        set_prescribed(ci, c, n, srco, zo, zdo, zddo)
-                        record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t_out, zo, zdo, zddo, srco,
-                                   out_t, out_q, out_F, out_c, ist[I_NOUT], hertz)
-                        ist[I_NOUT] += 1
-                        ist[I_NEXT_OUT] = j_out + 1
-                    if full:
+                    t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant: a call only when one is due
+                    if (t_out <= t + h + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
+                            and not step_rows(ci, cl, clf, mk, mon, c, n, ns, nh, ncl, fp, sc, sa, sb, t, h, z, zd, zdd,
+                                              z1, zd1, zdd1, zo, zdo, zddo, srco, out_t, out_q, out_F, out_c, ist, hertz)):
                         status = OUTPUT_FULL
                         break
                 # peaks at the step's end
@@ -1379,31 +1424,9 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
         if not event:
             return status
         # ---- the events at t (within the tolerance) ----
-        new_c = c
-        any_closing = False
-        for k in range(ncl):
-            closing[k] = 0
-            if cl[k, CL_MON] and tau[k] <= h + tol:
-                if c & cl[k, CL_BIT]:
-                    new_c &= ~cl[k, CL_BIT]
-                else:
-                    closing[k] = 1
-                    any_closing = True
-        rapid = t - fst[F_LAST_EVENT] <= fp[FP_ZWIN]
-        ist[I_RAPID] = ist[I_RAPID] + 1 if rapid else 0
-        fst[F_LAST_EVENT] = t
-        if ist[I_RAPID] >= ip[IP_ZSTOP]:
+        new_c = take_events(ip, fp, cl, clf, mass, c, t, h, tau, closing, x, v, src0, ev_f, ev_i, ist, fst, momentum)
+        if new_c < 0:
             return CHATTER
-        stick = ist[I_RAPID] >= ip[IP_ZSTICK]
-        for k in range(ncl):
-            if (c & cl[k, CL_BIT]) and not (new_c & cl[k, CL_BIT]):
-                u = 0.0
-                if cl[k, CL_SOFT]:  # the parts leave with their relative velocity; the overlap is shut
-                    snap_shut(cl, k, x, src0)
-                    u = relative_velocity(cl, k, v, src0)
-                add_event(ev_f, ev_i, ist, t, k, EV_OPENED, u, c, new_c)
-        if any_closing:
-            new_c = impact(ip, fp, cl, clf, mass, new_c, closing, src0, x, v, stick, ev_f, ev_i, ist, t, momentum)
         ist[I_CFG] = new_c
         ist[I_NEED_SETTLE] = 1
         fst[F_FINE_UNTIL] = t + fp[FP_REFWIN]
