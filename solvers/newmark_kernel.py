@@ -1309,18 +1309,22 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
             if t >= fst[F_CHUNK_END]:
                 status = CHUNK_END
                 break
-            t_quiet = advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist,
-                              fst, c, z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi)
-            if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
-                t = t_quiet
-                fill_sources(ns, nh, omega, sc, sa, sb, t, src0)
-                continue
             k_grid = ist[I_GRID]
-            grid_next = (k_grid + 1) * dt
             sub = ist[I_SUB]
+            refined = sub > 0 or t < fst[F_FINE_UNTIL]
+            # on a point of the step grid (advance's own test): quiet steps may follow. Off it, after an
+            # event, the call would return at once (and cost a reference-count pair per array argument)
+            if t == (k_grid * dt + sub * fine if refined else k_grid * dt) and not (every or ci[c, CI_HERTZ]):
+                t_quiet = advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist,
+                                  fst, c, z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi)
+                if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
+                    t = t_quiet
+                    fill_sources(ns, nh, omega, sc, sa, sb, t, src0)
+                    continue
+            grid_next = (k_grid + 1) * dt
             j_target = -1  # refined steps: the index of the refined grid point this step reaches
             target = grid_next
-            if sub > 0 or t < fst[F_FINE_UNTIL]:
+            if refined:
                 if t == k_grid * dt + sub * fine:
                     j_target = sub + 1
                 else:  # after an event, between the refined grid's points: on to the next one
