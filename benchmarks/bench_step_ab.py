@@ -1,0 +1,72 @@
+"""The Newmark kernel's cost per step on example 1A: this checkout against an earlier commit, alternating.
+
+Run: ``python3 benchmarks/bench_step_ab.py REF [--pairs N]`` (N = 5 pairs by default; the first
+pair also compiles both kernels into their own temporary numba caches, about 20 s each). Each
+process times the kernel's calls (``bench_newmark.kernel_seconds``: the time inside ``run_chunk``
+over the steps, the best of 4 rounds of 5 runs) in a warm run of ``gnilka-1a``; the two versions
+alternate, so that a machine whose speed drifts slows both alike, and the ratio of the best of
+each is the figure to quote. The earlier commit is laid out as ``bench_compile_ab.py`` does.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from bench_compile_ab import ROOT, layout
+
+os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
+
+TIMING = """
+import sys
+sys.path.insert(0, {benchmarks!r})
+from bench_newmark import kernel_seconds
+import vtool.solvers.newmark_kernel as kernel
+assert kernel.__file__.startswith({prefix!r}), kernel.__file__
+from vtool.presets import load_preset
+from vtool.solvers.model import assemble
+from vtool.solvers.newmark import NewmarkBackend
+spec = load_preset("gnilka-1a")
+mechanism = assemble(spec)
+backend = NewmarkBackend()
+options = backend.options_from_run(spec.run)
+steps = backend.simulate(mechanism, options).statistics.steps
+print(min(min(kernel_seconds(backend, mechanism, options) for _ in range(5)) for _ in range(4)) / steps)
+"""
+
+
+def per_step(path_entry: Path | None, prefix: str, cache: str) -> float:
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    if path_entry is not None:
+        env["PYTHONPATH"] = os.pathsep.join([str(path_entry), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    out = subprocess.run([sys.executable, "-c", TIMING.format(benchmarks=str(ROOT / "benchmarks"), prefix=prefix)],
+                         capture_output=True, text=True, env=env, cwd=tempfile.gettempdir())
+    if out.returncode != 0:
+        raise SystemExit(f"timing run failed:\n{out.stderr[-2000:]}")
+    return float(out.stdout.split()[-1])
+
+
+def main(argv: list[str]) -> None:
+    pairs = int(argv[argv.index("--pairs") + 1]) if "--pairs" in argv else 5
+    refs = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] != "--pairs")]
+    if not refs:
+        raise SystemExit("usage: python3 benchmarks/bench_step_ab.py REF [--pairs N]")
+    ref = refs[0]
+    old, new = [], []
+    with tempfile.TemporaryDirectory() as folder, tempfile.TemporaryDirectory() as cache_old, \
+            tempfile.TemporaryDirectory() as cache_new:
+        entry = layout(ref, Path(folder))
+        for _ in range(pairs):
+            old.append(per_step(entry, str(entry), cache_old))
+            new.append(per_step(None, str(ROOT), cache_new))
+            print(f"  {ref}: {old[-1] * 1e9:.1f} ns/step   this checkout: {new[-1] * 1e9:.1f} ns/step", flush=True)
+    a, b = min(old), min(new)
+    print(f"the kernel per step on gnilka-1a, best of {pairs} alternating processes: {ref} {a * 1e9:.1f} ns, "
+          f"this checkout {b * 1e9:.1f} ns; ratio {b / a:.3f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
