@@ -65,10 +65,18 @@ def compile_seconds(path_entry: Path | None, prefix: str) -> float:
     return float(out.stdout.split()[-1])
 
 
-def main(argv: list[str]) -> None:
-    pairs = int(argv[argv.index("--pairs") + 1]) if "--pairs" in argv else 3
+def arguments(argv: list[str], pairs: int, ref: str | None = None) -> tuple[str, int]:
+    """(REF, N) from ``[REF] [--pairs N]``, with these defaults (no default REF: it must be given)."""
+    if "--pairs" in argv:
+        pairs = int(argv[argv.index("--pairs") + 1])
     refs = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] != "--pairs")]
-    ref = refs[0] if refs else "79a928d"
+    if not refs and ref is None:
+        raise SystemExit("usage: REF [--pairs N]")
+    return (refs[0] if refs else str(ref)), pairs
+
+
+def main(argv: list[str]) -> None:
+    ref, pairs = arguments(argv, 3, "79a928d")
     old, new = [], []
     with tempfile.TemporaryDirectory() as folder:
         entry = layout(ref, Path(folder))

@@ -16,7 +16,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from bench_compile_ab import ROOT, layout
+from bench_compile_ab import ROOT, arguments, layout
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
@@ -50,11 +50,7 @@ def per_step(path_entry: Path | None, prefix: str, cache: str) -> float:
 
 
 def main(argv: list[str]) -> None:
-    pairs = int(argv[argv.index("--pairs") + 1]) if "--pairs" in argv else 5
-    refs = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] != "--pairs")]
-    if not refs:
-        raise SystemExit("usage: python3 benchmarks/bench_step_ab.py REF [--pairs N]")
-    ref = refs[0]
+    ref, pairs = arguments(argv, 5)
     old, new = [], []
     with tempfile.TemporaryDirectory() as folder, tempfile.TemporaryDirectory() as cache_old, \
             tempfile.TemporaryDirectory() as cache_new:
