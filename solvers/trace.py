@@ -386,9 +386,10 @@ class Trace:
         return "\n".join(lines)
 
 
-def cam_angle_deg(time: np.ndarray | float, omega: float) -> np.ndarray:
-    """Cam angle in degrees at time(s) t (s) for a cam speed omega (rad/s)."""
-    return np.asarray(time) * omega * 180.0 / math.pi
+def cam_angle_deg(time: np.ndarray | float, omega: float) -> np.ndarray | float:
+    """Cam angle in degrees at time(s) t (s) for a cam speed omega (rad/s): an array for an array,
+    a float for a float (with no array made for it: one per event)."""
+    return time * omega * 180.0 / math.pi
 
 
 class CsvStream:
@@ -502,7 +503,7 @@ class TraceBuilder:
     def add_event(self, t: float, clearance: int, kind: str, relative_velocity: float, before: int,
                   after: int) -> None:
         t = float(t)
-        self.events.append(Event(t, t * self.omega * 180.0 / math.pi,  # cam_angle_deg, for one float
+        self.events.append(Event(t, float(cam_angle_deg(t, self.omega)),
                                  self.spec.clearances[clearance].name, kind, float(relative_velocity),
                                  int(before), int(after)))
 
