@@ -288,6 +288,7 @@ def kernel_split(signature: tuple[Any, ...]) -> tuple[list[Job], list[Job]]:
         ("record_row", (ci, cl, clf, mk, mon, i8, i8, i8, i8, f8, f8, vec, vec, vec, vec, out_t, out_q, out_F, out_c,
                         i8, hertz)),
         ("track_peaks", (cl, clf, mk, mon, i8, i8, i8, i8, f8, b1, vec, vec, vec, vec, vec, peak, hertz)),
+        ("monitors", (cl, clf, mk, mon, i8, i8, i8, i8, f8, vec, vec, vec, vec, vec, hertz)),
     ]
     return helper, own
 

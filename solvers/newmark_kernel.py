@@ -200,8 +200,8 @@ def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:
 
 
 # ----- sources -----
-@jit
-def fill_sources(ns, nh, omega, sc, sa, sb, t, src):
+@tiny
+def sources(ns, nh, omega, sc, sa, sb, t, src):
     """src[3s : 3s + 3] = (x, v, a) of every source s at t (harmonics by angle addition)."""
     c1 = math.cos(omega * t)
     s1 = math.sin(omega * t)
@@ -220,6 +220,12 @@ def fill_sources(ns, nh, omega, sc, sa, sb, t, src):
             src[3 * s] += a * ck + b * sk
             src[3 * s + 1] += wk * (b * ck - a * sk)
             src[3 * s + 2] -= wk * wk * (a * ck + b * sk)
+
+
+@jit
+def fill_sources(ns, nh, omega, sc, sa, sb, t, src):
+    """:func:`sources`, for Python (the piecewise back ends) and the kernel's less frequent calls."""
+    sources(ns, nh, omega, sc, sa, sb, t, src)
 
 
 # ----- layer values of a configuration -----
@@ -279,7 +285,7 @@ def apply_operator(cp, c, plane, nf, m, coupled, src, z, zd, zdd, out):
         out[e] = r
 
 
-@inner
+@tiny
 def free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
     right, and the sources' pull through closed compliant contacts (``CP_RAW``)."""
@@ -508,7 +514,7 @@ def contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src):
     return f
 
 
-@inner
+@tiny
 def rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz):
     """Contact force of closed rigid clearance k: its linear row, plus the closed Hertz contacts' pull
     on it (``mon[c, k, 3n + 3ns + 1 + j]`` per unit Hertz force F_j)."""
@@ -522,7 +528,7 @@ def rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz):
     return f
 
 
-@inner
+@tiny
 def monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src, hertz):
     """What changes sign at clearance k's next event; 0 when not monitored.
 
@@ -538,6 +544,13 @@ def monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src, her
     if kind == MK_FORCE:
         return rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz)
     return 0.0
+
+
+@inner
+def monitors(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, z, zd, zdd, src, phi, hertz):
+    """phi[k] = :func:`monitor_value` of every clearance k: one call for all of them."""
+    for k in range(ncl):
+        phi[k] = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src, hertz)
 
 
 # ----- output -----
@@ -911,7 +924,7 @@ def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, 
         else:
             tau = (lo * fhi - hi * flo) / (fhi - flo)
         tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
-        fill_sources(ns, nh, fp[FP_OMEGA], sc, sa, sb, t + tau, src1)
+        sources(ns, nh, fp[FP_OMEGA], sc, sa, sb, t + tau, src1)
         factor_effective(ci, cm, c, beta, gamma, tau, L)
         layer_step(ci, cm, cp, c, beta, gamma, tau, CHOLESKY, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
                    cl, clf, mk, mon, hertz)
@@ -1265,6 +1278,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
     src1 = np.zeros(3 * ns)
     srco = np.zeros(3 * ns)
     phi = np.zeros(ncl)
+    phi_start = np.zeros(ncl)
     tau = np.zeros(ncl)
     closing = np.zeros(ncl, dtype=np.int64)
     rows = out_t.shape[0]
@@ -1350,17 +1364,18 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                     factor_effective(ci, cm, c, beta, gamma, h, L)
             layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1, zd1, zdd1, rhs, sol,
                        cl, clf, mk, mon, hertz)
+            monitors(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, z1, zd1, zdd1, src1, phi, hertz)
             fired = False
             for k in range(ncl):
-                phi[k] = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1, hertz)
                 if cl[k, CL_MON] and phi[k] < 0.0:
                     fired = True
             if fired:  # locate every sign change; the earliest is taken
+                monitors(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, z, zd, zdd, src0, phi_start, hertz)
                 tau_min = 2.0 * h
                 for k in range(ncl):
                     tau[k] = 2.0 * h
                     if cl[k, CL_MON] and phi[k] < 0.0:
-                        phi0 = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src0, hertz)
+                        phi0 = phi_start[k]
                         if phi0 < 0.0:
                             tau[k] = 0.0
                         else:
@@ -1373,9 +1388,8 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                     factor_effective(ci, cm, c, beta, gamma, h, L)
                     layer_step(ci, cm, cp, c, beta, gamma, h, CHOLESKY, L, n, src1, z, zd, zdd,
                                z1, zd1, zdd1, rhs, sol, cl, clf, mk, mon, hertz)
-                    for k in range(ncl):
-                        if mk[c, k, MK_KIND] == MK_FORCE or mk[c, k, MK_KIND] == MK_OVERLAP:
-                            phi[k] = monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z1, zd1, zdd1, src1, hertz)
+                    # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
+                    monitors(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, z1, zd1, zdd1, src1, phi, hertz)
                 else:
                     for j in range(n):
                         z1[j] = z[j]
