@@ -897,14 +897,16 @@ def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i,
 # ----- event location -----
 @inner
 def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi_lo, phi_hi,
-                 z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L, hertz):
+                 z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L, zl, zdl, zddl, srcl, hertz):
     """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from (z, ż, z̈) at t.
 
     Illinois (modified regula falsi) on phi(tau) = monitor after a Newmark
     step of length tau, bracketed by phi(0) >= 0 > phi(h), with a bisection
     whenever two iterations have not halved the bracket; returns the left end
     of the final bracket (the monitor still non-negative), within the time
-    tolerance of the crossing. Each trial factors S(tau) by Cholesky.
+    tolerance of the crossing. Each trial factors S(tau) by Cholesky. When
+    the left end is a trial (tau > 0), (zl, żl, z̈l) and srcl hold its step's
+    result and sources: the located step itself, which the caller need not take again.
     """
     beta, gamma, tol = fp[FP_BETA], fp[FP_GAMMA], fp[FP_TTOL]
     lo, hi = 0.0, h
@@ -939,6 +941,12 @@ def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, 
             if side == 1:
                 fhi *= 0.5
             side = 1
+            for j in range(ci[c, CI_M]):
+                zl[j] = z1[j]
+                zdl[j] = zd1[j]
+                zddl[j] = zdd1[j]
+            for j in range(3 * ns):
+                srcl[j] = src1[j]
     return lo
 
 
@@ -1277,6 +1285,9 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
     src0 = np.zeros(3 * ns)
     src1 = np.zeros(3 * ns)
     srco = np.zeros(3 * ns)
+    # the located steps (locate_event): the one being located, and the earliest so far
+    zl, zdl, zddl, srcl = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(3 * ns)
+    zb, zdb, zddb, srcb = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(3 * ns)
     phi = np.zeros(ncl)
     phi_start = np.zeros(ncl)
     tau = np.zeros(ncl)
@@ -1380,14 +1391,19 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                             tau[k] = 0.0
                         else:
                             tau[k] = locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h,
-                                                  phi0, phi[k], z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L, hertz)
-                        tau_min = min(tau_min, tau[k])
+                                                  phi0, phi[k], z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L,
+                                                  zl, zdl, zddl, srcl, hertz)
+                        if tau[k] < tau_min:  # its located step is kept (the next location writes the other set)
+                            tau_min = tau[k]
+                            zl, zdl, zddl, srcl, zb, zdb, zddb, srcb = zb, zdb, zddb, srcb, zl, zdl, zddl, srcl
                 h = tau_min
-                if h > 0.0:
-                    fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
-                    factor_effective(ci, cm, c, beta, gamma, h, L)
-                    layer_step(ci, cm, cp, c, beta, gamma, h, CHOLESKY, L, n, src1, z, zd, zdd,
-                               z1, zd1, zdd1, rhs, sol, cl, clf, mk, mon, hertz)
+                if h > 0.0:  # the step to the earliest crossing, as its location took it
+                    for j in range(ci[c, CI_M]):
+                        z1[j] = zb[j]
+                        zd1[j] = zdb[j]
+                        zdd1[j] = zddb[j]
+                    for j in range(3 * ns):
+                        src1[j] = srcb[j]
                     # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
                     monitors(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, z1, zd1, zdd1, src1, phi, hertz)
                 else:
