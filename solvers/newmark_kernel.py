@@ -895,6 +895,17 @@ def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i,
 
 
 # ----- event location -----
+@tiny
+def copy_state(m, z, zd, zdd, src, z_to, zd_to, zdd_to, src_to):
+    """The first m entries of (z, ż, z̈), and the sources, into (z_to, ż_to, z̈_to) and src_to."""
+    for j in range(m):
+        z_to[j] = z[j]
+        zd_to[j] = zd[j]
+        zdd_to[j] = zdd[j]
+    for j in range(src.shape[0]):
+        src_to[j] = src[j]
+
+
 @inner
 def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi_lo, phi_hi,
                  z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L, zl, zdl, zddl, srcl, hertz):
@@ -941,12 +952,7 @@ def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, 
             if side == 1:
                 fhi *= 0.5
             side = 1
-            for j in range(ci[c, CI_M]):
-                zl[j] = z1[j]
-                zdl[j] = zd1[j]
-                zddl[j] = zdd1[j]
-            for j in range(3 * ns):
-                srcl[j] = src1[j]
+            copy_state(ci[c, CI_M], z1, zd1, zdd1, src1, zl, zdl, zddl, srcl)
     return lo
 
 
@@ -1398,21 +1404,11 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
                             zl, zdl, zddl, srcl, zb, zdb, zddb, srcb = zb, zdb, zddb, srcb, zl, zdl, zddl, srcl
                 h = tau_min
                 if h > 0.0:  # the step to the earliest crossing, as its location took it
-                    for j in range(ci[c, CI_M]):
-                        z1[j] = zb[j]
-                        zd1[j] = zdb[j]
-                        zdd1[j] = zddb[j]
-                    for j in range(3 * ns):
-                        src1[j] = srcb[j]
+                    copy_state(ci[c, CI_M], zb, zdb, zddb, srcb, z1, zd1, zdd1, src1)
                     # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
                     monitors(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, z1, zd1, zdd1, src1, phi, hertz)
                 else:
-                    for j in range(n):
-                        z1[j] = z[j]
-                        zd1[j] = zd[j]
-                        zdd1[j] = zdd[j]
-                    for j in range(3 * ns):
-                        src1[j] = src0[j]
+                    copy_state(n, z, zd, zdd, src0, z1, zd1, zdd1, src1)
             if h > 0.0:
                 diverged = False
                 for j in range(ci[c, CI_NF]):
