@@ -123,6 +123,8 @@ class ConfigurationTables:
         self.cp = np.zeros((count, kernel.CP_SIZE, kernel.PART_SIZE, n, 3 * max(n, ns)))  # kernel.CP_RAW
         self.mk = np.zeros((count, ncl, kernel.MK_SIZE), dtype=np.int64)
         self.mon = np.zeros((count, ncl, 3 * n + 3 * ns + 1 + ncl))
+        self.mi = np.zeros((count, ncl, 3 * n + 3 * ns), dtype=np.int64)  # a force row's nonzero terms (kernel.MK_TERMS)
+        self.mc = np.zeros((count, ncl, 3 * n + 3 * ns))
         self.layers: dict[int, OrderedLayer] = {}
         self.step: tuple[float, float, float, float] | None = None  # (dt, beta, gamma, fine) of the inverses
 
@@ -242,9 +244,16 @@ class ConfigurationTables:
                               frow[part_index * n:(part_index + 1) * n])
                 mon[3 * n:3 * n + 3 * ns] = frow[3 * n:]
                 kind = kernel.MK_FORCE if c.rigid else kernel.MK_OVERLAP
-                mk[:] = (kind, int(group[c.ahead - 1]), behind, m)
+                used = np.zeros(3 * n + 3 * ns, dtype=bool)  # the layer's columns of (z, ż, z̈), and the sources
+                for part_index in range(3):
+                    used[part_index * n:part_index * n + m] = True
+                used[3 * n:] = True
+                columns = np.flatnonzero(used & (mon[:3 * n + 3 * ns] != 0.0))  # in column order
+                self.mi[mask, index, :columns.size] = columns
+                self.mc[mask, index, :columns.size] = mon[columns]
+                mk[:] = (kind, int(group[c.ahead - 1]), behind, m, columns.size)
             elif c.state == ENABLED:
-                mk[:] = (kernel.MK_GAP, int(group[c.ahead - 1]), behind, m)
+                mk[:] = (kernel.MK_GAP, int(group[c.ahead - 1]), behind, m, 0)
 
 
 @dataclass(frozen=True)

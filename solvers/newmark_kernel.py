@@ -130,9 +130,11 @@ CP_RAW, CP_STD, CP_FINE = range(3)
 CP_SIZE = 3
 PART_C, PART_K, PART_P, PART_S = range(4)
 PART_SIZE = 4
-# monitor per (configuration, clearance): (kind, ahead z index, behind z index or -1 - source, m)
-MK_KIND, MK_AHEAD, MK_BEHIND, MK_M = range(4)
-MK_SIZE = 4
+# monitor per (configuration, clearance): (kind, ahead z index, behind z index or -1 - source, m, and for
+# a force the number of its row's nonzero terms on (z, ż, z̈, sources): their columns of ``mon`` in order
+# in mi[c, k], their coefficients in mc[c, k]; :func:`advance` sums only those)
+MK_KIND, MK_AHEAD, MK_BEHIND, MK_M, MK_TERMS = range(5)
+MK_SIZE = 5
 MK_NONE, MK_GAP, MK_FORCE, MK_OVERLAP = range(4)  # MK_OVERLAP: a closed compliant clearance
 # peak rows: contact force over the run, after the first revolution, overlap of compliant contacts
 PEAK_ALL, PEAK_LATE, PEAK_OVERLAP = range(3)
@@ -505,10 +507,17 @@ def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk,
 
 @tiny
 def contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src):
-    """Contact force of closed clearance k: its row on (z, ż, z̈, sources, 1)."""
+    """Contact force of closed clearance k: its row on (z, ż, z̈, sources, 1), summed in the row's
+    column order. A zero term adds exactly nothing, so :func:`advance`, which sums only the nonzero
+    terms (``MK_TERMS``) in the same order, gets the same number to the last bit."""
+    m = mk[c, k, MK_M]
     f = mon[c, k, 3 * n + 3 * ns]
-    for j in range(mk[c, k, MK_M]):
-        f += mon[c, k, j] * z[j] + mon[c, k, n + j] * zd[j] + mon[c, k, 2 * n + j] * zdd[j]
+    for j in range(m):
+        f += mon[c, k, j] * z[j]
+    for j in range(m):
+        f += mon[c, k, n + j] * zd[j]
+    for j in range(m):
+        f += mon[c, k, 2 * n + j] * zdd[j]
     for j in range(3 * ns):
         f += mon[c, k, 3 * n + j] * src[j]
     return f
@@ -974,8 +983,8 @@ def track_peaks(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, after, phi, z, zd, z
 
 # ----- the hot loop -----
 @inner
-def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist, fst, c,
-            z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi):
+def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, out_F, out_c, peak, ist, fst, c,
+            z, zd, zdd, z1, zd1, zdd1, src1, y1, srco, zo, zdo, zddo, rhs, phi):
     """Standard and refined steps in configuration c while nothing happens; returns the time reached.
 
     Everything a quiet step does is written out here, with no call that
@@ -1003,6 +1012,8 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
     # this configuration's monitor tables, taken once (inner loops then index two dimensions, not three)
     W = mon[c]
     kinds = mk[c]
+    columns = mi[c]
+    terms = mc[c]
     t = fst[F_T]
     while True:
         k_grid = ist[I_GRID]
@@ -1069,12 +1080,10 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
                 value = (value if kind == MK_GAP else -value) + gap_noise
                 if value < 0.0:
                     return t
-            elif kind == MK_FORCE:
+            elif kind == MK_FORCE:  # the row's nonzero terms on y1 = (z1, ż1, z̈1, src1), in order
                 value = W[k, 3 * n + 3 * ns]
-                for j in range(m):
-                    value += W[k, j] * z1[j] + W[k, n + j] * zd1[j] + W[k, 2 * n + j] * zdd1[j]
-                for j in range(3 * ns):
-                    value += W[k, 3 * n + j] * src1[j]
+                for j in range(kinds[k, MK_TERMS]):
+                    value += terms[k, j] * y1[columns[k, j]]
                 if value < 0.0 and cl[k, CL_MON]:
                     return t
             phi[k] = value
@@ -1133,11 +1142,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             for k in range(ncl):
                 force = 0.0
                 if mk[c, k, MK_KIND] == MK_FORCE or mk[c, k, MK_KIND] == MK_OVERLAP:
-                    force = mon[c, k, 3 * n + 3 * ns]
-                    for j in range(m):
-                        force += mon[c, k, j] * zo[j] + mon[c, k, n + j] * zdo[j] + mon[c, k, 2 * n + j] * zddo[j]
-                    for j in range(3 * ns):
-                        force += mon[c, k, 3 * n + j] * srco[j]
+                    force = contact_force(mk, mon, c, k, n, ns, zo, zdo, zddo, srco)
                 out_F[row, k] = force
             ist[I_NOUT] = row + 1
             ist[I_NEXT_OUT] = j_out + 1
@@ -1151,11 +1156,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
                 if after and phi[k] > peak[PEAK_LATE, k]:
                     peak[PEAK_LATE, k] = phi[k]
             elif kind == MK_OVERLAP:
-                force = W[k, 3 * n + 3 * ns]
-                for j in range(m):
-                    force += W[k, j] * z1[j] + W[k, n + j] * zd1[j]
-                for j in range(3 * ns):
-                    force += W[k, 3 * n + j] * src1[j]
+                force = contact_force(mk, mon, c, k, n, ns, z1, zd1, zdd1, src1)
                 if force > peak[PEAK_ALL, k]:
                     peak[PEAK_ALL, k] = force
                 if after and force > peak[PEAK_LATE, k]:
@@ -1255,7 +1256,7 @@ def arrive(ist, fst, target, grid_next, k_grid, j_target):
 
 # ----- the run loop -----
 @jit
-def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
+def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
               out_t, out_q, out_F, out_c, ev_f, ev_i, peak, x, v, a, ist, fst, hertz, momentum):
     """Integrate from fst[F_T] until t_end, the chunk end, or something Python must do.
 
@@ -1279,9 +1280,11 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
     z = np.zeros(n)
     zd = np.zeros(n)
     zdd = np.zeros(n)
-    z1 = np.zeros(n)
-    zd1 = np.zeros(n)
-    zdd1 = np.zeros(n)
+    y1 = np.zeros(3 * n + 3 * ns)  # a step's end (z1, ż1, z̈1, src1), laid out as a monitor row's columns
+    z1 = y1[:n]
+    zd1 = y1[n:2 * n]
+    zdd1 = y1[2 * n:3 * n]
+    src1 = y1[3 * n:]
     zo = np.zeros(n)
     zdo = np.zeros(n)
     zddo = np.zeros(n)
@@ -1289,7 +1292,6 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
     sol = np.zeros(n)
     L = np.zeros((n, n))
     src0 = np.zeros(3 * ns)
-    src1 = np.zeros(3 * ns)
     srco = np.zeros(3 * ns)
     # the located steps (locate_event): the one being located, and the earliest so far
     zl, zdl, zddl, srcl = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(3 * ns)
@@ -1346,8 +1348,8 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
             # on a point of the step grid (advance's own test): quiet steps may follow. Off it, after an
             # event, the call would return at once (and cost a reference-count pair per array argument)
             if t == (k_grid * dt + sub * fine if refined else k_grid * dt) and not (every or ci[c, CI_HERTZ]):
-                t_quiet = advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist,
-                                  fst, c, z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi)
+                t_quiet = advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, out_F, out_c, peak,
+                                  ist, fst, c, z, zd, zdd, z1, zd1, zdd1, src1, y1, srco, zo, zdo, zddo, rhs, phi)
                 if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
                     t = t_quiet
                     fill_sources(ns, nh, omega, sc, sa, sb, t, src0)

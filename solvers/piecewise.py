@@ -90,7 +90,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
     G, H = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # monitors (kernel.monitor_value)
     GF, HF = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # contact forces (kernel.contact_force)
     for k in range(ncl):
-        kind, ahead, behind, _ = (int(v) for v in tables.mk[mask, k])
+        kind, ahead, behind = (int(v) for v in tables.mk[mask, k, :kernel.MK_M])
         if kind in (kernel.MK_GAP, kernel.MK_OVERLAP):
             sign = 1.0 if kind == kernel.MK_GAP else -1.0
             G[k] += sign * Zy[0, ahead]
