@@ -244,11 +244,10 @@ class ConfigurationTables:
                               frow[part_index * n:(part_index + 1) * n])
                 mon[3 * n:3 * n + 3 * ns] = frow[3 * n:]
                 kind = kernel.MK_FORCE if c.rigid else kernel.MK_OVERLAP
-                used = np.zeros(3 * n + 3 * ns, dtype=bool)  # the layer's columns of (z, ż, z̈), and the sources
-                for part_index in range(3):
-                    used[part_index * n:part_index * n + m] = True
-                used[3 * n:] = True
-                columns = np.flatnonzero(used & (mon[:3 * n + 3 * ns] != 0.0))  # in column order
+                # the nonzero terms in kernel.contact_force's order: z_j, ż_j, z̈_j for each layer index j, the sources
+                order = np.concatenate([np.arange(m)[:, None] + n * np.arange(3)[None, :], 3 * n + np.arange(3 * ns)],
+                                       axis=None)
+                columns = order[mon[order] != 0.0]
                 self.mi[mask, index, :columns.size] = columns
                 self.mc[mask, index, :columns.size] = mon[columns]
                 mk[:] = (kind, int(group[c.ahead - 1]), behind, m, columns.size)

@@ -277,7 +277,7 @@ def kernel_split(signature: tuple[Any, ...]) -> tuple[list[Job], list[Job]]:
         ("settle", (ip, fp, cl, clf, ci, cm, cp, mk, mon, i8, f8, x, v, a, vec, ev_f, ev_i, ist, vec, vec, vec, vec,
                     hertz)),
         ("locate_event", (ci, cm, cp, cl, clf, mk, mon, i8, i8, i8, i8, i8, fp, sc, sa, sb, f8, f8, f8, f8,
-                          *(vec,) * 9, mat, *(vec,) * 4, hertz)),
+                          *(vec,) * 9, mat, hertz)),
         ("step_rows", (ci, cl, clf, mk, mon, i8, i8, i8, i8, i8, fp, sc, sa, sb, f8, f8, *(vec,) * 10, out_t, out_q,
                        out_F, out_c, ist, hertz)),
     ]

@@ -131,8 +131,8 @@ CP_SIZE = 3
 PART_C, PART_K, PART_P, PART_S = range(4)
 PART_SIZE = 4
 # monitor per (configuration, clearance): (kind, ahead z index, behind z index or -1 - source, m, and for
-# a force the number of its row's nonzero terms on (z, ż, z̈, sources): their columns of ``mon`` in order
-# in mi[c, k], their coefficients in mc[c, k]; :func:`advance` sums only those)
+# a force the number of its row's nonzero terms on (z, ż, z̈, sources): their columns of ``mon`` in
+# mi[c, k], in :func:`contact_force`'s order, their coefficients in mc[c, k]; :func:`advance` sums only those)
 MK_KIND, MK_AHEAD, MK_BEHIND, MK_M, MK_TERMS = range(5)
 MK_SIZE = 5
 MK_NONE, MK_GAP, MK_FORCE, MK_OVERLAP = range(4)  # MK_OVERLAP: a closed compliant clearance
@@ -287,7 +287,7 @@ def apply_operator(cp, c, plane, nf, m, coupled, src, z, zd, zdd, out):
         out[e] = r
 
 
-@tiny
+@inner
 def free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
     right, and the sources' pull through closed compliant contacts (``CP_RAW``)."""
@@ -507,23 +507,21 @@ def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk,
 
 @tiny
 def contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src):
-    """Contact force of closed clearance k: its row on (z, ż, z̈, sources, 1), summed in the row's
-    column order. A zero term adds exactly nothing, so :func:`advance`, which sums only the nonzero
-    terms (``MK_TERMS``) in the same order, gets the same number to the last bit."""
-    m = mk[c, k, MK_M]
+    """Contact force of closed clearance k: its row on (z, ż, z̈, sources, 1), summed term by term in
+    the order z_0, ż_0, z̈_0, z_1, …, then the sources. A zero term adds exactly nothing, so
+    :func:`advance`, which sums only the nonzero terms (``MK_TERMS``) in the same order, gets the
+    same number to the last bit."""
     f = mon[c, k, 3 * n + 3 * ns]
-    for j in range(m):
+    for j in range(mk[c, k, MK_M]):
         f += mon[c, k, j] * z[j]
-    for j in range(m):
         f += mon[c, k, n + j] * zd[j]
-    for j in range(m):
         f += mon[c, k, 2 * n + j] * zdd[j]
     for j in range(3 * ns):
         f += mon[c, k, 3 * n + j] * src[j]
     return f
 
 
-@tiny
+@inner
 def rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz):
     """Contact force of closed rigid clearance k: its linear row, plus the closed Hertz contacts' pull
     on it (``mon[c, k, 3n + 3ns + 1 + j]`` per unit Hertz force F_j)."""
@@ -551,6 +549,8 @@ def monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src, her
         gap = z[mk[c, k, MK_AHEAD]] - other
         return (gap if kind == MK_GAP else -gap) + gap_noise
     if kind == MK_FORCE:
+        if hertz is None:  # the linear row alone, inline (no call)
+            return contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src)
         return rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz)
     return 0.0
 
@@ -891,7 +891,7 @@ def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i,
         worst_f = -fp[FP_FTOL]
         for k in range(ncl):
             if mk[c, k, MK_KIND] == MK_FORCE and cl[k, CL_MON]:
-                f = monitor_value(cl, clf, mk, mon, c, k, n, ns, fp[FP_GAPNOISE], z, zd, zdd, src, hertz)
+                f = rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz)
                 if f < worst_f:
                     worst = k
                     worst_f = f
@@ -904,29 +904,16 @@ def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i,
 
 
 # ----- event location -----
-@tiny
-def copy_state(m, z, zd, zdd, src, z_to, zd_to, zdd_to, src_to):
-    """The first m entries of (z, ż, z̈), and the sources, into (z_to, ż_to, z̈_to) and src_to."""
-    for j in range(m):
-        z_to[j] = z[j]
-        zd_to[j] = zd[j]
-        zdd_to[j] = zdd[j]
-    for j in range(src.shape[0]):
-        src_to[j] = src[j]
-
-
 @inner
 def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h, phi_lo, phi_hi,
-                 z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L, zl, zdl, zddl, srcl, hertz):
+                 z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L, hertz):
     """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from (z, ż, z̈) at t.
 
     Illinois (modified regula falsi) on phi(tau) = monitor after a Newmark
     step of length tau, bracketed by phi(0) >= 0 > phi(h), with a bisection
     whenever two iterations have not halved the bracket; returns the left end
     of the final bracket (the monitor still non-negative), within the time
-    tolerance of the crossing. Each trial factors S(tau) by Cholesky. When
-    the left end is a trial (tau > 0), (zl, żl, z̈l) and srcl hold its step's
-    result and sources: the located step itself, which the caller need not take again.
+    tolerance of the crossing. Each trial factors S(tau) by Cholesky.
     """
     beta, gamma, tol = fp[FP_BETA], fp[FP_GAMMA], fp[FP_TTOL]
     lo, hi = 0.0, h
@@ -961,7 +948,6 @@ def locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, 
             if side == 1:
                 fhi *= 0.5
             side = 1
-            copy_state(ci[c, CI_M], z1, zd1, zdd1, src1, zl, zdl, zddl, srcl)
     return lo
 
 
@@ -1243,6 +1229,17 @@ def take_events(ip, fp, cl, clf, mass, c, t, h, tau, closing, x, v, src0, ev_f, 
 
 
 @tiny
+def copy_state(m, z, zd, zdd, src, z_to, zd_to, zdd_to, src_to):
+    """The first m entries of (z, ż, z̈), and the sources, into (z_to, ż_to, z̈_to) and src_to."""
+    for j in range(m):
+        z_to[j] = z[j]
+        zd_to[j] = zd[j]
+        zdd_to[j] = zdd[j]
+    for j in range(src.shape[0]):
+        src_to[j] = src[j]
+
+
+@tiny
 def arrive(ist, fst, target, grid_next, k_grid, j_target):
     """Now at ``target``: the next standard grid point, or point ``j_target`` of the refined grid."""
     if target == grid_next:
@@ -1293,9 +1290,6 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
     L = np.zeros((n, n))
     src0 = np.zeros(3 * ns)
     srco = np.zeros(3 * ns)
-    # the located steps (locate_event): the one being located, and the earliest so far
-    zl, zdl, zddl, srcl = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(3 * ns)
-    zb, zdb, zddb, srcb = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(3 * ns)
     phi = np.zeros(ncl)
     phi_start = np.zeros(ncl)
     tau = np.zeros(ncl)
@@ -1399,14 +1393,14 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
                             tau[k] = 0.0
                         else:
                             tau[k] = locate_event(ci, cm, cp, cl, clf, mk, mon, c, k, n, ns, nh, fp, sc, sa, sb, t, h,
-                                                  phi0, phi[k], z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L,
-                                                  zl, zdl, zddl, srcl, hertz)
-                        if tau[k] < tau_min:  # its located step is kept (the next location writes the other set)
-                            tau_min = tau[k]
-                            zl, zdl, zddl, srcl, zb, zdb, zddb, srcb = zb, zdb, zddb, srcb, zl, zdl, zddl, srcl
+                                                  phi0, phi[k], z, zd, zdd, z1, zd1, zdd1, src1, rhs, sol, L, hertz)
+                        tau_min = min(tau_min, tau[k])
                 h = tau_min
-                if h > 0.0:  # the step to the earliest crossing, as its location took it
-                    copy_state(ci[c, CI_M], zb, zdb, zddb, srcb, z1, zd1, zdd1, src1)
+                if h > 0.0:
+                    fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
+                    factor_effective(ci, cm, c, beta, gamma, h, L)
+                    layer_step(ci, cm, cp, c, beta, gamma, h, CHOLESKY, L, n, src1, z, zd, zdd,
+                               z1, zd1, zdd1, rhs, sol, cl, clf, mk, mon, hertz)
                     # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
                     monitors(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, z1, zd1, zdd1, src1, phi, hertz)
                 else:
@@ -1439,12 +1433,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
                 track_peaks(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t + h >= t_rev, phi, z1, zd1, zdd1, src1,
                             peak, hertz)
                 ist[I_STEPS] += 1
-                for j in range(n):
-                    z[j] = z1[j]
-                    zd[j] = zd1[j]
-                    zdd[j] = zdd1[j]
-                for j in range(3 * ns):
-                    src0[j] = src1[j]
+                copy_state(n, z1, zd1, zdd1, src1, z, zd, zdd, src0)
                 t = t + h
                 fst[F_T] = t
                 if abs(t - target) <= 1e-9 * dt:
