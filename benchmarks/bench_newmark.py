@@ -1,7 +1,8 @@
 """Newmark back end benchmark: example 1A (850 degrees, dt = 1e-6 s), ratios measured in one run.
 
 Run: ``python3 benchmarks/bench_newmark.py`` (``--no-compile`` skips the empty-cache compile,
-and the first-run measure, about 30 s together). Prints figures, asserts nothing.
+and the first-run measure, about 30 s together; ``--ratio`` measures item 2 alone and prints
+every round). Prints figures, asserts nothing.
 
 1. Warm wall time of a whole run (``simulate``: assemble + contact problem + kernel), best of
    several, and its ratio to the 5 ms target; the kernel alone per step.
@@ -231,7 +232,40 @@ def second_process(bytecode: bool = True) -> tuple[float, float, int, int]:
     return total, float(solve_time), int(misses), int(hits)
 
 
+def kernel_rounds(backend, mechanism, options, steps: int) -> list[tuple[float, float]]:  # noqa: ANN001
+    """(kernel, dense loop) seconds per step in each of ROUNDS interleaved rounds: a machine whose
+    speed drifts slows both alike."""
+    return [(min(kernel_seconds(backend, mechanism, options) for _ in range(3)) / steps, dense_floor(steps))
+            for _ in range(ROUNDS)]
+
+
+def ratio_line(rounds: list[tuple[float, float]]) -> str:
+    per_step = min(k for k, _ in rounds)
+    floor = min(f for _, f in rounds)
+    ratios = sorted(k / f for k, f in rounds)
+    return (f"dense 8-coordinate Newmark loop: {floor * 1e9:5.0f} ns/step; the kernel (its calls alone) "
+            f"{per_step * 1e9:5.0f} ns/step, {per_step / floor:.2f} x the floor (target <= 2; the best of each "
+            f"over {ROUNDS} interleaved rounds; the rounds' median ratio {ratios[ROUNDS // 2]:.2f})")
+
+
+def ratio_only() -> None:
+    """Item 2 alone, every round printed."""
+    spec = load_preset("gnilka-1a")
+    mechanism = assemble(spec)
+    backend = NewmarkBackend()
+    options = backend.options_from_run(spec.run)
+    steps = backend.simulate(mechanism, options).statistics.steps
+    rounds = kernel_rounds(backend, mechanism, options, steps)
+    for number, (kernel, floor) in enumerate(rounds, 1):
+        print(f"  round {number}: kernel {kernel * 1e9:5.1f} ns/step, dense loop {floor * 1e9:5.1f} ns/step, "
+              f"ratio {kernel / floor:.2f}")
+    print("  " + ratio_line(rounds))
+
+
 def main() -> None:
+    if "--ratio" in sys.argv[1:]:
+        ratio_only()
+        return
     print("Newmark back end, ratios measured in this run")
     for name in ("gnilka-1a", "gnilka-1d", "gnilka-2"):
         spec = load_preset(name)
@@ -246,15 +280,9 @@ def main() -> None:
               f"on an assembled mechanism {reused * 1e3:6.2f} ms; {steps} steps, {len(trace.events)} events, "
               f"{reused / steps * 1e9:5.0f} ns/step")
         if name == "gnilka-1a":
-            rounds = [(min(kernel_seconds(backend, mechanism, options) for _ in range(3)) / steps, dense_floor(steps))
-                      for _ in range(ROUNDS)]  # interleaved: a machine whose speed drifts slows both alike
-            per_step = min(k for k, _ in rounds)
+            rounds = kernel_rounds(backend, mechanism, options, steps)
             floor = min(f for _, f in rounds)
-            ratios = sorted(k / f for k, f in rounds)
-            print(f"  dense 8-coordinate Newmark loop: {floor * 1e9:5.0f} ns/step; the kernel (its calls alone) "
-                  f"{per_step * 1e9:5.0f} ns/step, {per_step / floor:.2f} x the floor (target <= 2; the best of each "
-                  f"over {ROUNDS} interleaved rounds; the rounds' median ratio {ratios[ROUNDS // 2]:.2f}); "
-                  f"the whole 1A run per step {reused / steps / floor:.2f} x")
+            print(f"  {ratio_line(rounds)}; the whole 1A run per step {reused / steps / floor:.2f} x")
     if "--no-compile" not in sys.argv[1:]:
         compile_s, cpu, wall = first_compile()
         print(f"  first run with an empty numba cache: kernel compile {compile_s:.1f} s wall "
