@@ -44,6 +44,7 @@ TARGET_WARM_S = 0.005
 TARGET_COMPILE_S = 10.0
 TARGET_SECOND_PROCESS_S = 0.5
 ROUNDS = 7  # kernel and dense-loop timings, alternated
+REPEAT = 11  # runs per timing, the best taken
 
 
 @njit(cache=True, nogil=True)
@@ -94,7 +95,7 @@ def kernel_seconds(backend, mechanism, options) -> float:  # noqa: ANN001
     return spent[0]
 
 
-def best_of(function, repeat: int = 11) -> float:  # noqa: ANN001
+def best_of(function, repeat: int = REPEAT) -> float:  # noqa: ANN001
     function()
     best = float("inf")
     for _ in range(repeat):
@@ -234,8 +235,9 @@ def second_process(bytecode: bool = True) -> tuple[float, float, int, int]:
 
 def kernel_rounds(backend, mechanism, options, steps: int) -> list[tuple[float, float]]:  # noqa: ANN001
     """(kernel, dense loop) seconds per step in each of ROUNDS interleaved rounds: a machine whose
-    speed drifts slows both alike."""
-    return [(min(kernel_seconds(backend, mechanism, options) for _ in range(3)) / steps, dense_floor(steps))
+    speed drifts slows both alike. Each is the best of REPEAT runs (:func:`best_of`'s count), so
+    that both figures are the same estimator."""
+    return [(min(kernel_seconds(backend, mechanism, options) for _ in range(REPEAT)) / steps, dense_floor(steps))
             for _ in range(ROUNDS)]
 
 
