@@ -123,7 +123,8 @@ class ConfigurationTables:
         self.cp = np.zeros((count, kernel.CP_SIZE, kernel.PART_SIZE, n, 3 * max(n, ns)))  # kernel.CP_RAW
         self.mk = np.zeros((count, ncl, kernel.MK_SIZE), dtype=np.int64)
         self.mon = np.zeros((count, ncl, 3 * n + 3 * ns + 1 + ncl))
-        self.mi = np.zeros((count, ncl, 3 * n + 3 * ns), dtype=np.int64)  # a force row's nonzero terms (kernel.MK_TERMS)
+        # a force row's nonzero terms (kernel.MK_TERMS): their columns of mon, their coefficients
+        self.mi = np.zeros((count, ncl, 3 * n + 3 * ns), dtype=np.int64)
         self.mc = np.zeros((count, ncl, 3 * n + 3 * ns))
         self.layers: dict[int, OrderedLayer] = {}
         self.step: tuple[float, float, float, float] | None = None  # (dt, beta, gamma, fine) of the inverses
@@ -244,7 +245,8 @@ class ConfigurationTables:
                               frow[part_index * n:(part_index + 1) * n])
                 mon[3 * n:3 * n + 3 * ns] = frow[3 * n:]
                 kind = kernel.MK_FORCE if c.rigid else kernel.MK_OVERLAP
-                # the nonzero terms in kernel.contact_force's order: z_j, ż_j, z̈_j for each layer index j, the sources
+                # the nonzero terms in kernel.contact_force's order: z_j, ż_j, z̈_j for each layer index j,
+                # then the sources
                 order = np.concatenate([np.arange(m)[:, None] + n * np.arange(3)[None, :], 3 * n + np.arange(3 * ns)],
                                        axis=None)
                 columns = order[mon[order] != 0.0]

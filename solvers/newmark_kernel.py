@@ -980,13 +980,12 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, o
     rows at the output instants, the peaks. It stops, without taking it, at
     the first step that is neither a standard step on the grid nor a refined
     one, that would end past the chunk or the run, change a monitor's sign,
-    leave the divergence limit or overflow the output buffer, and in
-    every-step mode at once; :func:`run_chunk` takes that step with full
-    handling.
+    leave the divergence limit or overflow the output buffer;
+    :func:`run_chunk` takes that step with full handling. Not called in
+    every-step mode, nor in a configuration with closed Hertz contacts (each
+    of their steps goes through layer_step's iteration).
     """
     n, ncl, ns, nh = ip[IP_N], ip[IP_NCL], ip[IP_NS], ip[IP_NH]
-    if ip[IP_EVERY] or ci[c, CI_HERTZ]:  # Hertz contacts: every step through layer_step's iteration
-        return fst[F_T]
     beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
     omega, gap_noise, x_limit, t_rev = fp[FP_OMEGA], fp[FP_GAPNOISE], fp[FP_XLIM], fp[FP_TREV]
     refine = int(fp[FP_REFINE] + 0.5)
@@ -1018,7 +1017,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, o
             return t
         if t1 > t_end or t >= fst[F_CHUNK_END]:
             return t
-        # the sources at t + h
+        # the sources at t + h (sources' arithmetic, written out: the quiet step's loop bounds stay local)
         c1 = math.cos(omega * t1)
         s1 = math.sin(omega * t1)
         for s in range(ns):
@@ -1085,35 +1084,9 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, o
             row = ist[I_NOUT]
             if row >= rows:
                 return t
-            s_out = t_out - t
-            r = s_out / h
-            for j in range(nf):
-                da = zdd1[j] - zdd[j]
-                zddo[j] = zdd[j] + da * r
-                zdo[j] = zd[j] + zdd[j] * s_out + da * s_out * r / 2.0
-                zo[j] = z[j] + zd[j] * s_out + zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
-            co = math.cos(omega * t_out)
-            so = math.sin(omega * t_out)
-            for s in range(ns):
-                srco[3 * s] = sc[s]
-                srco[3 * s + 1] = 0.0
-                srco[3 * s + 2] = 0.0
-            ck = 1.0
-            sk = 0.0
-            for kh in range(nh):
-                ck, sk = ck * co - sk * so, sk * co + ck * so
-                wk = (kh + 1) * omega
-                for s in range(ns):
-                    ca = sa[s, kh]
-                    cb = sb[s, kh]
-                    srco[3 * s] += ca * ck + cb * sk
-                    srco[3 * s + 1] += wk * (cb * ck - ca * sk)
-                    srco[3 * s + 2] -= wk * wk * (ca * ck + cb * sk)
-            for j in range(nf, m):
-                sidx = ci[c, CI_HEAD + 2 * n + j]
-                zo[j] = srco[3 * sidx]
-                zdo[j] = srco[3 * sidx + 1]
-                zddo[j] = srco[3 * sidx + 2]
+            interpolate(nf, t_out - t, h, z, zd, zdd, zdd1, zo, zdo, zddo)
+            sources(ns, nh, omega, sc, sa, sb, t_out, srco)
+            set_prescribed(ci, c, n, srco, zo, zdo, zddo)
             out_t[row] = t_out
             out_c[row] = c
             for i in range(n):
@@ -1164,6 +1137,18 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, o
 
 
 
+@tiny
+def interpolate(nf, s_out, h, z, zd, zdd, zdd1, zo, zdo, zddo):
+    """The free coordinates at s_out into a step of length h from (z, ż, z̈) whose end acceleration is
+    z̈1: the linear-acceleration interpolant (exact for beta = 1/6; thesis eqs. B.3-B.5)."""
+    r = s_out / h
+    for j in range(nf):
+        da = zdd1[j] - zdd[j]
+        zddo[j] = zdd[j] + da * r
+        zdo[j] = zd[j] + zdd[j] * s_out + da * s_out * r / 2.0
+        zo[j] = z[j] + zd[j] * s_out + zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
+
+
 @inner
 def step_rows(ci, cl, clf, mk, mon, c, n, ns, nh, ncl, fp, sc, sa, sb, t, h, z, zd, zdd, z1, zd1, zdd1, zo, zdo, zddo,
               srco, out_t, out_q, out_F, out_c, ist, hertz):
@@ -1178,13 +1163,7 @@ def step_rows(ci, cl, clf, mk, mon, c, n, ns, nh, ncl, fp, sc, sa, sb, t, h, z, 
             return True
         if ist[I_NOUT] >= rows:
             return False
-        s_out = t_out - t
-        r = s_out / h
-        for j in range(ci[c, CI_NF]):
-            da = zdd1[j] - zdd[j]
-            zddo[j] = zdd[j] + da * r
-            zdo[j] = zd[j] + zdd[j] * s_out + da * s_out * r / 2.0
-            zo[j] = z[j] + zd[j] * s_out + zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
+        interpolate(ci[c, CI_NF], t_out - t, h, z, zd, zdd, zdd1, zo, zdo, zddo)
         fill_sources(ns, nh, omega, sc, sa, sb, t_out, srco)
         set_prescribed(ci, c, n, srco, zo, zdo, zddo)
         record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t_out, zo, zdo, zddo, srco,
