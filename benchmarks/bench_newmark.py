@@ -16,9 +16,11 @@ every round). Prints figures, asserts nothing.
    new user meets it (the default mode, no ``VTOOL_KERNEL``): ``vtool solve gnilka-1a`` with an
    empty cache, its wall time and steps run as plain Python, and when the background compile it
    started reached the cache (see newmark's "First run").
-4. A second process: ``vtool solve gnilka-1a`` in a fresh interpreter with the cache warm
+4. A second process: ``vtool solve gnilka-1a`` in a fresh interpreter, the default mode, after
+   the first run's background build has put the kernel's native module beside numba's cache
    (target: at most 0.5 s; best of five, Python's bytecode cache on as by default, and again
-   with ``PYTHONDONTWRITEBYTECODE=1``), and whether numba compiled anything in it.
+   with ``PYTHONDONTWRITEBYTECODE=1``), whether it imported numba, and the same process on
+   numba's cache instead (``VTOOL_NATIVE=0``) for comparison, measured in the same run.
 """
 
 from __future__ import annotations
@@ -143,9 +145,10 @@ try:
 except SystemExit as exc:
     assert exc.code in (0, None), output.getvalue()
 elapsed = time.perf_counter() - started
+native = "numba" not in sys.modules
 from vtool.solvers import newmark_kernel
 stats = newmark_kernel.run_chunk.stats
-print(elapsed, sum(stats.cache_misses.values()), sum(stats.cache_hits.values()))
+print(elapsed, sum(stats.cache_misses.values()), sum(stats.cache_hits.values()), int(native))
 """
 
 #: Import-time groups of the second process, by top-level package (``python -X importtime``).
@@ -162,7 +165,7 @@ def import_breakdown() -> tuple[float, dict[str, float]]:
     """
     started = time.perf_counter()
     out = subprocess.run([sys.executable, "-X", "importtime", "-m", "vtool.app.cli.main", "solve", "gnilka-1a"],
-                         capture_output=True, text=True, check=True)
+                         capture_output=True, text=True, check=True, env=user_env())
     wall = time.perf_counter() - started
     seconds: dict[str, float] = dict.fromkeys([*GROUPS, "other"], 0.0)
     for line in out.stderr.splitlines():
@@ -196,9 +199,23 @@ CACHED = ("import sys; from vtool.solvers import newmark_kernel as k; "
           "sys.exit(0 if k.is_cached(('run_chunk',), None, None) else 1)")
 
 
-def first_run_default() -> tuple[float, int, int, float]:
+NATIVE = ("import sys; from vtool.solvers import kernel_native as k; "
+          "sys.exit(0 if k.exists((None, None)) else 1)")
+
+
+def wait_for(probe: str, env: dict[str, str], started: float) -> float:
+    """Seconds from ``started`` until ``python -c probe`` exits 0 (nan after 600 s)."""
+    while subprocess.run([sys.executable, "-c", probe], env=env).returncode != 0:
+        if time.perf_counter() - started > 600.0:
+            return float("nan")
+        time.sleep(0.5)
+    return time.perf_counter() - started
+
+
+def first_run_default() -> tuple[float, int, int, float, float]:
     """(process wall s, plain-Python steps, steps, s from the start until the background compile is in
-    the cache) of ``vtool solve gnilka-1a --json`` with an empty numba cache, in the default mode."""
+    numba's cache, s until its native module is there) of ``vtool solve gnilka-1a --json`` with an empty
+    numba cache, in the default mode."""
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache)
         env.pop("VTOOL_KERNEL", None)
@@ -207,30 +224,46 @@ def first_run_default() -> tuple[float, int, int, float]:
                              text=True, check=True, env=env)
         wall = time.perf_counter() - started
         summary = json.loads(out.stdout)
-        while subprocess.run([sys.executable, "-c", CACHED], env=env).returncode != 0:
-            if time.perf_counter() - started > 600.0:
-                return wall, summary["plain_steps"], summary["steps"], float("nan")
-            time.sleep(0.5)
-        ready = time.perf_counter() - started
-    return wall, summary["plain_steps"], summary["steps"], ready
+        ready = wait_for(CACHED, env, started)
+        native = wait_for(NATIVE, env, started)
+    return wall, summary["plain_steps"], summary["steps"], ready, native
 
 
-def second_process(bytecode: bool = True) -> tuple[float, float, int, int]:
-    """(process wall time, in-process solve time, numba cache misses, cache hits) of the run loop.
+def user_env(native: bool = True) -> dict[str, str]:
+    """The environment of a user's ``vtool solve``: the default mode (no ``VTOOL_KERNEL``); ``native``
+    False sets ``VTOOL_NATIVE=0`` (numba's cache)."""
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONDONTWRITEBYTECODE", "VTOOL_KERNEL", "VTOOL_NATIVE")}
+    if not native:
+        env["VTOOL_NATIVE"] = "0"
+    return env
+
+
+def ensure_native() -> float:
+    """Run ``vtool solve gnilka-1a`` as a user would until its native module is built (the first run
+    that finds only numba's cache starts the build); seconds waited."""
+    started = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "vtool", "solve", "gnilka-1a"], env=user_env(), capture_output=True,
+                   check=True)
+    return wait_for(NATIVE, user_env(), started)
+
+
+def second_process(bytecode: bool = True, native: bool = True) -> tuple[float, float, int, int, bool]:
+    """(process wall time, in-process solve time, numba cache misses, cache hits, whether numba stayed
+    out) of ``vtool solve gnilka-1a`` as a user runs it (:func:`user_env`).
 
     ``bytecode``: Python's default, modules load from their ``__pycache__`` bytecode (written by
     the warm-up call before the measured one). False sets ``PYTHONDONTWRITEBYTECODE=1``, as some
     sandboxes and CI images do, so every process compiles vtool's sources again (about 50 ms).
     """
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    env = user_env(native)
     if not bytecode:
         env["PYTHONDONTWRITEBYTECODE"] = "1"
     started = time.perf_counter()
     out = subprocess.run([sys.executable, "-c", SECOND_PROCESS], capture_output=True, text=True, check=True,
                          env=env)
     total = time.perf_counter() - started
-    solve_time, misses, hits = out.stdout.split()
-    return total, float(solve_time), int(misses), int(hits)
+    solve_time, misses, hits, native_used = out.stdout.split()
+    return total, float(solve_time), int(misses), int(hits), native_used == "1"
 
 
 def kernel_rounds(backend, mechanism, options, steps: int) -> list[tuple[float, float]]:  # noqa: ANN001
@@ -290,20 +323,28 @@ def main() -> None:
         print(f"  first run with an empty numba cache: kernel compile {compile_s:.1f} s wall "
               f"(ratio to the 10 s target {compile_s / TARGET_COMPILE_S:.2f}); whole process {wall:.1f} s wall, "
               f"{cpu:.1f} s CPU")
-        wall, plain, steps, ready = first_run_default()
+        wall, plain, steps, ready, native = first_run_default()
         print(f"  first `vtool solve gnilka-1a` as a new user meets it (empty cache, default mode): {wall:.1f} s wall "
               f"(ratio to the 10 s target {wall / TARGET_COMPILE_S:.2f}), {plain} of {steps} steps as plain Python; "
-              f"the compile it started in the background was in the cache {ready:.1f} s after its start")
-    second_process()  # make sure the numba cache and the bytecode exist
+              f"the compile it started in the background was in numba's cache {ready:.1f} s after its start, "
+              f"the native module {native:.1f} s after it")
+    waited = ensure_native()
+    second_process()  # make sure the bytecode exists
     samples = sorted(second_process() for _ in range(5))
-    total, solve_time, misses, hits = samples[0]
+    total, solve_time, misses, hits, native_used = samples[0]
     median = samples[2][0]
     print(f"  second process: `vtool solve gnilka-1a` {total:.2f} s with interpreter start-up "
           f"(ratio to the 0.5 s target {total / TARGET_SECOND_PROCESS_S:.2f}; best of 5, median {median:.2f} s), "
-          f"{solve_time:.3f} s in-process; numba cache: {hits} hit(s), {misses} miss(es) (a miss means it recompiled)")
-    plain = sorted(second_process(bytecode=False)[0] for _ in range(5))
-    print(f"  the same with PYTHONDONTWRITEBYTECODE=1 (sources compiled in every process): best {plain[0]:.2f} s "
-          f"(ratio {plain[0] / TARGET_SECOND_PROCESS_S:.2f}), median {plain[2]:.2f} s")
+          f"{solve_time:.3f} s in-process; "
+          + ("on the native module, numba not imported" if native_used else
+             f"numba imported (no native module {waited:.0f} s after a run); numba cache: {hits} hit(s), "
+             f"{misses} miss(es) (a miss means it recompiled)"))
+    plain_bytes = sorted(second_process(bytecode=False)[0] for _ in range(5))
+    print(f"  the same with PYTHONDONTWRITEBYTECODE=1 (sources compiled in every process): best {plain_bytes[0]:.2f} s "
+          f"(ratio {plain_bytes[0] / TARGET_SECOND_PROCESS_S:.2f}), median {plain_bytes[2]:.2f} s")
+    jit = sorted(second_process(native=False) for _ in range(5))
+    print(f"  the same on numba's cache (VTOOL_NATIVE=0): best {jit[0][0]:.2f} s (ratio {jit[0][0] / total:.2f} "
+          f"x the native module's), median {jit[2][0]:.2f} s; numba cache: {jit[0][3]} hit(s), {jit[0][2]} miss(es)")
     wall, seconds = import_breakdown()
     parts = ", ".join(f"{group} {value:.2f} s" for group, value in seconds.items())
     print(f"  its imports (python -X importtime, {wall:.2f} s wall with the tracing): {sum(seconds.values()):.2f} s: "

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vtool.solvers import newmark_kernel as kernel
+from vtool.solvers import kernel_layout as layout
 from vtool.solvers.configurations import (
     clearance_bit,
     compliant_terms,
@@ -58,10 +58,10 @@ from vtool.solvers.spec import (
 )
 from vtool.solvers.trace import CLOSED, OPENED, RELEASED
 
-LAW_CODES = {MOMENTUM: kernel.LAW_MOMENTUM, LOCAL: kernel.LAW_LOCAL, THESIS: kernel.LAW_THESIS}
-SOFT_CODES = {RIGID: 0, LINEAR: kernel.SOFT_LINEAR, HERTZ: kernel.SOFT_HERTZ}
-EVENT_KINDS: dict[int, str] = {int(kernel.EV_OPENED): OPENED, int(kernel.EV_CLOSED): CLOSED,
-                              int(kernel.EV_RELEASED): RELEASED}
+LAW_CODES = {MOMENTUM: layout.LAW_MOMENTUM, LOCAL: layout.LAW_LOCAL, THESIS: layout.LAW_THESIS}
+SOFT_CODES = {RIGID: 0, LINEAR: layout.SOFT_LINEAR, HERTZ: layout.SOFT_HERTZ}
+EVENT_KINDS: dict[int, str] = {int(layout.EV_OPENED): OPENED, int(layout.EV_CLOSED): CLOSED,
+                              int(layout.EV_RELEASED): RELEASED}
 
 
 def source_series(mechanism: Mechanism) -> SourceSeries:
@@ -118,12 +118,12 @@ class ConfigurationTables:
         n, ncl, ns = spec.n_coordinates, len(spec.clearances), len(sources(spec))
         self.n, self.ncl, self.ns = n, ncl, ns
         count = 2**ncl
-        self.ci = np.zeros((count, kernel.CI_HEAD + 3 * n), dtype=np.int64)
-        self.cm = np.zeros((count, kernel.CM_SIZE, n, n))
-        self.cp = np.zeros((count, kernel.CP_SIZE, kernel.PART_SIZE, n, 3 * max(n, ns)))  # kernel.CP_RAW
-        self.mk = np.zeros((count, ncl, kernel.MK_SIZE), dtype=np.int64)
+        self.ci = np.zeros((count, layout.CI_HEAD + 3 * n), dtype=np.int64)
+        self.cm = np.zeros((count, layout.CM_SIZE, n, n))
+        self.cp = np.zeros((count, layout.CP_SIZE, layout.PART_SIZE, n, 3 * max(n, ns)))  # layout.CP_RAW
+        self.mk = np.zeros((count, ncl, layout.MK_SIZE), dtype=np.int64)
         self.mon = np.zeros((count, ncl, 3 * n + 3 * ns + 1 + ncl))
-        # a force row's nonzero terms (kernel.MK_TERMS): their columns of mon, their coefficients
+        # a force row's nonzero terms (layout.MK_TERMS): their columns of mon, their coefficients
         self.mi = np.zeros((count, ncl, 3 * n + 3 * ns), dtype=np.int64)
         self.mc = np.zeros((count, ncl, 3 * n + 3 * ns))
         self.layers: dict[int, OrderedLayer] = {}
@@ -142,16 +142,16 @@ class ConfigurationTables:
         if self.step is None:
             return
         dt, beta, gamma, fine = self.step
-        nf = int(self.ci[mask, kernel.CI_NF])
+        nf = int(self.ci[mask, layout.CI_NF])
         if not nf:
             return
         cm = self.cm[mask]
-        M, C, K = cm[kernel.CM_MFF, :nf, :nf], cm[kernel.CM_CFF, :nf, :nf], cm[kernel.CM_KFF, :nf, :nf]
-        cm[kernel.CM_SINV, :nf, :nf] = np.linalg.inv(M + gamma * dt * C + beta * dt * dt * K)
-        cm[kernel.CM_SINVF, :nf, :nf] = np.linalg.inv(M + gamma * fine * C + beta * fine * fine * K)
-        cp = self.cp[mask]  # G = S⁻¹R, part by part (see kernel.CP_RAW)
-        cp[kernel.CP_STD, :, :nf] = cm[kernel.CM_SINV, :nf, :nf] @ cp[kernel.CP_RAW, :, :nf]
-        cp[kernel.CP_FINE, :, :nf] = cm[kernel.CM_SINVF, :nf, :nf] @ cp[kernel.CP_RAW, :, :nf]
+        M, C, K = cm[layout.CM_MFF, :nf, :nf], cm[layout.CM_CFF, :nf, :nf], cm[layout.CM_KFF, :nf, :nf]
+        cm[layout.CM_SINV, :nf, :nf] = np.linalg.inv(M + gamma * dt * C + beta * dt * dt * K)
+        cm[layout.CM_SINVF, :nf, :nf] = np.linalg.inv(M + gamma * fine * C + beta * fine * fine * K)
+        cp = self.cp[mask]  # G = S⁻¹R, part by part (see layout.CP_RAW)
+        cp[layout.CP_STD, :, :nf] = cm[layout.CM_SINV, :nf, :nf] @ cp[layout.CP_RAW, :, :nf]
+        cp[layout.CP_FINE, :, :nf] = cm[layout.CM_SINVF, :nf, :nf] @ cp[layout.CP_RAW, :, :nf]
 
     def build(self, mask: int) -> OrderedLayer:
         """Partition configuration ``mask`` and fill its rows (see the module doc)."""
@@ -174,31 +174,31 @@ class ConfigurationTables:
         K_o = (layer.K + springs.layer_K(layer.T))[ix]
         S_o = (layer.T.T @ springs.S)[order]
         ci = self.ci[mask]
-        ci[kernel.CI_M], ci[kernel.CI_NF] = m, nf
-        head = kernel.CI_HEAD
+        ci[layout.CI_M], ci[layout.CI_NF] = m, nf
+        head = layout.CI_HEAD
         ci[head:head + m] = kept
         ci[head + n:head + 2 * n] = group
         ci[head + 2 * n + nf:head + 2 * n + m] = source
         cm = self.cm[mask]
-        cm[kernel.CM_MFF, :nf, :nf] = M_o[:nf, :nf]
-        cm[kernel.CM_CFF, :nf, :nf] = C_o[:nf, :nf]
-        cm[kernel.CM_KFF, :nf, :nf] = K_o[:nf, :nf]
+        cm[layout.CM_MFF, :nf, :nf] = M_o[:nf, :nf]
+        cm[layout.CM_CFF, :nf, :nf] = C_o[:nf, :nf]
+        cm[layout.CM_KFF, :nf, :nf] = K_o[:nf, :nf]
         if nf:
-            cm[kernel.CM_MINVFF, :nf, :nf] = np.linalg.inv(M_o[:nf, :nf])
-        raw = self.cp[mask, kernel.CP_RAW]  # layout: see kernel.CP_RAW
-        raw[kernel.PART_C, :nf, :nf] = C_o[:nf, :nf]
-        raw[kernel.PART_K, :nf, :nf] = K_o[:nf, :nf]
-        raw[kernel.PART_P, :nf, 0:3 * (m - nf):3] = M_o[:nf, nf:]
-        raw[kernel.PART_P, :nf, 1:3 * (m - nf):3] = C_o[:nf, nf:]
-        raw[kernel.PART_P, :nf, 2:3 * (m - nf):3] = K_o[:nf, nf:]
-        raw[kernel.PART_S, :nf, :S_o.shape[1]] = S_o[:nf]
-        ci[kernel.CI_SRC] = int(bool(S_o[:nf].any()))
-        ci[kernel.CI_HERTZ] = int(bool(springs.hertz))
+            cm[layout.CM_MINVFF, :nf, :nf] = np.linalg.inv(M_o[:nf, :nf])
+        raw = self.cp[mask, layout.CP_RAW]  # layout: see layout.CP_RAW
+        raw[layout.PART_C, :nf, :nf] = C_o[:nf, :nf]
+        raw[layout.PART_K, :nf, :nf] = K_o[:nf, :nf]
+        raw[layout.PART_P, :nf, 0:3 * (m - nf):3] = M_o[:nf, nf:]
+        raw[layout.PART_P, :nf, 1:3 * (m - nf):3] = C_o[:nf, nf:]
+        raw[layout.PART_P, :nf, 2:3 * (m - nf):3] = K_o[:nf, nf:]
+        raw[layout.PART_S, :nf, :S_o.shape[1]] = S_o[:nf]
+        ci[layout.CI_SRC] = int(bool(S_o[:nf].any()))
+        ci[layout.CI_HERTZ] = int(bool(springs.hertz))
         self._monitors(mask, part, group, m, springs)
         ordered = OrderedLayer(mask, M_o, C_o, K_o, nf, kept, group, source, S_o)
         self.layers[mask] = ordered
         self._inverses(mask)
-        ci[kernel.CI_BUILT] = 1
+        ci[layout.CI_BUILT] = 1
         return ordered
 
     def _monitors(self, mask: int, part, group: np.ndarray, m: int, springs) -> None:  # type: ignore[no-untyped-def]
@@ -244,7 +244,7 @@ class ConfigurationTables:
                     np.add.at(mon[part_index * n:(part_index + 1) * n], group,
                               frow[part_index * n:(part_index + 1) * n])
                 mon[3 * n:3 * n + 3 * ns] = frow[3 * n:]
-                kind = kernel.MK_FORCE if c.rigid else kernel.MK_OVERLAP
+                kind = layout.MK_FORCE if c.rigid else layout.MK_OVERLAP
                 # the nonzero terms in kernel.contact_force's order: z_j, ż_j, z̈_j for each layer index j,
                 # then the sources
                 order = np.concatenate([np.arange(m)[:, None] + n * np.arange(3)[None, :], 3 * n + np.arange(3 * ns)],
@@ -254,7 +254,7 @@ class ConfigurationTables:
                 self.mc[mask, index, :columns.size] = mon[columns]
                 mk[:] = (kind, int(group[c.ahead - 1]), behind, m, columns.size)
             elif c.state == ENABLED:
-                mk[:] = (kernel.MK_GAP, int(group[c.ahead - 1]), behind, m, 0)
+                mk[:] = (layout.MK_GAP, int(group[c.ahead - 1]), behind, m, 0)
 
 
 @dataclass(frozen=True)
@@ -280,24 +280,24 @@ class ContactProblem:
         self.series = source_series(mechanism)
         self.ns, self.nh = self.series.n_sources, self.series.n_harmonics
         self.source_numbers = self.series.numbers
-        cl = np.zeros((self.ncl, kernel.CL_SIZE), dtype=np.int64)
-        clf = np.zeros((self.ncl, kernel.CLF_SIZE))
+        cl = np.zeros((self.ncl, layout.CL_SIZE), dtype=np.int64)
+        clf = np.zeros((self.ncl, layout.CLF_SIZE))
         for k, c in enumerate(spec.clearances):
             cl[k] = (c.ahead - 1, c.behind - 1 if c.behind <= self.n else -1,
                      self.series.index(c.behind) if c.behind > self.n else -1,
                      int(c.state == ENABLED), int(c.state == PINNED), clearance_bit(spec, k),
                      LAW_CODES[spec.impact_law(c)], SOFT_CODES[c.contact])
-            clf[k, :kernel.CLF_HV] = (c.restitution, spec.contact.rocker_scale, c.contact_stiffness,
+            clf[k, :layout.CLF_HV] = (c.restitution, spec.contact.rocker_scale, c.contact_stiffness,
                                       c.contact_exponent)
         self.cl, self.clf = cl, clf
-        self.hertz, self.momentum = kernel.laws(cl)  # the kernel's law switches
+        self.hertz, self.momentum = layout.laws(cl)  # the kernel's law switches
         self.mass = np.stack([mechanism.M, np.linalg.inv(mechanism.M)])
         self.omega = mechanism.omega
         self.omega_max = mechanism.highest_frequency
         x_scale = max(spec.cam.amplitude + abs(mechanism.start.cam_offset), 1e-9)
         self.x_scale = x_scale
         self.rest_velocity = rules.rest_velocity or 1e-5 * self.velocity_scale()
-        self.clf[:, kernel.CLF_HV] = self.rest_velocity  # a Hertz contact's approach velocity, set at closing
+        self.clf[:, layout.CLF_HV] = self.rest_velocity  # a Hertz contact's approach velocity, set at closing
         self.gap_noise = 1e-13 * x_scale
         self.zeno_window = 1e-3 * 2 * math.pi / self.omega_max
         self.start_mask = mask_of(spec, spec.initial.closed)
@@ -316,18 +316,18 @@ class ContactProblem:
                    out_dt: float = 1.0, every_step: bool = False, time_tol: float = 1e-12,
                    refine: float = 1.0, refine_window: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """The kernel's integer and float parameter vectors."""
-        ip = np.zeros(kernel.IP_SIZE, dtype=np.int64)
-        ip[kernel.IP_N], ip[kernel.IP_NCL], ip[kernel.IP_NS], ip[kernel.IP_NH] = self.n, self.ncl, self.ns, self.nh
-        ip[kernel.IP_EVERY] = int(every_step)
-        ip[kernel.IP_ZSTICK], ip[kernel.IP_ZSTOP] = self.rules.zeno_stick, self.rules.zeno_stop
-        fp = np.zeros(kernel.FP_SIZE)
-        fp[kernel.FP_BETA], fp[kernel.FP_GAMMA], fp[kernel.FP_DT] = beta, gamma, dt
-        fp[kernel.FP_TEND], fp[kernel.FP_OUTDT], fp[kernel.FP_OMEGA] = t_end, out_dt, self.omega
-        fp[kernel.FP_TTOL], fp[kernel.FP_ZWIN] = time_tol, self.zeno_window
-        fp[kernel.FP_XLIM], fp[kernel.FP_VREST] = 1e3 * self.x_scale, self.rest_velocity
-        fp[kernel.FP_GAPNOISE], fp[kernel.FP_REFINE], fp[kernel.FP_REFWIN] = self.gap_noise, refine, refine_window
-        fp[kernel.FP_FTOL] = self.force_tolerance()
-        fp[kernel.FP_TREV] = 2 * math.pi / self.omega if self.omega > 0 else math.inf
+        ip = np.zeros(layout.IP_SIZE, dtype=np.int64)
+        ip[layout.IP_N], ip[layout.IP_NCL], ip[layout.IP_NS], ip[layout.IP_NH] = self.n, self.ncl, self.ns, self.nh
+        ip[layout.IP_EVERY] = int(every_step)
+        ip[layout.IP_ZSTICK], ip[layout.IP_ZSTOP] = self.rules.zeno_stick, self.rules.zeno_stop
+        fp = np.zeros(layout.FP_SIZE)
+        fp[layout.FP_BETA], fp[layout.FP_GAMMA], fp[layout.FP_DT] = beta, gamma, dt
+        fp[layout.FP_TEND], fp[layout.FP_OUTDT], fp[layout.FP_OMEGA] = t_end, out_dt, self.omega
+        fp[layout.FP_TTOL], fp[layout.FP_ZWIN] = time_tol, self.zeno_window
+        fp[layout.FP_XLIM], fp[layout.FP_VREST] = 1e3 * self.x_scale, self.rest_velocity
+        fp[layout.FP_GAPNOISE], fp[layout.FP_REFINE], fp[layout.FP_REFWIN] = self.gap_noise, refine, refine_window
+        fp[layout.FP_FTOL] = self.force_tolerance()
+        fp[layout.FP_TREV] = 2 * math.pi / self.omega if self.omega > 0 else math.inf
         return ip, fp
 
     def build(self, mask: int) -> OrderedLayer:
@@ -336,6 +336,10 @@ class ContactProblem:
     def sources_at(self, t: float) -> np.ndarray:
         """(x, v, a) of every source at t, as the kernel's src vector."""
         src = np.zeros(3 * self.ns)
+        from vtool.solvers import (
+            newmark_kernel as kernel,  # numba: only the back ends that call it load it
+        )
+
         s = self.series
         kernel.fill_sources(self.ns, self.nh, s.omega, s.const, s.cos, s.sin, t, src)
         return src
@@ -348,16 +352,18 @@ class ContactProblem:
         relative velocity, before, after). The same kernel function the
         back ends call.
         """
+        from vtool.solvers import newmark_kernel as kernel
+
         flags = np.zeros(self.ncl, dtype=np.int64)
         flags[list(closing)] = 1  # the indices of the closing clearances
         ip, fp = self.parameters()
         ev_f = np.zeros((4 * self.ncl + 4, 2))
         ev_i = np.zeros((4 * self.ncl + 4, 4), dtype=np.int64)
-        ist = np.zeros(kernel.I_SIZE, dtype=np.int64)
+        ist = np.zeros(layout.I_SIZE, dtype=np.int64)
         new = int(kernel.impact(ip, fp, self.cl, self.clf, self.mass, mask, flags, self.sources_at(t), x, v,
                                 stick, ev_f, ev_i, ist, t, self.momentum))
         events = [(int(ev_i[r, 0]), EVENT_KINDS[int(ev_i[r, 1])], float(ev_f[r, 1]), int(ev_i[r, 2]),
-                   int(ev_i[r, 3])) for r in range(int(ist[kernel.I_NEV]))]
+                   int(ev_i[r, 3])) for r in range(int(ist[layout.I_NEV]))]
         return new, events
 
     def label(self, mask: int) -> str:

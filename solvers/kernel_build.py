@@ -6,8 +6,9 @@ first step. Instead :func:`start` launches ``python -m
 vtool.solvers.kernel_build LOCK`` with the pickled jobs (here ``run_chunk`` and
 numba's types of its arguments) on its standard input and returns at once;
 the child compiles them (numba writes its cache as it compiles), removes the
-lock and exits. The parent never waits for it: between chunks it asks
-numba's cache whether the kernel is there
+lock and exits; a ``native`` job after ``run_chunk`` builds its native module
+(:mod:`vtool.solvers.kernel_native`). The parent never waits for it: between
+chunks it asks numba's cache whether the kernel is there
 (:func:`vtool.solvers.newmark_kernel.is_cached`) and then loads it. The
 child compiles ``run_chunk`` on two processes (:func:`compile_kernel`: a
 helper, ``python -m vtool.solvers.kernel_build --part``, compiles part of its
@@ -53,13 +54,14 @@ from typing import Any
 import numpy as np
 
 from vtool.errors import InputError
-from vtool.solvers import newmark_kernel as kernel
 
 #: A lock older than this (s) is from a child that did not finish; a new compile replaces it.
 STALE_S = 600.0
 KERNEL_MODES = ("auto", "compiled", "plain")  # VTOOL_KERNEL
 _children: list[subprocess.Popen] = []  # type: ignore[type-arg]  # polled so that finished children are reaped
 _plain_module: list[ModuleType] = []
+
+KERNEL_FILE = Path(__file__).with_name("newmark_kernel.py")  # the kernel's source (no import needed)
 
 #: A compile job: an entry point's name and numba's types of its arguments.
 Job = tuple[str, tuple[Any, ...]]
@@ -88,6 +90,14 @@ def numba_types(values: tuple[Any, ...]) -> tuple[Any, ...]:
     return tuple(found)
 
 
+def kernel() -> ModuleType:
+    """The kernel module, imported when first needed: it imports numba, which a run on the native module
+    (:mod:`vtool.solvers.kernel_native`) never does."""
+    from vtool.solvers import newmark_kernel
+
+    return newmark_kernel
+
+
 def kernel_mode() -> str:
     """``VTOOL_KERNEL`` (default ``auto``): how a run gets its compiled kernel (see the module doc)."""
     mode = os.environ.get("VTOOL_KERNEL", "").strip() or "auto"
@@ -98,15 +108,16 @@ def kernel_mode() -> str:
 
 def jit_enabled() -> bool:
     """False under ``NUMBA_DISABLE_JIT`` (the kernel module is plain Python already)."""
-    return hasattr(kernel.run_chunk, "py_func")  # a dispatcher (its ``signatures`` would list them: slower)
+    return hasattr(kernel().run_chunk, "py_func")  # a dispatcher (its ``signatures`` would list them: slower)
 
 
 def plain_kernel() -> ModuleType:
     """The kernel's source loaded a second time as plain Python (``newmark_kernel_plain``; no numba)."""
     if not jit_enabled():
-        return kernel
+        return kernel()
     if not _plain_module:
-        spec = importlib.util.spec_from_file_location(kernel.__name__ + kernel.PLAIN_SUFFIX, kernel.__file__)
+        compiled = kernel()
+        spec = importlib.util.spec_from_file_location(compiled.__name__ + compiled.PLAIN_SUFFIX, compiled.__file__)
         assert spec is not None and spec.loader is not None
         module = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(module)
@@ -140,9 +151,10 @@ def rules(hertz: bool | None, momentum: bool | None) -> Any:
     cached yet; ``plain`` mode) a :class:`RecordingRules` on the plain one."""
     mode = kernel_mode()
     if not jit_enabled() or mode == "compiled":
-        return kernel
-    if mode == "auto" and kernel.is_cached(("impact", "settle", "fill_sources"), hertz, momentum):
-        return kernel
+        return kernel()
+    compiled = kernel()
+    if mode == "auto" and compiled.is_cached(("impact", "settle", "fill_sources"), hertz, momentum):
+        return compiled
     return RecordingRules()
 
 
@@ -156,7 +168,7 @@ def compile_recorded(used: Any) -> None:
 
 def lock_path(jobs: list[Job]) -> Path:
     """The lock file of a compile of these jobs."""
-    source = Path(kernel.__file__).resolve()
+    source = KERNEL_FILE.resolve()
     stamp = source.stat()
     cache = os.environ.get("NUMBA_CACHE_DIR", "")
     key = f"{source}|{stamp.st_mtime_ns}|{stamp.st_size}|{cache}|{jobs!r}".encode()
@@ -324,10 +336,10 @@ def compile_kernel(signature: tuple[Any, ...]) -> None:
     try:
         if helper is not None:
             for name, arg_types in own:
-                getattr(kernel, name).compile(arg_types)
+                getattr(kernel(), name).compile(arg_types)
             with contextlib.suppress(subprocess.TimeoutExpired):
                 helper.wait(HELPER_WAIT_S)
-        kernel.run_chunk.compile(signature)
+        kernel().run_chunk.compile(signature)
     finally:
         if helper is not None and helper.poll() is None:
             helper.kill()
@@ -338,8 +350,12 @@ def _compile(jobs: list[Job]) -> None:
     for name, signature in jobs:
         if name == "run_chunk":
             compile_kernel(signature)
+        elif name == "native":  # (module name, run_chunk's types): after run_chunk, whose callees it reuses
+            from vtool.solvers import kernel_native
+
+            kernel_native.build(*signature)
         else:
-            getattr(kernel, name).compile(signature)
+            getattr(kernel(), name).compile(signature)
 
 
 def main(argv: list[str]) -> int:
@@ -349,7 +365,7 @@ def main(argv: list[str]) -> int:
     """
     if argv[:1] == ["--part"]:
         for name, signature in pickle.loads(sys.stdin.buffer.read()):
-            getattr(kernel, name).compile(signature)
+            getattr(kernel(), name).compile(signature)
         return 0
     lock = Path(argv[0]) if argv else None
     try:

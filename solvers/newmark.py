@@ -57,6 +57,10 @@ Method (see the kernel's docstring for the equations):
   them to the reference tolerances). ``VTOOL_KERNEL`` chooses otherwise:
   ``compiled`` compiles first, in this process (benchmarks, and the tests,
   which need the compiled kernel), ``plain`` never compiles.
+* Native module: after that compile the child also builds ``run_chunk`` as
+  a native extension module (:mod:`vtool.solvers.kernel_native`); a later
+  ``auto`` run that finds the module for its argument types calls it and
+  imports no numba (one that finds only numba's cache starts the build).
 * Stability: for gamma = 1/2 and beta < 1/4 the step must satisfy
   omega_max dt <= 1 / sqrt(gamma/2 - beta) (2 sqrt 3 for linear acceleration:
   dt <= sqrt(3)/pi T_min), with omega_max the highest natural frequency of
@@ -76,8 +80,8 @@ import numpy as np
 
 from vtool import numba_cache
 from vtool.errors import InputError, RunError
-from vtool.solvers import kernel_build
-from vtool.solvers import newmark_kernel as kernel
+from vtool.solvers import kernel_build, kernel_native
+from vtool.solvers import kernel_layout as layout
 from vtool.solvers.backends import Backend, Cancel, Progress
 from vtool.solvers.contact import EVENT_KINDS, ContactProblem
 from vtool.solvers.model import Mechanism
@@ -133,9 +137,11 @@ def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | Non
     milliseconds more, and says nothing (:mod:`vtool.solvers.kernel_build`).
     """
     names = ("run_chunk",) if backend == "newmark" else ("impact", "settle", "fill_sources")
-    if not kernel_build.jit_enabled() or kernel.is_cached(names, *laws):
-        return None
     mode = kernel_build.kernel_mode()
+    if mode == "auto" and backend == "newmark" and kernel_native.exists(laws):
+        return None  # (asked before numba is imported: a run on the native module imports none)
+    if not kernel_build.jit_enabled() or kernel_build.kernel().is_cached(names, *laws):
+        return None
     if mode == "plain":
         return None
     if mode == "auto" and numba_cache.CACHE_ENABLED:
@@ -204,8 +210,8 @@ class NewmarkBackend(Backend):
         run = KernelRun(problem, options, builder)
         run.execute(progress, cancel)
         o = options
-        return {"steps": int(run.ist[kernel.I_STEPS]), "peak": run.peak[kernel.PEAK_ALL].copy(),
-                "peak_late": run.peak[kernel.PEAK_LATE].copy(), "peak_overlap": run.peak[kernel.PEAK_OVERLAP].copy(),
+        return {"steps": int(run.ist[layout.I_STEPS]), "peak": run.peak[layout.PEAK_ALL].copy(),
+                "peak_late": run.peak[layout.PEAK_LATE].copy(), "peak_overlap": run.peak[layout.PEAK_OVERLAP].copy(),
                 "compile_time": run.compile_time, "plain_steps": run.plain_steps,
                 "settings": {"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
                              "refine_after_events": o.refine}}
@@ -239,24 +245,24 @@ class KernelRun:
         self.peak = np.zeros((3, ncl))
         start = mechanism.start
         self.x, self.v, self.a = start.q.copy(), start.qd.copy(), start.qdd.copy()
-        self.ist = np.zeros(kernel.I_SIZE, dtype=np.int64)
-        self.ist[kernel.I_CFG] = problem.start_mask
-        self.ist[kernel.I_NEED_SETTLE] = 1
-        self.fst = np.zeros(kernel.F_SIZE)
-        self.fst[kernel.F_LAST_EVENT] = -1.0
+        self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
+        self.ist[layout.I_CFG] = problem.start_mask
+        self.ist[layout.I_NEED_SETTLE] = 1
+        self.fst = np.zeros(layout.F_SIZE)
+        self.fst[layout.F_LAST_EVENT] = -1.0
         self.compile_time = 0.0
         self.plain_steps = 0  # steps taken by the plain-Python kernel (before the compiled one was ready)
 
     def flush(self) -> None:
         """Move the filled rows and events out of the kernel's buffers."""
-        nout = int(self.ist[kernel.I_NOUT])
-        nev = int(min(self.ist[kernel.I_NEV], self.ev_f.shape[0]))
+        nout = int(self.ist[layout.I_NOUT])
+        nev = int(min(self.ist[layout.I_NEV], self.ev_f.shape[0]))
         self.builder.add_rows(self.out_t[:nout], self.out_q[:nout], self.out_F[:nout], self.out_c[:nout])
         events = zip(self.ev_f[:nev, :2].tolist(), self.ev_i[:nev].tolist(), strict=True)  # Python numbers
         for (t, u), (k, kind, before, after) in events:
             self.builder.add_event(t, k, EVENT_KINDS[kind], u, before, after)
-        self.ist[kernel.I_NOUT] = 0
-        self.ist[kernel.I_NEV] = 0
+        self.ist[layout.I_NOUT] = 0
+        self.ist[layout.I_NEV] = 0
 
     def arguments(self) -> tuple:
         problem, tables = self.problem, self.problem.tables
@@ -276,6 +282,7 @@ class KernelRun:
         if not kernel_build.jit_enabled():
             return  # NUMBA_DISABLE_JIT (the plain reference)
         signature = self.signature
+        kernel = kernel_build.kernel()
         if signature in kernel.run_chunk.signatures:
             return  # compiled (or loaded) in this process already
         started = wallclock.perf_counter()
@@ -287,61 +294,76 @@ class KernelRun:
 
     def ready(self) -> bool:
         """True when ``run_chunk`` for these argument types is loaded in this process, or in numba's cache."""
+        kernel = kernel_build.kernel()
         return (self.signature in kernel.run_chunk.signatures
                 or kernel.is_cached(("run_chunk",), self.problem.hertz, self.problem.momentum))
 
     def first_kernel(self) -> tuple[ModuleType, bool]:
         """The kernel module that takes the first chunk, and whether a compile is under way meanwhile
         (see "First run" in the module doc)."""
-        if not kernel_build.jit_enabled():
-            return kernel, False
         mode = kernel_build.kernel_mode()
+        if mode == "auto":
+            native = kernel_native.load(self.arguments())
+            if native is not None:
+                return native, False  # numba is not imported
+        if not kernel_build.jit_enabled():
+            return kernel_build.kernel(), False
         if mode == "plain":
             return kernel_build.plain_kernel(), False
         if (mode == "compiled" or not numba_cache.CACHE_ENABLED or self.ready()
-                or not kernel_build.start([("run_chunk", self.signature)])):
+                or not kernel_build.start(self.jobs())):
             self.compile()
-            return kernel, False
+            if mode == "auto" and kernel_native.enabled():  # the kernel was cached but has no native module yet
+                kernel_build.start(self.jobs()[1:])
+            return kernel_build.kernel(), False
         return kernel_build.plain_kernel(), True
+
+    def jobs(self) -> list[kernel_build.Job]:
+        """What the background child builds for this run: ``run_chunk`` into numba's cache, then (unless
+        ``VTOOL_NATIVE=0``) its native module (:mod:`vtool.solvers.kernel_native`)."""
+        jobs: list[kernel_build.Job] = [("run_chunk", self.signature)]
+        if kernel_native.enabled():
+            jobs.append(("native", (kernel_native.module_name(self.arguments()), self.signature)))
+        return jobs
 
     def execute(self, progress: Progress | None, cancel: Cancel | None) -> None:
         problem = self.problem
         chunk = self.options.chunk_steps * self.options.time_step
         module, building = self.first_kernel()
         args = self.arguments()
-        self.fst[kernel.F_CHUNK_END] = self.fst[kernel.F_T] + chunk
+        self.fst[layout.F_CHUNK_END] = self.fst[layout.F_T] + chunk
         while True:
             # the child's compile is in the cache (or the child is gone without it: compile here): go on compiled
-            if building and (self.ready() or not kernel_build.compiling([("run_chunk", self.signature)])):
-                self.plain_steps = int(self.ist[kernel.I_STEPS])
+            if building and (self.ready() or not kernel_build.compiling(self.jobs())):
+                self.plain_steps = int(self.ist[layout.I_STEPS])
                 self.compile()
-                module, building = kernel, False
+                module, building = kernel_build.kernel(), False
             status = module.run_chunk(*args)
-            t = float(self.fst[kernel.F_T])
-            if status == kernel.NEED_CONFIG:
-                problem.build(int(self.ist[kernel.I_WANT_CFG]))
+            t = float(self.fst[layout.F_T])
+            if status == layout.NEED_CONFIG:
+                problem.build(int(self.ist[layout.I_WANT_CFG]))
                 continue
-            if status == kernel.OUTPUT_FULL:  # the chunk goes on (its end stays: progress and cancel keep coming)
+            if status == layout.OUTPUT_FULL:  # the chunk goes on (its end stays: progress and cancel keep coming)
                 self.flush()
                 continue
-            self.fst[kernel.F_CHUNK_END] = t + chunk
-            if status == kernel.DIVERGED:
+            self.fst[layout.F_CHUNK_END] = t + chunk
+            if status == layout.DIVERGED:
                 raise RunError(self._where("diverged", t))
-            if status == kernel.CHATTER:
+            if status == layout.CHATTER:
                 raise RunError(self._where(
                     f"chattering contact: {self.options.zeno_stop} events within "
                     f"{problem.zeno_window:.3g} s of each other, even with sticking contacts", t))
             if progress is not None:
                 progress(min(t / self.t_end, 1.0))
-            if status == kernel.FINISHED:
+            if status == layout.FINISHED:
                 self.flush()
-                if module is not kernel:
-                    self.plain_steps = int(self.ist[kernel.I_STEPS])
+                if getattr(module, "PLAIN", False):  # the whole run in plain Python
+                    self.plain_steps = int(self.ist[layout.I_STEPS])
                 return
             if cancel is not None and cancel():
                 raise RunError(f"cancelled at t = {t:.6g} s")
 
     def _where(self, what: str, t: float) -> str:
         angle = self.problem.time_to_angle(t)
-        label = self.problem.label(int(self.ist[kernel.I_CFG]))
+        label = self.problem.label(int(self.ist[layout.I_CFG]))
         return f"{what} at t = {t:.6g} s (cam angle {angle:.3f} deg) in configuration {label}"

@@ -1,12 +1,15 @@
 """Compiled Newmark integration of the valve train with clearances (numba).
 
 Everything the run loop touches lives in this one module (the numba cache
-misses edits in other files). The same source, run with
-``NUMBA_DISABLE_JIT=1``, is the plain-NumPy reference the tests compare the
+misses edits in other files), except the arrays' slot numbers and codes, in
+:mod:`vtool.solvers.kernel_layout` (numba-free, so that a run on the native
+module imports no numba), whose digest :data:`LAYOUT_FINGERPRINT` repeats:
+an edit there must change this file, and so the cache (a test checks).
+The same source, run with ``NUMBA_DISABLE_JIT=1``, is the plain-NumPy reference the tests compare the
 compiled kernel with. The arrays are built by :mod:`vtool.solvers.contact`
 (the contact problem every back end shares); their layout is given by the
 ``IP_*``, ``FP_*``, ``CL_*``, ``CI_*``, ``CM_*`` and ``MK_*`` slot numbers
-below.
+in :mod:`vtool.solvers.kernel_layout`.
 
 Conventions
 -----------
@@ -55,7 +58,7 @@ Compile time
 Entry points (``@jit``) get numba's CPython wrapper; functions only compiled
 code calls (``@inner``) get none; helpers of a few lines (``@tiny``) are
 copied into their callers as numba IR and never compiled on their own. The
-``hertz`` and ``momentum`` arguments (:func:`laws`) are None when no
+``hertz`` and ``momentum`` arguments (:func:`~vtool.solvers.kernel_layout.laws`) are None when no
 clearance uses that law: numba then prunes the branches under them before
 typing, so the Hertz iteration and the momentum-law LCP are compiled (and
 cached) only for mechanisms that use them.
@@ -75,6 +78,100 @@ from typing import Any
 import numpy as np
 
 from vtool import numba_cache
+from vtool.solvers.kernel_layout import (  # the slots and codes: see that module
+    CHATTER,
+    CHUNK_END,
+    CI_BUILT,
+    CI_HEAD,
+    CI_HERTZ,
+    CI_M,
+    CI_NF,
+    CI_SRC,
+    CL_AHEAD,
+    CL_BEHIND,
+    CL_BIT,
+    CL_LAW,
+    CL_MON,
+    CL_PIN,
+    CL_SOFT,
+    CL_SRC,
+    CLF_E,
+    CLF_HK,
+    CLF_HN,
+    CLF_HV,
+    CLF_SCALE,
+    CM_CFF,
+    CM_KFF,
+    CM_MFF,
+    CM_MINVFF,
+    CM_SINV,
+    CM_SINVF,
+    CP_FINE,
+    CP_RAW,
+    CP_STD,
+    DIVERGED,
+    EV_CLOSED,
+    EV_OPENED,
+    EV_RELEASED,
+    F_CHUNK_END,
+    F_FINE_UNTIL,
+    F_LAST_EVENT,
+    F_T,
+    FINISHED,
+    FP_BETA,
+    FP_DT,
+    FP_FTOL,
+    FP_GAMMA,
+    FP_GAPNOISE,
+    FP_OMEGA,
+    FP_OUTDT,
+    FP_REFINE,
+    FP_REFWIN,
+    FP_TEND,
+    FP_TREV,
+    FP_TTOL,
+    FP_VREST,
+    FP_XLIM,
+    FP_ZWIN,
+    I_CFG,
+    I_GRID,
+    I_NEED_SETTLE,
+    I_NEV,
+    I_NEXT_OUT,
+    I_NOUT,
+    I_RAPID,
+    I_STARTED,
+    I_STEPS,
+    I_SUB,
+    I_WANT_CFG,
+    IP_EVERY,
+    IP_N,
+    IP_NCL,
+    IP_NH,
+    IP_NS,
+    IP_ZSTICK,
+    IP_ZSTOP,
+    LAW_MOMENTUM,
+    LAW_THESIS,
+    MK_AHEAD,
+    MK_BEHIND,
+    MK_FORCE,
+    MK_GAP,
+    MK_KIND,
+    MK_M,
+    MK_OVERLAP,
+    MK_TERMS,
+    NEED_CONFIG,
+    OUTPUT_FULL,
+    PART_C,
+    PART_K,
+    PART_P,
+    PART_S,
+    PEAK_ALL,
+    PEAK_LATE,
+    PEAK_OVERLAP,
+    SOFT_HERTZ,
+)
 
 numba_cache.configure(os.path.dirname(os.path.abspath(__file__)))  # before numba: a read-only install caches elsewhere
 
@@ -97,54 +194,9 @@ inner = _plain if PLAIN else njit(**_INNER)
 # A few lines each: their code is copied into the caller (numba IR), with no compile of their own.
 tiny = _plain if PLAIN else njit(**_INNER, inline="always")
 
-# ----- slots of the integer and float parameter vectors -----
-IP_N, IP_NCL, IP_NS, IP_NH, IP_EVERY, IP_ZSTICK, IP_ZSTOP = range(7)
-IP_SIZE = 8
-(FP_BETA, FP_GAMMA, FP_DT, FP_TEND, FP_OUTDT, FP_OMEGA, FP_TTOL, FP_ZWIN, FP_XLIM, FP_VREST,
- FP_GAPNOISE, FP_REFINE, FP_REFWIN, FP_FTOL, FP_TREV) = range(15)
-FP_SIZE = 16
-# clearance table columns (int) and float columns
-CL_AHEAD, CL_BEHIND, CL_SRC, CL_MON, CL_PIN, CL_BIT, CL_LAW, CL_SOFT = range(8)
-CL_SIZE = 8  # CL_SOFT: SOFT_LINEAR or SOFT_HERTZ for a compliant clearance (no impact, no tie), else 0
-SOFT_LINEAR, SOFT_HERTZ = 1, 2
-# float columns: restitution, SCALE; Hertz stiffness and exponent; approach velocity of the contact
-CLF_E, CLF_SCALE, CLF_HK, CLF_HN, CLF_HV = range(5)
-CLF_SIZE = 5
-# impact laws
-LAW_MOMENTUM, LAW_LOCAL, LAW_THESIS = range(3)
-# event kinds
-EV_OPENED, EV_CLOSED, EV_RELEASED = np.int64(0), np.int64(1), np.int64(2)  # np.int64: add_event compiles once
-# configuration integer table: built, m, nf, source coupling, then kept[n], group[n], source of each z index[n]
-CI_BUILT, CI_M, CI_NF, CI_SRC, CI_HERTZ = range(5)
-CI_HEAD = 5
-# configuration matrices
-CM_MFF, CM_CFF, CM_KFF, CM_SINV, CM_SINVF, CM_MINVFF = range(6)
-CM_SIZE = 6
-# step operators: cp[c, plane, part, f, :] for free z index f; plane CP_RAW holds R, whose parts are
-# C_FF, K_FF, the (M, C, K) columns of each prescribed z index p (at 3p, 3p + 1, 3p + 2) and the
-# sources' pull S (3 per source), so that the free rows' ΔP is R·(ż, z, (z̈, ż, z)_P, src); planes
-# CP_STD and CP_FINE hold G = S⁻¹R of the standard and the refined step, so that a step with a stored
-# inverse computes z̈_F = -G·(ż̃, z̃, …) in one product (see :func:`apply_operator`). Parts, not column
-# offsets: an index that is a loop counter needs no negative-index fix-up.
-CP_RAW, CP_STD, CP_FINE = range(3)
-CP_SIZE = 3
-PART_C, PART_K, PART_P, PART_S = range(4)
-PART_SIZE = 4
-# monitor per (configuration, clearance): (kind, ahead z index, behind z index or -1 - source, m, and for
-# a force the number of its row's nonzero terms on (z, ż, z̈, sources): their columns of ``mon`` in
-# mi[c, k], in :func:`contact_force`'s order, their coefficients in mc[c, k]; :func:`advance` sums only those)
-MK_KIND, MK_AHEAD, MK_BEHIND, MK_M, MK_TERMS = range(5)
-MK_SIZE = 5
-MK_NONE, MK_GAP, MK_FORCE, MK_OVERLAP = range(4)  # MK_OVERLAP: a closed compliant clearance
-# peak rows: contact force over the run, after the first revolution, overlap of compliant contacts
-PEAK_ALL, PEAK_LATE, PEAK_OVERLAP = range(3)
-# run status
-FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED, CHATTER = range(1, 7)
-# integer and float state slots
-I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_SETTLE, I_WANT_CFG, I_STARTED, I_SUB = range(11)
-I_SIZE = 11  # I_SUB: refined steps taken since the grid point I_GRID (the refined steps' own grid)
-F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
-F_SIZE = 4
+#: :func:`vtool.solvers.kernel_layout.fingerprint` of the layout this file was compiled with (see there).
+LAYOUT_FINGERPRINT = "473f9d95f0d71566"
+
 # how a step solves S z̈ = rhs (layer_step's ``which``): stored inverses of the standard and refined
 # steps, or a Cholesky factor. np.int64 values, not int literals: numba compiles a function once per
 # literal argument value, and layer_step (with the Hertz iteration) is the kernel's largest callee.
@@ -166,8 +218,8 @@ def cached_signatures(name: str) -> list[tuple[Any, ...]]:
 
 def is_cached(names: tuple[str, ...] = ENTRY_POINTS, hertz: bool | None = None,
               momentum: bool | None = None) -> bool:
-    """True when these entry points' compiled code for these law switches (see :func:`laws`) is in the
-    numba cache (no compile needed).
+    """True when these entry points' compiled code for these law switches (see
+    :func:`~vtool.solvers.kernel_layout.laws`) is in the numba cache (no compile needed).
 
     Reads the cache's index (numba keeps one per function, stamped with this
     file's modification time and size, its keys led by the argument types);
@@ -184,21 +236,6 @@ def is_cached(names: tuple[str, ...] = ENTRY_POINTS, hertz: bool | None = None,
         return True
     except Exception:  # noqa: BLE001 (numba internals: anything unexpected means "compile")
         return False
-
-
-def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:
-    """The ``hertz`` and ``momentum`` switches of the kernel's entry points for clearance table ``cl``.
-
-    Each is True when some clearance uses that law and None when none does.
-    numba prunes the branches under ``if hertz is not None`` (``momentum``)
-    before typing when the switch is None, so a mechanism without Hertz
-    contacts (momentum-law impacts) compiles and caches a kernel without
-    that code, and one with them compiles its own. The plain-Python
-    reference takes the same branches.
-    """
-    hertz = bool(np.any(cl[:, CL_SOFT] == SOFT_HERTZ))
-    momentum = bool(np.any((cl[:, CL_LAW] == LAW_MOMENTUM) & (cl[:, CL_SOFT] == 0)))
-    return (True if hertz else None), (True if momentum else None)
 
 
 # ----- sources -----

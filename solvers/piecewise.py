@@ -32,7 +32,7 @@ import numpy as np
 
 from vtool.errors import InputError, RunError
 from vtool.solvers import kernel_build
-from vtool.solvers import newmark_kernel as kernel
+from vtool.solvers import kernel_layout as layout
 from vtool.solvers.backends import Backend, Cancel, Progress
 from vtool.solvers.contact import EVENT_KINDS, ContactProblem, OrderedLayer
 from vtool.solvers.model import Mechanism
@@ -90,9 +90,9 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
     G, H = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # monitors (kernel.monitor_value)
     GF, HF = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # contact forces (kernel.contact_force)
     for k in range(ncl):
-        kind, ahead, behind = (int(v) for v in tables.mk[mask, k, :kernel.MK_M])
-        if kind in (kernel.MK_GAP, kernel.MK_OVERLAP):
-            sign = 1.0 if kind == kernel.MK_GAP else -1.0
+        kind, ahead, behind = (int(v) for v in tables.mk[mask, k, :layout.MK_M])
+        if kind in (layout.MK_GAP, layout.MK_OVERLAP):
+            sign = 1.0 if kind == layout.MK_GAP else -1.0
             G[k] += sign * Zy[0, ahead]
             H[k] += sign * Zb[0, ahead]
             if behind >= 0:
@@ -101,7 +101,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
             else:
                 H[k] -= sign * src[3 * (-1 - behind)]
             H[k, 0] += problem.gap_noise
-        if kind in (kernel.MK_FORCE, kernel.MK_OVERLAP):
+        if kind in (layout.MK_FORCE, layout.MK_OVERLAP):
             row = tables.mon[mask, k]
             for i in range(3):
                 coefficients = row[i * n:i * n + m]
@@ -109,10 +109,10 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
                 HF[k] += coefficients @ Zb[i]
             HF[k] += row[3 * n:3 * n + 3 * ns] @ src
             HF[k, 0] += row[3 * n + 3 * ns]
-        if kind == kernel.MK_FORCE:
+        if kind == layout.MK_FORCE:
             G[k], H[k] = GF[k], HF[k]
-    ss.compliant = tables.mk[mask, :, kernel.MK_KIND] == kernel.MK_OVERLAP
-    hertz = np.flatnonzero(ss.compliant & (problem.cl[:, kernel.CL_SOFT] == kernel.SOFT_HERTZ))
+    ss.compliant = tables.mk[mask, :, layout.MK_KIND] == layout.MK_OVERLAP
+    hertz = np.flatnonzero(ss.compliant & (problem.cl[:, layout.CL_SOFT] == layout.SOFT_HERTZ))
     ss.hertz = hertz
     if hertz.size:  # F_j acts as F_j w_j: on ÿ through M_FF⁻¹ w_F, on the rigid forces through their rows
         GF[hertz], HF[hertz] = 0.0, 0.0
@@ -159,11 +159,11 @@ class PiecewiseRun(ABC):
         self.next_out = 0
         self.rapid = 0
         self.last_event = -1.0
-        self.monitored = problem.cl[:, kernel.CL_MON].astype(bool)
-        self.closed_bit = problem.cl[:, kernel.CL_BIT]
+        self.monitored = problem.cl[:, layout.CL_MON].astype(bool)
+        self.closed_bit = problem.cl[:, layout.CL_BIT]
         self.ev_f = np.zeros((4 * self.ncl + 4, 2))
         self.ev_i = np.zeros((4 * self.ncl + 4, 4), dtype=np.int64)
-        self.ist = np.zeros(kernel.I_SIZE, dtype=np.int64)
+        self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
         self.rules = kernel_build.rules(problem.hertz, problem.momentum)  # compiled, or plain until cached
 
     # ----- configuration data -----
@@ -315,7 +315,7 @@ class PiecewiseRun(ABC):
         problem, tables = self.problem, self.problem.tables
         m = problem.n
         while True:
-            self.ist[kernel.I_NEV] = 0
+            self.ist[layout.I_NEV] = 0
             result = int(self.rules.settle(self.ip, self.fp, problem.cl, problem.clf, tables.ci, tables.cm,
                                            tables.cp, tables.mk, tables.mon, mask, t, x, v, a, self.sources(t),
                                            self.ev_f, self.ev_i, self.ist, np.zeros(m), np.zeros(m), np.zeros(m),
@@ -328,10 +328,10 @@ class PiecewiseRun(ABC):
             self.space(mask)
 
     def _take_events(self) -> None:
-        for row in range(int(self.ist[kernel.I_NEV])):
+        for row in range(int(self.ist[layout.I_NEV])):
             k, kind, before, after = (int(value) for value in self.ev_i[row])
             self.builder.add_event(self.ev_f[row, 0], k, EVENT_KINDS[kind], self.ev_f[row, 1], before, after)
-        self.ist[kernel.I_NEV] = 0
+        self.ist[layout.I_NEV] = 0
 
     def apply_events(self, ss: StateSpace, t: float, y: np.ndarray,
                      fired: list[int]) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
@@ -353,14 +353,14 @@ class PiecewiseRun(ABC):
         for k in range(self.ncl):
             if (c & self.closed_bit[k]) and not (new_c & self.closed_bit[k]):
                 u = 0.0
-                if self.problem.cl[k, kernel.CL_SOFT]:  # the parts leave with their relative velocity
+                if self.problem.cl[k, layout.CL_SOFT]:  # the parts leave with their relative velocity
                     self.rules.snap_shut(self.problem.cl, k, x, src)
                     u = float(self.rules.relative_velocity(self.problem.cl, k, v, src))
-                self.builder.add_event(t, k, EVENT_KINDS[int(kernel.EV_OPENED)], u, c, new_c)
+                self.builder.add_event(t, k, EVENT_KINDS[int(layout.EV_OPENED)], u, c, new_c)
         if closing.any():
             stick = self.rapid >= self.problem.rules.zeno_stick
             problem = self.problem
-            self.ist[kernel.I_NEV] = 0
+            self.ist[layout.I_NEV] = 0
             new_c = int(self.rules.impact(self.ip, self.fp, problem.cl, problem.clf, problem.mass, new_c, closing,
                                           self.sources(t), x, v, stick, self.ev_f, self.ev_i, self.ist, t,
                                           problem.momentum))

@@ -304,7 +304,7 @@ def test_kernel_law_switches_follow_the_clearances() -> None:
     import dataclasses
 
     from vtool.presets import load_preset
-    from vtool.solvers import newmark_kernel as kernel
+    from vtool.solvers import kernel_layout
     from vtool.solvers.contact import ContactProblem
     from vtool.solvers.newmark import kernel_laws
 
@@ -313,7 +313,7 @@ def test_kernel_law_switches_follow_the_clearances() -> None:
     hertz = spec_from(hertz_doc())
     for spec, expected in ((thesis, (None, None)), (momentum, (None, True)), (hertz, (True, None))):
         assert kernel_laws(spec) == expected
-        assert kernel.laws(ContactProblem(assemble(spec)).cl) == expected
+        assert kernel_layout.laws(ContactProblem(assemble(spec)).cl) == expected
     assert kernel_laws(thesis, impacts=("local", "momentum")) == (None, True)  # vtool compare's runs
 
 

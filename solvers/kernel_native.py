@@ -1,0 +1,208 @@
+"""The kernel's run loop as a native extension module: a run that imports no numba at all.
+
+Why: with numba's cache warm, a second ``vtool solve gnilka-1a`` spends most
+of its second in numba itself (``import numba`` 0.4-0.9 s on the 2-core
+machine, then its target refresh and the load of the cached kernel, about
+0.3 s) and 5 ms in the run. numba can also compile ahead of time
+(``numba.pycc``): the result is a CPython extension module that needs only
+NumPy, and it imports in under a millisecond.
+
+What: after the kernel's first compile, the same background child
+(:mod:`vtool.solvers.kernel_build`) builds ``run_chunk`` for the run's
+argument types as such a module (:func:`build`), from the same source, with
+the same compiler, for the host CPU, and puts it beside numba's cache. From
+then on a run in the default mode (``VTOOL_KERNEL=auto``) whose argument
+types have a module calls it (:func:`load`) and imports no numba; any other
+run goes on as before. ``VTOOL_NATIVE=0`` turns the modules off (neither
+built nor used); the ``compiled`` and ``plain`` modes never use them.
+
+Which module: one serves one kernel source, one set of argument types (which
+include the law switches, see :func:`~vtool.solvers.kernel_layout.laws`),
+one numba, llvmlite, NumPy and Python, and one CPU. Its name carries a
+digest of all of them (:func:`module_name`), computed without numba: the
+SHA-256 of ``newmark_kernel.py`` and ``kernel_layout.py``, numba's and
+llvmlite's package files (path, modification time, size), NumPy's version,
+Python's cache tag, the machine and the CPU's model name and flags
+(``/proc/cpuinfo``; elsewhere :func:`platform.processor`), and each
+argument's type (:func:`type_key`: an array's dtype, dimensions, layout,
+writeability and alignment, the type of anything else). A change to any of
+them gives another name: a stale module is never loaded, only left unused.
+
+Same results: the module is the JIT kernel's source compiled by the same
+numba and LLVM with the same options; its results equal the JIT kernel's to
+the last bit (``tests/test_first_run.py`` compares a whole 1A run).
+
+Build: :func:`build` writes into a temporary folder beside the final file and
+renames it into place, so a reader never sees half a module. ``numba.pycc``
+needs a C compiler (for numba's small runtime helpers); without one the
+build fails, the child leaves its ``.failed`` note (see
+:mod:`vtool.solvers.kernel_build`) and runs stay on numba's cache.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.machinery
+import importlib.util
+import os
+import platform
+import shutil
+import sys
+import tempfile
+import warnings
+from functools import cache
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from vtool import numba_cache
+
+HERE = Path(__file__).resolve().parent
+SOURCES = (HERE / "newmark_kernel.py", HERE / "kernel_layout.py")  # what the module is compiled from
+PREFIX = "vtool_native_"
+_loaded: dict[str, ModuleType] = {}
+
+
+def enabled() -> bool:
+    """False under ``VTOOL_NATIVE=0`` or ``NUMBA_DISABLE_JIT`` (the plain reference runs), or with no cache folder."""
+    if os.environ.get("VTOOL_NATIVE", "").strip() == "0":
+        return False
+    if os.environ.get("NUMBA_DISABLE_JIT", "0").strip() not in ("", "0"):
+        return False
+    return folder() is not None
+
+
+def folder() -> Path | None:
+    """Where the modules live: numba's cache folder for the kernel (see :mod:`vtool.numba_cache`)."""
+    numba_cache.configure(HERE)  # numba-free: only chooses the folder
+    if not numba_cache.CACHE_ENABLED:
+        return None
+    chosen = os.environ.get("NUMBA_CACHE_DIR")
+    return Path(chosen) if chosen else HERE / "__pycache__"
+
+
+def type_key(values: tuple[Any, ...]) -> str:
+    """The argument types of ``values`` as text (what numba would compile ``run_chunk`` for)."""
+    parts = []
+    for value in values:
+        if type(value) is np.ndarray:
+            flags = value.flags
+            layout = "C" if flags.c_contiguous else "F" if flags.f_contiguous else "A"
+            parts.append(f"{value.dtype.str}/{value.ndim}{layout}{'w' if flags.writeable else 'r'}"
+                         f"{'a' if flags.aligned else 'u'}")
+        else:
+            parts.append(type(value).__name__)
+    return ",".join(parts)
+
+
+def _package_stamp(name: str) -> str:
+    spec = importlib.util.find_spec(name)
+    if spec is None or spec.origin is None:
+        return f"{name}:missing"
+    stat = os.stat(spec.origin)
+    return f"{spec.origin}:{stat.st_mtime_ns}:{stat.st_size}"
+
+
+def _cpu() -> str:
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as info:
+            lines = [line for line in info.read().split("\n\n")[0].splitlines()
+                     if line.startswith(("model name", "flags", "Features", "CPU part"))]
+        if lines:
+            return "\n".join(lines)
+    except OSError:
+        pass
+    return platform.processor()
+
+
+@cache
+def _environment() -> str:
+    digest = hashlib.sha256()
+    for source in SOURCES:
+        digest.update(source.read_bytes())
+    parts = [digest.hexdigest(), _package_stamp("numba"), _package_stamp("llvmlite"), np.__version__,
+             sys.implementation.cache_tag or "", platform.machine(), _cpu()]
+    return "\n".join(parts)
+
+
+def _digest(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _switches(hertz: bool | None, momentum: bool | None) -> str:
+    return f"h{int(hertz is not None)}m{int(momentum is not None)}"
+
+
+def module_name(values: tuple[Any, ...]) -> str:
+    """The module name (and file stem) for ``run_chunk`` on arguments ``values`` (see the module doc):
+    the law switches (``values``' last two), the environment's digest, the argument types' digest."""
+    return f"{PREFIX}{_switches(*values[-2:])}_{_digest(_environment())}_{_digest(type_key(values))}"
+
+
+def exists(laws: tuple[bool | None, bool | None]) -> bool:
+    """True when a native module for these law switches is there, for this kernel, numba and CPU (asked
+    before a run is set up: a valve-train run's argument types are given by its law switches)."""
+    where = folder() if enabled() else None
+    if where is None:
+        return False
+    pattern = f"{PREFIX}{_switches(*laws)}_{_digest(_environment())}_*{importlib.machinery.EXTENSION_SUFFIXES[0]}"
+    return any(where.glob(pattern))
+
+
+def path(name: str) -> Path:
+    where = folder()
+    assert where is not None
+    return where / (name + importlib.machinery.EXTENSION_SUFFIXES[0])
+
+
+def load(values: tuple[Any, ...]) -> ModuleType | None:
+    """The native module for arguments ``values``, or None when there is none (or it will not load)."""
+    if not enabled():
+        return None
+    name = module_name(values)
+    if name in _loaded:
+        return _loaded[name]
+    file = path(name)
+    if not file.exists():
+        return None
+    try:
+        loader = importlib.machinery.ExtensionFileLoader(name, str(file))
+        spec = importlib.util.spec_from_file_location(name, file, loader=loader)
+        assert spec is not None
+        module = importlib.util.module_from_spec(spec)
+        loader.exec_module(module)
+    except (ImportError, OSError):  # damaged or foreign: the JIT path still works
+        return None
+    _loaded[name] = module
+    return module
+
+
+def build(name: str, signature: tuple[Any, ...]) -> Path:
+    """Compile ``run_chunk`` for numba's argument types ``signature`` into module ``name`` (the child's job).
+
+    Returns the module's file. Atomic: written in a temporary folder beside it, then renamed.
+    """
+    from numba import types
+    from numba.pycc import CC
+
+    from vtool.solvers import newmark_kernel as kernel
+
+    target = path(name)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    scratch = Path(tempfile.mkdtemp(prefix=".native-", dir=target.parent))
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # numba.pycc's pending-deprecation notice
+            cc = CC(name)
+            cc.output_dir = str(scratch)
+            cc.target_cpu = "host"  # as the JIT compiles: this machine's CPU (part of the name's digest)
+            cc.verbose = False
+            cc.export("run_chunk", types.int64(*signature))(kernel.run_chunk.py_func)
+            cc.compile()
+        built = scratch / target.name
+        os.replace(built, target)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    return target

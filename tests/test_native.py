@@ -1,0 +1,111 @@
+"""The kernel's native module (:mod:`vtool.solvers.kernel_native`): built in the background after the
+first compile, then used by every default-mode run, which imports no numba and gets the JIT kernel's
+results to the last bit."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from tests.test_first_run import needs_jit, wait_until_cached
+from vtool.presets import load_preset
+from vtool.solvers import kernel_layout, kernel_native
+from vtool.solvers import newmark_kernel as kernel
+from vtool.solvers.run import simulate
+
+
+def test_the_kernel_names_the_layout_it_was_written_for() -> None:
+    """numba's cache is stamped by newmark_kernel.py alone: an edit of kernel_layout.py must change that file
+    too (update LAYOUT_FINGERPRINT to the value below), or cached kernels would keep the old slots."""
+    assert kernel.LAYOUT_FINGERPRINT == kernel_layout.fingerprint()
+
+
+def test_the_module_name_follows_the_argument_types_and_switches() -> None:
+    a = (np.zeros(3), np.zeros((2, 2), dtype=np.int64), None, None)
+    name = kernel_native.module_name(a)
+    assert name.startswith("vtool_native_h0m0_")
+    assert kernel_native.module_name((np.zeros(4), np.ones((3, 3), dtype=np.int64), None, None)) == name  # shapes: no
+    assert kernel_native.module_name((np.zeros(3), np.zeros((2, 2)), None, None)) != name  # dtype
+    assert kernel_native.module_name((np.zeros((3, 1)), a[1], None, None)) != name  # dimensions
+    assert kernel_native.module_name((np.zeros((3, 2)).T[0], a[1], None, None)) != name  # layout
+    readonly = np.zeros(3)
+    readonly.flags.writeable = False
+    assert kernel_native.module_name((readonly, a[1], None, None)) != name
+    assert kernel_native.module_name((*a[:2], True, None)).startswith("vtool_native_h1m0_")
+    assert kernel_native.module_name((*a[:2], None, True)).startswith("vtool_native_h0m1_")
+
+
+def test_no_module_is_used_when_turned_off(monkeypatch, tmp_path) -> None:  # noqa: ANN001
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("VTOOL_NATIVE", "0")
+    assert not kernel_native.enabled() and not kernel_native.exists((None, None))
+    assert kernel_native.load((np.zeros(1), None, None)) is None
+    monkeypatch.setenv("VTOOL_NATIVE", "1")
+    monkeypatch.setenv("NUMBA_DISABLE_JIT", "1")
+    assert not kernel_native.enabled()
+
+
+def test_a_damaged_module_is_not_loaded(monkeypatch, tmp_path) -> None:  # noqa: ANN001
+    """A file that will not load (truncated, foreign) leaves the run on numba's cache: load gives None."""
+    monkeypatch.setenv("VTOOL_NATIVE", "1")
+    monkeypatch.setattr(kernel_native, "folder", lambda: tmp_path)
+    values = (np.zeros(2), None, None)
+    kernel_native.path(kernel_native.module_name(values)).write_bytes(b"not a shared object")
+    assert kernel_native.exists((None, None))
+    assert kernel_native.load(values) is None
+
+
+RUN_NATIVE = """
+import sys
+import numpy as np
+from vtool.presets import load_preset
+from vtool.solvers.run import simulate
+trace = simulate(load_preset("gnilka-1a"))
+assert "numba" not in sys.modules, "numba was imported"
+np.savez(sys.argv[1], time=trace.time, q=trace.q, qd=trace.qd, qdd=trace.qdd, force=trace.contact_force,
+         configuration=trace.configuration, peak=trace.peak_force)
+"""
+
+
+@needs_jit
+@pytest.mark.slow
+def test_a_new_install_runs_at_once_then_compiled_then_native(tmp_path) -> None:  # noqa: ANN001
+    """Empty cache, the default mode: the first ``vtool solve`` announces the background compile and runs as
+    plain Python; the child fills numba's cache, then builds the native module; the next run is compiled
+    and silent, loads the native module, imports no numba and equals the JIT kernel's run to the last bit."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), VTOOL_NATIVE="1")
+    env.pop("VTOOL_KERNEL")
+    first = subprocess.run([sys.executable, "-m", "vtool", "solve", "gnilka-1a", "--json"], env=env,
+                           capture_output=True, text=True, timeout=600)
+    assert first.returncode == 0, first.stderr
+    assert "in the background" in first.stderr
+    summary = json.loads(first.stdout)
+    assert summary["plain_steps"] > 0 and summary["compile_time_s"] < 5.0
+    wait_until_cached(env, ("run_chunk",))
+    probe = "import sys; from vtool.solvers import kernel_native as k; sys.exit(0 if k.exists((None, None)) else 1)"
+    deadline = time.monotonic() + 600
+    while subprocess.run([sys.executable, "-c", probe], env=env).returncode != 0:
+        assert time.monotonic() < deadline, "no native module 600 s after the first run"
+        time.sleep(1.0)
+    second = subprocess.run([sys.executable, "-m", "vtool", "solve", "gnilka-1a", "--json"], env=env,
+                            capture_output=True, text=True, timeout=600)
+    assert second.returncode == 0, second.stderr
+    assert "compiling" not in second.stderr
+    again = json.loads(second.stdout)
+    assert again["plain_steps"] == 0 and again["compile_time_s"] == 0.0
+    assert again["events_list"] == summary["events_list"]
+    saved = tmp_path / "native.npz"
+    run = subprocess.run([sys.executable, "-c", RUN_NATIVE, str(saved)], env=env, capture_output=True, text=True,
+                         timeout=600)
+    assert run.returncode == 0, run.stderr
+    native = np.load(saved)
+    jit = simulate(load_preset("gnilka-1a"))  # this process: VTOOL_KERNEL=compiled, numba's JIT kernel
+    for name, value in (("time", jit.time), ("q", jit.q), ("qd", jit.qd), ("qdd", jit.qdd),
+                        ("force", jit.contact_force), ("configuration", jit.configuration), ("peak", jit.peak_force)):
+        np.testing.assert_array_equal(native[name], value, err_msg=name)
