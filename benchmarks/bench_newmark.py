@@ -19,8 +19,8 @@ every round). Prints figures, asserts nothing.
 4. A second process: ``vtool solve gnilka-1a`` in a fresh interpreter, the default mode, after
    the first run's background build has put the kernel's native module beside numba's cache
    (target: at most 0.5 s; best of five, Python's bytecode cache on as by default, and again
-   with ``PYTHONDONTWRITEBYTECODE=1``), whether it imported numba, and the same process on
-   numba's cache instead (``VTOOL_NATIVE=0``) for comparison, measured in the same run.
+   with ``PYTHONDONTWRITEBYTECODE=1``), whether it imported numba, the same with ``--csv``, and
+   both on numba's cache instead (``VTOOL_NATIVE=0``) for comparison, measured in the same run.
 """
 
 from __future__ import annotations
@@ -137,7 +137,7 @@ SECOND_PROCESS = """
 import contextlib, io, sys, time
 started = time.perf_counter()
 from vtool.app.cli import main as entry
-sys.argv = ["vtool", "solve", "gnilka-1a"]
+sys.argv = ["vtool", "solve", "gnilka-1a", *sys.argv[1:]]
 output = io.StringIO()
 try:
     with contextlib.redirect_stdout(output):
@@ -250,7 +250,8 @@ def ensure_native() -> float:
     return wait_for(NATIVE, user_env(), started)
 
 
-def second_process(bytecode: bool = True, native: bool = True) -> tuple[float, float, int, int, bool]:
+def second_process(bytecode: bool = True, native: bool = True, csv: str | None = None,
+                   ) -> tuple[float, float, int, int, bool]:
     """(process wall time, in-process solve time, numba cache misses, cache hits, whether numba stayed
     out) of ``vtool solve gnilka-1a`` as a user runs it (:func:`user_env`).
 
@@ -262,7 +263,8 @@ def second_process(bytecode: bool = True, native: bool = True) -> tuple[float, f
     if not bytecode:
         env["PYTHONDONTWRITEBYTECODE"] = "1"
     started = time.perf_counter()
-    out = subprocess.run([sys.executable, "-c", SECOND_PROCESS], capture_output=True, text=True, check=True,
+    extra = ["--csv", csv] if csv else []
+    out = subprocess.run([sys.executable, "-c", SECOND_PROCESS, *extra], capture_output=True, text=True, check=True,
                          env=env)
     total = time.perf_counter() - started
     solve_time, misses, hits, native_used = out.stdout.split()
@@ -348,6 +350,13 @@ def main() -> None:
     jit = sorted(second_process(native=False) for _ in range(5))
     print(f"  the same on numba's cache (VTOOL_NATIVE=0): best {jit[0][0]:.2f} s (ratio {jit[0][0] / total:.2f} "
           f"x the native module's), median {jit[2][0]:.2f} s; numba cache: {jit[0][3]} hit(s), {jit[0][2]} miss(es)")
+    with tempfile.TemporaryDirectory() as folder:
+        csv = os.path.join(folder, "gnilka-1a.csv")
+        with_csv = sorted(second_process(csv=csv) for _ in range(5))
+        jit_csv = sorted(second_process(native=False, csv=csv) for _ in range(5))
+    print(f"  with --csv (per-degree rows, the preset's quantities): best {with_csv[0][0]:.2f} s "
+          f"({'numba not imported' if with_csv[0][4] else 'numba imported'}; ratio to the 0.5 s target "
+          f"{with_csv[0][0] / TARGET_SECOND_PROCESS_S:.2f}); on numba's cache (VTOOL_NATIVE=0) {jit_csv[0][0]:.2f} s")
     wall, seconds = import_breakdown()
     parts = ", ".join(f"{group} {value:.2f} s" for group, value in seconds.items())
     print(f"  its imports (python -X importtime, {wall:.2f} s wall with the tracing): {sum(seconds.values()):.2f} s: "

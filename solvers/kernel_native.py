@@ -60,7 +60,8 @@ import numpy as np
 from vtool import numba_cache
 
 HERE = Path(__file__).resolve().parent
-SOURCES = (HERE / "newmark_kernel.py", HERE / "kernel_layout.py")  # what the module is compiled from
+#: What the module is compiled from: the run loop, and the CSV number formatter it carries too.
+SOURCES = (HERE / "newmark_kernel.py", HERE / "kernel_layout.py", HERE.parent / "vtool" / "csvrows_kernel.py")
 PREFIX = "vtool_native_"
 _loaded: dict[str, ModuleType] = {}
 
@@ -164,7 +165,29 @@ def load(values: tuple[Any, ...]) -> ModuleType | None:
     name = module_name(values)
     if name in _loaded:
         return _loaded[name]
-    file = path(name)
+    return _load_file(name, path(name))
+
+
+def csv_writer() -> Any | None:
+    """The CSV number formatter (:func:`vtool.csvrows_kernel.put_rows`) of a native module for this
+    kernel, numba and CPU (any law switches: each module carries it), or None (default mode only)."""
+    from vtool.solvers.kernel_build import kernel_mode
+
+    if kernel_mode() != "auto" or not enabled():
+        return None
+    for loaded in _loaded.values():
+        return loaded.put_rows
+    where = folder()
+    assert where is not None
+    suffix = importlib.machinery.EXTENSION_SUFFIXES[0]
+    for file in sorted(where.glob(f"{PREFIX}*_{_digest(_environment())}_*{suffix}")):
+        found = _load_file(file.name.removesuffix(suffix), file)
+        if found is not None:
+            return found.put_rows
+    return None
+
+
+def _load_file(name: str, file: Path) -> ModuleType | None:
     if not file.exists():
         return None
     try:
@@ -180,13 +203,16 @@ def load(values: tuple[Any, ...]) -> ModuleType | None:
 
 
 def build(name: str, signature: tuple[Any, ...]) -> Path:
-    """Compile ``run_chunk`` for numba's argument types ``signature`` into module ``name`` (the child's job).
+    """Compile ``run_chunk`` for numba's argument types ``signature`` into module ``name`` (the child's job),
+    and beside it the CSV writer ``put_rows`` (for the types :func:`vtool.csvrows.arguments` gives).
 
     Returns the module's file. Atomic: written in a temporary folder beside it, then renamed.
     """
+    import numba
     from numba import types
     from numba.pycc import CC
 
+    from vtool import csvrows, csvrows_kernel
     from vtool.solvers import newmark_kernel as kernel
 
     target = path(name)
@@ -200,6 +226,9 @@ def build(name: str, signature: tuple[Any, ...]) -> Path:
             cc.target_cpu = "host"  # as the JIT compiles: this machine's CPU (part of the name's digest)
             cc.verbose = False
             cc.export("run_chunk", types.int64(*signature))(kernel.run_chunk.py_func)
+            example = csvrows.arguments(np.zeros((1, 1)), ["label"], np.zeros(1, dtype=np.int64))
+            rows = types.int64(*(numba.typeof(value) for value in example))
+            cc.export("put_rows", rows)(csvrows_kernel.put_rows.py_func)
             cc.compile()
         built = scratch / target.name
         os.replace(built, target)

@@ -172,7 +172,9 @@ class Trace:
         already); ``header=False`` leaves out the header row (a block of a streamed run).
         """
         from vtool.csvrows import write_rows
+        from vtool.solvers.kernel_native import csv_writer
 
+        native = csv_writer()  # a native module's formatter: no numba
         names, columns = self.csv_columns(quantities)
         if header:
             handle.write(",".join(names) + "\n")
@@ -182,7 +184,7 @@ class Trace:
             rows = slice(start, min(start + chunk, len(self.time)))
             block = np.column_stack([column(rows) for column in columns])
             write_rows(handle, block, labels, np.searchsorted(masks, self.configuration[rows]),
-                       compiled=compiled if compiled is not None or len(self.time) < chunk else True)
+                       compiled=compiled if compiled is not None or len(self.time) < chunk else True, native=native)
 
     def csv_text(self, quantities: tuple[str, ...] = ()) -> str:
         """CSV with one header row naming each quantity and its unit."""
@@ -390,6 +392,16 @@ def cam_angle_deg(time: np.ndarray | float, omega: float) -> np.ndarray | float:
     """Cam angle in degrees at time(s) t (s) for a cam speed omega (rad/s): an array for an array,
     a float for a float (with no array made for it: one per event)."""
     return time * omega * 180.0 / math.pi
+
+
+def csv_compile_notice() -> str | None:
+    """The line to show before an every-step CSV's number formatter compiles
+    (:func:`vtool.csvrows.compile_notice`), or None; None at once, with no numba imported, when a native
+    module carries the formatter (:func:`vtool.solvers.kernel_native.csv_writer`)."""
+    from vtool import csvrows
+    from vtool.solvers.kernel_native import csv_writer
+
+    return None if csv_writer() is not None else csvrows.compile_notice()
 
 
 class CsvStream:

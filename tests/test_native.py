@@ -4,6 +4,7 @@ results to the last bit."""
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import subprocess
@@ -51,6 +52,20 @@ def test_no_module_is_used_when_turned_off(monkeypatch, tmp_path) -> None:  # no
     assert not kernel_native.enabled()
 
 
+def test_the_csv_writer_is_chosen_without_numba_when_it_can_be(monkeypatch) -> None:  # noqa: ANN001
+    from vtool import csvrows
+
+    def native(*args):  # noqa: ANN002, ANN202
+        raise AssertionError("not called")
+
+    assert csvrows.choose(10, None, native) is native
+    assert csvrows.choose(10**6, None, native) is native
+    assert csvrows.choose(10**6, True, native) is native
+    assert csvrows.choose(10, False, native) is None  # Python's formatting asked for
+    monkeypatch.delitem(sys.modules, "numba", raising=False)  # (put back after the test)
+    assert csvrows.choose(10, None) is None  # small, numba not loaded: Python's, numba not imported for it
+
+
 def test_a_damaged_module_is_not_loaded(monkeypatch, tmp_path) -> None:  # noqa: ANN001
     """A file that will not load (truncated, foreign) leaves the run on numba's cache: load gives None."""
     monkeypatch.setenv("VTOOL_NATIVE", "1")
@@ -62,14 +77,21 @@ def test_a_damaged_module_is_not_loaded(monkeypatch, tmp_path) -> None:  # noqa:
 
 
 RUN_NATIVE = """
-import sys
+import contextlib, io, sys
 import numpy as np
+from vtool.app.cli.main import main
 from vtool.presets import load_preset
 from vtool.solvers.run import simulate
 trace = simulate(load_preset("gnilka-1a"))
-assert "numba" not in sys.modules, "numba was imported"
 np.savez(sys.argv[1], time=trace.time, q=trace.q, qd=trace.qd, qdd=trace.qdd, force=trace.contact_force,
          configuration=trace.configuration, peak=trace.peak_force)
+sys.argv = ["vtool", "solve", "gnilka-1a", "--csv", sys.argv[2]]
+try:
+    with contextlib.redirect_stdout(io.StringIO()):
+        main()
+except SystemExit as exc:
+    assert exc.code in (0, None), exc.code
+assert "numba" not in sys.modules, "numba was imported"
 """
 
 
@@ -78,7 +100,8 @@ np.savez(sys.argv[1], time=trace.time, q=trace.q, qd=trace.qd, qdd=trace.qdd, fo
 def test_a_new_install_runs_at_once_then_compiled_then_native(tmp_path) -> None:  # noqa: ANN001
     """Empty cache, the default mode: the first ``vtool solve`` announces the background compile and runs as
     plain Python; the child fills numba's cache, then builds the native module; the next run is compiled
-    and silent, loads the native module, imports no numba and equals the JIT kernel's run to the last bit."""
+    and silent, loads the native module, imports no numba and equals the JIT kernel's run to the last bit;
+    ``vtool solve --csv`` writes Python's text with the module's formatter, numba still not imported."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), VTOOL_NATIVE="1")
     env.pop("VTOOL_KERNEL")
     first = subprocess.run([sys.executable, "-m", "vtool", "solve", "gnilka-1a", "--json"], env=env,
@@ -100,12 +123,15 @@ def test_a_new_install_runs_at_once_then_compiled_then_native(tmp_path) -> None:
     again = json.loads(second.stdout)
     assert again["plain_steps"] == 0 and again["compile_time_s"] == 0.0
     assert again["events_list"] == summary["events_list"]
-    saved = tmp_path / "native.npz"
-    run = subprocess.run([sys.executable, "-c", RUN_NATIVE, str(saved)], env=env, capture_output=True, text=True,
-                         timeout=600)
+    saved, csv = tmp_path / "native.npz", tmp_path / "native.csv"
+    run = subprocess.run([sys.executable, "-c", RUN_NATIVE, str(saved), str(csv)], env=env, capture_output=True,
+                         text=True, timeout=600)
     assert run.returncode == 0, run.stderr
     native = np.load(saved)
     jit = simulate(load_preset("gnilka-1a"))  # this process: VTOOL_KERNEL=compiled, numba's JIT kernel
     for name, value in (("time", jit.time), ("q", jit.q), ("qd", jit.qd), ("qdd", jit.qdd),
                         ("force", jit.contact_force), ("configuration", jit.configuration), ("peak", jit.peak_force)):
         np.testing.assert_array_equal(native[name], value, err_msg=name)
+    python = io.StringIO()
+    jit.write_csv_to(python, jit.spec.run.quantities, compiled=False)  # Python's own '%.10g'
+    assert csv.read_text() == python.getvalue()  # the native module's CSV writer, same text

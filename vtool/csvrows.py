@@ -23,156 +23,29 @@ How the kernel writes ``x`` with 10 significant digits (C's ``%.10g``):
 So the text is identical to Python's for every value (a test compares them
 on random and edge values). ``NUMBA_DISABLE_JIT=1`` runs the same source as
 plain Python (the reference).
+
+The kernel itself is :mod:`vtool.csvrows_kernel` (numba). This module imports
+no numba: a caller may hand in the same kernel from a native module (the
+valve-train kernel's, :mod:`vtool.solvers.kernel_native`), and otherwise numba
+is imported only when its kernel is worth it (:func:`choose`).
 """
 
 from __future__ import annotations
 
-import math
+import sys
+from collections.abc import Callable
+from types import ModuleType
+from typing import Any
 
 import numpy as np
-
-from vtool import numba_cache
-
-numba_cache.configure()
-
-from numba import njit  # noqa: E402 (after the cache folder is chosen)
-
-jit = njit(cache=numba_cache.CACHE_ENABLED, nogil=True, error_model="numpy")
 
 #: Characters one value can take at most (``-1.234567891e-100``) plus its comma.
 VALUE_WIDTH = 18
 #: Outputs of at least this many rows compile the kernel when it is not cached yet (smaller ones
 #: are written by Python: about 25 µs per row of 46 values, under a second for 20,000 rows).
 WORTH_COMPILING_ROWS = 20_000
-#: Fractions of s this close to one half are left to Python's correctly rounded formatting.
-TIE_MARGIN = 1e-5
 #: Decimal shifts 10^k, |k| <= MAX_SHIFT, are one multiplication by the nearest double.
 MAX_SHIFT = 44
-LOG10_2 = 0.30102999566398120
-COMMA, NEWLINE, MINUS, PLUS, DOT, ZERO, LETTER_E = 44, 10, 45, 43, 46, 48, 101
-
-
-@jit
-def put_value(x, bits, powers, out, pos):  # noqa: ANN001, ANN201 (a numba kernel)
-    """Write ``'%.10g' % x`` at out[pos:] (``bits``: x's IEEE bits, for its binary exponent); returns the
-    new position, or -1 when Python must write it."""
-    if x != x or x - x != 0.0:  # nan or inf
-        return -1
-    if x == 0.0:
-        if np.signbit(x):
-            out[pos] = MINUS
-            pos += 1
-        out[pos] = ZERO
-        return pos + 1
-    ax = abs(x)
-    e = int(math.floor((((bits >> 52) & 0x7FF) - 1023) * LOG10_2))  # e or e - 1 (subnormals: Python)
-    scaled = 0.0
-    for _ in range(3):
-        k = 9 - e
-        if k > MAX_SHIFT or k < -MAX_SHIFT:
-            return -1
-        scaled = ax * powers[k + MAX_SHIFT]
-        if scaled >= 1e10:
-            e += 1
-        elif scaled < 1e9:
-            e -= 1
-        else:
-            break
-    if not 1e9 <= scaled < 1e10:
-        return -1
-    whole = np.floor(scaled)
-    fraction = scaled - whole
-    if abs(fraction - 0.5) < TIE_MARGIN:
-        return -1
-    m = np.int64(whole) + (1 if fraction > 0.5 else 0)
-    if m == 10_000_000_000:
-        m = 1_000_000_000
-        e += 1
-    if x < 0.0:
-        out[pos] = MINUS
-        pos += 1
-    if 0 <= e < 10:  # d0..de . d(e+1)..d9 in place, then trailing zeros (and a bare point) cut
-        for j in range(9, -1, -1):
-            out[pos + j + (1 if j > e else 0)] = ZERO + m % 10
-            m //= 10
-        out[pos + e + 1] = DOT
-        end = pos + 11
-        while end > pos + e + 2 and out[end - 1] == ZERO:
-            end -= 1
-        return end - 1 if end == pos + e + 2 else end
-    if -4 <= e < 0:  # 0.000d0..d9
-        out[pos] = ZERO
-        out[pos + 1] = DOT
-        start = pos - e + 1
-        for j in range(pos + 2, start):
-            out[j] = ZERO
-        for j in range(9, -1, -1):
-            out[start + j] = ZERO + m % 10
-            m //= 10
-        end = start + 10
-        while out[end - 1] == ZERO:  # d0 is not zero
-            end -= 1
-        return end
-    for j in range(9, -1, -1):  # d0 . d1..d9 e±XX
-        out[pos + j + (1 if j > 0 else 0)] = ZERO + m % 10
-        m //= 10
-    out[pos + 1] = DOT
-    end = pos + 11
-    while end > pos + 2 and out[end - 1] == ZERO:
-        end -= 1
-    pos = end - 1 if end == pos + 2 else end
-    out[pos] = LETTER_E
-    out[pos + 1] = MINUS if e < 0 else PLUS
-    pos += 2
-    ae = -e if e < 0 else e
-    if ae >= 100:
-        out[pos] = ZERO + ae // 100
-        pos += 1
-    out[pos] = ZERO + (ae // 10) % 10
-    out[pos + 1] = ZERO + ae % 10
-    return pos + 2
-
-
-@jit
-def put_rows(values, bits, same, powers, label_text, label_start, label_of_row, out, offsets,  # noqa: ANN001, ANN201
-             fallback):
-    """Rows of ``values`` with their labels into ``out`` (see the module doc); returns the bytes written.
-
-    ``label_text[label_start[i]:label_start[i + 1]]`` is label i (UTF-8);
-    row r ends with label ``label_of_row[r]``. ``offsets[r]`` is where row r
-    starts (``offsets[rows]`` the end); ``fallback[r]`` is set for a row that
-    Python must write (its bytes here are incomplete). A column c with
-    ``same[c] = j >= 0`` holds the values of the earlier column j: its text is
-    copied, not formatted again.
-    """
-    rows, cols = values.shape
-    starts = np.zeros(cols, dtype=np.int64)
-    ends = np.zeros(cols, dtype=np.int64)
-    pos = 0
-    for r in range(rows):
-        offsets[r] = pos
-        for c in range(cols):
-            j = same[c]
-            if j >= 0:
-                end = pos + ends[j] - starts[j]
-                out[pos:end] = out[starts[j]:ends[j]]
-            else:
-                end = put_value(values[r, c], bits[r, c], powers, out, pos)
-                if end < 0:
-                    fallback[r] = True
-                    end = pos
-            starts[c] = pos
-            ends[c] = end
-            out[end] = COMMA
-            pos = end + 1
-        label = label_of_row[r]
-        for j in range(label_start[label], label_start[label + 1]):
-            out[pos] = label_text[j]
-            pos += 1
-        out[pos] = NEWLINE
-        pos += 1
-    offsets[rows] = pos
-    return pos
 
 
 #: 10^k for k = -MAX_SHIFT..MAX_SHIFT, each the double nearest to it (exact for 0 <= k <= 22).
@@ -204,31 +77,47 @@ def repeated_columns(values: np.ndarray) -> np.ndarray:
     return same
 
 
+#: A compiled ``put_rows`` (:mod:`vtool.csvrows_kernel`'s signature; numba's or a native module's).
+Formatter = Callable[..., int]
+
+
+def kernel() -> ModuleType:
+    """The numba kernel's module (imported when first needed: it imports numba)."""
+    from vtool import csvrows_kernel
+
+    return csvrows_kernel
+
+
 def ready() -> bool:
-    """True when the kernel needs no compiling: loaded in this process, or in numba's cache."""
+    """True when numba's kernel needs no compiling: loaded in this process, or in numba's cache."""
+    put_rows = kernel().put_rows
     if not hasattr(put_rows, "signatures") or put_rows.signatures:
         return True  # NUMBA_DISABLE_JIT (plain Python), or compiled or loaded already
     return compile_notice() is None
 
 
-def use_kernel(rows: int, compiled: bool | None) -> bool:
-    """``compiled`` if given; else the kernel when it is ready or the output is large enough to pay
-    for its compile (a few seconds, once): a per-degree CSV does not wait for it."""
-    return compiled if compiled is not None else (rows >= WORTH_COMPILING_ROWS or ready())
+def choose(rows: int, compiled: bool | None, native: Formatter | None = None) -> Formatter | None:
+    """The formatter for ``rows`` rows, or None for Python's formatting.
+
+    ``compiled`` False: Python's; otherwise a ``native`` formatter when one is
+    given (a native module's, no numba); else numba's kernel when ``compiled``
+    is True, when the output is large enough to pay for the kernel's compile
+    (a few seconds, once; a per-degree CSV does not wait for it), or when
+    numba is loaded in this process already and the kernel is cached (not
+    worth importing numba for: Python writes 20,000 rows in about 0.5 s).
+    """
+    if compiled is False:
+        return None
+    if native is not None:
+        return native
+    if compiled or rows >= WORTH_COMPILING_ROWS or ("numba" in sys.modules and ready()):
+        return kernel().put_rows  # type: ignore[no-any-return]
+    return None
 
 
-def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
-            compiled: bool | None = None) -> list:  # type: ignore[type-arg]
-    """The rows' UTF-8 text as a list of byte buffers (the kernel's, and Python's rows where it gave up)."""
-    values = np.ascontiguousarray(values, dtype=np.float64)
-    if values.ndim != 2:
-        raise ValueError(f"values must be a 2-D array (got {values.ndim} dimensions)")
+def arguments(values: np.ndarray, labels: list[str], label_of_row: np.ndarray) -> tuple[Any, ...]:
+    """``put_rows``' arguments for these rows (its buffers allocated); ``values`` C-contiguous float64."""
     rows = values.shape[0]
-    if rows == 0:
-        return []
-    if not use_kernel(rows, compiled):
-        text = "".join(python_row(values[r], labels[int(label_of_row[r])]) for r in range(rows))
-        return [text.encode("utf-8")]
     encoded = [label.encode("utf-8") for label in labels]
     label_start = np.zeros(len(encoded) + 1, dtype=np.int64)
     label_start[1:] = np.cumsum([len(b) for b in encoded])
@@ -240,8 +129,26 @@ def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
     out = np.empty(rows * (values.shape[1] * VALUE_WIDTH + width + 2), dtype=np.uint8)
     offsets = np.zeros(rows + 1, dtype=np.int64)
     fallback = np.zeros(rows, dtype=np.bool_)
-    end = put_rows(values, values.view(np.int64), repeated_columns(values), POWERS, label_text, label_start,
-                   label_of_row, out, offsets, fallback)
+    return (values, values.view(np.int64), repeated_columns(values), POWERS, label_text, label_start,
+            label_of_row, out, offsets, fallback)
+
+
+def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
+            compiled: bool | None = None, native: Formatter | None = None) -> list:  # type: ignore[type-arg]
+    """The rows' UTF-8 text as a list of byte buffers (the kernel's, and Python's rows where it gave up)."""
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    if values.ndim != 2:
+        raise ValueError(f"values must be a 2-D array (got {values.ndim} dimensions)")
+    rows = values.shape[0]
+    if rows == 0:
+        return []
+    put_rows = choose(rows, compiled, native)
+    if put_rows is None:
+        text = "".join(python_row(values[r], labels[int(label_of_row[r])]) for r in range(rows))
+        return [text.encode("utf-8")]
+    args = arguments(values, labels, label_of_row)
+    end = put_rows(*args)
+    label_of_row, out, offsets, fallback = args[6:]
     pieces, done = [], 0
     for r in np.flatnonzero(fallback).tolist():
         pieces.append(out[offsets[done]:offsets[r]])
@@ -252,25 +159,25 @@ def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
 
 
 def format_rows(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
-                compiled: bool | None = None) -> str:
+                compiled: bool | None = None, native: Formatter | None = None) -> str:
     """CSV text of the rows of ``values`` (2-D), each ending with ``labels[label_of_row[r]]``.
 
-    ``compiled``: True for the kernel, False for Python's formatting (the same text), None to
-    choose (:func:`use_kernel`)."""
-    pieces = _encode(values, labels, label_of_row, compiled)
+    ``compiled``: True for a compiled kernel, False for Python's formatting (the same text), None to
+    choose; ``native``: a native module's kernel, used unless ``compiled`` is False (:func:`choose`)."""
+    pieces = _encode(values, labels, label_of_row, compiled, native)
     return b"".join(bytes(piece) for piece in pieces).decode("utf-8")
 
 
 def write_rows(handle, values: np.ndarray, labels: list[str], label_of_row: np.ndarray,  # type: ignore[no-untyped-def]
-               compiled: bool | None = None) -> None:
+               compiled: bool | None = None, native: Formatter | None = None) -> None:
     """Write :func:`format_rows`'s text to a text handle; to a UTF-8 file's binary buffer directly
     (no text copy) when it has one."""
     binary = getattr(handle, "buffer", None)
     if binary is None or (getattr(handle, "encoding", "") or "").lower().replace("-", "") != "utf8":
-        handle.write(format_rows(values, labels, label_of_row, compiled))
+        handle.write(format_rows(values, labels, label_of_row, compiled, native))
         return
     handle.flush()  # what was written as text goes first
-    for piece in _encode(values, labels, label_of_row, compiled):
+    for piece in _encode(values, labels, label_of_row, compiled, native):
         binary.write(piece)
 
 
@@ -283,7 +190,8 @@ _cached: list[bool] = []  # the cache's answer, read once per process
 
 def compile_notice() -> str | None:
     """The line to show before the first large CSV output compiles the formatter, or None when it is
-    cached (or compiled in this process)."""
+    cached (or compiled in this process). Imports numba: ask only when no native module is there."""
+    put_rows = kernel().put_rows
     if not hasattr(put_rows, "signatures") or put_rows.signatures:
         return None
     if not _cached:

@@ -145,8 +145,8 @@ def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()
     if notice:
         click.echo(notice, err=True)
     if csv:
-        from vtool.csvrows import compile_notice as csv_notice
+        from vtool.solvers.trace import csv_compile_notice
 
-        notice = csv_notice()
+        notice = csv_compile_notice()
         if notice:
             click.echo(notice, err=True)
