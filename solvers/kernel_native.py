@@ -230,8 +230,7 @@ def build(name: str, signature: tuple[Any, ...]) -> Path:
             rows = types.int64(*(numba.typeof(value) for value in example))
             cc.export("put_rows", rows)(csvrows_kernel.put_rows.py_func)
             cc.compile()
-        built = scratch / target.name
-        os.replace(built, target)
+        os.replace(scratch / cc.output_file, target)  # (pycc's own suffix; the loader takes any)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     return target
