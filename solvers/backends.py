@@ -18,7 +18,7 @@ The contract every back end follows (subclass :class:`Backend`)
    :class:`~vtool.solvers.trace.TraceBuilder`; apply the shared event rules
    (kernel functions ``impact`` and ``settle``); return the statistics
    (``steps``, ``peak``, ``peak_late``, ``peak_overlap``, ``configurations``, ``settings``; optionally
-   ``compile_time`` and ``plain_steps``, see :class:`~vtool.solvers.trace.RunStatistics`).
+   ``compile_time``, ``plain_steps`` and ``kernel``, see :class:`~vtool.solvers.trace.RunStatistics`).
    ``progress(f)`` is called with the fraction done (0..1) between chunks,
    ``cancel()`` polled between chunks (a true answer stops the run).
 5. Errors: a run that cannot be completed (divergence, endless chattering,
@@ -126,6 +126,7 @@ class Backend(ABC):
             settings["contact"] = {c.name: c.contact for c in spec.clearances if not c.rigid}
         statistics = RunStatistics(self.name, int(stats["steps"]), len(builder.events), wall,
                                    tuple(sorted(stats.get("configurations", problem.tables.layers))), settings,
-                                   compile_time=compile_time, plain_steps=int(stats.get("plain_steps", 0)))
+                                   compile_time=compile_time, plain_steps=int(stats.get("plain_steps", 0)),
+                                   kernel=str(stats.get("kernel", "")))
         return builder.build(stats["peak"], statistics, stats.get("peak_late"), sort=stats.get("sort", False),
                              peak_overlap=stats.get("peak_overlap"))

@@ -212,9 +212,18 @@ class NewmarkBackend(Backend):
         o = options
         return {"steps": int(run.ist[layout.I_STEPS]), "peak": run.peak[layout.PEAK_ALL].copy(),
                 "peak_late": run.peak[layout.PEAK_LATE].copy(), "peak_overlap": run.peak[layout.PEAK_OVERLAP].copy(),
-                "compile_time": run.compile_time, "plain_steps": run.plain_steps,
+                "compile_time": run.compile_time, "plain_steps": run.plain_steps, "kernel": run.kernel,
                 "settings": {"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
                              "refine_after_events": o.refine}}
+
+
+def kernel_kind(module: ModuleType) -> str:
+    """What a kernel module is: "native" (:mod:`vtool.solvers.kernel_native`'s extension module), "numba"
+    (numba's compiled kernel) or "plain" (the source as plain Python: a first run before the compile, or
+    ``VTOOL_KERNEL=plain``, or ``NUMBA_DISABLE_JIT``)."""
+    if module.__name__.startswith(kernel_native.PREFIX):
+        return "native"
+    return "numba" if hasattr(module.run_chunk, "py_func") else "plain"
 
 
 class KernelRun:
@@ -252,6 +261,7 @@ class KernelRun:
         self.fst[layout.F_LAST_EVENT] = -1.0
         self.compile_time = 0.0
         self.plain_steps = 0  # steps taken by the plain-Python kernel (before the compiled one was ready)
+        self.kernel = ""  # what took the last chunk: "native" (module), "numba" or "plain" (see kernel_kind)
 
     def flush(self) -> None:
         """Move the filled rows and events out of the kernel's buffers."""
@@ -357,6 +367,7 @@ class KernelRun:
                 progress(min(t / self.t_end, 1.0))
             if status == layout.FINISHED:
                 self.flush()
+                self.kernel = kernel_kind(module)
                 if getattr(module, "PLAIN", False):  # the whole run in plain Python
                     self.plain_steps = int(self.ist[layout.I_STEPS])
                 return

@@ -79,6 +79,7 @@ class RunStatistics:
     error_estimate: float | None = None
     compile_time: float = 0.0  # s spent compiling (or loading) the kernel, not in wall_time
     plain_steps: int = 0  # of ``steps``, those run as plain Python (before the compiled kernel was ready)
+    kernel: str = ""  # newmark: what ran its last steps, "native", "numba" or "plain" (newmark.kernel_kind)
 
 
 @dataclass(frozen=True)
@@ -319,6 +320,7 @@ class Trace:
             "wall_time_s": stats.wall_time,
             "compile_time_s": stats.compile_time,
             "plain_steps": stats.plain_steps,
+            "kernel": stats.kernel,
             "episode_window_deg": EPISODE_WINDOW_DEG,
             "configurations_built": [configuration_label(self.spec, m) for m in stats.configurations_built],
             "events_list": [

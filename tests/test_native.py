@@ -16,6 +16,7 @@ import pytest
 
 from tests.test_first_run import needs_jit, wait_until_cached
 from vtool.presets import load_preset
+from vtool.presets.valvetrain import with_run_overrides
 from vtool.solvers import kernel_layout, kernel_native
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.run import simulate
@@ -40,6 +41,16 @@ def test_the_module_name_follows_the_argument_types_and_switches() -> None:
     assert kernel_native.module_name((readonly, a[1], None, None)) != name
     assert kernel_native.module_name((*a[:2], True, None)).startswith("vtool_native_h1m0_")
     assert kernel_native.module_name((*a[:2], None, True)).startswith("vtool_native_h0m1_")
+
+
+@needs_jit
+def test_a_run_names_the_kernel_that_ran_it(monkeypatch) -> None:  # noqa: ANN001
+    assert simulate(load_preset("gnilka-1a")).statistics.kernel == "numba"  # the tests' mode: compiled
+    monkeypatch.setenv("VTOOL_KERNEL", "plain")
+    short = with_run_overrides(load_preset("gnilka-1a"), degrees=20.0)
+    assert simulate(short).statistics.kernel == "plain"
+    exact = with_run_overrides(short, backend="exact")
+    assert simulate(exact).statistics.kernel == ""  # (the piecewise back ends call only the event rules)
 
 
 def test_no_module_is_used_when_turned_off(monkeypatch, tmp_path) -> None:  # noqa: ANN001
@@ -81,6 +92,7 @@ import contextlib, io, sys
 import numpy as np
 from vtool.app.cli.main import main
 from vtool.presets import load_preset
+from vtool.presets.valvetrain import with_run_overrides
 from vtool.solvers.run import simulate
 trace = simulate(load_preset("gnilka-1a"))
 np.savez(sys.argv[1], time=trace.time, q=trace.q, qd=trace.qd, qdd=trace.qdd, force=trace.contact_force,
@@ -110,6 +122,7 @@ def test_a_new_install_runs_at_once_then_compiled_then_native(tmp_path) -> None:
     assert "in the background" in first.stderr
     summary = json.loads(first.stdout)
     assert summary["plain_steps"] > 0 and summary["compile_time_s"] < 5.0
+    assert summary["kernel"] in ("plain", "numba")  # numba if the compile finished before the run did
     wait_until_cached(env, ("run_chunk",))
     probe = "import sys; from vtool.solvers import kernel_native as k; sys.exit(0 if k.exists((None, None)) else 1)"
     deadline = time.monotonic() + 600
@@ -121,7 +134,7 @@ def test_a_new_install_runs_at_once_then_compiled_then_native(tmp_path) -> None:
     assert second.returncode == 0, second.stderr
     assert "compiling" not in second.stderr
     again = json.loads(second.stdout)
-    assert again["plain_steps"] == 0 and again["compile_time_s"] == 0.0
+    assert again["plain_steps"] == 0 and again["compile_time_s"] == 0.0 and again["kernel"] == "native"
     assert again["events_list"] == summary["events_list"]
     saved, csv = tmp_path / "native.npz", tmp_path / "native.csv"
     run = subprocess.run([sys.executable, "-c", RUN_NATIVE, str(saved), str(csv)], env=env, capture_output=True,
