@@ -20,13 +20,18 @@ Which module: one serves one kernel source, one set of argument types (which
 include the law switches, see :func:`~vtool.solvers.kernel_layout.laws`),
 one numba, llvmlite, NumPy and Python, and one CPU. Its name carries a
 digest of all of them (:func:`module_name`), computed without numba: the
-SHA-256 of ``newmark_kernel.py`` and ``kernel_layout.py``, numba's and
-llvmlite's package files (path, modification time, size), NumPy's version,
-Python's cache tag, the machine and the CPU's model name and flags
-(``/proc/cpuinfo``; elsewhere :func:`platform.processor`), and each
-argument's type (:func:`type_key`: an array's dtype, dimensions, layout,
-writeability and alignment, the type of anything else). A change to any of
-them gives another name: a stale module is never loaded, only left unused.
+SHA-256 of ``newmark_kernel.py``, ``kernel_layout.py``, ``csvrows_kernel.py``
+and this file, numba's and llvmlite's package files (path, modification
+time, size), NumPy's version, Python's cache tag, the machine and the CPU's
+model name and flags (``/proc/cpuinfo``; elsewhere
+:func:`platform.processor`), and each argument's type (:func:`type_key`: an
+array's dtype, dimensions, layout, writeability and alignment, the type of
+anything else). A change to any of them gives another name: a stale module
+is never loaded, only left unused.
+
+The GIL: the module's functions release it around the call, as the JIT
+kernel (``nogil=True``) does, so threads (a ``local-threads:N`` sweep) run
+in parallel on it (:func:`_releasing_the_gil`).
 
 Same results: the module is the JIT kernel's source compiled by the same
 numba and LLVM with the same options; its results equal the JIT kernel's to
@@ -41,6 +46,7 @@ build fails, the child leaves its ``.failed`` note (see
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.machinery
 import importlib.util
@@ -50,6 +56,7 @@ import shutil
 import sys
 import tempfile
 import warnings
+from collections.abc import Iterator
 from functools import cache
 from pathlib import Path
 from types import ModuleType
@@ -121,7 +128,7 @@ def _cpu() -> str:
 @cache
 def _environment() -> str:
     digest = hashlib.sha256()
-    for source in SOURCES:
+    for source in (*SOURCES, Path(__file__)):  # and how it is built (this file)
         digest.update(source.read_bytes())
     parts = [digest.hexdigest(), _package_stamp("numba"), _package_stamp("llvmlite"), np.__version__,
              sys.implementation.cache_tag or "", platform.machine(), _cpu()]
@@ -202,6 +209,28 @@ def _load_file(name: str, file: Path) -> ModuleType | None:
     return module
 
 
+@contextlib.contextmanager
+def _releasing_the_gil() -> Iterator[None]:
+    """numba.pycc's exported functions keep the GIL (its compile flags have no ``nogil``); the JIT kernel
+    releases it (``nogil=True``), and a threaded sweep (``local-threads:N``) relies on that. For the
+    compile, pycc's flags are made to release it too: the functions' CPython wrappers then drop the GIL
+    around the call, as the JIT's do."""
+    from numba.pycc import compiler
+
+    original = compiler.Flags
+
+    class Releasing(original):  # type: ignore[misc, valid-type]
+        def __init__(self, *args: Any, **kwargs: Any) -> None:
+            super().__init__(*args, **kwargs)
+            self.release_gil = True
+
+    compiler.Flags = Releasing
+    try:
+        yield
+    finally:
+        compiler.Flags = original
+
+
 def build(name: str, signature: tuple[Any, ...]) -> Path:
     """Compile ``run_chunk`` for numba's argument types ``signature`` into module ``name`` (the child's job),
     and beside it the CSV writer ``put_rows`` (for the types :func:`vtool.csvrows.arguments` gives).
@@ -229,7 +258,8 @@ def build(name: str, signature: tuple[Any, ...]) -> Path:
             example = csvrows.arguments(np.zeros((1, 1)), ["label"], np.zeros(1, dtype=np.int64))
             rows = types.int64(*(numba.typeof(value) for value in example))
             cc.export("put_rows", rows)(csvrows_kernel.put_rows.py_func)
-            cc.compile()
+            with _releasing_the_gil():
+                cc.compile()
         os.replace(scratch / cc.output_file, target)  # (pycc's own suffix; the loader takes any)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
