@@ -224,11 +224,11 @@ def _releasing_the_gil() -> Iterator[None]:
             super().__init__(*args, **kwargs)
             self.release_gil = True
 
-    compiler.Flags = Releasing
+    compiler.Flags = Releasing  # type: ignore[misc]
     try:
         yield
     finally:
-        compiler.Flags = original
+        compiler.Flags = original  # type: ignore[misc]
 
 
 def build(name: str, signature: tuple[Any, ...]) -> Path:
