@@ -55,6 +55,7 @@ import platform
 import shutil
 import sys
 import tempfile
+import time
 import warnings
 from collections.abc import Iterator
 from functools import cache
@@ -246,6 +247,10 @@ def build(name: str, signature: tuple[Any, ...]) -> Path:
 
     target = path(name)
     target.parent.mkdir(parents=True, exist_ok=True)
+    for left in target.parent.glob(".native-*"):  # of a build that was killed (an hour is long past any build)
+        with contextlib.suppress(OSError):
+            if time.time() - left.stat().st_mtime > 3600.0:
+                shutil.rmtree(left, ignore_errors=True)
     scratch = Path(tempfile.mkdtemp(prefix=".native-", dir=target.parent))
     try:
         with warnings.catch_warnings():
