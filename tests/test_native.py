@@ -148,3 +148,35 @@ def test_a_new_install_runs_at_once_then_compiled_then_native(tmp_path) -> None:
     python = io.StringIO()
     jit.write_csv_to(python, jit.spec.run.quantities, compiled=False)  # Python's own '%.10g'
     assert csv.read_text() == python.getvalue()  # the native module's CSV writer, same text
+
+
+@needs_jit
+@pytest.mark.slow
+def test_a_hertz_contact_runs_on_its_own_module_to_the_last_bit(monkeypatch, tmp_path) -> None:  # noqa: ANN001
+    """The Hertz switch is an argument type (see kernel_layout.laws): its module is another one, built with
+    the Hertz iteration, and equal to the JIT kernel's run bit for bit (the drop test on a Hertz seat)."""
+    from tests.test_compliant import hertz_doc
+    from tests.valvetrain_cases import spec_from
+    from vtool.solvers.contact import ContactProblem
+    from vtool.solvers.model import assemble
+    from vtool.solvers.newmark import KernelRun, NewmarkOptions
+    from vtool.solvers.trace import TraceBuilder
+
+    spec = spec_from(hertz_doc())
+    jit = simulate(spec)  # the tests' mode: numba's kernel
+    mechanism = assemble(spec)
+    problem = ContactProblem(mechanism)
+    run = KernelRun(problem, NewmarkOptions.from_run(spec.run), TraceBuilder(spec, problem.source_numbers,
+                                                                              problem.omega))
+    monkeypatch.setattr(kernel_native, "folder", lambda: tmp_path)
+    monkeypatch.setenv("VTOOL_NATIVE", "1")
+    name = kernel_native.module_name(run.arguments())
+    assert name.startswith("vtool_native_h1m0_")
+    kernel_native.build(name, run.signature)
+    assert kernel_native.exists((True, None)) and not kernel_native.exists((None, None))
+    monkeypatch.setenv("VTOOL_KERNEL", "auto")
+    native = simulate(spec)
+    assert native.statistics.kernel == "native"
+    assert len(native.events) == len(jit.events)
+    for name in ("time", "q", "qd", "qdd", "contact_force", "configuration", "peak_force", "peak_overlap"):
+        np.testing.assert_array_equal(getattr(native, name), getattr(jit, name), err_msg=name)
