@@ -68,8 +68,6 @@ import numpy as np
 from vtool import numba_cache
 
 HERE = Path(__file__).resolve().parent
-#: What the module is compiled from: the run loop, and the CSV number formatter it carries too.
-SOURCES = (HERE / "newmark_kernel.py", HERE / "kernel_layout.py", HERE.parent / "vtool" / "csvrows_kernel.py")
 PREFIX = "vtool_native_"
 _loaded: dict[str, ModuleType] = {}
 
@@ -126,10 +124,18 @@ def _cpu() -> str:
     return platform.processor()
 
 
+def sources() -> list[Path]:
+    """What a module is compiled from (the run loop, its layout, the CSV formatter it carries too) and how
+    (this file). Found, not imported: the CSV formatter's module imports numba."""
+    csv = importlib.util.find_spec("vtool.csvrows_kernel")
+    assert csv is not None and csv.origin is not None
+    return [HERE / "newmark_kernel.py", HERE / "kernel_layout.py", Path(csv.origin), Path(__file__)]
+
+
 @cache
 def _environment() -> str:
     digest = hashlib.sha256()
-    for source in (*SOURCES, Path(__file__)):  # and how it is built (this file)
+    for source in sources():
         digest.update(source.read_bytes())
     parts = [digest.hexdigest(), _package_stamp("numba"), _package_stamp("llvmlite"), np.__version__,
              sys.implementation.cache_tag or "", platform.machine(), _cpu()]

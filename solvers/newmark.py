@@ -88,7 +88,7 @@ from vtool.solvers.model import Mechanism
 from vtool.solvers.spec import HERTZ, MOMENTUM, RIGID, RunSpec
 from vtool.solvers.trace import TraceBuilder
 
-COMPILE_ESTIMATE_S = 15.0  # first compile of the kernel on a 2-core machine (benchmarks/bench_newmark.py)
+COMPILE_ESTIMATE_S = 20.0  # first compile of the kernel on a 2-core machine: 18.6-19.7 s (benchmarks/bench_newmark.py)
 RULES_COMPILE_ESTIMATE_S = 5.0  # of the event rules alone (impact, settle, fill_sources: the piecewise back ends)
 ROW_BUFFER = 4096  # output rows between flushes: memory stays bounded for any run length
 EVENT_BUFFER = 4096

@@ -10,6 +10,7 @@ import os
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -180,3 +181,14 @@ def test_a_hertz_contact_runs_on_its_own_module_to_the_last_bit(monkeypatch, tmp
     assert len(native.events) == len(jit.events)
     for name in ("time", "q", "qd", "qdd", "contact_force", "configuration", "peak_force", "peak_overlap"):
         np.testing.assert_array_equal(getattr(native, name), getattr(jit, name), err_msg=name)
+
+
+def test_the_digest_reads_the_files_the_module_is_built_from() -> None:
+    from vtool import csvrows
+
+    files = kernel_native.sources()
+    assert all(file.is_file() for file in files)
+    assert {file.name for file in files} == {"newmark_kernel.py", "kernel_layout.py", "csvrows_kernel.py",
+                                              "kernel_native.py"}
+    assert files[0] == Path(kernel.__file__).resolve()
+    assert files[2].parent == Path(csvrows.__file__).parent  # beside the CSV writer, whatever the install
