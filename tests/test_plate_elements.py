@@ -75,8 +75,12 @@ def test_constant_curvature_patch(element, dx, dy, nu, alpha, beta, gamma) -> No
     u = _nodal_values(element, dx, dy, _quadratic(alpha, beta, gamma))
     kxx, kyy, kxy = 2 * alpha, 2 * gamma, beta
     exact = D * dx * dy * (kxx**2 + kyy**2 + 2 * nu * kxx * kyy + 2 * (1 - nu) * kxy**2)
-    # rounding: nodal w grows like (size)², the energy like curvature²; allow 1e-7
-    assert u @ K @ u == pytest.approx(exact, rel=1e-7, abs=1e-7 * D * dx * dy)
+    # rounding: the form sums n² products u_i K_ij u_j (n = 24 at most) whose sizes grow with the element's
+    # aspect (nodal values like size², stiffnesses like size⁻²) while the energy does not: its error is
+    # bounded by n ε Σ|u_i K_ij u_j|. That is 1e-12 of the energy on a square element and 1e-5 of it on
+    # one of aspect 80 (where a fixed 1e-7 failed: 1.6e-7, dx = 17.5, dy = 0.21875, all rounding).
+    scale = np.abs(u) @ np.abs(K) @ np.abs(u)
+    assert u @ K @ u == pytest.approx(exact, rel=1e-12, abs=len(u) * np.finfo(float).eps * scale)
 
 
 @pytest.mark.parametrize("element", ELEMENTS, ids=lambda e: e.name)
