@@ -113,15 +113,12 @@ def _package_stamp(name: str) -> str:
 
 
 def _cpu() -> str:
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as info:
-            lines = [line for line in info.read().split("\n\n")[0].splitlines()
-                     if line.startswith(("model name", "flags", "Features", "CPU part"))]
-        if lines:
-            return "\n".join(lines)
-    except OSError:
-        pass
-    return platform.processor()
+    """The first CPU's model and flags from /proc/cpuinfo (Linux), else :func:`platform.processor`."""
+    lines: list[str] = []
+    with contextlib.suppress(OSError), open("/proc/cpuinfo", encoding="utf-8", errors="replace") as info:
+        lines = [line for line in info.read().split("\n\n")[0].splitlines()
+                 if line.startswith(("model name", "flags", "Features", "CPU part"))]
+    return "\n".join(lines) if lines else platform.processor()
 
 
 def sources() -> list[Path]:

@@ -321,16 +321,17 @@ class KernelRun:
         if mode == "plain":
             return kernel_build.plain_kernel(), False
         if (mode == "compiled" or not numba_cache.CACHE_ENABLED or self.ready()
-                or not kernel_build.start(self.jobs())):
+                or not kernel_build.start(self.jobs)):
             self.compile()
             if mode == "auto" and kernel_native.enabled():  # the kernel was cached but has no native module yet
-                kernel_build.start(self.jobs()[1:])
+                kernel_build.start(self.jobs[1:])
             return kernel_build.kernel(), False
         return kernel_build.plain_kernel(), True
 
+    @cached_property
     def jobs(self) -> list[kernel_build.Job]:
         """What the background child builds for this run: ``run_chunk`` into numba's cache, then (unless
-        ``VTOOL_NATIVE=0``) its native module (:mod:`vtool.solvers.kernel_native`)."""
+        ``VTOOL_NATIVE=0``) its native module (:mod:`vtool.solvers.kernel_native`). Fixed for the run."""
         jobs: list[kernel_build.Job] = [("run_chunk", self.signature)]
         if kernel_native.enabled():
             jobs.append(("native", (kernel_native.module_name(self.arguments()), self.signature)))
@@ -344,7 +345,7 @@ class KernelRun:
         self.fst[layout.F_CHUNK_END] = self.fst[layout.F_T] + chunk
         while True:
             # the child's compile is in the cache (or the child is gone without it: compile here): go on compiled
-            if building and (self.ready() or not kernel_build.compiling(self.jobs())):
+            if building and (self.ready() or not kernel_build.compiling(self.jobs)):
                 self.plain_steps = int(self.ist[layout.I_STEPS])
                 self.compile()
                 module, building = kernel_build.kernel(), False
