@@ -10,6 +10,12 @@ variable themselves (tests/test_first_run.py).
 ``VTOOL_NATIVE=0``: no run builds or uses the kernel's native module
 (:mod:`vtool.solvers.kernel_native`), so that a test in ``auto`` mode starts no
 native build in the background; the native module's own tests set it to 1.
+
+The suite runs on pytest-xdist workers (``-n auto``, at most four: see
+``pyproject.toml``), each a process of its own that imports this file: the
+workers share numba's cache, so a kernel one of them compiled is loaded by
+the others. On the 2-core development machine two workers took the suite
+from 8 min 21 s to 5 min 34 s (2026-11-26, empty numba cache both times).
 """
 
 import os

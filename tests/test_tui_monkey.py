@@ -12,7 +12,7 @@ CI runs one sequence of 30 events (about 11 s; docs/tui.md, "Monkey test",
 says where a sequence's time goes); ``VTOOL_MONKEY=1000`` runs 1,000
 sequences of 50 events and prints what it found::
 
-    VTOOL_MONKEY=1000 .venv/bin/python -m pytest -q -s tests/test_tui_monkey.py
+    VTOOL_MONKEY=1000 .venv/bin/python -m pytest -q -n 0 -s tests/test_tui_monkey.py
 
 A failure names the seed; ``VTOOL_MONKEY_SEED=<seed> VTOOL_MONKEY=1`` replays it.
 """
