@@ -26,7 +26,9 @@ beside the lock with its error; later runs then compile in their own process
 
 Which kernel a run uses (``VTOOL_KERNEL``, :func:`kernel_mode`): ``auto``
 (the default) as above; ``compiled`` compiles in the run's own process
-before its first step, as numba does by default; ``plain`` never compiles.
+before its first step, as numba does by default (or, while another process
+compiles the same kernel, waits for it and loads it: :func:`compile_once`);
+``plain`` never compiles.
 The piecewise back ends call only the event rules (``settle``, ``impact``,
 ``fill_sources`` and, with compliant contacts, ``snap_shut``,
 ``relative_velocity``, ``hertz_law``), a few hundred times a run: in
@@ -181,6 +183,8 @@ def failed_path(lock: Path) -> Path:
 
 
 def _alive(pid: int) -> bool:
+    for child in _children:  # this process's own children: one that has ended is reaped, not taken for alive
+        child.poll()
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -344,6 +348,48 @@ def compile_kernel(signature: tuple[Any, ...]) -> None:
         if helper is not None and helper.poll() is None:
             helper.kill()
             helper.wait()
+
+
+#: How often (s) a run polls the lock of a compile another process is doing (:func:`compile_once`).
+POLL_S = 0.2
+
+
+def compile_once(signature: tuple[Any, ...], cached: Any) -> None:
+    """:func:`compile_kernel` for ``signature``, or, while another process compiles the same kernel,
+    wait for it and load its result from numba's cache.
+
+    ``cached()`` says whether the kernel is in the cache. The compile holds
+    the lock of the job ``("run_chunk", signature)`` (:func:`lock_path`; a
+    child started with that job list holds the same one): so the workers
+    of a sweep, the processes of a parallel test run or terminals started
+    together in the ``compiled`` mode compile a kernel once between them,
+    where each compiled it on two processes of its own, all at once. A lock
+    whose process dies, or that outlives :data:`STALE_S`, stops the wait;
+    then this process compiles. Without a cache to share through (or
+    without a lock), it compiles at once.
+    """
+    from vtool import numba_cache
+
+    lock = lock_path([("run_chunk", signature)])
+    while numba_cache.CACHE_ENABLED:
+        taken = _take(lock)
+        if taken is None:
+            break  # no lock can be made here: compile without one
+        if taken is False:  # another process compiles it
+            while holder_alive(lock):
+                time.sleep(POLL_S)
+            if cached():
+                kernel().run_chunk.compile(signature)  # a load from the cache
+                return
+            continue  # it ended without the kernel: take the lock and compile here
+        try:
+            with contextlib.suppress(OSError):
+                lock.write_text(str(os.getpid()))
+            compile_kernel(signature)
+        finally:
+            lock.unlink(missing_ok=True)
+        return
+    compile_kernel(signature)
 
 
 def _compile(jobs: list[Job]) -> None:

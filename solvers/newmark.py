@@ -298,8 +298,9 @@ class KernelRun:
         started = wallclock.perf_counter()
         if self.ready():
             kernel.run_chunk.compile(signature)  # a load from the cache
-        else:
-            kernel_build.compile_kernel(signature)  # on two processes
+        else:  # on two processes; once, should another process be compiling the same kernel
+            kernel_build.compile_once(signature, lambda: kernel.is_cached(
+                ("run_chunk",), self.problem.hertz, self.problem.momentum))
         self.compile_time += wallclock.perf_counter() - started
 
     def ready(self) -> bool:

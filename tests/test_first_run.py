@@ -12,6 +12,7 @@ import json
 import os
 import subprocess
 import sys
+import threading
 import time
 
 import numpy as np
@@ -145,6 +146,59 @@ def test_one_lock_per_compile(tmp_path) -> None:  # noqa: ANN001
     lock.write_text("not a process id")
     assert not kernel_build.holder_alive(lock)
     assert kernel_build._take(tmp_path / "missing" / "kernel.lock") is None  # no lock to be had
+
+
+class FakeKernel:
+    """Stands in for the kernel module in compile_once's tests: notes the loads of run_chunk."""
+
+    def __init__(self) -> None:
+        self.loads: list[tuple] = []
+        self.run_chunk = self
+
+    def compile(self, signature: tuple) -> None:
+        self.loads.append(signature)
+
+
+def test_compiled_runs_compile_a_kernel_once_between_processes(tmp_path, monkeypatch) -> None:  # noqa: ANN001
+    """compile_once: with no compile under way it holds the lock while it compiles; while another
+    process holds it, it waits and loads the result; if that process ends without the kernel, it
+    compiles itself."""
+    from vtool import numba_cache
+
+    monkeypatch.setattr(numba_cache, "CACHE_ENABLED", True)
+    lock = tmp_path / "kernel.lock"
+    monkeypatch.setattr(kernel_build, "lock_path", lambda jobs: lock if jobs == [("run_chunk", ("sig",))] else None)
+    monkeypatch.setattr(kernel_build, "POLL_S", 0.01)
+    fake = FakeKernel()
+    monkeypatch.setattr(kernel_build, "kernel", lambda: fake)
+    compiled: list[str] = []
+
+    def compile_kernel(signature: tuple) -> None:
+        compiled.append(lock.read_text())  # the lock is held, with this process's id, meanwhile
+    monkeypatch.setattr(kernel_build, "compile_kernel", compile_kernel)
+
+    kernel_build.compile_once(("sig",), cached=lambda: False)  # nobody else: compiled here
+    assert compiled == [str(os.getpid())] and not lock.exists() and fake.loads == []
+
+    compiled.clear()
+    lock.write_text(str(os.getpid()))  # another compile of the same kernel holds the lock (a live process)
+    threading.Timer(0.5, lock.unlink).start()  # ... and finishes in 0.5 s
+    started = time.monotonic()
+    kernel_build.compile_once(("sig",), cached=lambda: True)
+    assert time.monotonic() - started >= 0.4  # it waited for the other compile ...
+    assert compiled == [] and fake.loads == [("sig",)]  # ... and loaded its kernel from the cache
+
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True, check=True).stdout.strip()
+    lock.write_text(gone)  # the other process died without the kernel
+    kernel_build.compile_once(("sig",), cached=lambda: False)
+    assert compiled == [str(os.getpid())] and not lock.exists()
+
+    monkeypatch.setattr(numba_cache, "CACHE_ENABLED", False)  # nothing to share: compiled at once
+    compiled.clear()
+    lock.write_text(str(os.getpid()))
+    kernel_build.compile_once(("sig",), cached=lambda: True)
+    assert len(compiled) == 1
 
 
 def test_a_failed_child_leaves_its_error_and_no_lock(tmp_path, monkeypatch) -> None:  # noqa: ANN001
