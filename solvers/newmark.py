@@ -90,8 +90,16 @@ from vtool.solvers.trace import TraceBuilder
 
 COMPILE_ESTIMATE_S = 20.0  # first compile of the kernel on a 2-core machine: 18.6-19.7 s (benchmarks/bench_newmark.py)
 RULES_COMPILE_ESTIMATE_S = 5.0  # of the event rules alone (impact, settle, fill_sources: the piecewise back ends)
-ROW_BUFFER = 4096  # output rows between flushes: memory stays bounded for any run length
-EVENT_BUFFER = 4096
+ROW_BUFFER = 4096  # output rows between flushes at most: memory stays bounded for any run length
+EVENT_BUFFER = 1024  # events between flushes
+
+
+def row_buffer(t_end: float, out_dt: float, every_step: bool) -> int:
+    """Rows of a run's output buffer: :data:`ROW_BUFFER`, or fewer when the run's rows at the output
+    interval (the start's included) fit in fewer (1A: 852 rows, not 4096, to allocate per run)."""
+    if every_step or not out_dt > 0.0:
+        return ROW_BUFFER
+    return int(min(ROW_BUFFER, t_end / out_dt + 3.0))
 
 
 @dataclass(frozen=True)
@@ -239,18 +247,21 @@ class KernelRun:
         self.t_end = spec.run.degrees * math.pi / 180.0 / problem.omega
         fine = dt / options.refine
         problem.tables.use_step(dt, options.beta, options.gamma, fine)
+        out_dt = options.output_interval * math.pi / 180.0 / problem.omega
         self.ip, self.fp = problem.parameters(
             dt=dt, beta=options.beta, gamma=options.gamma, t_end=self.t_end,
-            out_dt=options.output_interval * math.pi / 180.0 / problem.omega, every_step=options.every_step,
+            out_dt=out_dt, every_step=options.every_step,
             time_tol=options.time_tolerance or 1e-6 * dt, refine=float(options.refine),
             refine_window=options.refine_periods * 2 * math.pi / problem.omega_max)
         n, ncl, ns = problem.n, problem.ncl, problem.ns
-        self.out_t = np.zeros(ROW_BUFFER)
-        self.out_q = np.zeros((ROW_BUFFER, 3, n + ns))
-        self.out_F = np.zeros((ROW_BUFFER, ncl))
-        self.out_c = np.zeros(ROW_BUFFER, dtype=np.int64)
-        self.ev_f = np.zeros((EVENT_BUFFER, 2))
-        self.ev_i = np.zeros((EVENT_BUFFER, 4), dtype=np.int64)
+        rows = row_buffer(self.t_end, out_dt, options.every_step)
+        # uninitialised: the kernel fills a row (an event) whole before flush reads it, and reads no other
+        self.out_t = np.empty(rows)
+        self.out_q = np.empty((rows, 3, n + ns))
+        self.out_F = np.empty((rows, ncl))
+        self.out_c = np.empty(rows, dtype=np.int64)
+        self.ev_f = np.empty((EVENT_BUFFER, 2))
+        self.ev_i = np.empty((EVENT_BUFFER, 4), dtype=np.int64)
         self.peak = np.zeros((3, ncl))
         start = mechanism.start
         self.x, self.v, self.a = start.q.copy(), start.qd.copy(), start.qdd.copy()
