@@ -120,7 +120,7 @@ class ConfigurationTables:
         count = 2**ncl
         self.ci = np.zeros((count, layout.CI_HEAD + 3 * n), dtype=np.int64)
         self.cm = np.zeros((count, layout.CM_SIZE, n, n))
-        self.cp = np.zeros((count, layout.CP_SIZE, layout.PART_SIZE, n, 3 * max(n, ns)))  # layout.CP_RAW
+        self.cp = np.zeros((count, layout.CP_SIZE, layout.PART_SIZE, 3 * max(n, ns), n))  # layout.CP_RAW
         self.mk = np.zeros((count, ncl, layout.MK_SIZE), dtype=np.int64)
         self.mon = np.zeros((count, ncl, 3 * n + 3 * ns + 1 + ncl))
         # a force row's nonzero terms (layout.MK_TERMS): their columns of mon, their coefficients
@@ -149,9 +149,10 @@ class ConfigurationTables:
         M, C, K = cm[layout.CM_MFF, :nf, :nf], cm[layout.CM_CFF, :nf, :nf], cm[layout.CM_KFF, :nf, :nf]
         cm[layout.CM_SINV, :nf, :nf] = np.linalg.inv(M + gamma * dt * C + beta * dt * dt * K)
         cm[layout.CM_SINVF, :nf, :nf] = np.linalg.inv(M + gamma * fine * C + beta * fine * fine * K)
-        cp = self.cp[mask]  # G = S⁻¹R, part by part (see layout.CP_RAW)
-        cp[layout.CP_STD, :, :nf] = cm[layout.CM_SINV, :nf, :nf] @ cp[layout.CP_RAW, :, :nf]
-        cp[layout.CP_FINE, :, :nf] = cm[layout.CM_SINVF, :nf, :nf] @ cp[layout.CP_RAW, :, :nf]
+        cp = self.cp[mask]  # G = S⁻¹R, part by part, stored transposed as R is (see layout.CP_RAW)
+        raw = np.ascontiguousarray(np.swapaxes(cp[layout.CP_RAW, :, :, :nf], 1, 2))  # R's free rows
+        cp[layout.CP_STD, :, :, :nf] = np.swapaxes(cm[layout.CM_SINV, :nf, :nf] @ raw, 1, 2)
+        cp[layout.CP_FINE, :, :, :nf] = np.swapaxes(cm[layout.CM_SINVF, :nf, :nf] @ raw, 1, 2)
 
     def build(self, mask: int) -> OrderedLayer:
         """Partition configuration ``mask`` and fill its rows (see the module doc)."""
@@ -185,13 +186,13 @@ class ConfigurationTables:
         cm[layout.CM_KFF, :nf, :nf] = K_o[:nf, :nf]
         if nf:
             cm[layout.CM_MINVFF, :nf, :nf] = np.linalg.inv(M_o[:nf, :nf])
-        raw = self.cp[mask, layout.CP_RAW]  # layout: see layout.CP_RAW
-        raw[layout.PART_C, :nf, :nf] = C_o[:nf, :nf]
-        raw[layout.PART_K, :nf, :nf] = K_o[:nf, :nf]
-        raw[layout.PART_P, :nf, 0:3 * (m - nf):3] = M_o[:nf, nf:]
-        raw[layout.PART_P, :nf, 1:3 * (m - nf):3] = C_o[:nf, nf:]
-        raw[layout.PART_P, :nf, 2:3 * (m - nf):3] = K_o[:nf, nf:]
-        raw[layout.PART_S, :nf, :S_o.shape[1]] = S_o[:nf]
+        raw = self.cp[mask, layout.CP_RAW]  # Rᵀ: see layout.CP_RAW
+        raw[layout.PART_C, :nf, :nf] = C_o[:nf, :nf].T
+        raw[layout.PART_K, :nf, :nf] = K_o[:nf, :nf].T
+        raw[layout.PART_P, 0:3 * (m - nf):3, :nf] = M_o[:nf, nf:].T
+        raw[layout.PART_P, 1:3 * (m - nf):3, :nf] = C_o[:nf, nf:].T
+        raw[layout.PART_P, 2:3 * (m - nf):3, :nf] = K_o[:nf, nf:].T
+        raw[layout.PART_S, :S_o.shape[1], :nf] = S_o[:nf].T
         ci[layout.CI_SRC] = int(bool(S_o[:nf].any()))
         ci[layout.CI_HERTZ] = int(bool(springs.hertz))
         self._monitors(mask, part, group, m, springs)

@@ -43,7 +43,8 @@ CI_HEAD = 5
 # configuration matrices
 CM_MFF, CM_CFF, CM_KFF, CM_SINV, CM_SINVF, CM_MINVFF = range(6)
 CM_SIZE = 6
-# step operators: cp[c, plane, part, f, :] for free z index f; plane CP_RAW holds R, whose parts are
+# step operators, transposed: cp[c, plane, part, :, f] for free z index f (each column's coefficients
+# on the free rows side by side: see :func:`apply_operator`); plane CP_RAW holds R, whose parts are
 # C_FF, K_FF, the (M, C, K) columns of each prescribed z index p (at 3p, 3p + 1, 3p + 2) and the
 # sources' pull S (3 per source), so that the free rows' ΔP is R·(ż, z, (z̈, ż, z)_P, src); planes
 # CP_STD and CP_FINE hold G = S⁻¹R of the standard and the refined step, so that a step with a stored

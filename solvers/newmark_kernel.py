@@ -195,7 +195,7 @@ inner = _plain if PLAIN else njit(**_INNER)
 tiny = _plain if PLAIN else njit(**_INNER, inline="always")
 
 #: :func:`vtool.solvers.kernel_layout.fingerprint` of the layout this file was compiled with (see there).
-LAYOUT_FINGERPRINT = "473f9d95f0d71566"
+LAYOUT_FINGERPRINT = "af2d183818068fad"
 
 # how a step solves S z̈ = rhs (layer_step's ``which``): stored inverses of the standard and refined
 # steps, or a Cholesky factor. np.int64 values, not int literals: numba compiles a function once per
@@ -302,29 +302,31 @@ def set_prescribed(ci, c, n, src, z, zd, zdd):
 def apply_operator(cp, c, plane, nf, m, coupled, src, z, zd, zdd, out):
     """out_F = -R·(ż_F, z_F, (z̈, ż, z)_P, src) for step operator R = cp[c, plane] (see ``CP_RAW``).
 
-    Two rows at a time (the second repeats the first when nf is odd), each summed in column order:
-    the two running sums are independent, so the processor overlaps them. Indexed in place: a view
-    of cp (an array rebound in the step loop) would cost a reference-count increment and decrement
-    per step."""
-    for f in range(0, nf, 2):
-        e = f + 1 if f + 1 < nf else f
-        s = 0.0
-        r = 0.0
-        for g in range(nf):
-            s -= cp[c, plane, PART_C, f, g] * zd[g] + cp[c, plane, PART_K, f, g] * z[g]
-            r -= cp[c, plane, PART_C, e, g] * zd[g] + cp[c, plane, PART_K, e, g] * z[g]
-        for p in range(m - nf):
-            j = nf + p
-            s -= (cp[c, plane, PART_P, f, 3 * p] * zdd[j] + cp[c, plane, PART_P, f, 3 * p + 1] * zd[j]
-                  + cp[c, plane, PART_P, f, 3 * p + 2] * z[j])
-            r -= (cp[c, plane, PART_P, e, 3 * p] * zdd[j] + cp[c, plane, PART_P, e, 3 * p + 1] * zd[j]
-                  + cp[c, plane, PART_P, e, 3 * p + 2] * z[j])
-        if coupled:
-            for j in range(src.shape[0]):
-                s -= cp[c, plane, PART_S, f, j] * src[j]
-                r -= cp[c, plane, PART_S, e, j] * src[j]
-        out[f] = s
-        out[e] = r
+    Column by column: cp holds Rᵀ, each column's coefficients on the free rows side by side, so
+    that every row's running sum takes the column's term in one pass over the rows, a loop the
+    compiler runs on vectors of rows; each row is still summed in column order. Indexed in place: a
+    view of cp (an array rebound in the step loop) would cost a reference-count increment and
+    decrement per step."""
+    for f in range(nf):
+        out[f] = 0.0
+    for g in range(nf):
+        a = zd[g]
+        b = z[g]
+        for f in range(nf):
+            out[f] -= cp[c, plane, PART_C, g, f] * a + cp[c, plane, PART_K, g, f] * b
+    for p in range(m - nf):
+        j = nf + p
+        a = zdd[j]
+        b = zd[j]
+        d = z[j]
+        for f in range(nf):
+            out[f] -= (cp[c, plane, PART_P, 3 * p, f] * a + cp[c, plane, PART_P, 3 * p + 1, f] * b
+                       + cp[c, plane, PART_P, 3 * p + 2, f] * d)
+    if coupled:
+        for j in range(src.shape[0]):
+            a = src[j]
+            for f in range(nf):
+                out[f] -= cp[c, plane, PART_S, j, f] * a
 
 
 @inner
