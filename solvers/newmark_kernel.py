@@ -307,25 +307,28 @@ def apply_operator(cp, c, plane, nf, m, coupled, src, z, zd, zdd, out):
     compiler runs on vectors of rows; each row is still summed in column order. Indexed in place: a
     view of cp (an array rebound in the step loop) would cost a reference-count increment and
     decrement per step."""
-    for f in range(nf):
+    # the rows run on to a multiple of four where out and cp have room: a whole number of 4-row vectors,
+    # no row-by-row remainder; the rows past nf have zero coefficients, and nobody reads them from out
+    rows = min((nf + 3) // 4 * 4, out.shape[0], cp.shape[4])
+    for f in range(rows):
         out[f] = 0.0
     for g in range(nf):
         a = zd[g]
         b = z[g]
-        for f in range(nf):
+        for f in range(rows):
             out[f] -= cp[c, plane, PART_C, g, f] * a + cp[c, plane, PART_K, g, f] * b
     for p in range(m - nf):
         j = nf + p
         a = zdd[j]
         b = zd[j]
         d = z[j]
-        for f in range(nf):
+        for f in range(rows):
             out[f] -= (cp[c, plane, PART_P, 3 * p, f] * a + cp[c, plane, PART_P, 3 * p + 1, f] * b
                        + cp[c, plane, PART_P, 3 * p + 2, f] * d)
     if coupled:
         for j in range(src.shape[0]):
             a = src[j]
-            for f in range(nf):
+            for f in range(rows):
                 out[f] -= cp[c, plane, PART_S, j, f] * a
 
 
