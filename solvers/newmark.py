@@ -96,7 +96,7 @@ EVENT_BUFFER = 1024  # events between flushes
 
 def row_buffer(t_end: float, out_dt: float, every_step: bool) -> int:
     """Rows of a run's output buffer: :data:`ROW_BUFFER`, or fewer when the run's rows at the output
-    interval (the start's included) fit in fewer (1A: 852 rows, not 4096, to allocate per run)."""
+    interval (the start's included) fit in fewer (1A: 853 for its 851 rows, not 4096, to allocate per run)."""
     if every_step or not out_dt > 0.0:
         return ROW_BUFFER
     return int(min(ROW_BUFFER, t_end / out_dt + 3.0))

@@ -156,6 +156,22 @@ def test_quiet_steps_cam_angle_by_rotation_equals_libm_every_step(monkeypatch) -
     assert not np.array_equal(rotated.q, exact.q)  # (the switch did change the arithmetic)
 
 
+def test_the_row_buffer_holds_a_run_at_its_output_interval_or_4096_rows() -> None:
+    """KernelRun allocates its output rows per run (newmark.row_buffer): the rows at the output
+    interval, the start's and a round-off's included, up to ROW_BUFFER; an every-step run takes the
+    cap (the kernel flushes a full buffer and goes on, so any size is correct, only slower)."""
+    from vtool.solvers.newmark import ROW_BUFFER, row_buffer
+
+    assert row_buffer(850.0, 1.0, every_step=False) == 853  # 1A: 851 rows at 1 degree (0 to 850)
+    assert row_buffer(850.0 * (1 + 1e-15), 1.0, every_step=False) == 853
+    assert row_buffer(36000.0, 1.0, every_step=False) == ROW_BUFFER
+    assert row_buffer(850.0, 1.0, every_step=True) == ROW_BUFFER
+    assert row_buffer(850.0, 0.0, every_step=False) == ROW_BUFFER
+    assert row_buffer(850.0, math.nan, every_step=False) == ROW_BUFFER
+    trace = simulate(load_preset("gnilka-1a"))
+    assert len(trace.time) == 851 <= row_buffer(trace.time[-1], trace.time[1] - trace.time[0], False)
+
+
 def test_stability_limit_of_linear_acceleration() -> None:
     assert stability_limit(1 / 6, 0.5, 1.0) == pytest.approx(math.sqrt(12))
     assert stability_limit(0.25, 0.5, 1.0) == math.inf
