@@ -35,7 +35,7 @@ in parallel on it (:func:`_releasing_the_gil`).
 
 Same results: the module is the JIT kernel's source compiled by the same
 numba and LLVM with the same options; its results equal the JIT kernel's to
-the last bit (``tests/test_first_run.py`` compares a whole 1A run).
+the last bit (``tests/test_native.py`` compares a whole 1A run).
 
 Build: :func:`build` writes into a temporary folder beside the final file and
 renames it into place, so a reader never sees half a module. ``numba.pycc``
@@ -153,14 +153,18 @@ def module_name(values: tuple[Any, ...]) -> str:
     return f"{PREFIX}{_switches(*values[-2:])}_{_digest(_environment())}_{_digest(type_key(values))}"
 
 
+def _pattern(switches: str) -> str:
+    """The file names of this kernel's, numba's and CPU's modules for law switches ``switches`` (``*``: any)."""
+    return f"{PREFIX}{switches}_{_digest(_environment())}_*{importlib.machinery.EXTENSION_SUFFIXES[0]}"
+
+
 def exists(laws: tuple[bool | None, bool | None]) -> bool:
     """True when a native module for these law switches is there, for this kernel, numba and CPU (asked
     before a run is set up: a valve-train run's argument types are given by its law switches)."""
     where = folder() if enabled() else None
     if where is None:
         return False
-    pattern = f"{PREFIX}{_switches(*laws)}_{_digest(_environment())}_*{importlib.machinery.EXTENSION_SUFFIXES[0]}"
-    return any(where.glob(pattern))
+    return any(where.glob(_pattern(_switches(*laws))))
 
 
 def path(name: str) -> Path:
@@ -190,9 +194,8 @@ def csv_writer() -> Any | None:
         return loaded.put_rows
     where = folder()
     assert where is not None
-    suffix = importlib.machinery.EXTENSION_SUFFIXES[0]
-    for file in sorted(where.glob(f"{PREFIX}*_{_digest(_environment())}_*{suffix}")):
-        found = _load_file(file.name.removesuffix(suffix), file)
+    for file in sorted(where.glob(_pattern("*"))):
+        found = _load_file(file.name.removesuffix(importlib.machinery.EXTENSION_SUFFIXES[0]), file)
         if found is not None:
             return found.put_rows
     return None

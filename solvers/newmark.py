@@ -310,8 +310,7 @@ class KernelRun:
         if self.ready():
             kernel.run_chunk.compile(signature)  # a load from the cache
         else:  # on two processes; once, should another process be compiling the same kernel
-            kernel_build.compile_once(signature, lambda: kernel.is_cached(
-                ("run_chunk",), self.problem.hertz, self.problem.momentum))
+            kernel_build.compile_once(signature, self.ready)
         self.compile_time += wallclock.perf_counter() - started
 
     def ready(self) -> bool:
