@@ -56,8 +56,12 @@ pull (an impact so released is a bounce: two events at one instant).
 Compile time
 ------------
 Entry points (``@jit``) get numba's CPython wrapper; functions only compiled
-code calls (``@inner``) get none; helpers of a few lines (``@tiny``) are
-copied into their callers as numba IR and never compiled on their own. The
+code calls (``@inner``) get none. Each is compiled once and linked into its
+callers, where LLVM inlines the small ones. Only :func:`apply_operator`, the
+quiet step's product, is ``@tiny``: copied into its callers as numba IR, so
+that LLVM vectorizes it in place (with it ``@inner`` too the quiet step was 21 % slower
+on 1A; numba's copies of the other helpers cost a sixth of the compile and no
+run speed: ``bench_step_ab.py``, ``bench_compile_ab.py``). The
 ``hertz`` and ``momentum`` arguments (:func:`~vtool.solvers.kernel_layout.laws`) are None when no
 clearance uses that law: numba then prunes the branches under them before
 typing, so the Hertz iteration and the momentum-law LCP are compiled (and
@@ -191,7 +195,7 @@ _INNER: dict[str, Any] = {**_OPTIONS, "no_cpython_wrapper": True, "no_cfunc_wrap
 jit = _plain if PLAIN else njit(**_OPTIONS)  # entry points, callable from Python
 # Called only from compiled code: no CPython or C wrapper to build (about 0.07 s of compile each).
 inner = _plain if PLAIN else njit(**_INNER)
-# A few lines each: their code is copied into the caller (numba IR), with no compile of their own.
+# Copied into the caller as numba IR, with no compile of its own (see "Compile time" above).
 tiny = _plain if PLAIN else njit(**_INNER, inline="always")
 
 #: :func:`vtool.solvers.kernel_layout.fingerprint` of the layout this file was compiled with (see there).
@@ -242,7 +246,7 @@ def is_cached(names: tuple[str, ...] = ENTRY_POINTS, hertz: bool | None = None,
 
 
 # ----- sources -----
-@tiny
+@inner
 def sources(ns, nh, omega, sc, sa, sb, t, src):
     """src[3s : 3s + 3] = (x, v, a) of every source s at t (harmonics by angle addition)."""
     c1 = math.cos(omega * t)
@@ -271,7 +275,7 @@ def fill_sources(ns, nh, omega, sc, sa, sb, t, src):
 
 
 # ----- layer values of a configuration -----
-@tiny
+@inner
 def gather(ci, c, n, x, v, a, z, zd, zdd):
     for j in range(ci[c, CI_M]):
         i = ci[c, CI_HEAD + j]
@@ -280,7 +284,7 @@ def gather(ci, c, n, x, v, a, z, zd, zdd):
         zdd[j] = a[i]
 
 
-@tiny
+@inner
 def scatter(ci, c, n, z, zd, zdd, x, v, a):
     for i in range(n):
         j = ci[c, CI_HEAD + n + i]
@@ -289,7 +293,7 @@ def scatter(ci, c, n, z, zd, zdd, x, v, a):
         a[i] = zdd[j]
 
 
-@tiny
+@inner
 def set_prescribed(ci, c, n, src, z, zd, zdd):
     for j in range(ci[c, CI_NF], ci[c, CI_M]):
         s = ci[c, CI_HEAD + 2 * n + j]
@@ -354,7 +358,7 @@ def factor_effective(ci, cm, c, beta, gamma, h, L):
                 L[f, g] = s / L[g, g]
 
 
-@tiny
+@inner
 def cholesky_solve(nf, L, rhs, out):
     for f in range(nf):
         s = rhs[f]
@@ -402,7 +406,7 @@ def hertz_law(clf, k, delta, rate):
     return force, exponent * power / delta * (1.0 + lam * rate), power * lam
 
 
-@tiny
+@inner
 def overlap_and_rate(mon, c, k, n, ns, z, zd, src):
     """(δ, δ̇) of a closed Hertz contact: its monitor row holds -w on z and on ż, +1 on its source."""
     delta = 0.0
@@ -550,7 +554,7 @@ def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk,
         zdd[f] = s
 
 
-@tiny
+@inner
 def contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src):
     """Contact force of closed clearance k: its row on (z, ż, z̈, sources, 1), summed term by term in
     the order z_0, ż_0, z̈_0, z_1, …, then the sources. A zero term adds exactly nothing, so
@@ -580,7 +584,7 @@ def rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz):
     return f
 
 
-@tiny
+@inner
 def monitor_value(cl, clf, mk, mon, c, k, n, ns, gap_noise, z, zd, zdd, src, hertz):
     """What changes sign at clearance k's next event; 0 when not monitored.
 
@@ -632,7 +636,7 @@ def record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, sr
 
 
 # ----- impacts -----
-@tiny
+@inner
 def add_event(ev_f, ev_i, ist, t, k, kind, u, c_from, c_to):
     row = ist[I_NEV]
     if row < ev_f.shape[0]:
@@ -810,7 +814,7 @@ def impact_momentum(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, e
     return mask
 
 
-@tiny
+@inner
 def prescribed_velocity(cl, c, ncl, coordinate, src):
     """Velocity of the source a coordinate is tied to in configuration c, or nan if it is free."""
     for k in range(ncl):
@@ -1204,7 +1208,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, o
 
 
 
-@tiny
+@inner
 def interpolate(nf, s_out, h, z, zd, zdd, zdd1, zo, zdo, zddo):
     """The free coordinates at s_out into a step of length h from (z, ż, z̈) whose end acceleration is
     z̈1: the linear-acceleration interpolant (exact for beta = 1/6; thesis eqs. B.3-B.5)."""
@@ -1274,7 +1278,7 @@ def take_events(ip, fp, cl, clf, mass, c, t, h, tau, closing, x, v, src0, ev_f, 
     return new_c
 
 
-@tiny
+@inner
 def copy_state(m, z, zd, zdd, src, z_to, zd_to, zdd_to, src_to):
     """The first m entries of (z, ż, z̈), and the sources, into (z_to, ż_to, z̈_to) and src_to."""
     for j in range(m):
@@ -1285,7 +1289,7 @@ def copy_state(m, z, zd, zdd, src, z_to, zd_to, zdd_to, src_to):
         src_to[j] = src[j]
 
 
-@tiny
+@inner
 def arrive(ist, fst, target, grid_next, k_grid, j_target):
     """Now at ``target``: the next standard grid point, or point ``j_target`` of the refined grid."""
     if target == grid_next:
