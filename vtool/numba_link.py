@@ -1,0 +1,167 @@
+"""Link-only numba libraries: a function that only compiled code calls gets no machine code of its own.
+
+How numba compiles a call chain. Each jitted function is lowered into its own
+code library. Finalizing a library links its callees' finished modules into
+it, runs LLVM's module passes (``-O3``, inlining) over the whole and makes
+machine code of it. numba finalizes every library as soon as its function is
+compiled, also for a function that only other compiled code calls (no CPython
+and no C wrapper: the kernels' ``@inner`` helpers, and numba's own overloads
+such as ``np.zeros``'s). So a callee at depth d of the call tree is optimized
+and made into machine code d + 1 times: for itself, inside its caller, inside
+its caller's caller, ... and only the copy in the entry point's library is
+ever run. For the Newmark kernel's first compile that was about a quarter of
+the compile's work (``benchmarks/bench_compile_phases.py``: module passes and
+code generation outside ``run_chunk``).
+
+What :func:`install` changes. The library of a function compiled with neither
+wrapper is *link-only*:
+
+* finalizing it links its callees' modules in and stops there (no module
+  passes, no machine code); its functions have had LLVM's function passes, as
+  numba runs them when it adds each module;
+* a library with a wrapper (an entry point) that links it in is finalized as
+  numba does it: its module passes see all the linked code at once, and its
+  machine code is the only one made;
+* numba's cache keeps a link-only library as its bitcode (kind ``"link"``),
+  which is all a caller needs, instead of machine code plus bitcode; loading
+  one gives a link-only library again;
+* an environment (numba's per-function object that dynamic exception messages
+  use) is set only where its symbol has machine code, and the entry point's
+  library sets those of the link-only callees in it after its code is made.
+
+Same results: the entry point's code is made from the same functions by the
+same passes. The Newmark kernel's runs (1A, 2, 3, the ramped cam, a Hertz
+drop) are equal to the last bit with and without it, and its quiet step is as
+fast (``tests/test_numba_link.py``; ``benchmarks/bench_compile_ab.py``).
+
+Guard: it installs only on a numba whose internals have the shape it was
+written for (numba 0.59 and later: ``CPUCodeLibrary.finalize``,
+``serialize_using_object_code``, ``_unserialize``, ``CPUContext.get_executable``,
+``JITCPUCodegen.set_env``); elsewhere numba runs as shipped. ``VTOOL_LINK_ONLY=0``
+makes no new library link-only (for comparisons); loading a cached one stays
+possible.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+#: Set on a library that is link-only (finalized without module passes or machine code).
+LINK_ONLY = "_vtool_link_only"
+#: numba's cache kind of a link-only library: its module's bitcode.
+KIND = "link"
+_installed: list[bool] = []
+
+
+def installed() -> bool:
+    """True when :func:`install` has patched this process's numba."""
+    return bool(_installed)
+
+
+def enabled() -> bool:
+    """False under ``VTOOL_LINK_ONLY=0``: new libraries are finalized as numba does."""
+    return os.environ.get("VTOOL_LINK_ONLY", "").strip() != "0"
+
+
+def install() -> bool:
+    """Patch numba (once per process) as the module docstring says; returns whether it is patched."""
+    if _installed:
+        return True
+    try:
+        from numba import _dynfunc
+        from numba.core import codegen, cpu
+        from numba.core.environment import lookup_environment
+
+        library_class = codegen.CPUCodeLibrary
+        jit_library = codegen.JITCodeLibrary
+        finalize = library_class.finalize
+        serialize = library_class.serialize_using_object_code
+        unserialize = library_class.__dict__["_unserialize"].__func__
+        finalize_specific = jit_library._finalize_specific
+        get_executable = cpu.CPUContext.get_executable
+        set_env = codegen.JITCPUCodegen.set_env
+        for needed in ("_finalize_dynamic_globals", "_verify_declare_only_symbols", "_get_module_for_linking",
+                       "_ensure_finalized", "_raise_if_finalized"):
+            getattr(library_class, needed)
+    except (ImportError, AttributeError, KeyError):
+        return False
+
+    def is_link_only(library: Any) -> bool:
+        return bool(getattr(library, LINK_ONLY, False))
+
+    def link_only_finalize(self: Any) -> None:
+        if not is_link_only(self):
+            return finalize(self)
+        self._raise_if_finalized()
+        seen = set()
+        for library in self._linking_libraries:
+            if library not in seen:
+                self._reload_init.update(library._reload_init)
+                seen.add(library)
+                self._final_module.link_in(library._get_module_for_linking(), preserve=True)
+        self._final_module.verify()
+        self._finalize_dynamic_globals()
+        self._verify_declare_only_symbols()
+        self._finalized = True
+        return None
+
+    def has_wrapper(library: Any, fndesc: Any) -> bool:
+        for name in (fndesc.llvm_cpython_wrapper_name, fndesc.llvm_cfunc_wrapper_name):
+            try:
+                library._final_module.get_function(name)
+            except NameError:
+                continue
+            return True
+        return False
+
+    def link_only_executable(self: Any, library: Any, fndesc: Any, env: Any) -> Any:
+        fresh = not library._finalized and enabled() and not has_wrapper(library, fndesc)
+        if fresh:
+            setattr(library, LINK_ONLY, True)
+        if not (fresh or is_link_only(library)):
+            return get_executable(self, library, fndesc, env)
+        # as numba's, with no function pointer (there is no wrapper to point at) and no machine code
+        return _dynfunc.make_function(fndesc.lookup_module(), fndesc.qualname.split(".")[-1],
+                                      f"compiled, link-only: {fndesc.qualname!r}", 0, env, (library,))
+
+    def link_only_serialize(self: Any) -> Any:
+        if not is_link_only(self):
+            return serialize(self)
+        self._ensure_finalized()
+        return (self.name, KIND, self._final_module.as_bitcode())
+
+    def link_only_unserialize(cls: Any, codegen_: Any, state: Any) -> Any:
+        name, kind, data = state
+        if kind != KIND:
+            return unserialize(cls, codegen_, state)
+        from llvmlite import binding
+
+        self = codegen_.create_library(name)
+        self._final_module = binding.parse_bitcode(data)
+        self._finalize_dynamic_globals()
+        setattr(self, LINK_ONLY, True)
+        self._finalized = True
+        return self
+
+    def guarded_set_env(self: Any, env_name: str, env: Any) -> None:
+        if self._engine.get_global_value_address(env_name):  # no machine code for a link-only symbol
+            set_env(self, env_name, env)
+
+    def finalize_and_set_envs(self: Any) -> None:
+        finalize_specific(self)
+        # the link-only callees' environments, now that their code is in this library's
+        for variable in self._final_module.global_variables:
+            if variable.name.startswith("_ZN08NumbaEnv"):
+                env = lookup_environment(variable.name)
+                if env is not None:
+                    guarded_set_env(self._codegen, variable.name, env)
+
+    library_class.finalize = link_only_finalize  # type: ignore[method-assign]
+    library_class.serialize_using_object_code = link_only_serialize  # type: ignore[method-assign]
+    library_class._unserialize = classmethod(link_only_unserialize)  # type: ignore[assignment]
+    jit_library._finalize_specific = finalize_and_set_envs  # type: ignore[method-assign]
+    cpu.CPUContext.get_executable = link_only_executable  # type: ignore[method-assign]
+    codegen.JITCPUCodegen.set_env = guarded_set_env  # type: ignore[method-assign]
+    _installed.append(True)
+    return True
