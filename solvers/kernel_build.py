@@ -286,7 +286,7 @@ def kernel_split(signature: tuple[Any, ...]) -> tuple[list[Job], list[Job]]:
     from numba import types
 
     (ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, out_F, out_c, ev_f, ev_i, peak,
-     x, v, a, ist, fst, hertz, momentum) = signature
+     x, v, a, ist, fst, work, L, closing, hertz, momentum) = signature
     i8, f8, b1 = types.int64, types.float64, types.boolean
     vec, mat, ivec = types.Array(f8, 1, "C"), types.Array(f8, 2, "C"), types.Array(i8, 1, "C")
     helper: list[Job] = [

@@ -69,6 +69,8 @@ I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_SETTLE, I_WAN
 I_SIZE = 11  # I_SUB: refined steps taken since the grid point I_GRID (the refined steps' own grid)
 F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
 F_SIZE = 4
+# run_chunk's float scratch ``work``: this many values per coordinate, per source and per clearance
+WORK_PER_N, WORK_PER_SOURCE, WORK_PER_CLEARANCE = 11, 9, 3
 
 
 def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:

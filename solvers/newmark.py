@@ -270,6 +270,10 @@ class KernelRun:
         self.ist[layout.I_NEED_SETTLE] = 1
         self.fst = np.zeros(layout.F_SIZE)
         self.fst[layout.F_LAST_EVENT] = -1.0
+        # run_chunk's scratch (it zeroes them at each call)
+        self.work = np.zeros(layout.WORK_PER_N * n + layout.WORK_PER_SOURCE * ns + layout.WORK_PER_CLEARANCE * ncl)
+        self.L = np.zeros((n, n))
+        self.closing = np.zeros(ncl, dtype=np.int64)
         self.compile_time = 0.0
         self.plain_steps = 0  # steps taken by the plain-Python kernel (before the compiled one was ready)
         self.kernel = ""  # what took the last chunk: "native" (module), "numba" or "plain" (see kernel_kind)
@@ -291,7 +295,8 @@ class KernelRun:
                 problem.series.sin, problem.mass, tables.ci, tables.cm, tables.cp, tables.mk, tables.mon,
                 tables.mi, tables.mc,
                 self.out_t, self.out_q, self.out_F, self.out_c, self.ev_f, self.ev_i, self.peak,
-                self.x, self.v, self.a, self.ist, self.fst, problem.hertz, problem.momentum)
+                self.x, self.v, self.a, self.ist, self.fst, self.work, self.L, self.closing, problem.hertz,
+                problem.momentum)
 
     @cached_property
     def signature(self) -> tuple[Any, ...]:

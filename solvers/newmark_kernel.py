@@ -175,6 +175,9 @@ from vtool.solvers.kernel_layout import (  # the slots and codes: see that modul
     PEAK_LATE,
     PEAK_OVERLAP,
     SOFT_HERTZ,
+    WORK_PER_CLEARANCE,
+    WORK_PER_N,
+    WORK_PER_SOURCE,
 )
 
 numba_cache.configure(os.path.dirname(os.path.abspath(__file__)))  # before numba: a read-only install caches elsewhere
@@ -203,7 +206,7 @@ inner = _plain if PLAIN else njit(**_INNER)
 tiny = _plain if PLAIN else njit(**_INNER, inline="always")
 
 #: :func:`vtool.solvers.kernel_layout.fingerprint` of the layout this file was compiled with (see there).
-LAYOUT_FINGERPRINT = "af2d183818068fad"
+LAYOUT_FINGERPRINT = "b325a5b0283c51e3"
 
 # how a step solves S z̈ = rhs (layer_step's ``which``): stored inverses of the standard and refined
 # steps, or a Cholesky factor. np.int64 values, not int literals: numba compiles a function once per
@@ -900,7 +903,6 @@ def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist,
     """
     ncl = ip[IP_NCL]
     mask = c
-    joint = np.zeros(ncl, dtype=np.int64)  # the momentum-law closings, solved together
     any_momentum = False
     for k in range(ncl):
         if not closing[k]:
@@ -912,12 +914,15 @@ def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist,
             clf[k, CLF_HV] = max(-u, fp[FP_VREST], 1e-300)  # the Hertz contact's approach velocity
             add_event(ev_f, ev_i, ist, t, k, EV_CLOSED, u, c, mask)
         elif cl[k, CL_LAW] == LAW_MOMENTUM:
-            joint[k] = 1
             any_momentum = True
         else:
             mask = impact_local(ip, fp, cl, clf, mass, mask, k, src, v, stick, ev_f, ev_i, ist, t)
-    if momentum is not None:  # None: no clearance has the momentum law (see laws)
+    if momentum is not None:  # None: no clearance has the momentum law (see laws), and no array is made
         if any_momentum:
+            joint = np.zeros(ncl, dtype=np.int64)  # the momentum-law closings, solved together
+            for k in range(ncl):
+                if closing[k] and not cl[k, CL_SOFT] and cl[k, CL_LAW] == LAW_MOMENTUM:
+                    joint[k] = 1
             mask = impact_momentum(ip, fp, cl, clf, mass, mask, joint, src, x, v, stick, ev_f, ev_i, ist, t)
     return mask
 
@@ -1308,7 +1313,7 @@ def arrive(ist, fst, target, grid_next, k_grid, j_target):
 # ----- the run loop -----
 @jit
 def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
-              out_t, out_q, out_F, out_c, ev_f, ev_i, peak, x, v, a, ist, fst, hertz, momentum):
+              out_t, out_q, out_F, out_c, ev_f, ev_i, peak, x, v, a, ist, fst, work, L, closing, hertz, momentum):
     """Integrate from fst[F_T] until t_end, the chunk end, or something Python must do.
 
     Returns a status (FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED,
@@ -1319,7 +1324,11 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
     interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); ``peak[PEAK_ALL]``
     holds the peak contact forces over every step, ``peak[PEAK_LATE]`` those
     after the first cam revolution, ``peak[PEAK_OVERLAP]`` the largest overlap
-    of each compliant contact.
+    of each compliant contact. ``work`` (WORK_PER_N n + WORK_PER_SOURCE ns +
+    WORK_PER_CLEARANCE ncl values), ``L`` (n x n) and ``closing`` (ncl) are
+    scratch, zeroed here at each call as fresh arrays would be: the kernel
+    allocates none (numba's ``np.zeros`` costs each compiling process about a
+    second of compile the first time).
     """
     n, ncl, ns, nh = ip[IP_N], ip[IP_NCL], ip[IP_NS], ip[IP_NH]
     every = ip[IP_EVERY]
@@ -1328,26 +1337,34 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
     refine = int(fp[FP_REFINE] + 0.5)
     fine = dt / refine
     t_rev = fp[FP_TREV]
-    z = np.zeros(n)
-    zd = np.zeros(n)
-    zdd = np.zeros(n)
-    y1 = np.zeros(3 * n + 3 * ns)  # a step's end (z1, ż1, z̈1, src1), laid out as a monitor row's columns
+    for i in range(WORK_PER_N * n + WORK_PER_SOURCE * ns + WORK_PER_CLEARANCE * ncl):
+        work[i] = 0.0
+    for i in range(n):
+        for j in range(n):
+            L[i, j] = 0.0
+    for k in range(ncl):
+        closing[k] = 0
+    z = work[:n]
+    zd = work[n:2 * n]
+    zdd = work[2 * n:3 * n]
+    y1 = work[3 * n:6 * n + 3 * ns]  # a step's end (z1, ż1, z̈1, src1), laid out as a monitor row's columns
     z1 = y1[:n]
     zd1 = y1[n:2 * n]
     zdd1 = y1[2 * n:3 * n]
     src1 = y1[3 * n:]
-    zo = np.zeros(n)
-    zdo = np.zeros(n)
-    zddo = np.zeros(n)
-    rhs = np.zeros(n)
-    sol = np.zeros(n)
-    L = np.zeros((n, n))
-    src0 = np.zeros(3 * ns)
-    srco = np.zeros(3 * ns)
-    phi = np.zeros(ncl)
-    phi_start = np.zeros(ncl)
-    tau = np.zeros(ncl)
-    closing = np.zeros(ncl, dtype=np.int64)
+    o = 6 * n + 3 * ns
+    zo = work[o:o + n]
+    zdo = work[o + n:o + 2 * n]
+    zddo = work[o + 2 * n:o + 3 * n]
+    rhs = work[o + 3 * n:o + 4 * n]
+    sol = work[o + 4 * n:o + 5 * n]
+    o += 5 * n
+    src0 = work[o:o + 3 * ns]
+    srco = work[o + 3 * ns:o + 6 * ns]
+    o += 6 * ns
+    phi = work[o:o + ncl]
+    phi_start = work[o + ncl:o + 2 * ncl]
+    tau = work[o + 2 * ncl:o + 3 * ncl]
     rows = out_t.shape[0]
     while True:
         t = fst[F_T]
