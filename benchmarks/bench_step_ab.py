@@ -1,7 +1,7 @@
 """The Newmark kernel's cost per step on example 1A: this checkout against an earlier commit, alternating.
 
 Run: ``python3 benchmarks/bench_step_ab.py REF [--pairs N]`` (N = 5 pairs by default; the first
-pair also compiles both kernels into their own temporary numba caches, about 20 s each). Each
+pair also compiles both kernels into their own temporary numba caches, about 15 s each). Each
 process times the kernel's calls (``bench_newmark.kernel_seconds``: the time inside ``run_chunk``
 over the steps, the best of 4 rounds of 5 runs) in a warm run of ``gnilka-1a``; the two versions
 alternate, so that a machine whose speed drifts slows both alike, and the ratio of the best of

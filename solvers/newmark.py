@@ -88,7 +88,7 @@ from vtool.solvers.model import Mechanism
 from vtool.solvers.spec import HERTZ, MOMENTUM, RIGID, RunSpec
 from vtool.solvers.trace import TraceBuilder
 
-COMPILE_ESTIMATE_S = 20.0  # first compile of the kernel on a 2-core machine: 18.6-19.7 s (benchmarks/bench_newmark.py)
+COMPILE_ESTIMATE_S = 15.0  # first compile of the kernel on a 2-core machine: 12.4-17.8 s, median 14.4-14.8 (bench_compile_ab.py)
 RULES_COMPILE_ESTIMATE_S = 5.0  # of the event rules alone (impact, settle, fill_sources: the piecewise back ends)
 ROW_BUFFER = 4096  # output rows between flushes at most: memory stays bounded for any run length
 EVENT_BUFFER = 1024  # events between flushes
