@@ -56,12 +56,13 @@ pull (an impact so released is a bounce: two events at one instant).
 Compile time
 ------------
 Entry points (``@jit``) get numba's CPython wrapper; functions only compiled
-code calls (``@inner``) get none. Each is compiled once and linked into its
-callers, where LLVM inlines the small ones. Only :func:`apply_operator`, the
-quiet step's product, is ``@tiny``: copied into its callers as numba IR, so
-that LLVM vectorizes it in place (with it ``@inner`` too the quiet step was 21 % slower
-on 1A; numba's copies of the other helpers cost a sixth of the compile and no
-run speed: ``bench_step_ab.py``, ``bench_compile_ab.py``). The
+code calls (``@inner``) get none, and their code libraries are link-only
+(:mod:`vtool.numba_link`). Each is compiled once and linked into its callers,
+where LLVM inlines the small ones. Only :func:`apply_operator`, the quiet
+step's product, is ``@tiny``: copied into its callers as numba IR, so that
+LLVM vectorizes it in place (with it ``@inner`` too, the quiet step was 21 %
+slower on 1A; numba's copies of the other helpers cost a sixth of the compile
+and no run speed: ``bench_step_ab.py``, ``bench_compile_ab.py``). The
 ``hertz`` and ``momentum`` arguments (:func:`~vtool.solvers.kernel_layout.laws`) are None when no
 clearance uses that law: numba then prunes the branches under them before
 typing, so the Hertz iteration and the momentum-law LCP are compiled (and
