@@ -38,11 +38,13 @@ kernel as fast (135.6 against 138.9 ns/step on 1A, one process each, warm);
 fresh, from the cache and linked from the cache.
 
 Guard: it installs only on a numba whose internals have the shape it was
-written for (numba 0.59 and later: ``CPUCodeLibrary.finalize``,
-``serialize_using_object_code``, ``_unserialize``, ``CPUContext.get_executable``,
-``JITCPUCodegen.set_env``); elsewhere numba runs as shipped. ``VTOOL_LINK_ONLY=0``
-makes no new library link-only (for comparisons); loading a cached one stays
-possible.
+written for (``CPUCodeLibrary.finalize``, ``serialize_using_object_code``,
+``_unserialize``, ``CPUContext.get_executable``, ``JITCPUCodegen.set_env`` and
+the library methods they call; written and checked on numba 0.68 with
+llvmlite 0.50); elsewhere numba runs as shipped, and
+``tests/test_numba_link.py`` fails so that the change is seen.
+``VTOOL_LINK_ONLY=0`` makes no new library link-only (for comparisons);
+loading a cached one stays possible.
 """
 
 from __future__ import annotations
