@@ -176,9 +176,6 @@ from vtool.solvers.kernel_layout import (  # the slots and codes: see that modul
     PEAK_LATE,
     PEAK_OVERLAP,
     SOFT_HERTZ,
-    WORK_PER_CLEARANCE,
-    WORK_PER_N,
-    WORK_PER_SOURCE,
 )
 
 numba_cache.configure(os.path.dirname(os.path.abspath(__file__)))  # before numba: a read-only install caches elsewhere
@@ -1325,8 +1322,8 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
     interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); ``peak[PEAK_ALL]``
     holds the peak contact forces over every step, ``peak[PEAK_LATE]`` those
     after the first cam revolution, ``peak[PEAK_OVERLAP]`` the largest overlap
-    of each compliant contact. ``work`` (WORK_PER_N n + WORK_PER_SOURCE ns +
-    WORK_PER_CLEARANCE ncl values), ``L`` (n x n) and ``closing`` (ncl) are
+    of each compliant contact. ``work`` (kernel_layout.WORK_PER_N n +
+    WORK_PER_SOURCE ns + WORK_PER_CLEARANCE ncl values), ``L`` (n x n) and ``closing`` (ncl) are
     scratch, zeroed here at each call as fresh arrays would be: the kernel
     allocates none (numba's ``np.zeros`` costs each compiling process about a
     second of compile the first time).
@@ -1338,7 +1335,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
     refine = int(fp[FP_REFINE] + 0.5)
     fine = dt / refine
     t_rev = fp[FP_TREV]
-    for i in range(WORK_PER_N * n + WORK_PER_SOURCE * ns + WORK_PER_CLEARANCE * ncl):
+    for i in range(work.shape[0]):
         work[i] = 0.0
     for i in range(n):
         for j in range(n):
