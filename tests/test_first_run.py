@@ -304,3 +304,24 @@ def test_a_new_install_runs_the_exact_back_end_without_waiting(tmp_path) -> None
     second = subprocess.run(command, env=env, capture_output=True, text=True, timeout=600)
     assert second.returncode == 0, second.stderr
     assert json.loads(second.stdout)["events_list"] == json.loads(first.stdout)["events_list"]
+
+
+def test_the_collector_is_paused_during_a_compile_and_restored_after() -> None:
+    """kernel_build.collector_paused: off inside; after it, as it was before (also after an error)."""
+    import gc
+
+    was = gc.isenabled()
+    try:
+        gc.enable()
+        with kernel_build.collector_paused():
+            assert not gc.isenabled()
+        assert gc.isenabled()
+        with pytest.raises(RuntimeError), kernel_build.collector_paused():
+            raise RuntimeError("a failed compile")
+        assert gc.isenabled()
+        gc.disable()
+        with kernel_build.collector_paused():
+            assert not gc.isenabled()
+        assert not gc.isenabled()  # off before: left off
+    finally:
+        (gc.enable if was else gc.disable)()
