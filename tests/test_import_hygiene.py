@@ -79,12 +79,12 @@ def test_declined_blas_probe_leaves_numba_linear_algebra_working() -> None:
         "import sys, numpy as np\nfrom vtool.presets import load_preset\n"
         "from vtool.solvers.run import simulate\nsimulate(load_preset('gnilka-1d'))\n"
         "before = 'scipy.linalg' in sys.modules\nfrom numba import njit\n"
-        "f = njit(lambda a, b: (np.dot(a, b), np.linalg.solve(np.diag(a), b)))\n"
-        "d, x = f(np.array([2.0, 4.0]), np.array([2.0, 2.0]))\n"
-        "print(before, d, x.tolist())\n"
+        "f = njit(lambda a, b: (np.dot(a, b), np.linalg.cholesky(np.diag(a))))\n"  # BLAS, LAPACK
+        "d, x = f(np.array([4.0, 9.0]), np.array([2.0, 2.0]))\n"
+        "print(before, d, np.diag(x).tolist())\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.split() == ["False", "12.0", "[1.0,", "0.5]"]
+    assert out.stdout.split() == ["False", "26.0", "[2.0,", "3.0]"]
 
 
 def test_import_linter_contracts_are_kept(tmp_path) -> None:  # type: ignore[no-untyped-def]
