@@ -16,6 +16,9 @@ whole and split into numba's phases, each phase's time without the phases inside
 * ``other``: the rest (bytecode to numba IR, the untyped passes, the inlining of ``@tiny``
   helpers, nested overloads such as ``np.zeros``, caching).
 
+Python's garbage collector is paused around each function's compile, as the solver pauses it
+(``kernel_build.collector_paused``); the pass that follows each one is in no phase.
+
 From these it estimates the two-process compile's wall time (the larger share, then
 ``run_chunk``), which ``bench_newmark.py`` measures. The phases are read by wrapping numba
 internals (``numba.core.typed_passes``, ``numba.core.codegen``; numba 0.6x): a numba without
@@ -111,7 +114,8 @@ def main(argv: list[str]) -> None:
             for name, arg_types in jobs:
                 spent.clear()
                 started = time.perf_counter()
-                getattr(kernel, name).compile(arg_types)
+                with kernel_build.collector_paused():  # as compile_kernel and its helper compile
+                    getattr(kernel, name).compile(arg_types)
                 whole = time.perf_counter() - started
                 shares[share] += whole
                 for phase in PHASES:
