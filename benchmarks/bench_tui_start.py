@@ -3,8 +3,8 @@
 Run: ``python3 benchmarks/bench_tui_start.py [--rounds N]`` (N = 3). Prints figures, asserts nothing.
 
 Each round starts the app on ``gnilka-1c`` in Textual's headless test driver (100 x 30 cells)
-twice in one process, once with Python's collector as Python sets it and once as ``vtool tui``
-sets it (``gc.freeze`` after the imports, thresholds 10000, 20, 20), in alternating order, and
+in two processes, one with Python's collector as Python sets it and one as ``vtool tui``
+sets it (``vtool.app.cli.tui.tune_collector`` after the imports), in alternating order, and
 prints the start's wall time and the collector's time (``gc.callbacks``).
 """
 
@@ -17,8 +17,8 @@ ONE = """
 import asyncio, gc, sys, time
 from vtool.app.tui.app import create_app
 if {tuned!r}:
-    gc.freeze()
-    gc.set_threshold(10_000, 20, 20)
+    from vtool.app.cli.tui import tune_collector
+    tune_collector()
 started, spent = [], [0.0]
 def timer(phase, info):
     if phase == "start":

@@ -17,9 +17,9 @@ workers share numba's cache, so a kernel one of them compiled is loaded by
 the others. On the 2-core development machine two workers took the suite
 from 8 min 21 s to 5 min 34 s (2026-11-26, empty numba cache both times).
 
-Python's garbage collector: each test process freezes what it has imported
-(``gc.freeze``: never scanned again) and collects less often
-(:data:`COLLECTOR_THRESHOLDS`, against Python's 700, 10, 10). A TUI test
+Python's garbage collector: each test process sets it as ``vtool tui`` does
+(``vtool.app.cli.tui.tune_collector``: what is imported is frozen, never
+scanned again, and it collects less often). A TUI test
 makes hundreds of thousands of short-lived objects (Textual's styles,
 messages, strips), and the collector's passes over them and over the
 imported modules were a sixth to a fifth of the TUI tests' time (the two
@@ -33,14 +33,12 @@ import os
 os.environ["VTOOL_KERNEL"] = "compiled"
 os.environ["VTOOL_NATIVE"] = "0"
 
-#: The test processes' collector thresholds (``gc.set_threshold``): see above.
-COLLECTOR_THRESHOLDS = (10_000, 20, 20)
-
 
 def pytest_configure(config) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
-    """The thresholds, and pytest's own objects frozen."""
-    gc.freeze()
-    gc.set_threshold(*COLLECTOR_THRESHOLDS)
+    """The collector as ``vtool tui`` sets it; pytest's own objects frozen."""
+    from vtool.app.cli.tui import tune_collector
+
+    tune_collector()
 
 
 def pytest_collection_finish(session) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
