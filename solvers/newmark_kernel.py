@@ -182,9 +182,10 @@ numba_cache.configure(os.path.dirname(os.path.abspath(__file__)))  # before numb
 
 from numba import njit  # noqa: E402 (after the cache folder is chosen)
 
-from vtool import numba_link  # noqa: E402
+from vtool import numba_link, numba_typing  # noqa: E402
 
 numba_link.install()  # the @inner functions' libraries are link-only (see there): a quarter of the compile
+numba_typing.install()  # each call's typing resolved once, not at every revisit and again in lowering (see there)
 
 #: Module-name suffix of this source loaded a second time as plain Python (:func:`vtool.solvers.kernel_build.plain_kernel`).
 PLAIN_SUFFIX = "_plain"

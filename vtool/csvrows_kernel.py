@@ -23,6 +23,10 @@ numba_cache.configure()
 
 from numba import njit  # noqa: E402 (after the cache folder is chosen)
 
+from vtool import numba_typing  # noqa: E402
+
+numba_typing.install()  # each call's typing resolved once (see there)
+
 jit = njit(cache=numba_cache.CACHE_ENABLED, nogil=True, error_model="numpy")
 
 #: Fractions of s this close to one half are left to Python's correctly rounded formatting.
