@@ -292,8 +292,8 @@ def kernel_split(signature: tuple[Any, ...]) -> tuple[list[Job], list[Job]]:
     i8, f8, b1 = types.int64, types.float64, types.boolean
     vec, mat, ivec = types.Array(f8, 1, "C"), types.Array(f8, 2, "C"), types.Array(i8, 1, "C")
     helper: list[Job] = [
-        ("settle", (ip, fp, cl, clf, ci, cm, cp, mk, mon, i8, f8, x, v, a, vec, ev_f, ev_i, ist, vec, vec, vec, vec,
-                    hertz)),
+        ("release_pulling", (ip, fp, cl, clf, ci, cm, cp, mk, mon, i8, f8, x, v, a, vec, ev_f, ev_i, ist, vec, vec, vec,
+                             vec, hertz)),
         ("locate_event", (ci, cm, cp, cl, clf, mk, mon, i8, i8, i8, i8, i8, fp, sc, sa, sb, f8, f8, f8, f8,
                           *(vec,) * 9, mat, hertz)),
         ("step_rows", (ci, cl, clf, mk, mon, i8, i8, i8, i8, i8, fp, sc, sa, sb, f8, f8, *(vec,) * 10, out_t, out_q,

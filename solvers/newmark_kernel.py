@@ -68,6 +68,14 @@ clearance uses that law: numba then prunes the branches under them before
 typing, so the Hertz iteration and the momentum-law LCP are compiled (and
 cached) only for mechanisms that use them.
 
+The event rules the piecewise back ends call
+from Python (``settle``, ``impact``, ``fill_sources``, ``snap_shut``,
+``relative_velocity``, ``hertz_law``) are entry points that only call an
+``@inner`` function, which is what the kernel calls: a kernel compile then
+makes no machine code for them (an entry point's library is finalized into
+machine code of its own, which ``run_chunk`` never runs), and a piecewise
+back end's compile of them links the cached inner functions.
+
 Loaded a second time under the module name ``…newmark_kernel_plain``
 (:data:`PLAIN`), the same source is plain Python, numba left out: a new
 install's first run goes on in it while a child process compiles the kernel
@@ -276,7 +284,7 @@ def sources(ns, nh, omega, sc, sa, sb, t, src):
 
 @jit
 def fill_sources(ns, nh, omega, sc, sa, sb, t, src):
-    """:func:`sources`, for Python (the piecewise back ends) and the kernel's less frequent calls."""
+    """:func:`sources`, for Python (the piecewise back ends; see "Compile time" above)."""
     sources(ns, nh, omega, sc, sa, sb, t, src)
 
 
@@ -394,8 +402,8 @@ def effective_solve(cm, c, which, L, nf, b, out):
 
 
 # ----- Hertz contacts (Hunt-Crossley) -----
-@jit
-def hertz_law(clf, k, delta, rate):
+@inner
+def hertz_force(clf, k, delta, rate):
     """(F, dF/dδ, dF/dδ̇) of Hertz contact k: F = K δⁿ (1 + 3(1 - e)/2 · δ̇/v⁻), never pulling.
 
     v⁻ is the approach velocity of the contact's closing (Hunt and Crossley
@@ -410,6 +418,12 @@ def hertz_law(clf, k, delta, rate):
     if force <= 0.0:
         return 0.0, 0.0, 0.0
     return force, exponent * power / delta * (1.0 + lam * rate), power * lam
+
+
+@jit
+def hertz_law(clf, k, delta, rate):
+    """:func:`hertz_force`, for Python (the piecewise back ends)."""
+    return hertz_force(clf, k, delta, rate)
 
 
 @inner
@@ -432,7 +446,7 @@ def compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz):
     if hertz is not None:
         if cl[k, CL_SOFT] == SOFT_HERTZ:
             delta, rate = overlap_and_rate(mon, c, k, n, ns, z, zd, src)
-            return hertz_law(clf, k, delta, rate)[0]
+            return hertz_force(clf, k, delta, rate)[0]
     return contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src)
 
 
@@ -487,7 +501,7 @@ def hertz_correction(ci, cm, cl, clf, mk, mon, c, beta, gamma, h, which, L, n, n
             for j in range(nc):
                 delta += beta * h * h * A[i, j] * F[j]
                 rate += gamma * h * A[i, j] * F[j]
-            value, d_delta, d_rate = hertz_law(clf, idx[i], delta, rate)
+            value, d_delta, d_rate = hertz_force(clf, idx[i], delta, rate)
             R[i] = value - F[i]
             for j in range(nc):
                 J[i, j] = (d_delta * beta * h * h + d_rate * gamma * h) * A[i, j] - (1.0 if i == j else 0.0)
@@ -550,7 +564,7 @@ def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk,
             for k in range(cl.shape[0]):
                 if mk[c, k, MK_KIND] == MK_OVERLAP and cl[k, CL_SOFT] == SOFT_HERTZ:
                     delta, rate = overlap_and_rate(mon, c, k, n, src.shape[0] // 3, z, zd, src)
-                    force = hertz_law(clf, k, delta, rate)[0]
+                    force = hertz_force(clf, k, delta, rate)[0]
                     for f in range(nf):
                         rhs[f] -= mon[c, k, f] * force
     for f in range(nf):
@@ -586,7 +600,7 @@ def rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz):
         for j in range(cl.shape[0]):
             if mon[c, k, head + j] != 0.0:
                 delta, rate = overlap_and_rate(mon, c, j, n, ns, z, zd, src)
-                f += mon[c, k, head + j] * hertz_law(clf, j, delta, rate)[0]
+                f += mon[c, k, head + j] * hertz_force(clf, j, delta, rate)[0]
     return f
 
 
@@ -877,21 +891,33 @@ def impact_local(ip, fp, cl, clf, mass, c, k, src, v, stick, ev_f, ev_i, ist, t)
     return mask
 
 
-@jit
-def snap_shut(cl, k, x, src):
+@inner
+def shut_gap(cl, k, x, src):
     """Clearance k's gap (or overlap) set to exactly zero: it is within the time tolerance of zero."""
     x[cl[k, CL_AHEAD]] = x[cl[k, CL_BEHIND]] if cl[k, CL_BEHIND] >= 0 else src[3 * cl[k, CL_SRC]]
 
 
 @jit
-def relative_velocity(cl, k, v, src):
+def snap_shut(cl, k, x, src):
+    """:func:`shut_gap`, for Python (the piecewise back ends)."""
+    shut_gap(cl, k, x, src)
+
+
+@inner
+def gap_velocity(cl, k, v, src):
     """Velocity of clearance k's gap: v_ahead - v_behind (or the source's)."""
     behind = cl[k, CL_BEHIND]
     return v[cl[k, CL_AHEAD]] - (v[behind] if behind >= 0 else src[3 * cl[k, CL_SRC] + 1])
 
 
 @jit
-def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t, momentum):
+def relative_velocity(cl, k, v, src):
+    """:func:`gap_velocity`, for Python (the piecewise back ends)."""
+    return gap_velocity(cl, k, v, src)
+
+
+@inner
+def apply_impacts(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t, momentum):
     """Apply the impact law of every closing clearance at t; returns the new configuration mask.
 
     Local-law closings are applied one after the other (each changes only its
@@ -906,10 +932,10 @@ def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist,
     for k in range(ncl):
         if not closing[k]:
             continue
-        snap_shut(cl, k, x, src)
+        shut_gap(cl, k, x, src)
         if cl[k, CL_SOFT]:
             mask |= cl[k, CL_BIT]
-            u = relative_velocity(cl, k, v, src)
+            u = gap_velocity(cl, k, v, src)
             clf[k, CLF_HV] = max(-u, fp[FP_VREST], 1e-300)  # the Hertz contact's approach velocity
             add_event(ev_f, ev_i, ist, t, k, EV_CLOSED, u, c, mask)
         elif cl[k, CL_LAW] == LAW_MOMENTUM:
@@ -927,7 +953,13 @@ def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist,
 
 
 @jit
-def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist, rhs, z, zd, zdd, hertz):
+def impact(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t, momentum):
+    """:func:`apply_impacts`, for Python (the piecewise back ends)."""
+    return apply_impacts(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t, momentum)
+
+
+@inner
+def release_pulling(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist, rhs, z, zd, zdd, hertz):
     """Consistent accelerations of configuration c; release at once every contact that would pull.
 
     Returns the settled configuration, or -1 - c2 when configuration c2 must
@@ -958,6 +990,13 @@ def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i,
         add_event(ev_f, ev_i, ist, t, worst, EV_OPENED, 0.0, c, new_c)
         c = new_c
     return c
+
+
+@jit
+def settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist, rhs, z, zd, zdd, hertz):
+    """:func:`release_pulling`, for Python (the piecewise back ends)."""
+    return release_pulling(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src, ev_f, ev_i, ist, rhs, z, zd, zdd,
+                           hertz)
 
 
 # ----- event location -----
@@ -1243,7 +1282,7 @@ def step_rows(ci, cl, clf, mk, mon, c, n, ns, nh, ncl, fp, sc, sa, sb, t, h, z, 
         if ist[I_NOUT] >= rows:
             return False
         interpolate(ci[c, CI_NF], t_out - t, h, z, zd, zdd, zdd1, zo, zdo, zddo)
-        fill_sources(ns, nh, omega, sc, sa, sb, t_out, srco)
+        sources(ns, nh, omega, sc, sa, sb, t_out, srco)
         set_prescribed(ci, c, n, srco, zo, zdo, zddo)
         record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t_out, zo, zdo, zddo, srco,
                    out_t, out_q, out_F, out_c, ist[I_NOUT], hertz)
@@ -1278,11 +1317,12 @@ def take_events(ip, fp, cl, clf, mass, c, t, h, tau, closing, x, v, src0, ev_f, 
         if (c & cl[k, CL_BIT]) and not (new_c & cl[k, CL_BIT]):
             u = 0.0
             if cl[k, CL_SOFT]:  # the parts leave with their relative velocity; the overlap is shut
-                snap_shut(cl, k, x, src0)
-                u = relative_velocity(cl, k, v, src0)
+                shut_gap(cl, k, x, src0)
+                u = gap_velocity(cl, k, v, src0)
             add_event(ev_f, ev_i, ist, t, k, EV_OPENED, u, c, new_c)
     if any_closing:
-        new_c = impact(ip, fp, cl, clf, mass, new_c, closing, src0, x, v, stick, ev_f, ev_i, ist, t, momentum)
+        new_c = apply_impacts(ip, fp, cl, clf, mass, new_c, closing, src0, x, v, stick, ev_f, ev_i, ist, t,
+                              momentum)
     return new_c
 
 
@@ -1373,10 +1413,10 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
             return NEED_CONFIG
         if ist[I_NEV] + 3 * ncl + 2 >= ev_f.shape[0]:
             return OUTPUT_FULL
-        fill_sources(ns, nh, omega, sc, sa, sb, t, src0)
+        sources(ns, nh, omega, sc, sa, sb, t, src0)
         if ist[I_NEED_SETTLE]:
-            settled = settle(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src0, ev_f, ev_i, ist,
-                             rhs, z, zd, zdd, hertz)
+            settled = release_pulling(ip, fp, cl, clf, ci, cm, cp, mk, mon, c, t, x, v, a, src0, ev_f, ev_i, ist,
+                                      rhs, z, zd, zdd, hertz)
             if settled < 0:
                 ist[I_CFG] = -1 - settled
                 ist[I_WANT_CFG] = -1 - settled
@@ -1416,7 +1456,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
                                   ist, fst, c, z, zd, zdd, z1, zd1, zdd1, src1, y1, srco, zo, zdo, zddo, rhs, phi)
                 if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
                     t = t_quiet
-                    fill_sources(ns, nh, omega, sc, sa, sb, t, src0)
+                    sources(ns, nh, omega, sc, sa, sb, t, src0)
                     continue
             grid_next = (k_grid + 1) * dt
             j_target = -1  # refined steps: the index of the refined grid point this step reaches
@@ -1437,7 +1477,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
             if h <= 1e-9 * dt:  # at a grid point but for round-off
                 t = arrive(ist, fst, target, grid_next, k_grid, j_target)
                 continue
-            fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
+            sources(ns, nh, omega, sc, sa, sb, t + h, src1)
             which = STANDARD
             if h != dt:
                 if h == fine:
@@ -1467,7 +1507,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
                         tau_min = min(tau_min, tau[k])
                 h = tau_min
                 if h > 0.0:
-                    fill_sources(ns, nh, omega, sc, sa, sb, t + h, src1)
+                    sources(ns, nh, omega, sc, sa, sb, t + h, src1)
                     factor_effective(ci, cm, c, beta, gamma, h, L)
                     layer_step(ci, cm, cp, c, beta, gamma, h, CHOLESKY, L, n, src1, z, zd, zdd,
                                z1, zd1, zdd1, rhs, sol, cl, clf, mk, mon, hertz)
