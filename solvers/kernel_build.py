@@ -12,7 +12,8 @@ chunks it asks numba's cache whether the kernel is there
 (:func:`vtool.solvers.newmark_kernel.is_cached`) and then loads it. The
 child compiles ``run_chunk`` on two processes (:func:`compile_kernel`: a
 helper, ``python -m vtool.solvers.kernel_build --part``, compiles part of its
-callees meanwhile); so does a ``compiled``-mode run in its own process.
+callees meanwhile, then the machine code of all of them); so does a
+``compiled``-mode run in its own process.
 
 One compile at a time: the lock file (in the temporary folder, named by the
 kernel file's path, modification time and size, ``NUMBA_CACHE_DIR`` and the
@@ -45,6 +46,8 @@ import hashlib
 import importlib.util
 import os
 import pickle
+import secrets
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -334,6 +337,33 @@ def collector_paused() -> Iterator[None]:
 
 #: How long (s) a compile waits for its helper process before going on without it.
 HELPER_WAIT_S = 300.0
+#: How often (s) the two processes of a compile look for each other's marks (:func:`compile_kernel`).
+MARK_POLL_S = 0.01
+
+
+def _wait_for(path: Path, alive: Any, timeout: float) -> bool:
+    """True once ``path`` exists; False if ``alive()`` turns false first (after one more look) or at ``timeout`` s."""
+    deadline = time.monotonic() + timeout
+    while not path.exists():
+        if not alive():
+            return path.exists()
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(MARK_POLL_S)
+    return True
+
+
+def _bundle_fetcher(folder: Path, helper: Any) -> Any:
+    """The callable that gives ``run_chunk``'s library the helper's bundle (or None: the helper failed)."""
+    def fetch() -> dict[str, Any] | None:
+        if not _wait_for(folder / "bundle", lambda: helper.poll() is None, HELPER_WAIT_S):
+            return None
+        with contextlib.suppress(OSError, pickle.UnpicklingError, EOFError):
+            bundle = pickle.loads((folder / "bundle").read_bytes())
+            if isinstance(bundle, dict):
+                return bundle
+        return None
+    return fetch
 
 
 def compile_kernel(signature: tuple[Any, ...]) -> None:
@@ -341,37 +371,86 @@ def compile_kernel(signature: tuple[Any, ...]) -> None:
 
     A helper process compiles its share of the callees (:func:`kernel_split`)
     into numba's cache while this one compiles the rest; then ``run_chunk``
-    is compiled here, loading the helper's from the cache: on two cores the
-    compile's wall time is that of the larger share and ``run_chunk`` itself
+    is compiled here, loading the helper's from the cache. Meanwhile the
+    helper loads this process's share from the cache and makes the machine
+    code of both shares (a bundle, :func:`vtool.numba_link.build_bundle`),
+    which ``run_chunk``'s library takes instead of linking them in
+    (:func:`vtool.numba_link.expecting_bundle`). The two processes mark their
+    progress with empty files in a temporary folder (``own``, ``share``; the
+    bundle arrives as ``bundle``). On two cores the compile's wall time is
+    that of the larger share, then the larger of ``run_chunk``'s typing and
+    lowering and the bundle, then ``run_chunk``'s own machine code
     (``python3 benchmarks/bench_compile_ab.py REF`` measures it against an
-    earlier commit). Without a cache to share through, or
-    without a helper (it could not start, or failed: this process then
-    compiles what it left), the compile is the plain one.
+    earlier commit). Without a cache to share through, or without a helper
+    (it could not start, or failed: this process then compiles what it left,
+    and links it in as numba does), the compile is the plain one.
     """
-    from vtool import numba_cache
+    from vtool import numba_cache, numba_link
 
     helper_jobs, own = kernel_split(signature)
     helper = None
+    folder = Path(tempfile.mkdtemp(prefix="vtool-compile-"))
+    bundle = numba_link.installed() and numba_link.enabled()
     if numba_cache.CACHE_ENABLED:
         with contextlib.suppress(OSError):
             helper = subprocess.Popen([sys.executable, "-m", "vtool.solvers.kernel_build", "--part"],
                                       stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                       close_fds=True)
             assert helper.stdin is not None
-            helper.stdin.write(pickle.dumps(helper_jobs))
+            helper.stdin.write(pickle.dumps({"jobs": helper_jobs, "bundle": (own, str(folder)) if bundle else None}))
             helper.stdin.close()
     try:
         with collector_paused():
-            if helper is not None:
-                for name, arg_types in own:
-                    getattr(kernel(), name).compile(arg_types)
-                with contextlib.suppress(subprocess.TimeoutExpired):
-                    helper.wait(HELPER_WAIT_S)
-            kernel().run_chunk.compile(signature)
+            if helper is None:
+                kernel().run_chunk.compile(signature)
+                return
+            for name, arg_types in own:
+                getattr(kernel(), name).compile(arg_types)
+            (folder / "own").touch()  # the helper may now bundle these with its own
+            _wait_for(folder / "share", lambda: helper.poll() is None, HELPER_WAIT_S)
+            with numba_link.expecting_bundle("run_chunk", _bundle_fetcher(folder, helper)):
+                kernel().run_chunk.compile(signature)
     finally:
         if helper is not None and helper.poll() is None:
             helper.kill()
             helper.wait()
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _part(payload: Any) -> None:
+    """The helper's work (``--part``): its share of the callees, then (with a bundle folder) their bundle.
+
+    The share goes into numba's cache and a ``share`` mark into the folder.
+    Then, once the compiling process has marked its own share done (``own``),
+    the helper loads that share from the cache and makes the bundle of both
+    (:func:`vtool.numba_link.build_bundle`) into the folder's ``bundle``
+    file (written whole, then renamed), while the compiling process types and
+    lowers ``run_chunk``, which takes it (:func:`compile_kernel`).
+    """
+    if isinstance(payload, list):
+        payload = {"jobs": payload, "bundle": None}
+    jobs = payload["jobs"]
+    for name, signature in jobs:
+        getattr(kernel(), name).compile(signature)
+    if payload["bundle"] is None:
+        return
+    own, folder_name = payload["bundle"]
+    folder = Path(folder_name)
+    (folder / "share").touch()
+    parent = os.getppid()
+    if not _wait_for(folder / "own", lambda: os.getppid() == parent, HELPER_WAIT_S):
+        return
+    from vtool import numba_link
+
+    compiled = []
+    for name, signature in [*jobs, *own]:
+        dispatcher = getattr(kernel(), name)
+        dispatcher.compile(signature)  # the compiling process's share: from the cache
+        compiled.append((name, dispatcher.overloads[tuple(signature)]))
+    bundle = numba_link.build_bundle(compiled, secrets.token_hex(6))
+    partial = folder / "bundle.part"
+    partial.write_bytes(pickle.dumps(bundle))
+    partial.replace(folder / "bundle")
 
 
 #: How often (s) a run polls the lock of a compile another process is doing (:func:`compile_once`).
@@ -436,8 +515,7 @@ def main(argv: list[str]) -> int:
     """
     if argv[:1] == ["--part"]:
         with collector_paused():
-            for name, signature in pickle.loads(sys.stdin.buffer.read()):
-                getattr(kernel(), name).compile(signature)
+            _part(pickle.loads(sys.stdin.buffer.read()))
         # done: numba wrote each function's cache files as it compiled them. The compiling process
         # waits for this one to end, and Python's own shutdown (modules, objects, numba's exit
         # handlers) took about 0.7 s more on the 2-core machine: end here, as a forked child does

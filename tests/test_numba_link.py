@@ -10,7 +10,7 @@ from pathlib import Path
 
 from vtool import numba_link
 
-MODULE = '''
+HEADER = '''
 from numba import njit
 
 from vtool import numba_link
@@ -24,7 +24,9 @@ def scale(a, s):
     for i in range(a.shape[0]):
         a[i] *= s
     return a.sum()
+'''
 
+MODULE = HEADER + '''
 
 @inner
 def checked(x):
@@ -87,3 +89,55 @@ def test_a_callee_is_link_only_and_gives_the_same_results_fresh_cached_and_linke
     assert run(tmp_path, env, 1.5) == "True 15.0 ('negative input:', -1.5) [False] 0"  # entry from the cache
     # entry for an integer x: a new compile, which finds scale's link-only library in the cache
     assert run(tmp_path, env, 3) == "True 18.0 ('negative input:', -3) [True, False] 1"
+
+
+BUNDLE_MODULE = HEADER + '''
+
+@inner
+def twice(a, s):
+    return scale(a, s) + scale(a, 2.0)  # (scale is this bundle's own, and the entry calls it too)
+
+
+@njit(cache=True)
+def entry(a, s):
+    return twice(a, s) - scale(a, 0.25)
+'''
+
+BUNDLE_RUN = '''
+import sys
+import numpy as np
+from numba import types
+sys.path.insert(0, {folder!r})
+import toy2
+from vtool import numba_link
+vec = types.Array(types.float64, 1, "C")
+if {make!r}:
+    toy2.twice.compile((vec, types.float64))
+    bundle = numba_link.build_bundle([("twice", toy2.twice.overloads[(vec, types.float64)])], "t0")
+    with numba_link.expecting_bundle("entry", lambda: bundle):
+        value = toy2.entry(np.arange(5.0), 3.0)
+else:
+    value = toy2.entry(np.arange(5.0), 3.0)
+library = toy2.entry.overloads[toy2.entry.signatures[0]].library
+print(repr(value), getattr(library, numba_link.BUNDLE, None) is not None, toy2.entry.stats.cache_hits.total())
+'''
+
+
+def test_an_entry_point_calls_its_callees_in_a_bundle_fresh_and_from_the_cache(tmp_path: Path) -> None:
+    """A bundle (the callees' machine code made apart, vtool.numba_link.build_bundle) gives the entry point
+    numba's own result; numba's cache keeps the entry point with its bundle, and a second process loads
+    both and gets the same result again."""
+    (tmp_path / "toy2.py").write_text(textwrap.dedent(BUNDLE_MODULE))
+
+    def bundle_run(env: dict[str, str], make: bool) -> str:
+        out = subprocess.run([sys.executable, "-c", BUNDLE_RUN.format(folder=str(tmp_path), make=make)],
+                             capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+        assert out.returncode == 0, out.stderr[-3000:]
+        return out.stdout.strip()
+
+    stock = bundle_run(dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "stock")), make=False)
+    value = stock.split()[0]
+    assert float(value) == 3.0 * 10.0 + 6.0 * 10.0 - 1.5 * 10.0  # a scaled by 3, 2 and 0.25; sum(0..4) = 10
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    assert bundle_run(env, make=True) == f"{value} True 0"
+    assert bundle_run(env, make=False) == f"{value} True 1"  # from the cache, bundle and all

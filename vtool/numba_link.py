@@ -37,6 +37,26 @@ kernel as fast (135.6 against 138.9 ns/step on 1A, one process each, warm);
 ``tests/test_numba_link.py`` holds a small call chain to numba's own results,
 fresh, from the cache and linked from the cache.
 
+Bundles: the callees' machine code made in another process. An entry
+point's library makes machine code for everything linked into it, after its
+own function is lowered: for the Newmark kernel's ``run_chunk`` that last
+stage was half the compile's wall time, on one core. :func:`build_bundle`
+(run by the helper process of :func:`vtool.solvers.kernel_build.compile_kernel`)
+links some compiled functions' libraries into one module, with each of them
+exported under a new name (``<symbol>.<tag>``, a tag per bundle, so that two
+bundles never define the same symbol) and everything else internal, runs the
+module passes numba runs on an entry point and makes machine code of it.
+Inside :func:`expecting_bundle`, the entry point's library takes it
+(:func:`take_bundle`): its calls to those functions are renamed to the
+exported names, their libraries are not linked in, and the bundle's machine
+code is added to numba's JIT beside its own, where the calls resolve. So the
+bundle's machine code is made while the entry point is typed and lowered. The
+machine code comes from the same IR by the same passes, so the results are
+the same; LLVM only no longer inlines a bundled callee into the entry point.
+numba's cache keeps such an entry point as its object code, its bitcode for
+linking and the bundle (kind ``"bundled"``); loading it adds the bundle to
+the JIT first.
+
 Guard: it installs only on a numba whose internals have the shape it was
 written for (``CPUCodeLibrary.finalize``, ``serialize_using_object_code``,
 ``_unserialize``, ``CPUContext.get_executable``, ``JITCPUCodegen.set_env`` and
@@ -49,14 +69,94 @@ loading a cached one stays possible.
 
 from __future__ import annotations
 
+import contextlib
 import os
+from collections.abc import Callable, Iterator
 from typing import Any
 
 #: Set on a library that is link-only (finalized without module passes or machine code).
 LINK_ONLY = "_vtool_link_only"
 #: numba's cache kind of a link-only library: its module's bitcode.
 KIND = "link"
+#: Set on an entry point's library that took a bundle (the bundle: see :func:`build_bundle`).
+BUNDLE = "_vtool_bundle"
+#: numba's cache kind of such a library: numba's object code and bitcode, and the bundle.
+BUNDLED = "bundled"
 _installed: list[bool] = []
+#: (library name, a callable that returns the bundle or None) while :func:`expecting_bundle` runs.
+_expecting: list[tuple[str, Callable[[], dict[str, Any] | None]]] = []
+
+
+@contextlib.contextmanager
+def expecting_bundle(name: str, fetch: Callable[[], dict[str, Any] | None]) -> Iterator[None]:
+    """Inside: the next JIT library named ``name`` to be finalized takes the bundle ``fetch()`` returns
+    (called then; None: no bundle, the library is finalized as numba does it)."""
+    _expecting.append((name, fetch))
+    try:
+        yield
+    finally:
+        _expecting.remove((name, fetch))
+
+
+def build_bundle(functions: list[tuple[str, Any]], tag: str) -> dict[str, Any]:
+    """One module of these compiled functions, ``(name, numba's CompileResult)``, made into machine code.
+
+    Returns the bundle: ``object`` (the machine code), ``exports`` (each
+    function's symbol -> (its name in the bundle, ``name``)) and ``envs``
+    (the numba environments its code refers to).
+    """
+    module = None
+    for _, compiled in functions:
+        part = compiled.library._get_module_for_linking().clone()
+        # external before linking: LLVM links a linkonce definition in only where something uses it
+        part.get_function(compiled.fndesc.mangled_name).linkage = "external"
+        if module is None:
+            module = part
+        else:
+            module.link_in(part)
+    assert module is not None
+    exports: dict[str, tuple[str, str]] = {}
+    for name, compiled in functions:
+        symbol = compiled.fndesc.mangled_name
+        exports[symbol] = (f"{symbol}.{tag}", name)
+        module.get_function(symbol).name = exports[symbol][0]
+    exported = {new for new, _ in exports.values()}
+    for function in module.functions:
+        if not function.is_declaration and function.name.startswith("_ZN") and function.name not in exported:
+            # the bundle's own: internal (LLVM may change its arguments) and renamed, since the JIT's linker
+            # resolves another module's call by name to a local function too
+            function.linkage = "internal"
+            function.name = f"{function.name}.{tag}"
+    codegen_ = functions[0][1].library.codegen
+    library = codegen_.create_library(f"bundle.{tag}")
+    library._final_module = module
+    library._optimize_final_module()  # numba's module passes for an entry point, as in finalize
+    return {"object": codegen_._tm.emit_object(library._final_module), "exports": exports,
+            "envs": [variable.name for variable in library._final_module.global_variables
+                     if variable.name.startswith("_ZN08NumbaEnv")]}
+
+
+def take_bundle(library: Any, bundle: dict[str, Any]) -> None:
+    """``library`` (not finalized yet) calls the bundle's functions: see "Bundles" in the module doc."""
+    from llvmlite import binding
+
+    exports = bundle["exports"]
+    for symbol, (new, _) in exports.items():
+        try:
+            function = library._final_module.get_function(symbol)
+        except NameError:
+            continue
+        if function.is_declaration:
+            function.name = new
+    kept = []
+    for linked in library._linking_libraries:
+        defined = {function.name for function in linked._final_module.functions if not function.is_declaration}
+        if any(symbol in defined and linked.name == name for symbol, (_, name) in exports.items()):
+            continue  # a bundled function's own library
+        kept.append(linked)
+    library._linking_libraries[:] = kept
+    library._codegen._engine._ee.add_object_file(binding.ObjectFileRef.from_data(bundle["object"]))
+    setattr(library, BUNDLE, bundle)
 
 
 def installed() -> bool:
@@ -87,7 +187,7 @@ def install() -> bool:
         get_executable = cpu.CPUContext.get_executable
         set_env = codegen.JITCPUCodegen.set_env
         for needed in ("_finalize_dynamic_globals", "_verify_declare_only_symbols", "_get_module_for_linking",
-                       "_ensure_finalized", "_raise_if_finalized"):
+                       "_ensure_finalized", "_raise_if_finalized", "_optimize_final_module"):
             getattr(library_class, needed)
     except (ImportError, AttributeError, KeyError):
         return False
@@ -97,6 +197,10 @@ def install() -> bool:
 
     def link_only_finalize(self: Any) -> None:
         if not is_link_only(self):
+            if _expecting and isinstance(self, jit_library) and self.name == _expecting[-1][0]:
+                bundle = _expecting[-1][1]()
+                if bundle is not None:
+                    take_bundle(self, bundle)
             return finalize(self)
         self._raise_if_finalized()
         seen = set()
@@ -132,12 +236,23 @@ def install() -> bool:
 
     def link_only_serialize(self: Any) -> Any:
         if not is_link_only(self):
-            return serialize(self)
+            name, kind, data = serialize(self)
+            bundle = getattr(self, BUNDLE, None)
+            return (name, kind, data) if bundle is None else (name, BUNDLED, (*data, bundle))
         self._ensure_finalized()
         return (self.name, KIND, self._final_module.as_bitcode())
 
     def link_only_unserialize(cls: Any, codegen_: Any, state: Any) -> Any:
         name, kind, data = state
+        if kind == BUNDLED:
+            from llvmlite import binding
+
+            object_code, bitcode, bundle = data
+            codegen_._engine._ee.add_object_file(binding.ObjectFileRef.from_data(bundle["object"]))
+            library = unserialize(cls, codegen_, (name, "object", (object_code, bitcode)))
+            setattr(library, BUNDLE, bundle)
+            set_envs(codegen_, bundle["envs"])
+            return library
         if kind != KIND:
             return unserialize(cls, codegen_, state)
         from llvmlite import binding
@@ -153,14 +268,18 @@ def install() -> bool:
         if self._engine.get_global_value_address(env_name):  # no machine code for a link-only symbol
             set_env(self, env_name, env)
 
+    def set_envs(codegen_: Any, names: list[str]) -> None:
+        for name in names:
+            env = lookup_environment(name)
+            if env is not None:
+                guarded_set_env(codegen_, name, env)
+
     def finalize_and_set_envs(self: Any) -> None:
         finalize_specific(self)
-        # the link-only callees' environments, now that their code is in this library's
-        for variable in self._final_module.global_variables:
-            if variable.name.startswith("_ZN08NumbaEnv"):
-                env = lookup_environment(variable.name)
-                if env is not None:
-                    guarded_set_env(self._codegen, variable.name, env)
+        # the link-only callees' environments, now that their code is in this library's (or its bundle's)
+        set_envs(self._codegen, [variable.name for variable in self._final_module.global_variables
+                                 if variable.name.startswith("_ZN08NumbaEnv")])
+        set_envs(self._codegen, getattr(self, BUNDLE, {}).get("envs", []))
 
     library_class.finalize = link_only_finalize  # type: ignore[method-assign]
     library_class.serialize_using_object_code = link_only_serialize  # type: ignore[method-assign]
