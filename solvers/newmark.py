@@ -88,7 +88,9 @@ from vtool.solvers.model import Mechanism
 from vtool.solvers.spec import HERTZ, MOMENTUM, RIGID, RunSpec
 from vtool.solvers.trace import TraceBuilder
 
-COMPILE_ESTIMATE_S = 15.0  # first compile of the kernel on a 2-core machine: 12.4-17.8 s, median 14.4-14.8 (bench_compile_ab.py)
+#: first compile of the kernel on a 2-core machine, on its own: 8.9-10.5 s, median 9.5 (bench_compile_ab.py, 4 pairs);
+#: longer while a run shares the cores
+COMPILE_ESTIMATE_S = 10.0
 RULES_COMPILE_ESTIMATE_S = 5.0  # of the event rules alone (impact, settle, fill_sources: the piecewise back ends)
 ROW_BUFFER = 4096  # output rows between flushes at most: memory stays bounded for any run length
 EVENT_BUFFER = 1024  # events between flushes
