@@ -390,6 +390,7 @@ def compile_kernel(signature: tuple[Any, ...]) -> None:
     helper_jobs, own = kernel_split(signature)
     helper = None
     folder = Path(tempfile.mkdtemp(prefix="vtool-compile-"))
+    kernel()  # imported (it installs numba_link) before asking for a bundle: the background child has not yet
     bundle = numba_link.installed() and numba_link.enabled()
     if numba_cache.CACHE_ENABLED:
         with contextlib.suppress(OSError):

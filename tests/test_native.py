@@ -108,11 +108,22 @@ assert "numba" not in sys.modules, "numba was imported"
 """
 
 
+BUNDLED_PROBE = """
+from vtool import numba_link
+from vtool.solvers import newmark_kernel as kernel
+types = kernel.cached_signatures("run_chunk")[0]
+kernel.run_chunk.compile(types)
+library = kernel.run_chunk.overloads[tuple(types)].library
+print("bundled" if getattr(library, numba_link.BUNDLE, None) is not None else "linked")
+"""
+
+
 @needs_jit
 @pytest.mark.slow
 def test_a_new_install_runs_at_once_then_compiled_then_native(tmp_path) -> None:  # noqa: ANN001
     """Empty cache, the default mode: the first ``vtool solve`` announces the background compile and runs as
-    plain Python; the child fills numba's cache, then builds the native module; the next run is compiled
+    plain Python; the child fills numba's cache (``run_chunk`` with its callees' bundle, see
+    vtool.numba_link), then builds the native module; the next run is compiled
     and silent, loads the native module, imports no numba and equals the JIT kernel's run to the last bit;
     ``vtool solve --csv`` writes Python's text with the module's formatter, numba still not imported."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), VTOOL_NATIVE="1")
@@ -125,6 +136,9 @@ def test_a_new_install_runs_at_once_then_compiled_then_native(tmp_path) -> None:
     assert summary["plain_steps"] > 0 and summary["compile_time_s"] < 5.0
     assert summary["kernel"] in ("plain", "numba")  # numba if the compile finished before the run did
     wait_until_cached(env, ("run_chunk",))
+    bundled = subprocess.run([sys.executable, "-c", BUNDLED_PROBE], env=env, capture_output=True, text=True,
+                             timeout=600)
+    assert bundled.stdout.strip() == "bundled", bundled.stderr  # the child's compile made its callees' bundle
     probe = "import sys; from vtool.solvers import kernel_native as k; sys.exit(0 if k.exists((None, None)) else 1)"
     deadline = time.monotonic() + 600
     while subprocess.run([sys.executable, "-c", probe], env=env).returncode != 0:
