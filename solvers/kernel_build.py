@@ -301,6 +301,8 @@ def kernel_split(signature: tuple[Any, ...]) -> tuple[list[Job], list[Job]]:
                           *(vec,) * 9, mat, hertz)),
         ("step_rows", (ci, cl, clf, mk, mon, i8, i8, i8, i8, i8, fp, sc, sa, sb, f8, f8, *(vec,) * 10, out_t, out_q,
                        out_F, out_c, ist, hertz)),
+        # (compiled by locate_event already; a job so that the bundle holds run_chunk's own calls of it too)
+        ("layer_step", (ci, cm, cp, i8, f8, f8, f8, i8, mat, i8, *(vec,) * 9, cl, clf, mk, mon, hertz)),
     ]
     own: list[Job] = [
         ("advance", (ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, out_F, out_c, peak, ist, fst,
