@@ -207,7 +207,8 @@ def _plain(function: Any) -> Any:
 _OPTIONS: dict[str, Any] = {"cache": numba_cache.CACHE_ENABLED, "nogil": True, "error_model": "numpy"}
 _INNER: dict[str, Any] = {**_OPTIONS, "no_cpython_wrapper": True, "no_cfunc_wrapper": True}
 # entry points, callable from Python: the CPython wrapper only (numba's C-callable one went unused)
-jit = _plain if PLAIN else njit(**_OPTIONS, no_cfunc_wrapper=True)
+_ENTRY: dict[str, Any] = {**_OPTIONS, "no_cfunc_wrapper": True}
+jit = _plain if PLAIN else njit(**_ENTRY)
 # Called only from compiled code: no CPython or C wrapper to build (about 0.07 s of compile each).
 inner = _plain if PLAIN else njit(**_INNER)
 # Copied into the caller as numba IR, with no compile of its own (see "Compile time" above).

@@ -152,6 +152,7 @@ def take_bundle(library: Any, bundle: dict[str, Any]) -> None:
     for linked in library._linking_libraries:
         defined = {function.name for function in linked._final_module.functions if not function.is_declaration}
         if any(symbol in defined and linked.name == name for symbol, (_, name) in exports.items()):
+            library._reload_init.update(linked._reload_init)  # (as numba's finalize does for what it links)
             continue  # a bundled function's own library
         kept.append(linked)
     library._linking_libraries[:] = kept
