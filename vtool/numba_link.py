@@ -71,6 +71,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -83,19 +84,29 @@ BUNDLE = "_vtool_bundle"
 #: numba's cache kind of such a library: numba's object code and bitcode, and the bundle.
 BUNDLED = "bundled"
 _installed: list[bool] = []
-#: (library name, a callable that returns the bundle or None) while :func:`expecting_bundle` runs.
-_expecting: list[tuple[str, Callable[[], dict[str, Any] | None]]] = []
+#: Per thread (numba finalizes a library in the thread that compiles it): ``stack``, the (library name, a
+#: callable that returns the bundle or None) pairs of the :func:`expecting_bundle` blocks it is in.
+_expecting = threading.local()
 
 
 @contextlib.contextmanager
 def expecting_bundle(name: str, fetch: Callable[[], dict[str, Any] | None]) -> Iterator[None]:
     """Inside: the next JIT library named ``name`` to be finalized takes the bundle ``fetch()`` returns
-    (called then; None: no bundle, the library is finalized as numba does it)."""
-    _expecting.append((name, fetch))
+    (called then; None: no bundle, the library is finalized as numba does it). Only the compiles of
+    this thread: another thread's compile of a library of that name goes on as numba does it."""
+    stack = _expected()
+    stack.append((name, fetch))
     try:
         yield
     finally:
-        _expecting.remove((name, fetch))
+        stack.remove((name, fetch))
+
+
+def _expected() -> list[tuple[str, Callable[[], dict[str, Any] | None]]]:
+    """This thread's :func:`expecting_bundle` blocks, innermost last."""
+    if not hasattr(_expecting, "stack"):
+        _expecting.stack = []
+    return _expecting.stack  # type: ignore[no-any-return]
 
 
 def build_bundle(functions: list[tuple[str, Any]], tag: str) -> dict[str, Any]:
@@ -198,8 +209,9 @@ def install() -> bool:
 
     def link_only_finalize(self: Any) -> None:
         if not is_link_only(self):
-            if _expecting and isinstance(self, jit_library) and self.name == _expecting[-1][0]:
-                bundle = _expecting[-1][1]()
+            expected = _expected()
+            if expected and isinstance(self, jit_library) and self.name == expected[-1][0]:
+                bundle = expected[-1][1]()
                 if bundle is not None:
                     take_bundle(self, bundle)
             return finalize(self)
