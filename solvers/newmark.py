@@ -91,6 +91,9 @@ from vtool.solvers.trace import TraceBuilder
 #: first compile of the kernel on a 2-core machine, on its own: 8.9-10.5 s, median 9.5 (bench_compile_ab.py, 4 pairs);
 #: longer while a run shares the cores
 COMPILE_ESTIMATE_S = 10.0
+#: the same compile in the background beside a first run in plain Python, which shares the cores: in numba's
+#: cache 14.1-14.4 s after the run's start (bench_newmark.py, 2026-11-26)
+BACKGROUND_COMPILE_ESTIMATE_S = 15.0
 RULES_COMPILE_ESTIMATE_S = 5.0  # of the event rules alone (impact, settle, fill_sources: the piecewise back ends)
 ROW_BUFFER = 4096  # output rows between flushes at most: memory stays bounded for any run length
 EVENT_BUFFER = 1024  # events between flushes
@@ -158,7 +161,7 @@ def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | Non
         if backend != "newmark":
             return None
         return (f"compiling the solver for these contact laws in the background, once (about "
-                f"{COMPILE_ESTIMATE_S:.0f} s on two cores); this run starts now in plain Python and "
+                f"{BACKGROUND_COMPILE_ESTIMATE_S:.0f} s on two cores); this run starts now in plain Python and "
                 "moves to the compiled solver when it is ready")
     estimate = COMPILE_ESTIMATE_S if backend == "newmark" else RULES_COMPILE_ESTIMATE_S
     return (f"compiling the solver for these contact laws, once (about {estimate:.0f} s on two cores); "
