@@ -53,7 +53,7 @@ import sys
 import tempfile
 import time
 import traceback
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -355,7 +355,7 @@ def _wait_for(path: Path, alive: Any, timeout: float) -> bool:
     return True
 
 
-def _bundle_fetcher(folder: Path, helper: Any) -> Any:
+def _bundle_fetcher(folder: Path, helper: Any) -> Callable[[], dict[str, Any] | None]:
     """The callable that gives ``run_chunk``'s library the helper's bundle (or None: the helper failed)."""
     def fetch() -> dict[str, Any] | None:
         if not _wait_for(folder / "bundle", lambda: helper.poll() is None, HELPER_WAIT_S):

@@ -10,8 +10,9 @@ extensions), most of them Python functions that look at the types and say
 no. It keeps no memory of the answer. Type inference asks again each time a
 constraint is revisited, and lowering asks once more for every call it
 lowers. For the Newmark kernel's first compile that was 4,823 resolutions of
-which 4,629 repeated one already made: about a quarter of the compile's work
-(``benchmarks/bench_compile_phases.py``), a few milliseconds per array index.
+which 4,629 repeated one already made, a few milliseconds per array index
+(``python3 benchmarks/bench_compile_ab.py 6b6ad5c`` measures the two-process
+compile against the commit before this module).
 
 What :func:`install` changes. ``get_call_type`` keeps its answers, keyed by
 the function type, the typing context, the target (numba's
