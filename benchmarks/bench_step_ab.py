@@ -1,11 +1,13 @@
 """The Newmark kernel's cost per step on example 1A: this checkout against an earlier commit, alternating.
 
-Run: ``python3 benchmarks/bench_step_ab.py REF [--pairs N]`` (N = 5 pairs by default; the first
+Run: ``python3 benchmarks/bench_step_ab.py REF [--pairs N] [--whole]`` (N = 5 pairs by default; the first
 pair also compiles both kernels into their own temporary numba caches, about 15 s each). Each
 process times the kernel's calls (``bench_newmark.kernel_seconds``: the time inside ``run_chunk``
 over the steps, the best of 4 rounds of 5 runs) in a warm run of ``gnilka-1a``; the two versions
 alternate, so that a machine whose speed drifts slows both alike, and the ratio of the best of
 each is the figure to quote. The earlier commit is laid out as ``bench_compile_ab.py`` does.
+``--whole`` times the whole warm run instead, ``simulate(spec)`` as ``bench_newmark.py``'s first
+figure does (assembly, contact problem, kernel, trace; the best of 4 rounds of 5 runs).
 """
 
 from __future__ import annotations
@@ -37,12 +39,29 @@ steps = backend.simulate(mechanism, options).statistics.steps
 print(min(min(kernel_seconds(backend, mechanism, options) for _ in range(5)) for _ in range(4)) / steps)
 """
 
+WHOLE = """
+import sys, time
+sys.path.insert(0, {benchmarks!r})
+import vtool.solvers.newmark_kernel as kernel
+assert kernel.__file__.startswith({prefix!r}), kernel.__file__
+from vtool.presets import load_preset
+from vtool.solvers.run import simulate
+spec = load_preset("gnilka-1a")
+simulate(spec)
+best = float("inf")
+for _ in range(20):
+    started = time.perf_counter()
+    simulate(spec)
+    best = min(best, time.perf_counter() - started)
+print(best)
+"""
 
-def per_step(path_entry: Path | None, prefix: str, cache: str) -> float:
+
+def per_step(path_entry: Path | None, prefix: str, cache: str, whole: bool = False) -> float:
     env = dict(os.environ, NUMBA_CACHE_DIR=cache)
     if path_entry is not None:
         env["PYTHONPATH"] = os.pathsep.join([str(path_entry), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
-    out = subprocess.run([sys.executable, "-c", TIMING.format(benchmarks=str(ROOT / "benchmarks"), prefix=prefix)],
+    out = subprocess.run([sys.executable, "-c", (WHOLE if whole else TIMING).format(benchmarks=str(ROOT / "benchmarks"), prefix=prefix)],
                          capture_output=True, text=True, env=env, cwd=tempfile.gettempdir())
     if out.returncode != 0:
         raise SystemExit(f"timing run failed:\n{out.stderr[-2000:]}")
@@ -50,18 +69,21 @@ def per_step(path_entry: Path | None, prefix: str, cache: str) -> float:
 
 
 def main(argv: list[str]) -> None:
-    ref, pairs = arguments(argv, 5)
+    whole = "--whole" in argv
+    ref, pairs = arguments([a for a in argv if a != "--whole"], 5)
+    scale, unit = (1e3, "ms/run") if whole else (1e9, "ns/step")
     old, new = [], []
     with tempfile.TemporaryDirectory() as folder, tempfile.TemporaryDirectory() as cache_old, \
             tempfile.TemporaryDirectory() as cache_new:
         entry = layout(ref, Path(folder))
         for _ in range(pairs):
-            old.append(per_step(entry, str(entry), cache_old))
-            new.append(per_step(None, str(ROOT), cache_new))
-            print(f"  {ref}: {old[-1] * 1e9:.1f} ns/step   this checkout: {new[-1] * 1e9:.1f} ns/step", flush=True)
+            old.append(per_step(entry, str(entry), cache_old, whole))
+            new.append(per_step(None, str(ROOT), cache_new, whole))
+            print(f"  {ref}: {old[-1] * scale:.2f} {unit}   this checkout: {new[-1] * scale:.2f} {unit}", flush=True)
     a, b = min(old), min(new)
-    print(f"the kernel per step on gnilka-1a, best of {pairs} alternating processes: {ref} {a * 1e9:.1f} ns, "
-          f"this checkout {b * 1e9:.1f} ns; ratio {b / a:.3f}")
+    what = "the whole warm run (simulate)" if whole else "the kernel per step"
+    print(f"{what} on gnilka-1a, best of {pairs} alternating processes: {ref} {a * scale:.2f} {unit}, "
+          f"this checkout {b * scale:.2f} {unit}; ratio {b / a:.3f}")
 
 
 if __name__ == "__main__":

@@ -262,7 +262,9 @@ class KernelRun:
         rows = row_buffer(self.t_end, out_dt, options.every_step)
         # uninitialised: the kernel fills a row (an event) whole before flush reads it, and reads no other
         self.out_t = np.empty(rows)
-        self.out_q = np.empty((rows, 3, n + ns))
+        # (x, v, a) planes, each rows x (n + ns): a plane's filled rows are the trace's q, q̇ or q̈ as they
+        # are (contiguous), with no copy at the end of a run (see flush)
+        self.out_q = np.empty((3, rows, n + ns))
         self.out_F = np.empty((rows, ncl))
         self.out_c = np.empty(rows, dtype=np.int64)
         self.ev_f = np.empty((EVENT_BUFFER, 2))
@@ -283,11 +285,14 @@ class KernelRun:
         self.plain_steps = 0  # steps taken by the plain-Python kernel (before the compiled one was ready)
         self.kernel = ""  # what took the last chunk: "native" (module), "numba" or "plain" (see kernel_kind)
 
-    def flush(self) -> None:
-        """Move the filled rows and events out of the kernel's buffers."""
+    def flush(self, final: bool = False) -> None:
+        """Move the filled rows and events out of the kernel's buffers. ``final``: the run is over and
+        the kernel writes no more rows, so the trace may keep the buffers themselves rather than copies
+        (a copy, and the fresh memory it faults in, was a tenth of a warm 1A run: ``bench_newmark.py``)."""
         nout = int(self.ist[layout.I_NOUT])
         nev = int(min(self.ist[layout.I_NEV], self.ev_f.shape[0]))
-        self.builder.add_rows(self.out_t[:nout], self.out_q[:nout], self.out_F[:nout], self.out_c[:nout])
+        self.builder.add_rows(self.out_t[:nout], self.out_q[:, :nout].transpose(1, 0, 2), self.out_F[:nout],
+                              self.out_c[:nout], copy=not final)
         events = zip(self.ev_f[:nev, :2].tolist(), self.ev_i[:nev].tolist(), strict=True)  # Python numbers
         for (t, u), (k, kind, before, after) in events:
             self.builder.add_event(t, k, EVENT_KINDS[kind], u, before, after)
@@ -388,7 +393,7 @@ class KernelRun:
             if progress is not None:
                 progress(min(t / self.t_end, 1.0))
             if status == layout.FINISHED:
-                self.flush()
+                self.flush(final=True)
                 self.kernel = kernel_kind(module)
                 if getattr(module, "PLAIN", False):  # the whole run in plain Python
                     self.plain_steps = int(self.ist[layout.I_STEPS])

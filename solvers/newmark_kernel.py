@@ -641,13 +641,13 @@ def record_row(ci, cl, clf, mk, mon, c, n, ns, ncl, gap_noise, t, z, zd, zdd, sr
     out_c[row] = c
     for i in range(n):
         j = ci[c, CI_HEAD + n + i]
-        out_q[row, 0, i] = z[j]
-        out_q[row, 1, i] = zd[j]
-        out_q[row, 2, i] = zdd[j]
+        out_q[0, row, i] = z[j]
+        out_q[1, row, i] = zd[j]
+        out_q[2, row, i] = zdd[j]
     for s in range(ns):
-        out_q[row, 0, n + s] = src[3 * s]
-        out_q[row, 1, n + s] = src[3 * s + 1]
-        out_q[row, 2, n + s] = src[3 * s + 2]
+        out_q[0, row, n + s] = src[3 * s]
+        out_q[1, row, n + s] = src[3 * s + 1]
+        out_q[2, row, n + s] = src[3 * s + 2]
     for k in range(ncl):
         if mk[c, k, MK_KIND] == MK_FORCE:
             out_F[row, k] = rigid_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz)
@@ -1208,13 +1208,13 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, o
             out_c[row] = c
             for i in range(n):
                 j = ci[c, CI_HEAD + n + i]
-                out_q[row, 0, i] = zo[j]
-                out_q[row, 1, i] = zdo[j]
-                out_q[row, 2, i] = zddo[j]
+                out_q[0, row, i] = zo[j]
+                out_q[1, row, i] = zdo[j]
+                out_q[2, row, i] = zddo[j]
             for s in range(ns):
-                out_q[row, 0, n + s] = srco[3 * s]
-                out_q[row, 1, n + s] = srco[3 * s + 1]
-                out_q[row, 2, n + s] = srco[3 * s + 2]
+                out_q[0, row, n + s] = srco[3 * s]
+                out_q[1, row, n + s] = srco[3 * s + 1]
+                out_q[2, row, n + s] = srco[3 * s + 2]
             for k in range(ncl):
                 force = 0.0
                 if mk[c, k, MK_KIND] == MK_FORCE or mk[c, k, MK_KIND] == MK_OVERLAP:

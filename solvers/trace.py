@@ -504,7 +504,9 @@ class TraceBuilder:
             keep[at_top[np.unique(stretch[at_top], return_index=True)[1]]] = True
         return keep
 
-    def add_rows(self, t: np.ndarray, q3: np.ndarray, F: np.ndarray, cfg: np.ndarray) -> None:
+    def add_rows(self, t: np.ndarray, q3: np.ndarray, F: np.ndarray, cfg: np.ndarray, copy: bool = True) -> None:
+        """Take a block of rows. ``copy=False``: the caller never writes these arrays again, so the
+        builder keeps them as they are (and the trace may too, see :meth:`build`)."""
         if not len(t):
             return
         if self.stream is not None:
@@ -512,8 +514,9 @@ class TraceBuilder:
             if self.stream.thin:
                 keep = self.thinned(t, q3, cfg)
                 t, q3, F, cfg = t[keep], q3[keep], F[keep], cfg[keep]
-        self.blocks.append((np.array(t, dtype=float), np.array(q3, dtype=float),
-                            np.array(F, dtype=float), np.array(cfg, dtype=np.int64)))
+        self.blocks.append((np.array(t, dtype=float, copy=copy or None), np.array(q3, dtype=float, copy=copy or None),
+                            np.array(F, dtype=float, copy=copy or None),
+                            np.array(cfg, dtype=np.int64, copy=copy or None)))
     def add_event(self, t: float, clearance: int, kind: str, relative_velocity: float, before: int,
                   after: int) -> None:
         t = float(t)
@@ -526,8 +529,13 @@ class TraceBuilder:
         n = self.spec.n_coordinates + len(self.source_numbers)
         ncl = len(self.spec.clearances)
         rows = sum(len(b[0]) for b in self.blocks)
-        t, F, cfg = np.zeros(rows), np.zeros((rows, ncl)), np.zeros(rows, dtype=np.int64)
-        q, qd, qdd = np.zeros((rows, n)), np.zeros((rows, n)), np.zeros((rows, n))
+        if len(self.blocks) == 1:  # the block's own arrays (a copy only where one is not contiguous)
+            bt, bq, bF, bc = self.blocks.pop()
+            t, F, cfg = np.ascontiguousarray(bt), np.ascontiguousarray(bF), np.ascontiguousarray(bc)
+            q, qd, qdd = (np.ascontiguousarray(bq[:, i]) for i in range(3))
+        else:
+            t, F, cfg = np.zeros(rows), np.zeros((rows, ncl)), np.zeros(rows, dtype=np.int64)
+            q, qd, qdd = np.zeros((rows, n)), np.zeros((rows, n)), np.zeros((rows, n))
         start = 0
         while self.blocks:  # copy block by block, freeing each: the peak is the result plus one block
             bt, bq, bF, bc = self.blocks.pop(0)
