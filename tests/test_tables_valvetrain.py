@@ -33,6 +33,8 @@ def _script():  # noqa: ANN202
 
 
 tables = _script()
+# one worker takes the whole module: its studies (about 12 s) are computed once, not on every worker
+pytestmark = pytest.mark.xdist_group("tables_valvetrain")
 SCIPY_PRESETS = tables.PRESETS if os.environ.get("VTOOL_FULL_TABLES") else ("gnilka-1a",)
 
 
