@@ -238,6 +238,27 @@ def _releasing_the_gil() -> Iterator[None]:
         compiler.Flags = original  # type: ignore[misc]
 
 
+@contextlib.contextmanager
+def _mixins_beside(cc: Any, where: Path) -> Iterator[None]:
+    """pycc's C runtime helpers (its "mixins", about 3 s of gcc on the 2-core machine) compiled on a
+    thread of their own from the start, while numba compiles the exports: ``CC.compile`` compiles the
+    exports, then the mixins, one after the other, though neither needs the other. Each gcc is a
+    process of its own, so the two run on two cores; the module is linked from the same objects."""
+    import concurrent.futures
+
+    where.mkdir()
+    cc._toolchain.verbose = cc.verbose  # (what compile() sets first)
+    compile_mixins = cc._compile_mixins
+    with concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="pycc-mixins") as pool:
+        objects = pool.submit(compile_mixins, str(where))
+        cc._compile_mixins = lambda build_dir: objects.result()
+        try:
+            yield
+        finally:
+            del cc._compile_mixins
+            objects.cancel()
+
+
 def build(name: str, signature: tuple[Any, ...]) -> Path:
     """Compile ``run_chunk`` for numba's argument types ``signature`` into module ``name`` (the child's job),
     and beside it the CSV writer ``put_rows`` (for the types :func:`vtool.csvrows.arguments` gives).
@@ -269,7 +290,7 @@ def build(name: str, signature: tuple[Any, ...]) -> Path:
             example = csvrows.arguments(np.zeros((1, 1)), ["label"], np.zeros(1, dtype=np.int64))
             rows = types.int64(*(numba.typeof(value) for value in example))
             cc.export("put_rows", rows)(csvrows_kernel.put_rows.py_func)
-            with _releasing_the_gil():
+            with _releasing_the_gil(), _mixins_beside(cc, scratch / "mixins"):
                 cc.compile()
         os.replace(scratch / cc.output_file, target)  # (pycc's own suffix; the loader takes any)
     finally:
