@@ -5,7 +5,9 @@ and the first-run measure, about 30 s together; ``--ratio`` measures item 2 alon
 every round). Prints figures, asserts nothing.
 
 1. Warm wall time of a whole run (``simulate``: assemble + contact problem + kernel), best of
-   several, and its ratio to the 5 ms target; the kernel alone per step.
+   several, and its ratio to the 5 ms target; the kernel alone per step. For 1A also over the
+   rounds of item 2, each round's best of several: the best round, the median one, and the one
+   whose dense loop ran slowest (this machine's speed drifts by up to half within a minute).
 2. A dense 8-coordinate Newmark step loop in numba (no clearances, no events: the machine's
    floor for this problem size), measured in the same run, alternating with the kernel; the
    kernel's per-step cost (the time inside its calls over the steps) as a ratio to it (target: at
@@ -271,18 +273,35 @@ def second_process(bytecode: bool = True, native: bool = True, csv: str | None =
     return total, float(solve_time), int(misses), int(hits), native_used == "1"
 
 
-def kernel_rounds(backend, mechanism, options, steps: int) -> list[tuple[float, float]]:  # noqa: ANN001
-    """(kernel, dense loop) seconds per step in each of ROUNDS interleaved rounds: a machine whose
-    speed drifts slows both alike. Each is the best of REPEAT runs (:func:`best_of`'s count), so
-    that both figures are the same estimator."""
-    return [(min(kernel_seconds(backend, mechanism, options) for _ in range(REPEAT)) / steps, dense_floor(steps))
-            for _ in range(ROUNDS)]
+def kernel_rounds(backend, mechanism, options, steps: int,  # noqa: ANN001
+                  spec=None) -> list[tuple[float, float, float]]:  # noqa: ANN001
+    """(kernel, dense loop) seconds per step in each of ROUNDS interleaved rounds, and with ``spec``
+    the whole warm run's seconds (``simulate(spec)``) in the same round (else NaN): a machine whose
+    speed drifts slows them alike. Each is the best of REPEAT runs (:func:`best_of`'s count), so
+    that the figures are the same estimator."""
+    rounds = []
+    for _ in range(ROUNDS):
+        whole = best_of(lambda: simulate(spec)) if spec is not None else float("nan")
+        kernel = min(kernel_seconds(backend, mechanism, options) for _ in range(REPEAT)) / steps
+        rounds.append((kernel, dense_floor(steps), whole))
+    return rounds
 
 
-def ratio_line(rounds: list[tuple[float, float]]) -> str:
-    per_step = min(k for k, _ in rounds)
-    floor = min(f for _, f in rounds)
-    ratios = sorted(k / f for k, f in rounds)
+def whole_line(rounds: list[tuple[float, float, float]]) -> str:
+    """The whole warm run over the rounds: the best, the median, and in the round whose dense loop was
+    slowest (the machine at its slowest in this run)."""
+    wholes = sorted(w for _, _, w in rounds)
+    _, slow_floor, slow_whole = max(rounds, key=lambda r: r[1])
+    return (f"simulate over the {ROUNDS} rounds: best {wholes[0] * 1e3:.2f} ms (ratio to the 5 ms target "
+            f"{wholes[0] / TARGET_WARM_S:.2f}), median {wholes[ROUNDS // 2] * 1e3:.2f} ms "
+            f"({wholes[ROUNDS // 2] / TARGET_WARM_S:.2f}); in the round with the slowest dense loop "
+            f"({slow_floor * 1e9:.0f} ns/step) {slow_whole * 1e3:.2f} ms ({slow_whole / TARGET_WARM_S:.2f})")
+
+
+def ratio_line(rounds: list[tuple[float, float, float]]) -> str:
+    per_step = min(k for k, _, _ in rounds)
+    floor = min(f for _, f, _ in rounds)
+    ratios = sorted(k / f for k, f, _ in rounds)
     return (f"dense 8-coordinate Newmark loop: {floor * 1e9:5.0f} ns/step; the kernel (its calls alone) "
             f"{per_step * 1e9:5.0f} ns/step, {per_step / floor:.2f} x the floor (target <= 2; the best of each "
             f"over {ROUNDS} interleaved rounds; the rounds' median ratio {ratios[ROUNDS // 2]:.2f})")
@@ -296,7 +315,7 @@ def ratio_only() -> None:
     options = backend.options_from_run(spec.run)
     steps = backend.simulate(mechanism, options).statistics.steps
     rounds = kernel_rounds(backend, mechanism, options, steps)
-    for number, (kernel, floor) in enumerate(rounds, 1):
+    for number, (kernel, floor, _) in enumerate(rounds, 1):
         print(f"  round {number}: kernel {kernel * 1e9:5.1f} ns/step, dense loop {floor * 1e9:5.1f} ns/step, "
               f"ratio {kernel / floor:.2f}")
     print("  " + ratio_line(rounds))
@@ -320,9 +339,10 @@ def main() -> None:
               f"on an assembled mechanism {reused * 1e3:6.2f} ms; {steps} steps, {len(trace.events)} events, "
               f"{reused / steps * 1e9:5.0f} ns/step")
         if name == "gnilka-1a":
-            rounds = kernel_rounds(backend, mechanism, options, steps)
-            floor = min(f for _, f in rounds)
+            rounds = kernel_rounds(backend, mechanism, options, steps, spec)
+            floor = min(f for _, f, _ in rounds)
             print(f"  {ratio_line(rounds)}; the whole 1A run per step {reused / steps / floor:.2f} x")
+            print(f"  {name}: {whole_line(rounds)}")
     if "--no-compile" not in sys.argv[1:]:
         compile_s, cpu, wall = first_compile()
         print(f"  first run with an empty numba cache: kernel compile {compile_s:.1f} s wall "
