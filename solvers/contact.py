@@ -292,7 +292,7 @@ class ContactProblem:
                                       c.contact_exponent)
         self.cl, self.clf = cl, clf
         self.hertz, self.momentum = layout.laws(cl)  # the kernel's law switches
-        self.mass = np.stack([mechanism.M, np.linalg.inv(mechanism.M)])
+        self.mass = mechanism.mass_and_inverse
         self.omega = mechanism.omega
         self.omega_max = mechanism.highest_frequency
         x_scale = max(spec.cam.amplitude + abs(mechanism.start.cam_offset), 1e-9)
@@ -305,9 +305,7 @@ class ContactProblem:
 
     def velocity_scale(self) -> float:
         """Cam amplitude times the larger of the cam speed and the lowest elastic frequency."""
-        omega = self.mechanism.start_layer.modes.omega
-        lowest = float(omega[omega > 0].min()) if np.any(omega > 0) else 0.0
-        return self.spec.cam.amplitude * max(self.omega, lowest)
+        return self.spec.cam.amplitude * max(self.omega, self.mechanism.lowest_start_frequency)
 
     def force_tolerance(self) -> float:
         """Contact forces above -this count as pushing when a transition is settled."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -19,6 +20,9 @@ from vtool.solvers.damping import undamped_modes
 from vtool.solvers.initial import StaticStart, static_start
 from vtool.solvers.layers import Layer, build_layer, internal_layer_names, possible_layers
 from vtool.solvers.spec import INTERNAL, LINEAR, MechanismSpec, RunSpec
+
+#: Static starts a mechanism keeps (one per cam speed) before it forgets them all.
+DERIVED_KEPT = 64
 
 
 class Mechanism:
@@ -30,8 +34,12 @@ class Mechanism:
             self.M, self.K = assemble_full(spec)
             self._layers: dict[frozenset[str], Layer] = {}
             self._tables: list = []  # the speed-independent configuration tables, made on demand
+            # what a run derives from the mechanism and its cam speed alone (the static start per speed,
+            # the mass matrix and its inverse): a rerun at the same speed takes it as it is
+            self._derived: dict[Any, Any] = {}
         else:  # the same mechanism run with other run settings: share what does not depend on them
             self.M, self.K, self._layers, self._tables = _shared.M, _shared.K, _shared._layers, _shared._tables
+            self._derived = _shared._derived
             if "highest_frequency" in _shared.__dict__:
                 self.__dict__["highest_frequency"] = _shared.highest_frequency
 
@@ -99,12 +107,37 @@ class Mechanism:
 
     @cached_property
     def start(self) -> StaticStart:
-        start = static_start(self.spec, self.start_layer, self.omega)
-        if self.spec.cam.profile != "harmonic":  # a lift table: start where its lift puts the cam
-            from vtool.solvers.cam import table_start
+        """The static start at this cam speed (kept for the mechanism's other runs at the same speed: its
+        arrays are shared, and every back end copies them before it integrates)."""
+        key = ("start", self.omega)
+        start = self._derived.get(key)
+        if start is None:
+            start = static_start(self.spec, self.start_layer, self.omega)
+            if self.spec.cam.profile != "harmonic":  # a lift table: start where its lift puts the cam
+                from vtool.solvers.cam import table_start
 
-            start = table_start(self.spec, start, self.omega)
+                start = table_start(self.spec, start, self.omega)
+            if len(self._derived) > DERIVED_KEPT:  # a sweep over speeds: keep the memory bounded
+                self._derived.clear()
+            self._derived[key] = start
         return start
+
+    @property
+    def lowest_start_frequency(self) -> float:
+        """The starting layer's lowest elastic natural frequency (rad/s; 0 when it has none)."""
+        lowest = self._derived.get("lowest")
+        if lowest is None:
+            omega = self.start_layer.modes.omega
+            lowest = self._derived["lowest"] = float(omega[omega > 0].min()) if np.any(omega > 0) else 0.0
+        return lowest
+
+    @property
+    def mass_and_inverse(self) -> np.ndarray:
+        """[M, M⁻¹] stacked (2 x n x n; shared by the mechanism's runs, which only read it)."""
+        pair = self._derived.get("mass")
+        if pair is None:
+            pair = self._derived["mass"] = np.stack([self.M, np.linalg.inv(self.M)])
+        return pair
 
     def cam_position(self, t: np.ndarray | float) -> np.ndarray | float:
         from vtool.solvers.cam import derivatives, lift_series
