@@ -167,7 +167,8 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         that reports no progress still shows that it is working.
         """
         self.progress.update(total=None if running else 1.0, progress=0)
-        self.set_class(running, "-running")
+        # on the bar itself: on the screen, each change restyled every widget of the form and the charts
+        self.progress.set_class(running, "-running")
 
     # ----- what a domain screen provides -----
     @abstractmethod
@@ -331,8 +332,8 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         self.messages_seen.append(message)
         self.results, self.results_spec = None, message.spec
         self.show_progress(False)
-        if self.size.width < NARROW and not self.has_class("-form-hidden"):
-            self.add_class("-form-hidden")
+        if self.size.width < NARROW and not self.form_hidden:
+            self.set_form_hidden(True)
             self.notify("form hidden to show the results: ctrl+f shows it", timeout=3)
         return True
 
@@ -343,7 +344,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         self.refresh_bindings()
         self.app.refresh_bindings()
         if event.state in (WorkerState.SUCCESS, WorkerState.ERROR, WorkerState.CANCELLED):
-            self.set_class(False, "-running")
+            self.progress.set_class(False, "-running")
         if event.state == WorkerState.ERROR:
             error = event.worker.error
             if isinstance(error, InputError):
@@ -423,7 +424,21 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
 
     # ----- view -----
     def action_toggle_form(self) -> None:
-        self.toggle_class("-form-hidden")
+        self.set_form_hidden(not self.form_hidden)
+
+    @property
+    def form_hidden(self) -> bool:
+        return not self.query_one("#form-panel").display
+
+    def set_form_hidden(self, hidden: bool) -> None:
+        """Hide or show the form; with the form hidden the side panel (shown on huge terminals) widens.
+
+        Set on the two panels themselves, not as a class of the screen: a class change restyles the
+        whole subtree it is set on (the form's hundreds of widgets and the charts: about a tenth of a
+        second on the 2-core machine)."""
+        self.query_one("#form-panel").display = not hidden
+        for side in self.query("#side-panel"):  # (the valve-train screen's)
+            side.styles.width = 80 if hidden else None
 
     def action_next_tab(self) -> None:
         tabs = self.tabs
