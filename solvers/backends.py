@@ -111,7 +111,7 @@ class Backend(ABC):
                            zeno_stop=getattr(options, "zeno_stop", 400))
         with limited():
             started = wallclock.perf_counter()
-            problem = ContactProblem(mechanism, rules)
+            problem = ContactProblem.for_run(mechanism, rules)
             builder = TraceBuilder(mechanism.spec, problem.source_numbers, problem.omega, stream)
             stats = self.integrate(problem, options, builder, progress, cancel)
             compile_time = float(stats.get("compile_time", 0.0))

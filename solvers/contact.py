@@ -27,6 +27,7 @@ run at any speed (a sweep builds each configuration once per worker).
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 
@@ -302,6 +303,21 @@ class ContactProblem:
         self.gap_noise = 1e-13 * x_scale
         self.zeno_window = 1e-3 * 2 * math.pi / self.omega_max
         self.start_mask = mask_of(spec, spec.initial.closed)
+
+    @classmethod
+    def for_run(cls, mechanism: Mechanism, rules: EventRules | None = None) -> ContactProblem:
+        """The contact problem of one run: a copy of the mechanism's problem at this cam speed and these
+        rules, built at its first run and kept with the mechanism (see ``Mechanism.start``), with the
+        run's own mechanism and its own ``clf`` (the only table the kernel writes: a Hertz contact's
+        approach velocity). Everything else depends on the mechanism, the cam speed and the rules alone."""
+        rules = rules or EventRules()
+        key = ("problem", mechanism.omega, rules)
+        kept = mechanism._derived.get(key)
+        if kept is None:
+            kept = mechanism._derived[key] = cls(mechanism, rules)
+        problem = copy.copy(kept)
+        problem.mechanism, problem.spec, problem.clf = mechanism, mechanism.spec, kept.clf.copy()
+        return problem
 
     def velocity_scale(self) -> float:
         """Cam amplitude times the larger of the cam speed and the lowest elastic frequency."""

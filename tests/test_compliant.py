@@ -329,3 +329,36 @@ def test_a_kernel_is_cached_per_law_switch_pair() -> None:
         pytest.skip("no writable numba cache")
     assert kernel.is_cached(("run_chunk",), None, None)
     assert not kernel.is_cached(("run_chunk",), 1.0, None)  # no kernel takes a float switch
+
+
+def test_a_rerun_of_a_hertz_mechanism_equals_its_first_run_to_the_last_bit() -> None:
+    """A mechanism's reruns share its contact problem (``ContactProblem.for_run``), all but the run's own
+    mechanism and the table the kernel writes, a Hertz contact's approach velocity: a lossy Hertz drop
+    run three times in one process, and once more on a mechanism assembled afresh, gives the same run
+    to the last bit; a rerun at the same speed with another length runs its own length."""
+    from tests.valvetrain_cases import spec_from
+    from vtool.solvers.contact import ContactProblem
+    from vtool.solvers.model import assemble
+    from vtool.solvers.newmark import NewmarkBackend
+    from vtool.solvers.run import simulate
+
+    doc = hertz_doc(restitution=0.5)
+    spec = spec_from(doc)
+    backend = NewmarkBackend()
+
+    def fresh(spec):  # noqa: ANN001, ANN202
+        return backend.simulate(assemble(spec), backend.options_from_run(spec.run))
+
+    runs = [simulate(spec) for _ in range(3)] + [fresh(spec)]
+    assert len(runs[0].events) >= 2
+    for other in runs[1:]:
+        for name in ("time", "q", "qd", "qdd", "contact_force", "configuration", "peak_force", "peak_overlap"):
+            np.testing.assert_array_equal(getattr(other, name), getattr(runs[0], name), err_msg=name)
+    doc["run"]["degrees"] = 2e-4
+    shorter = spec_from(doc)
+    steps = simulate(shorter).statistics.steps  # (the output is per degree: the start's row alone)
+    assert steps == fresh(shorter).statistics.steps < runs[0].statistics.steps
+    mechanism = assemble(spec)
+    first, second = ContactProblem.for_run(mechanism), ContactProblem.for_run(mechanism)
+    assert first.clf is not second.clf and first.cl is second.cl  # each run writes its own clf
+    np.testing.assert_array_equal(first.clf, second.clf)
