@@ -480,3 +480,31 @@ async def test_a_new_run_cancels_and_joins_the_old_one_before_it_starts(monkeypa
         assert await until(lambda: screen.results is not None, 60.0)
         assert log == ["start 400000", "end 400000", "start 30", "end 30"]
         assert screen.results.spec.run.degrees == 30 and app.errors_shown == []
+
+
+async def test_opening_a_preset_of_the_same_form_shows_what_a_fresh_form_shows() -> None:
+    """Another preset with the same fields keeps the rows and refills them (no remount): the texts equal
+    a form opened on that preset, the edited field's star goes, and so does its error."""
+    from vtool.app.tui.form import FieldRow
+
+    async def texts(app) -> dict[str, str]:  # type: ignore[no-untyped-def]
+        return {row.field.name: row.text for row in app.screen.form.query(FieldRow)}
+
+    fresh_app = make_app("gnilka-3")
+    async with fresh_app.run_test(size=(100, 30)) as pilot:
+        await pilot.pause()
+        fresh = await texts(fresh_app)
+    app = make_app("gnilka-1d")
+    async with app.run_test(size=(100, 30)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        rows = list(screen.form.query(FieldRow))
+        assert await texts(app) != fresh  # the two presets differ in some field
+        await set_field(pilot, screen, "run.rpm", "-5")
+        assert screen.form.row("run.rpm").has_class("-changed")
+        assert screen.form.row("run.rpm").has_class("-invalid")
+        assert await app.open_preset("gnilka-3")
+        await pilot.pause()
+        assert list(screen.form.query(FieldRow)) == rows  # the same rows, refilled
+        assert await texts(app) == fresh
+        assert not any(row.has_class("-changed") or row.has_class("-invalid") for row in rows)

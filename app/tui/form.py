@@ -171,6 +171,17 @@ class FieldRow(Widget):
         yield Label(f.unit, classes="field-unit", markup=False)
         yield Static("", classes="field-error", markup=False)
 
+    def reload(self, value: Any) -> None:
+        """The row as a new row of its field with ``value`` would be: that value, unchanged, no error."""
+        self.initial = self.field.default if value is None else value
+        f = self.field
+        if f.kind == CHOICE:
+            self.set_text(self.initial if self.initial in f.choices else f.choices[0])
+        else:
+            self.set_text(format_value(self.initial))
+        self.mark_changed(False)
+        self.show_error(None)
+
     @property
     def editor(self) -> Input | Select:
         return self.query_one(f"#{self.field.widget_id}-editor")  # type: ignore[return-value]
@@ -229,9 +240,20 @@ class ParamForm(VerticalScroll, can_focus=False):
         yield Static("", id="form-error", markup=False)
 
     async def set_fields(self, fields: Iterable[Field], doc: dict[str, Any]) -> None:
-        """Replace the rows with ``fields``, filled from ``doc``."""
-        self.fields = list(fields)
+        """Replace the rows with ``fields``, filled from ``doc``. When the fields are the rows' own (a
+        preset of the same form loaded again, or another one of the same shape), the rows stay and
+        only their values change: mounting sixty rows anew restyled the whole form."""
+        fields = list(fields)
         self._filling = True
+        rows = list(self.query(FieldRow))
+        if [row.field for row in rows] == fields:
+            self.fields = fields
+            for row in rows:
+                row.reload(get_path(doc, row.field.path))
+            self.show_error(None)
+            self.call_after_refresh(self._done_filling)
+            return
+        self.fields = fields
         await self.query("FieldRow, .group-title").remove()
         widgets: list[Widget] = []
         group = None
