@@ -307,14 +307,11 @@ class ContactProblem:
     @classmethod
     def for_run(cls, mechanism: Mechanism, rules: EventRules | None = None) -> ContactProblem:
         """The contact problem of one run: a copy of the mechanism's problem at this cam speed and these
-        rules, built at its first run and kept with the mechanism (see ``Mechanism.start``), with the
+        rules, built at its first run and kept with the mechanism (:meth:`Mechanism.kept`), with the
         run's own mechanism and its own ``clf`` (the only table the kernel writes: a Hertz contact's
         approach velocity). Everything else depends on the mechanism, the cam speed and the rules alone."""
         rules = rules or EventRules()
-        key = ("problem", mechanism.omega, rules)
-        kept = mechanism._derived.get(key)
-        if kept is None:
-            kept = mechanism._derived[key] = cls(mechanism, rules)
+        kept = mechanism.kept(("contact problem", mechanism.omega, rules), lambda: cls(mechanism, rules))
         problem = copy.copy(kept)
         problem.mechanism, problem.spec, problem.clf = mechanism, mechanism.spec, kept.clf.copy()
         return problem

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable, Hashable
 from functools import cached_property
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -21,8 +22,11 @@ from vtool.solvers.initial import StaticStart, static_start
 from vtool.solvers.layers import Layer, build_layer, internal_layer_names, possible_layers
 from vtool.solvers.spec import INTERNAL, LINEAR, MechanismSpec, RunSpec
 
-#: Static starts a mechanism keeps (one per cam speed) before it forgets them all.
+#: Values a mechanism keeps for its runs (:meth:`Mechanism.kept`: a static start and a contact problem
+#: per cam speed, ...) before it forgets them all: a sweep over speeds keeps its memory bounded.
 DERIVED_KEPT = 64
+
+T = TypeVar("T")
 
 
 class Mechanism:
@@ -34,8 +38,7 @@ class Mechanism:
             self.M, self.K = assemble_full(spec)
             self._layers: dict[frozenset[str], Layer] = {}
             self._tables: list = []  # the speed-independent configuration tables, made on demand
-            # what a run derives from the mechanism and its cam speed alone (the static start per speed,
-            # the mass matrix and its inverse): a rerun at the same speed takes it as it is
+            # what a run derives from the mechanism and its cam speed alone (see kept)
             self._derived: dict[Any, Any] = {}
         else:  # the same mechanism run with other run settings: share what does not depend on them
             self.M, self.K, self._layers, self._tables = _shared.M, _shared.K, _shared._layers, _shared._tables
@@ -105,39 +108,45 @@ class Mechanism:
     def start_layer(self) -> Layer:
         return self.layer(frozenset(self.spec.initial.closed))
 
+    def kept(self, key: Hashable, make: Callable[[], T]) -> T:
+        """``make()``, made once for this mechanism and every one :meth:`with_run` gives (they differ in
+        run settings only): ``key`` names what it depends on beyond the mechanism (the cam speed, say).
+        What it returns is shared by those runs, which only read it."""
+        value = self._derived.get(key)
+        if value is None:
+            value = make()
+            if len(self._derived) >= DERIVED_KEPT:
+                self._derived.clear()
+            self._derived[key] = value
+        return value
+
     @cached_property
     def start(self) -> StaticStart:
-        """The static start at this cam speed (kept for the mechanism's other runs at the same speed: its
-        arrays are shared, and every back end copies them before it integrates)."""
-        key = ("start", self.omega)
-        start = self._derived.get(key)
-        if start is None:
+        """The static start at this cam speed (its arrays shared by the runs at this speed: every back end
+        copies them before it integrates)."""
+        def make() -> StaticStart:
             start = static_start(self.spec, self.start_layer, self.omega)
             if self.spec.cam.profile != "harmonic":  # a lift table: start where its lift puts the cam
                 from vtool.solvers.cam import table_start
 
                 start = table_start(self.spec, start, self.omega)
-            if len(self._derived) > DERIVED_KEPT:  # a sweep over speeds: keep the memory bounded
-                self._derived.clear()
-            self._derived[key] = start
-        return start
+            return start
+
+        return self.kept(("start", self.omega), make)
 
     @property
     def lowest_start_frequency(self) -> float:
         """The starting layer's lowest elastic natural frequency (rad/s; 0 when it has none)."""
-        lowest = self._derived.get("lowest")
-        if lowest is None:
+        def make() -> float:
             omega = self.start_layer.modes.omega
-            lowest = self._derived["lowest"] = float(omega[omega > 0].min()) if np.any(omega > 0) else 0.0
-        return lowest
+            return float(omega[omega > 0].min()) if np.any(omega > 0) else 0.0
+
+        return self.kept("lowest start frequency", make)
 
     @property
     def mass_and_inverse(self) -> np.ndarray:
-        """[M, M⁻¹] stacked (2 x n x n; shared by the mechanism's runs, which only read it)."""
-        pair = self._derived.get("mass")
-        if pair is None:
-            pair = self._derived["mass"] = np.stack([self.M, np.linalg.inv(self.M)])
-        return pair
+        """[M, M⁻¹] stacked (2 x n x n)."""
+        return self.kept("mass and inverse", lambda: np.stack([self.M, np.linalg.inv(self.M)]))
 
     def cam_position(self, t: np.ndarray | float) -> np.ndarray | float:
         from vtool.solvers.cam import derivatives, lift_series

@@ -514,9 +514,10 @@ class TraceBuilder:
             if self.stream.thin:
                 keep = self.thinned(t, q3, cfg)
                 t, q3, F, cfg = t[keep], q3[keep], F[keep], cfg[keep]
-        self.blocks.append((np.array(t, dtype=float, copy=copy or None), np.array(q3, dtype=float, copy=copy or None),
-                            np.array(F, dtype=float, copy=copy or None),
-                            np.array(cfg, dtype=np.int64, copy=copy or None)))
+        how = True if copy else None  # None: a copy only where numpy must make one (another dtype)
+        self.blocks.append((np.array(t, dtype=float, copy=how), np.array(q3, dtype=float, copy=how),
+                            np.array(F, dtype=float, copy=how), np.array(cfg, dtype=np.int64, copy=how)))
+
     def add_event(self, t: float, clearance: int, kind: str, relative_velocity: float, before: int,
                   after: int) -> None:
         t = float(t)
