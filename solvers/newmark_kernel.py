@@ -1367,9 +1367,12 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
     after the first cam revolution, ``peak[PEAK_OVERLAP]`` the largest overlap
     of each compliant contact. ``work`` (kernel_layout.WORK_PER_N n +
     WORK_PER_SOURCE ns + WORK_PER_CLEARANCE ncl values), ``L`` (n x n) and ``closing`` (ncl) are
-    scratch, zeroed here at each call as fresh arrays would be: the kernel
-    allocates none (numba's ``np.zeros`` costs each compiling process about a
-    second of compile the first time).
+    scratch, zeroed here at each call as fresh arrays would be: the steps
+    allocate none (numba's ``np.zeros`` costs each compiling process about a
+    second of compile the first time). Only the momentum law's impacts and
+    the Hertz iteration allocate their small systems (at such an impact, or a
+    step with a closed Hertz contact), in the kernels compiled with them
+    (``kernel_layout.laws``).
     """
     n, ncl, ns, nh = ip[IP_N], ip[IP_NCL], ip[IP_NS], ip[IP_NH]
     every = ip[IP_EVERY]
