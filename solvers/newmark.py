@@ -288,8 +288,8 @@ class KernelRun:
     def flush(self, final: bool = False) -> None:
         """Move the filled rows and events out of the kernel's buffers. ``final``: the run is over and
         the kernel writes no more rows, so the trace may keep the buffers themselves rather than copies
-        (each copy took fresh memory, which the machine faulted in page by page: about 80 page faults a
-        warm 1A run, none now; ``perf stat -e page-faults``)."""
+        (in a process on the native module each copy took fresh memory, which the machine faulted in
+        page by page: 68 page faults a warm 1A run, none now; ``benchmarks/bench_page_faults.py``)."""
         nout = int(self.ist[layout.I_NOUT])
         nev = int(min(self.ist[layout.I_NEV], self.ev_f.shape[0]))
         self.builder.add_rows(self.out_t[:nout], self.out_q[:, :nout].transpose(1, 0, 2), self.out_F[:nout],
