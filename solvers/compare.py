@@ -13,6 +13,7 @@ lift.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -95,13 +96,15 @@ class Variant:
 
 
 def compare(spec: MechanismSpec, impacts: tuple[str, ...] = IMPACT_LAWS, starts: tuple[str, ...] | None = None,
-            every_step: bool = False) -> list[Variant]:
-    """Run every (impact law, start) combination with the preset's back end and step."""
+            every_step: bool = False, before_run: Callable[[], None] | None = None) -> list[Variant]:
+    """Run every (impact law, start) combination with the preset's back end and step; ``before_run()``
+    once the first variant's input checks have passed (see :func:`vtool.solvers.run.simulate`)."""
     starts = starts or (spec.initial.velocities,)
     variants = []
     for impact in impacts:
         for start in starts:
-            trace = simulate(with_model(spec, impact, start), every_step=every_step)
+            trace = simulate(with_model(spec, impact, start), every_step=every_step, before_run=before_run)
+            before_run = None
             variants.append(Variant(impact, start, trace))
     return variants
 

@@ -100,6 +100,7 @@ def simulate(
     max_steps: float | None = None,
     max_bytes: float | None = None,
     stream: CsvStream | None = None,
+    before_run: Callable[[], None] | None = None,
 ) -> Trace:
     """Run the preset's back end (``spec.run.backend``) on the assembled mechanism.
 
@@ -107,7 +108,10 @@ def simulate(
     (:data:`vtool.solvers.cost.MAX_STEPS`, :data:`vtool.solvers.cost.MAX_BYTES`).
     With a ``stream`` the rows are written to its CSV as the run goes; a
     thinning stream keeps the memory of an every-step run to that of a run at
-    the output interval (the memory limit counts it so).
+    the output interval (the memory limit counts it so). ``before_run()`` is
+    called once every input check has passed (the cost limits, the back end's
+    settings), just before the run: the CLI prints its compile notice there,
+    so that bad input stays one line.
     """
     backend = backends.get(spec.run.backend)()
     mechanism = _assemble(spec)
@@ -118,6 +122,9 @@ def simulate(
         warnings.warn(PresetWarning(reach), stacklevel=2)
     if options is None:
         options = backend.options_from_run(spec.run, every_step)
+    if before_run is not None:
+        backend.check(mechanism, options)  # (checked again in backend.simulate, for its direct callers)
+        before_run()
     try:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             trace = backend.simulate(

@@ -289,6 +289,28 @@ def test_exact_refuses_a_hertz_contact_in_one_line(tmp_path) -> None:  # noqa: A
     assert result.output.count("\n") == 1 and "hertz contact" in result.output
 
 
+@pytest.mark.parametrize("command", [["solve"], ["compare", "--impact", "thesis"]])
+def test_bad_input_is_one_line_even_when_a_compile_is_due(tmp_path, monkeypatch, command) -> None:  # noqa: ANN001
+    """The compile notice comes after the input checks: a refused run prints its one line and no notice,
+    whatever this process has compiled before (the notice forced on here); a good run prints the notice."""
+    import tomli_w
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+    from vtool.solvers import newmark
+
+    monkeypatch.setattr(newmark, "compile_notice", lambda *args: "compiling the solver (forced by the test)")
+    refused, good = tmp_path / "exact.toml", tmp_path / "newmark.toml"
+    refused.write_text(tomli_w.dumps(hertz_doc(backend="exact")))
+    good.write_text(tomli_w.dumps(hertz_doc()))
+    result = CliRunner().invoke(cli, [*command, str(refused)])
+    assert result.exit_code == 2, result.output
+    assert result.output.count("\n") == 1 and "hertz contact" in result.output
+    result = CliRunner().invoke(cli, [*command, str(good)])
+    assert result.exit_code == 0, result.output
+    assert result.stderr.startswith("compiling the solver (forced by the test)\n")
+
+
 def test_a_hertz_contact_starts_open() -> None:
     doc = hertz_doc()
     doc["clearances"][0]["state"] = "enabled"

@@ -44,8 +44,7 @@ def compare(preset: str, impacts: tuple[str, ...], starts: tuple[str, ...] | Non
         spec = dataclasses.replace(spec, run=dataclasses.replace(spec.run, degrees=degrees))
     from vtool.app.cli.solve import announce_compile
 
-    announce_compile(spec, impacts=impacts)
-    variants = run_compare(spec, impacts, starts)
+    variants = run_compare(spec, impacts, starts, before_run=lambda: announce_compile(spec, impacts=impacts))
     header, rows = table(variants)
     if as_json:
         click.echo(json.dumps({"title": spec.title, "backend": spec.run.backend, "rpm": spec.run.rpm,

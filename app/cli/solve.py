@@ -105,11 +105,15 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
     from vtool.solvers.run import simulate
 
     spec = with_run_overrides(spec, backend=backend, time_step=dt, rpm=rpm, degrees=degrees)
-    announce_compile(spec, csv=csv_path is not None and every_step)
     progress = DelayedProgress(f"{spec.run.backend} {spec.run.degrees:g} deg")
+
+    def before_run() -> None:  # the input is checked: announce a compile, if one is to come
+        announce_compile(spec, csv=csv_path is not None and every_step)
+
     try:
         if csv_path is None:
-            trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps)
+            trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps,
+                             before_run=before_run)
         else:  # rows go to the temporary file as the run makes them; renamed over the target at the end
             from vtool.files import open_atomic
             from vtool.solvers.trace import CsvStream
@@ -117,7 +121,7 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
             with open_atomic(csv_path, "--csv") as handle:
                 stream = CsvStream(handle, spec.run.quantities, thin=every_step)
                 trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps,
-                                 stream=stream)
+                                 stream=stream, before_run=before_run)
     finally:
         progress.close()
     if as_json:
