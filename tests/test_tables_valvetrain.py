@@ -38,6 +38,13 @@ pytestmark = pytest.mark.xdist_group("tables_valvetrain")
 SCIPY_PRESETS = tables.PRESETS if os.environ.get("VTOOL_FULL_TABLES") else ("gnilka-1a",)
 
 
+def test_the_module_runs_on_one_worker(request: pytest.FixtureRequest) -> None:
+    """Under ``--dist loadgroup`` (pyproject's addopts) pytest-xdist names the group in the test's id; a pytest
+    that drops the name (9.2 with xdist 3.8) spreads the module over the workers, each computing the studies."""
+    if os.environ.get("PYTEST_XDIST_WORKER") and request.config.getoption("loadgroup", False):  # (set on workers)
+        assert request.node.nodeid.endswith("@tables_valvetrain"), request.node.nodeid
+
+
 @pytest.fixture(scope="module")
 def studies() -> dict:
     return {name: tables.study(name, scipy=name in SCIPY_PRESETS) for name in tables.PRESETS}
