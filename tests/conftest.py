@@ -17,6 +17,22 @@ workers share numba's cache, so a kernel one of them compiled is loaded by
 the others. On the 2-core development machine two workers took the suite
 from 8 min 21 s to 5 min 34 s (2026-11-26, empty numba cache both times).
 
+Scheduling: ``--dist loadgroup`` (pyproject's addopts) sends the modules marked
+``xdist_group`` whole to one worker, and first, the larger groups before the
+smaller and before the single tests: the longest tests (the native builds, the
+valve-train tables' studies, mypy, numba_link's compiles) start at once and the
+short ones fill in at the end, so that neither worker idles at the end of a run
+(mypy last took 16 s of tail, 2026-11-26). tests/test_tables_valvetrain.py
+checks that pytest-xdist still sees the groups.
+
+Compiles shared out: in a whole run on pytest-xdist workers (at least
+:data:`SHARED_OUT_FROM` tests), each worker first compiles its share of the
+kernels the suite needs (the newmark kernel per contact-law pair, the event
+rules of the piecewise back ends) into numba's shared cache, a different share
+on each worker, and loads the rest from the cache when a test needs it. Without
+it both workers' first tests wanted the same kernel and one waited for the
+other's compile (10-16 s idle in each empty-cache run, 2026-11-26).
+
 Python's garbage collector: each test process sets it as ``vtool tui`` does
 (``vtool.app.cli.tui.tune_collector``: what is imported is frozen, never
 scanned again, and it collects less often). A TUI test
@@ -29,6 +45,8 @@ tests check does not depend on when cycles are collected.
 
 import gc
 import os
+
+import pytest
 
 os.environ["VTOOL_KERNEL"] = "compiled"
 os.environ["VTOOL_NATIVE"] = "0"
@@ -44,3 +62,45 @@ def pytest_configure(config) -> None:  # type: ignore[no-untyped-def]  # noqa: A
 def pytest_collection_finish(session) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
     """The test modules and what they import (numpy, numba, Textual, vtool) frozen too."""
     gc.freeze()
+
+
+#: the fewest collected tests for which the workers share out the compiles (a whole run, not a file)
+SHARED_OUT_FROM = 300
+
+
+def _compile_run(backend: str = "newmark", impact: str | None = None, hertz: bool = False) -> None:
+    """A run of one degree (its kernel compiled, or loaded from numba's cache: VTOOL_KERNEL=compiled)."""
+    from vtool.presets import load_preset
+    from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.compare import with_model
+    from vtool.solvers.run import simulate
+
+    if hertz:
+        from tests.test_compliant import hertz_doc
+        from tests.valvetrain_cases import spec_from
+
+        spec = spec_from(hertz_doc())
+    else:
+        spec = with_run_overrides(with_model(load_preset("gnilka-1a"), impact), degrees=1.0, backend=backend)
+    simulate(spec)
+
+
+#: in turn over the workers: worker k compiles entries k, k + n, ... (n workers)
+#: (on two workers 12 and 17 s: the newmark kernel 11 s, the Hertz one 10, the momentum one 8, the rules 1)
+SHARED_COMPILES = (
+    lambda: _compile_run(),  # the thesis presets' newmark kernel
+    lambda: _compile_run(hertz=True),
+    lambda: _compile_run("exact"),  # the piecewise back ends' event rules
+    lambda: _compile_run(impact="momentum"),
+)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def compiles_shared_out(request: pytest.FixtureRequest) -> None:
+    """This worker's share of the suite's compiles, before its first test (see the module doc)."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "")
+    if not worker.startswith("gw") or len(request.session.items) < SHARED_OUT_FROM:
+        return
+    count = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    for compile_kernel in SHARED_COMPILES[int(worker[2:])::count]:
+        compile_kernel()

@@ -22,6 +22,9 @@ from vtool.solvers import kernel_layout, kernel_native
 from vtool.solvers import newmark_kernel as kernel
 from vtool.solvers.run import simulate
 
+# one worker, scheduled first with the other groups (see conftest.py): two native builds, 40-65 s
+pytestmark = pytest.mark.xdist_group("native")
+
 
 def test_the_kernel_names_the_layout_it_was_written_for() -> None:
     """numba's cache is stamped by newmark_kernel.py alone: an edit of kernel_layout.py must change that file

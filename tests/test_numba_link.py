@@ -8,10 +8,17 @@ import sys
 import textwrap
 from pathlib import Path
 
+import pytest
+
 from vtool import numba_link
+
+# one worker, early (see conftest.py): seven child processes that compile, 18 s
+pytestmark = pytest.mark.xdist_group("numba_link")
 
 HEADER = '''
 from numba import njit
+
+import pytest
 
 from vtool import numba_link
 
@@ -45,6 +52,8 @@ import sys
 import numpy as np
 sys.path.insert(0, {folder!r})
 import toy
+import pytest
+
 from vtool import numba_link
 x = {x!r}
 value = toy.entry(np.arange(4.0), 2.0, x)
@@ -109,6 +118,8 @@ import numpy as np
 from numba import types
 sys.path.insert(0, {folder!r})
 import toy2
+import pytest
+
 from vtool import numba_link
 vec = types.Array(types.float64, 1, "C")
 if {make!r}:

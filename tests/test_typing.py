@@ -14,6 +14,9 @@ import pytest
 
 from tests import typing_tree
 
+# one worker, early (see conftest.py): mypy on an empty cache takes 15 s; last in the run, it was the tail
+pytestmark = pytest.mark.xdist_group("typing")
+
 
 @pytest.fixture(scope="module")
 def tree(tmp_path_factory: pytest.TempPathFactory) -> Path:
