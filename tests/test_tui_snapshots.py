@@ -121,3 +121,38 @@ async def test_boom_limits_show_the_answer_column_without_scrolling(size: tuple[
     for r in results.rows:  # every row's answer, in both units, on screen
         row = next(line for line in lines if r.criterion in line and f"{r.pressure:.4g}" in line)
         assert f"{r.pressure_alt:.4g}" in row
+
+
+async def test_width_class_is_the_widest_breakpoint_not_wider() -> None:
+    from vtool.app.tui.app import VtoolApp
+    from vtool.app.tui.base import width_class
+
+    breakpoints = VtoolApp.HORIZONTAL_BREAKPOINTS or []
+    expected = {0: "-narrow", 80: "-narrow", 119: "-narrow", 120: "-wide", 169: "-wide", 170: "-huge", 400: "-huge"}
+    assert {width: width_class(width, breakpoints) for width in expected} == expected
+    assert width_class(10, [(20, "-big")]) == ""
+
+
+@pytest.mark.parametrize("width", [80, 150])
+async def test_the_screen_is_composed_with_its_width_class(width: int) -> None:
+    """The screen has Textual's width class before its widgets mount (one restyle of the whole screen fewer
+    at the start), and the one class Textual gives it, whatever the width; a resize still moves it."""
+    from vtool.app.tui.base import DomainScreen
+
+    seen: list[set[str]] = []
+    compose = DomainScreen.compose
+
+    def recording(self):  # type: ignore[no-untyped-def]  # noqa: ANN001, ANN202
+        seen.append(set(self.classes))
+        return compose(self)
+
+    app = create_app("gnilka-1a", remember=False, chart_color=False)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(DomainScreen, "compose", recording)
+        async with app.run_test(size=(width, 30)) as pilot:
+            await pilot.pause()
+            named = {"-narrow", "-wide", "-huge"}
+            assert seen and seen[0] & named == app.screen.classes & named == {"-narrow" if width < 120 else "-wide"}
+            await pilot.resize_terminal(200, 30)
+            await pilot.pause()
+            assert app.screen.classes & named == {"-huge"}
