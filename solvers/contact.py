@@ -57,12 +57,10 @@ from vtool.solvers.spec import (
     RIGID,
     THESIS,
 )
-from vtool.solvers.trace import CLOSED, OPENED, RELEASED
+from vtool.solvers.trace import EVENT_KINDS
 
 LAW_CODES = {MOMENTUM: layout.LAW_MOMENTUM, LOCAL: layout.LAW_LOCAL, THESIS: layout.LAW_THESIS}
 SOFT_CODES = {RIGID: 0, LINEAR: layout.SOFT_LINEAR, HERTZ: layout.SOFT_HERTZ}
-EVENT_KINDS: dict[int, str] = {int(layout.EV_OPENED): OPENED, int(layout.EV_CLOSED): CLOSED,
-                              int(layout.EV_RELEASED): RELEASED}
 
 
 def source_series(mechanism: Mechanism) -> SourceSeries:

@@ -83,7 +83,7 @@ from vtool.errors import InputError, RunError
 from vtool.solvers import kernel_build, kernel_native
 from vtool.solvers import kernel_layout as layout
 from vtool.solvers.backends import Backend, Cancel, Progress
-from vtool.solvers.contact import EVENT_KINDS, ContactProblem
+from vtool.solvers.contact import ContactProblem
 from vtool.solvers.model import Mechanism
 from vtool.solvers.spec import HERTZ, MOMENTUM, RIGID, RunSpec
 from vtool.solvers.trace import TraceBuilder
@@ -294,9 +294,7 @@ class KernelRun:
         nev = int(min(self.ist[layout.I_NEV], self.ev_f.shape[0]))
         self.builder.add_rows(self.out_t[:nout], self.out_q[:, :nout].transpose(1, 0, 2), self.out_F[:nout],
                               self.out_c[:nout], copy=not final)
-        events = zip(self.ev_f[:nev, :2].tolist(), self.ev_i[:nev].tolist(), strict=True)  # Python numbers
-        for (t, u), (k, kind, before, after) in events:
-            self.builder.add_event(t, k, EVENT_KINDS[kind], u, before, after)
+        self.builder.add_events(self.ev_f[:nev], self.ev_i[:nev])
         self.ist[layout.I_NOUT] = 0
         self.ist[layout.I_NEV] = 0
 

@@ -34,12 +34,12 @@ from vtool.errors import InputError, RunError
 from vtool.solvers import kernel_build
 from vtool.solvers import kernel_layout as layout
 from vtool.solvers.backends import Backend, Cancel, Progress
-from vtool.solvers.contact import EVENT_KINDS, ContactProblem, OrderedLayer
+from vtool.solvers.contact import ContactProblem, OrderedLayer
 from vtool.solvers.model import Mechanism
 from vtool.solvers.sources import SourceSeries
 from vtool.solvers.spec import HERTZ
 from vtool.solvers.statespace import StateSpace, from_layer
-from vtool.solvers.trace import TraceBuilder
+from vtool.solvers.trace import OPENED, TraceBuilder
 
 #: The state spaces of a mechanism's configurations, kept as long as its configuration tables: a
 #: second run of the same mechanism (a sweep, a benchmark, the TUI) reuses them and what the back
@@ -328,9 +328,8 @@ class PiecewiseRun(ABC):
             self.space(mask)
 
     def _take_events(self) -> None:
-        for row in range(int(self.ist[layout.I_NEV])):
-            k, kind, before, after = (int(value) for value in self.ev_i[row])
-            self.builder.add_event(self.ev_f[row, 0], k, EVENT_KINDS[kind], self.ev_f[row, 1], before, after)
+        nev = int(self.ist[layout.I_NEV])
+        self.builder.add_events(self.ev_f[:nev], self.ev_i[:nev])
         self.ist[layout.I_NEV] = 0
 
     def apply_events(self, ss: StateSpace, t: float, y: np.ndarray,
@@ -356,7 +355,7 @@ class PiecewiseRun(ABC):
                 if self.problem.cl[k, layout.CL_SOFT]:  # the parts leave with their relative velocity
                     self.rules.snap_shut(self.problem.cl, k, x, src)
                     u = float(self.rules.relative_velocity(self.problem.cl, k, v, src))
-                self.builder.add_event(t, k, EVENT_KINDS[int(layout.EV_OPENED)], u, c, new_c)
+                self.builder.add_event(t, k, OPENED, u, c, new_c)
         if closing.any():
             stick = self.rapid >= self.problem.rules.zeno_stick
             problem = self.problem

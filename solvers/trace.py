@@ -18,12 +18,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vtool.files import open_atomic
+from vtool.solvers import kernel_layout as layout
 from vtool.solvers.configurations import closed_names, configuration_label, thesis_number
 from vtool.solvers.spec import EXTERNAL, MechanismSpec
 
 OPENED = "opened"
 CLOSED = "closed"
 RELEASED = "released"  # a persistent contact pulled apart by another contact's impact
+#: the kernels' event codes (:mod:`vtool.solvers.kernel_layout`) to the kinds above
+EVENT_KINDS: dict[int, str] = {int(layout.EV_OPENED): OPENED, int(layout.EV_CLOSED): CLOSED,
+                              int(layout.EV_RELEASED): RELEASED}
 
 #: Events at one clearance closer than this (degrees of cam rotation) form one physical episode.
 EPISODE_WINDOW_DEG = 0.1
@@ -517,6 +521,19 @@ class TraceBuilder:
         how = True if copy else None  # None: a copy only where numpy must make one (another dtype)
         self.blocks.append((np.array(t, dtype=float, copy=how), np.array(q3, dtype=float, copy=how),
                             np.array(F, dtype=float, copy=how), np.array(cfg, dtype=np.int64, copy=how)))
+
+    def add_events(self, floats: np.ndarray, ints: np.ndarray) -> None:
+        """Take the rows of a kernel's event buffers (:mod:`vtool.solvers.kernel_layout`): ``floats`` holds
+        (time, relative velocity), ``ints`` (clearance, event code, configuration before, after). Equal to
+        :meth:`add_event` row by row, with less Python around each :class:`Event` (1A's 59: 102 -> 85 µs;
+        making the events is the rest)."""
+        if not len(ints):
+            return
+        names = [c.name for c in self.spec.clearances]
+        times, velocities = floats[:, 0].tolist(), floats[:, 1].tolist()
+        angles = (floats[:, 0] * self.omega * 180.0 / math.pi).tolist()  # (cam_angle_deg's operations)
+        self.events += [Event(t, angle, names[k], EVENT_KINDS[kind], u, before, after) for t, angle, u, (
+            k, kind, before, after) in zip(times, angles, velocities, ints.tolist(), strict=True)]
 
     def add_event(self, t: float, clearance: int, kind: str, relative_velocity: float, before: int,
                   after: int) -> None:
