@@ -14,6 +14,7 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -38,13 +39,20 @@ def assert_same_run(a, b) -> None:  # noqa: ANN001 (two Traces)
 
 
 def wait_until_cached(env: dict, names: tuple[str, ...]) -> None:
-    """Poll (in fresh processes, with ``env``'s cache) until the background compile has cached ``names``."""
+    """Poll (in fresh processes, with ``env``'s cache) until the background compile has cached ``names``.
+
+    A probe process imports numba (about a second of CPU, taken from the compile it waits for), so one
+    starts only once each name has an index file in ``env``'s cache folder; the probe then decides."""
     probe = ("import sys; from vtool.solvers import newmark_kernel as k; "
              f"sys.exit(0 if k.is_cached({names!r}, None, None) else 1)")
+    folder = Path(env["NUMBA_CACHE_DIR"])
     deadline = time.monotonic() + 600
-    while subprocess.run([sys.executable, "-c", probe], env=env).returncode != 0:
+    while True:
+        if (all(any(folder.rglob(f"newmark_kernel.{name}-*.nbi")) for name in names)
+                and subprocess.run([sys.executable, "-c", probe], env=env).returncode == 0):
+            return
         assert time.monotonic() < deadline, f"the background compile of {names} did not reach the cache in 600 s"
-        time.sleep(1.0)
+        time.sleep(0.25)
 
 
 def test_kernel_mode_comes_from_the_environment(monkeypatch) -> None:  # noqa: ANN001
