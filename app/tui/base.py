@@ -76,7 +76,7 @@ def width_class(width: int, breakpoints: list[tuple[int, str]]) -> str:
 
     A screen takes it in ``__init__``, before its widgets mount: Textual sets it on
     the screen's first resize, after they mount, and restyled the whole screen for
-    it (0.3 s of a 2.3 s start, ``benchmarks/bench_tui_actions.py``).
+    it (about 0.4 s of a 2.2 s start, ``benchmarks/bench_tui_actions.py``).
     """
     return max((b for b in breakpoints if width >= b[0]), key=lambda b: b[0], default=(0, ""))[1]
 
