@@ -1,0 +1,64 @@
+"""The whole test suite, ``python3 -m pytest -q``: this checkout's last commit against an earlier one.
+
+Run: ``python3 benchmarks/bench_suite_ab.py REF [--pairs N] [-k EXPRESSION]`` (N = 2; a run takes
+4-5 min on the 2-core machine, so the default is about 20 min). Prints figures, asserts nothing.
+
+Each run is the suite of one commit (REF, then HEAD, alternating, so that a drift of the machine's
+speed slows both alike) in a fresh ``git archive`` of it, laid out as ``bench_compile_ab.py`` does
+and first on ``PYTHONPATH``: numba's cache, the native modules' folder and mypy's cache start
+empty, as in CI's fresh clone. Both run under the pytest and the libraries installed here (CI's
+fresh install may pick other versions: pyproject pins pytest below 9.2 for that reason). ``-k``
+passes a selection to pytest (to try the script on a few tests).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from bench_compile_ab import ROOT, layout
+
+
+def run_suite(ref: str, select: str | None) -> tuple[float, str]:
+    """Wall seconds of ``python3 -m pytest -q`` in a fresh tree of ``ref``, and pytest's last line."""
+    with tempfile.TemporaryDirectory() as folder:
+        entry = layout(ref, Path(folder))
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join([str(entry), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+        env.pop("NUMBA_CACHE_DIR", None)  # numba's cache beside the tree's sources: empty
+        command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
+        if select:
+            command += ["-k", select]
+        started = time.perf_counter()
+        out = subprocess.run(command, cwd=Path(folder) / "tree", env=env, capture_output=True, text=True)
+        seconds = time.perf_counter() - started
+    last = out.stdout.strip().splitlines()[-1] if out.stdout.strip() else out.stderr[-300:]
+    if out.returncode != 0:
+        raise SystemExit(f"the suite of {ref} failed ({last}):\n{out.stdout[-3000:]}")
+    return seconds, last
+
+
+def main(argv: list[str]) -> None:
+    if not argv or argv[0].startswith("-"):
+        raise SystemExit("usage: REF [--pairs N] [-k EXPRESSION]")
+    ref = argv[0]
+    pairs = int(argv[argv.index("--pairs") + 1]) if "--pairs" in argv else 2
+    select = argv[argv.index("-k") + 1] if "-k" in argv else None
+    head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                          check=True).stdout.strip()
+    old, new = [], []
+    for _ in range(pairs):
+        for label, commit, times in ((ref, ref, old), (f"HEAD {head}", head, new)):
+            seconds, last = run_suite(commit, select)
+            times.append(seconds)
+            print(f"  {label}: {seconds:.1f} s ({last})", flush=True)
+    print(f"the suite, {pairs} alternating pair(s): {ref} {min(old):.1f}-{max(old):.1f} s, HEAD {head} "
+          f"{min(new):.1f}-{max(new):.1f} s; ratio of the sums {sum(new) / sum(old):.2f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
