@@ -531,7 +531,7 @@ class TraceBuilder:
             return
         names = [c.name for c in self.spec.clearances]
         times, velocities = floats[:, 0].tolist(), floats[:, 1].tolist()
-        angles = (floats[:, 0] * self.omega * 180.0 / math.pi).tolist()  # (cam_angle_deg's operations)
+        angles = np.asarray(cam_angle_deg(floats[:, 0], self.omega)).tolist()
         self.events += [Event(t, angle, names[k], EVENT_KINDS[kind], u, before, after) for t, angle, u, (
             k, kind, before, after) in zip(times, angles, velocities, ints.tolist(), strict=True)]
 
