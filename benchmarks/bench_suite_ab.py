@@ -22,6 +22,11 @@ from pathlib import Path
 
 from bench_compile_ab import ROOT, layout
 
+#: Where each package a run imports comes from (run in the tree, as pytest and the tests' own processes are):
+#: all must be the tree's.
+PROBE = "import vtool.app, vtool.assessments, vtool.presets, vtool.solvers as s, vtool.errors as e; " \
+        "print(*(m.__file__ for m in (vtool.app, vtool.assessments, vtool.presets, s, e)))"
+
 
 def run_suite(ref: str, select: str | None) -> tuple[float, str]:
     """Wall seconds of ``python3 -m pytest -q`` in a fresh tree of ``ref``, and pytest's last line."""
@@ -30,7 +35,18 @@ def run_suite(ref: str, select: str | None) -> tuple[float, str]:
         env = dict(os.environ)
         env["PYTHONPATH"] = os.pathsep.join([str(entry), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
         env.pop("NUMBA_CACHE_DIR", None)  # numba's cache beside the tree's sources: empty
-        command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
+        # the tree's own folder never first on sys.path (PYTHONSAFEPATH for pytest and every process a test
+        # starts in the tree; pytest appends it, for tests/): its vtool/ holds the core alone, and its
+        # subpackages would then come from the package installed here, whose editable finder maps them
+        # to this checkout, so that the suite of REF would run this checkout's solvers
+        env["PYTHONSAFEPATH"] = "1"
+        where = subprocess.run([sys.executable, "-c", PROBE], cwd=Path(folder) / "tree", env=env, capture_output=True,
+                               text=True)
+        files = where.stdout.split()
+        if where.returncode != 0 or len(files) != 5 or not all(Path(f).resolve().is_relative_to(
+                Path(folder).resolve()) for f in files):
+            raise SystemExit(f"the tree of {ref} does not import its own packages: {where.stdout}{where.stderr[-500:]}")
+        command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--import-mode=append"]
         if select:
             command += ["-k", select]
         started = time.perf_counter()

@@ -78,7 +78,8 @@ def enabled() -> bool:
         return False
     if os.environ.get("NUMBA_DISABLE_JIT", "0").strip() not in ("", "0"):
         return False
-    return folder() is not None
+    numba_cache.configure(HERE)
+    return numba_cache.CACHE_ENABLED  # (what folder() is None says, without making its path)
 
 
 def folder() -> Path | None:
@@ -147,10 +148,23 @@ def _switches(hertz: bool | None, momentum: bool | None) -> str:
     return f"h{int(hertz is not None)}m{int(momentum is not None)}"
 
 
+#: The bits of ``ndarray.flags.num`` that :func:`type_key` reads: C and F contiguous, aligned, writeable.
+FLAG_BITS = 0x1 | 0x2 | 0x100 | 0x400
+_names: dict[tuple[Any, ...], str] = {}
+
+
 def module_name(values: tuple[Any, ...]) -> str:
     """The module name (and file stem) for ``run_chunk`` on arguments ``values`` (see the module doc):
-    the law switches (``values``' last two), the environment's digest, the argument types' digest."""
-    return f"{PREFIX}{_switches(*values[-2:])}_{_digest(_environment())}_{_digest(type_key(values))}"
+    the law switches (``values``' last two), the environment's digest, the argument types' digest.
+
+    Kept per process by what :func:`type_key` reads of each argument, in a cheaper form (each array's
+    dtype, dimensions and flag bits; each other value's type): 13 µs a run instead of 28."""
+    key = tuple([(value.dtype, value.ndim, value.flags.num & FLAG_BITS) if type(value) is np.ndarray else type(value)
+                 for value in values])
+    name = _names.get(key)
+    if name is None:
+        name = _names[key] = f"{PREFIX}{_switches(*values[-2:])}_{_digest(_environment())}_{_digest(type_key(values))}"
+    return name
 
 
 def _pattern(switches: str) -> str:

@@ -48,7 +48,11 @@ class Mechanism:
 
     def with_run(self, run: RunSpec) -> Mechanism:
         """This mechanism with other run settings (cam speed, step, ...), sharing its layers and tables."""
-        return Mechanism(dataclasses.replace(self.spec, run=run), _shared=self)
+        return self.for_spec(dataclasses.replace(self.spec, run=run))
+
+    def for_spec(self, spec: MechanismSpec) -> Mechanism:
+        """This mechanism for ``spec``, a spec equal to its own but for the run settings (not checked)."""
+        return Mechanism(spec, _shared=self)
 
     def configuration_tables(self):  # type: ignore[no-untyped-def]
         """The configuration tables of :mod:`vtool.solvers.contact`, shared by every run of this mechanism."""

@@ -47,6 +47,27 @@ def test_the_module_name_follows_the_argument_types_and_switches() -> None:
     assert kernel_native.module_name((*a[:2], None, True)).startswith("vtool_native_h0m1_")
 
 
+def test_the_kept_module_names_are_those_the_types_give() -> None:
+    """module_name keeps its names by a cheaper key than type_key's text: the name is always the one the
+    text gives, and arrays whose texts differ (alignment, byte order, layout, writeability) never share it,
+    in whatever order they come; a view and its owner (owning its data is not a type) share it."""
+    base = np.zeros(8)
+    unaligned = np.ndarray(8, dtype=np.float64, buffer=bytearray(65), offset=1)
+    readonly = np.zeros(8)
+    readonly.flags.writeable = False
+    variants = [base, base[:4], np.zeros((8, 1))[:, 0], unaligned, np.zeros(8, dtype=">f8"), readonly,
+                np.zeros((2, 4), order="F"), np.zeros((2, 4)), np.zeros((4, 4))[:, ::2], np.zeros(8, dtype=np.int64)]
+    assert not unaligned.flags.aligned and base[:4].flags.owndata is False
+    for order in (variants, variants[::-1]):
+        for value in order:
+            values = (value, None, None)
+            expected = (f"{kernel_native.PREFIX}h0m0_{kernel_native._digest(kernel_native._environment())}_"
+                        f"{kernel_native._digest(kernel_native.type_key(values))}")
+            assert kernel_native.module_name(values) == expected
+    texts = {kernel_native.type_key((v,)) for v in variants}
+    assert len({kernel_native.module_name((v, None, None)) for v in variants}) == len(texts) == len(variants) - 2
+
+
 @needs_jit
 def test_a_run_names_the_kernel_that_ran_it(monkeypatch) -> None:  # noqa: ANN001
     assert simulate(load_preset("gnilka-1a")).statistics.kernel == "numba"  # the tests' mode: compiled

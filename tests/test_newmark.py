@@ -253,3 +253,73 @@ def test_an_every_step_run_reports_progress_and_can_be_cancelled() -> None:
     assert len(seen) >= 3 and seen[-1] == 1.0
     with pytest.raises(RunError, match="cancelled"):
         simulate(spec, every_step=True, cancel=lambda: True)
+
+
+def test_events_taken_whole_from_the_buffers_equal_events_made_one_by_one() -> None:
+    """``TraceBuilder.add_events`` makes each Event without its dataclass __init__ (for speed): the events
+    equal, and hash as, those :meth:`add_event` makes through Event(...), and stay frozen."""
+    import dataclasses
+
+    from vtool.solvers.trace import EVENT_KINDS, Event, TraceBuilder
+
+    spec = load_preset("gnilka-1a")
+    problem = ContactProblem(assemble(spec))
+    trace = simulate(spec)
+    whole = TraceBuilder(spec, problem.source_numbers, problem.omega)
+    one_by_one = TraceBuilder(spec, problem.source_numbers, problem.omega)
+    floats = np.array([[e.time, e.relative_velocity] for e in trace.events])
+    codes = {kind: code for code, kind in EVENT_KINDS.items()}
+    names = [c.name for c in spec.clearances]
+    ints = np.array([[names.index(e.clearance), codes[e.kind], e.before, e.after] for e in trace.events])
+    whole.add_events(floats, ints)
+    for e in trace.events:
+        one_by_one.add_event(e.time, names.index(e.clearance), e.kind, e.relative_velocity, e.before, e.after)
+    assert len(whole.events) == len(trace.events) > 50
+    assert whole.events == one_by_one.events == list(trace.events)
+    assert [hash(e) for e in whole.events] == [hash(e) for e in one_by_one.events]
+    assert all(type(e) is Event and vars(e) == vars(o) for e, o in zip(whole.events, one_by_one.events, strict=True))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        whole.events[0].time = 0.0  # type: ignore[misc]
+
+
+def test_a_kept_mechanism_serves_equal_specs_whatever_their_run_settings() -> None:
+    """run._assemble keeps the last mechanisms by the spec's fields but its run settings: an equal spec
+    (another object, another speed) shares the kept layers; another member or a clearance does not."""
+    import dataclasses
+
+    from vtool.solvers import run
+
+    spec = load_preset("gnilka-1a")
+    first = run._assemble(spec)
+    assert first.spec is spec
+    again = run._assemble(load_preset("gnilka-1a"))
+    faster = run._assemble(dataclasses.replace(spec, run=dataclasses.replace(spec.run, rpm=2 * spec.run.rpm)))
+    assert again._layers is first._layers and faster._layers is first._layers
+    assert faster.spec.run.rpm == 2 * spec.run.rpm
+    member = dataclasses.replace(spec.members[0], length=spec.members[0].length * 1.01)
+    other = run._assemble(dataclasses.replace(spec, members=(member, *spec.members[1:])))
+    assert other._layers is not first._layers
+    assert not np.array_equal(other.K, first.K)
+    clearance = dataclasses.replace(spec.clearances[0], restitution=0.5)
+    assert run._assemble(dataclasses.replace(spec, clearances=(clearance, *spec.clearances[1:])))._layers \
+        is not first._layers
+
+
+@pytest.mark.parametrize("name", ["q", "qd", "qdd", "contact_force"])
+def test_a_non_finite_value_anywhere_in_a_trace_is_a_run_error_naming_it(name: str) -> None:
+    """run._check_finite: huge finite values (two 1e308s) are no error, a nan or an inf in any place is,
+    at its row's time and cam angle."""
+    import dataclasses
+
+    from vtool.solvers import run
+
+    trace = simulate(load_preset("gnilka-1a"))
+    huge = getattr(trace, name).copy()
+    huge[:2, 0] = 1e308
+    run._check_finite(dataclasses.replace(trace, **{name: huge}))
+    for bad in (np.nan, np.inf, -np.inf):
+        values = getattr(trace, name).copy()
+        values[7, -1] = bad
+        with pytest.raises(RunError, match=rf"^the run diverged: non-finite {name} at t = "
+                                           rf"{trace.time[7]:.6g} s \(cam angle {trace.cam_angle[7]:.4g} deg\)"):
+            run._check_finite(dataclasses.replace(trace, **{name: values}))
