@@ -8,7 +8,7 @@ import tomllib
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from vtool.app.tui.form import get_path, set_path
+from vtool.app.tui.form import first_line, get_path, set_path
 from vtool.app.tui.presetfile import round_trip_text, save_text
 from vtool.presets import find_preset, valvetrain
 
@@ -54,3 +54,16 @@ def test_a_second_save_replaces_the_was_note() -> None:
     twice["run"]["rpm"] = 8000
     second = round_trip_text(first, once, twice)
     assert "rpm = 8000 # was 9000" in second and "11000" not in second.split("[run]")[1].split("\n")[1]
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.text("abcdefghij.^/", min_size=1, max_size=22), min_size=1, max_size=5), st.integers(4, 20))
+def test_a_rows_label_line_is_the_first_line_rich_wraps_it_to(words: list[str], width: int) -> None:
+    """FieldRow draws its label's first line (form.first_line): the first line Rich gives the label at that
+    width, as the Label widget it replaced showed it in a one-line cell (words wrapped, a long word cut)."""
+    from rich.console import Console
+    from rich.text import Text
+
+    label = " ".join(words)
+    lines = Text(label).wrap(Console(width=200), width)
+    assert first_line(label, width) == lines[0].plain.rstrip()

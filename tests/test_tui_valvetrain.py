@@ -395,9 +395,14 @@ async def test_changed_fields_are_starred_and_the_thesis_quantities_can_all_be_p
         assert app.focused is screen.form.row("run.rpm").editor  # typing starts at the first field
         await put(pilot, screen, "run.degrees", "40")
         row = screen.form.row("run.degrees")
-        assert row.has_class("-changed") and "*cam degrees" in str(row.query_one("Label").render())
+        drawn = row.render()  # the row draws its label and unit (the editor is its one child)
+        assert row.has_class("-changed") and drawn.plain.startswith("*cam degrees") and drawn.plain.endswith("deg")
+        label_style = drawn.get_style_at_offset(app.console, 0)
+        assert label_style.bold and label_style == row.get_component_rich_style("field-row--label")
+        assert drawn.get_style_at_offset(app.console, len(drawn) - 1) == row.get_component_rich_style("field-row--unit")
         await put(pilot, screen, "run.degrees", "850")  # back to the preset's value: no star
-        assert not row.has_class("-changed")
+        assert not row.has_class("-changed") and row.render().plain.startswith("cam degrees ")
+        assert not row.get_component_rich_style("field-row--label").bold
         await put(pilot, screen, "run.degrees", "40")
         await run_and_wait(pilot, app)
         trace = screen.trace
