@@ -513,3 +513,28 @@ async def test_opening_a_preset_of_the_same_form_shows_what_a_fresh_form_shows()
         assert list(screen.form.query(FieldRow)) == rows  # the same rows, refilled
         assert await texts(app) == fresh
         assert not any(row.has_class("-changed") or row.has_class("-invalid") for row in rows)
+
+
+async def test_the_sweep_tab_makes_its_widgets_when_first_opened_for_the_preset_shown() -> None:
+    """The Sweep tab's pane is lazy: no widgets at the start; opened, it has its inputs, buttons and
+    chart, for the preset the form shows then, with that preset's metrics."""
+    from textual.widgets import Button, Input, Select
+
+    from vtool.app.tui.sweep import SweepPane
+    from vtool.solvers.metrics import metric_columns
+
+    app = make_app("gnilka-1a")
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        pane = app.screen.query_one(SweepPane)
+        assert not pane.children and not pane.composed
+        assert await app.open_preset("gnilka-2")
+        await pilot.pause()
+        app.screen.tabs.active = "tab-sweep"
+        await pilot.pause()
+        await pilot.pause()
+        assert pane.composed and len(pane.query(Input)) == 4 and len(pane.query(Button)) == 3
+        assert pane.preset.endswith("gnilka-2.toml") or pane.preset == "gnilka-2"
+        options = [value for _, value in pane.query_one("#sweep-metric", Select)._options]
+        assert options == [name for name, _ in metric_columns(load_preset("gnilka-2"))]
+        assert pane.status_text == ""

@@ -67,7 +67,7 @@ class SweepPane(Widget):
 
     def __init__(self, preset: str | Path = "gnilka-1a", *, workers: int | None = 1, field: str = "run.rpm",
                  values: str = "9000:12000:250", fixed: str = "", metric: str = "spring_margin",
-                 id: str | None = None) -> None:
+                 id: str | None = None, lazy: bool = False) -> None:
         super().__init__(id=id)
         self.preset = str(preset)
         self.sweep_workers = workers
@@ -75,8 +75,13 @@ class SweepPane(Widget):
         self.plan: Any = None
         self.outcome: Any = None
         self.worker: Worker[Any] | None = None
+        # lazy: the widgets are made when the pane is first shown (a tab not yet opened costs the screen's
+        # start nothing: the valve-train screen's Sweep tab was 25 of its widgets)
+        self.composed = not lazy
 
     def compose(self) -> ComposeResult:
+        if not self.composed:
+            return
         field, values, fixed, metric = self._initial
         with Vertical():
             with Horizontal():
@@ -95,6 +100,11 @@ class SweepPane(Widget):
             yield Static("", id="sweep-status", markup=False)
             yield ChartView("run a sweep to see the chart", id="sweep-chart")
             yield TextPanel("", id="sweep-table")
+
+    async def on_show(self) -> None:
+        if not self.composed:  # a lazy pane's first showing
+            self.composed = True
+            await self.recompose()
 
     def _metric_names(self) -> tuple[str, ...]:
         """The preset's metrics (its own force labels), or a default list if it does not load."""

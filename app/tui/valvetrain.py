@@ -136,7 +136,7 @@ class ValveTrainScreen(DomainScreen):
             TabPane("Events", TextPanel("no run yet", id="events"), id="tab-events"),
             TabPane("Summary", TextPanel("no run yet", id="summary"), id="tab-summary"),
             TabPane("Anim.", MechanismAnimation(id="animation", color=color), id="tab-animation"),
-            TabPane("Sweep", SweepPane(self.DEFAULT_PRESET, workers=None, id="sweep"), id="tab-sweep"),
+            TabPane("Sweep", SweepPane(self.DEFAULT_PRESET, workers=None, id="sweep", lazy=True), id="tab-sweep"),
         ]
 
     def on_source_changed(self, source: str) -> None:
