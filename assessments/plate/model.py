@@ -20,6 +20,7 @@ from vtool.assessments.plate.constraints import restrict
 from vtool.assessments.plate.masters import MasterSetError, labelled_set, named_set
 from vtool.assessments.plate.reduction import guyan_T, henshell_ong_masters, irs_T, reduce
 from vtool.errors import RunError
+from vtool.threads import limited
 
 METHODS = ("guyan", "irs")
 
@@ -104,6 +105,7 @@ def master_positions(mesh: Mesh, selection: MasterSelection, free: np.ndarray,
     return henshell_ong_masters(M_c, K_c, int(selection.auto))  # type: ignore[arg-type]
 
 
+@limited()  # small dense matrices: one BLAS thread (vtool.threads)
 def build_model(plate: Plate, case: Case) -> ReducedModel:
     """Assemble, constrain and reduce one case."""
     start = time.perf_counter()

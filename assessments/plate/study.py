@@ -45,6 +45,7 @@ from vtool.assessments.plate.transient import (
 )
 from vtool.assessments.plate.vibration import FreeVibration, convergence_order, free_vibration
 from vtool.errors import InputError
+from vtool.threads import limited
 
 #: Transient window in exact fundamental periods: 2 holds the exact peak of
 #: every load case of the 40:27 plate (the point-load displacement peaks at
@@ -270,6 +271,7 @@ def optima(rows: list[TransientRow], settings: TransientSettings, full_case: str
     return out
 
 
+@limited()  # small dense matrices: one BLAS thread (vtool.threads)
 def run_study(study: Study, *, transient: bool = True, cancel: Cancel | None = None) -> StudyResult:
     """Free vibration of every case, mesh convergence, cost and transient accuracy.
 
@@ -354,6 +356,7 @@ def check_run_options(load: str, scheme: str, omega_max_h: float, periods: float
         raise InputError(f"{prefix}exact_modes", exact_modes, f"an integer >= 2 and <= {MAX_EXACT_MODES}")
 
 
+@limited()  # small dense matrices: one BLAS thread (vtool.threads)
 def run_case(plate: Plate, case: Case, load: str, scheme: str = "rk4", omega_max_h: float = 1.0,
              periods: float = DEFAULT_PERIODS, exact_modes: int = 200, *, halving: bool = True,
              cancel: Cancel | None = None) -> CaseRun:

@@ -20,6 +20,7 @@ import scipy.linalg as sla
 from vtool.assessments.plate.assembly import Plate
 from vtool.assessments.plate.exact import NavierMode, lowest_modes
 from vtool.assessments.plate.model import ReducedModel
+from vtool.threads import limited
 
 
 @dataclass(frozen=True)
@@ -45,6 +46,7 @@ def natural_frequencies(M: np.ndarray, K: np.ndarray) -> np.ndarray:
     return np.sqrt(np.clip(lam, 0.0, None))
 
 
+@limited()  # small dense matrices: one BLAS thread (vtool.threads)
 def free_vibration(plate: Plate, model: ReducedModel, count: int = 6) -> FreeVibration:
     """Lowest ``count`` frequencies of a reduced model with their percentage errors."""
     start = time.perf_counter()
