@@ -25,6 +25,7 @@ from vtool.solvers.model import Mechanism, assemble
 from vtool.solvers.preflight import seat_reach_warning
 from vtool.solvers.spec import MechanismSpec, RunSpec
 from vtool.solvers.trace import CsvStream, Trace
+from vtool.threads import limited
 
 CANONICAL_RUN = RunSpec(rpm=1.0, degrees=1.0, time_step=1.0)  # the run settings of a kept mechanism's key
 
@@ -81,11 +82,12 @@ def _assemble(spec: MechanismSpec) -> Mechanism:
         key, base = None, None
     if base is None:
         try:
-            base = assemble(dataclasses.replace(spec, run=CANONICAL_RUN))
+            with limited():  # (the runs' BLAS setting for the assembly and its modes too)
+                base = assemble(dataclasses.replace(spec, run=CANONICAL_RUN))
+                base.highest_frequency  # noqa: B018 (computed once: every run of the mechanism shares it)
         except NUMERICAL_FAILURES as exc:
             raise RunError(f"assembling the mechanism failed ({type(exc).__name__}: {str(exc)[:80]}); "
                            "check the members' sections, moduli and masses") from None
-        base.highest_frequency  # noqa: B018 (computed once: every run of the mechanism shares it)
         if key is not None:
             kept[key] = base
             while len(kept) > ASSEMBLED_KEPT:

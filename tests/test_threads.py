@@ -70,12 +70,18 @@ def test_a_whole_plate_study_runs_on_one_blas_thread(monkeypatch: pytest.MonkeyP
 
 
 def test_a_valve_train_run_runs_on_one_blas_thread(monkeypatch: pytest.MonkeyPatch) -> None:
-    from vtool.presets.valvetrain import with_run_overrides
-    from vtool.solvers import contact
-    from vtool.solvers.run import simulate
+    """The run, and the assembly of a mechanism no run has kept yet (and its modes) before it."""
+    import dataclasses
 
-    seen = watching(monkeypatch, contact.ContactProblem, "for_run")
+    from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers import contact, run
+
+    spec = with_run_overrides(load_preset("gnilka-1a"), degrees=5.0)
+    member = dataclasses.replace(spec.members[0], length=spec.members[0].length * 1.000123)  # a new mechanism
+    spec = dataclasses.replace(spec, members=(member, *spec.members[1:]))
+    assembled = watching(monkeypatch, run, "assemble")
+    problems = watching(monkeypatch, contact.ContactProblem, "for_run")
     with two_threads():
-        simulate(with_run_overrides(load_preset("gnilka-1a"), degrees=5.0))
+        run.simulate(spec)
         assert set(blas_threads()) == {2}
-    assert seen and all(set(threads) == {1} for threads in seen)
+    assert assembled and problems and all(set(threads) == {1} for threads in assembled + problems)
