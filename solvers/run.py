@@ -58,7 +58,7 @@ _KEY_FIELDS = tuple(f.name for f in dataclasses.fields(MechanismSpec) if f.compa
 class _Key:
     """A spec's fields but its run settings, hashed once (the kept mechanisms' ordered dict hashes its
     key at each lookup and move, and a spec's hash goes through every member and clearance: the lookup
-    of a kept mechanism took 45 µs, now 15)."""
+    of a kept mechanism took 45 µs, now 17, by timeit)."""
 
     __slots__ = ("fields", "hash")
 
