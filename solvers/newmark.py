@@ -239,6 +239,11 @@ def kernel_kind(module: ModuleType) -> str:
     return "numba" if hasattr(module.run_chunk, "py_func") else "plain"
 
 
+#: Native modules whose build this process found failed, or could not start: each warm run on numba's
+#: kernel asked again (the build's lock file named and its failure note looked for: 0.25 ms a run).
+_no_native_build: set[str] = set()
+
+
 class KernelRun:
     """The kernel's buffers and state for one run, and its chunked calls."""
 
@@ -349,7 +354,9 @@ class KernelRun:
                 or not kernel_build.start(self.jobs)):
             self.compile()
             if mode == "auto" and kernel_native.enabled():  # the kernel was cached but has no native module yet
-                kernel_build.start(self.jobs[1:])
+                name = kernel_native.module_name(self.arguments())
+                if name not in _no_native_build and not kernel_build.start(self.jobs[1:]):
+                    _no_native_build.add(name)  # its build failed (no C compiler?): not asked again in this process
             return kernel_build.kernel(), False
         return kernel_build.plain_kernel(), True
 

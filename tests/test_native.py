@@ -230,3 +230,28 @@ def test_the_digest_reads_the_files_the_module_is_built_from() -> None:
                                               "kernel_native.py"}
     assert files[0] == Path(kernel.__file__).resolve()
     assert files[2].parent == Path(csvrows.__file__).parent  # beside the CSV writer, whatever the install
+
+
+@needs_jit
+def test_a_failed_native_build_is_not_asked_again_by_every_run(monkeypatch) -> None:  # noqa: ANN001
+    """Default mode, the kernel in numba's cache, its native module's build failed (no C compiler, say):
+    the first run finds the failure, later runs of the process go on numba's kernel without asking."""
+    from vtool.solvers import kernel_build, newmark
+
+    asked: list[list] = []
+
+    def start(jobs: list) -> bool:
+        asked.append(jobs)
+        return False  # as start() answers when the build's failure note is there
+
+    monkeypatch.setenv("VTOOL_KERNEL", "auto")
+    monkeypatch.setenv("VTOOL_NATIVE", "1")
+    monkeypatch.setattr(kernel_native, "load", lambda values: None)  # no module built
+    monkeypatch.setattr(kernel_build, "start", start)
+    monkeypatch.setattr(newmark, "_no_native_build", set())
+    short = with_run_overrides(load_preset("gnilka-1a"), degrees=2.0)
+    runs = [simulate(short) for _ in range(3)]
+    assert [run.statistics.kernel for run in runs] == ["numba"] * 3
+    assert len(asked) == 1 and [job[0] for job in asked[0]] == ["native"]
+    other = with_run_overrides(load_preset("gnilka-2"), degrees=2.0)  # the same module (same argument types)
+    assert simulate(other).statistics.kernel == "numba" and len(asked) == 1
