@@ -267,6 +267,9 @@ class PiecewiseRun(ABC):
         if not self.rows:
             return
         blocks, self.rows = self.rows, []
+        if len(blocks) == 1:  # one block: in time order as emitted; fresh arrays nobody writes again, kept as they are
+            self.builder.add_rows(*blocks[0], copy=False)
+            return
         t, q3, F, cfg = (np.concatenate(parts) for parts in zip(*blocks, strict=True))
         if np.any(np.diff(t) < 0.0):
             order = np.argsort(t, kind="stable")

@@ -133,15 +133,29 @@ def fourier_basis(omega: float, harmonics: int, t: float | np.ndarray, rate: boo
     t = np.asarray(t, dtype=float)
     k_omega = omega * np.arange(1, harmonics + 1)
     phase = np.multiply.outer(k_omega, t)
-    cos, sin = np.cos(phase), np.sin(phase)
+    out = np.empty((1 + 2 * harmonics,) + t.shape)  # filled in place: a block's basis is a few calls, not ten
     if rate:
         kw = k_omega.reshape((-1,) + (1,) * t.ndim)
-        return np.concatenate([np.zeros((1,) + t.shape), -kw * sin, kw * cos])
-    return np.concatenate([np.ones((1,) + t.shape), cos, sin])
+        out[0] = 0.0
+        np.multiply(np.sin(phase), -kw, out=out[1:harmonics + 1])
+        np.multiply(kw, np.cos(phase), out=out[harmonics + 1:])
+        return out
+    out[0] = 1.0
+    np.cos(phase, out=out[1:harmonics + 1])
+    np.sin(phase, out=out[harmonics + 1:])
+    return out
 
 
 def shift_coefficients(coefficients: np.ndarray, omega: float, harmonics: int, t: float) -> np.ndarray:
     """C' with C' u(τ) = C u(t + τ) (the angle-addition formulas, harmonic by harmonic)."""
+    if harmonics == 1:  # the thesis cam: the same arithmetic on scalars, and one array made
+        cos, sin = math.cos(omega * t), math.sin(omega * t)
+        out = np.empty_like(coefficients)
+        c_part, s_part = coefficients[:, 1], coefficients[:, 2]
+        out[:, 0] = coefficients[:, 0]
+        out[:, 1] = c_part * cos + s_part * sin
+        out[:, 2] = s_part * cos - c_part * sin
+        return out
     phase = omega * t * np.arange(1, harmonics + 1)
     cos, sin = np.cos(phase), np.sin(phase)
     c_part, s_part = coefficients[:, 1:harmonics + 1], coefficients[:, harmonics + 1:]
@@ -257,6 +271,7 @@ class Propagator:
         self.drift_x = self.drift_v = np.zeros(0, dtype=np.int64)
         self.drift = np.zeros(0)
         self._powers: np.ndarray | None = None
+        self._real_powers = np.zeros((0, 0))
         if n:
             balanced = T is not None and Tinv is not None
             Az = T @ A @ Tinv if balanced else A
@@ -308,8 +323,13 @@ class Propagator:
             return rows @ hs, lambda index: hs[:, index]
         if self._powers is None or self._powers.shape[1] < count:
             self._powers = np.exp(np.multiply.outer(self.lam, self.step * np.arange(1, max(count, 256) + 1)))
+            # the same powers as real rows (Re p_j, -Im p_j) side by side, so that Re(rows h · powers) is
+            # one real product with (rows h) read as its (re, im) pairs: half the work of the complex one
+            self._real_powers = np.empty((2 * self.lam.size, self._powers.shape[1]))
+            self._real_powers[0::2] = self._powers.real
+            self._real_powers[1::2] = -self._powers.imag
         powers = self._powers
-        values = ((rows * h) @ powers[:, :count]).real
+        values = (rows * h).view(float) @ self._real_powers[:, :count]
         drift = self.drift * h[self.drift_v]
         if drift.size:
             values += np.multiply.outer((rows[:, self.drift_x] @ drift).real, self.step * np.arange(1, count + 1))

@@ -21,13 +21,15 @@ import numpy as np
 import pytest
 import scipy.linalg
 import threadpoolctl
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tests.test_backends import base_excited_doc
 from tests.valvetrain_cases import base_excited_response, spec_from
 from vtool.errors import InputError, RunError
 from vtool.presets import load_preset
 from vtool.solvers.contact import ContactProblem
-from vtool.solvers.exact import ExactOptions, _ExactRun, peak_brackets
+from vtool.solvers.exact import ExactOptions, _ExactRun, peak_brackets, safe_newton
 from vtool.solvers.model import assemble
 from vtool.solvers.scipy_backend import ScipyBackend, ScipyOptions
 from vtool.solvers.sources import SourceSeries
@@ -176,6 +178,38 @@ def test_peak_brackets_cover_interior_and_end_maxima() -> None:
     found = peak_brackets(values, np.array([True, True]), np.array([3.0, 0.0]), margin=0.0)
     assert found == [(0, 0, 2), (0, 3, 4), (1, 0, 1)]
     assert peak_brackets(values, np.array([False, True]), np.array([0.0, 9.0]), margin=0.0) == []
+
+
+@settings(max_examples=300, deadline=None)
+@given(root=st.floats(0.02, 0.98), slope=st.floats(1e-6, 1e6), curve=st.floats(-0.5, 0.5),
+       wave=st.floats(0.0, 0.4), frequency=st.floats(0.5, 40.0), tol=st.sampled_from([1e-12, 1e-9, 1e-4]))
+def test_safe_newton_finds_the_one_root_to_the_tolerance(
+        root: float, slope: float, curve: float, wave: float, frequency: float, tol: float) -> None:
+    """f(x) = slope (r - x)(1 + curve (x - r) + wave sin(frequency x)) / 1.5, the second factor positive:
+    one root r in (0, 1), positive before it and negative after, with a derivative far from f's secant
+    (curvature, ripples, not monotone); the result is within the tolerance of r, whatever the scale."""
+    def both(x: float) -> tuple[float, float]:
+        shape = 1.0 + curve * (x - root) + wave * math.sin(frequency * x)
+        rate = curve + wave * frequency * math.cos(frequency * x)
+        return slope * (root - x) * shape / 1.5, slope * (-shape + (root - x) * rate) / 1.5
+    assert all(1.0 + curve * (x - root) + wave * math.sin(frequency * x) > 0 for x in np.linspace(0, 1, 101))
+    found = safe_newton(both, 0.0, 1.0, both(0.0)[0], both(1.0)[0], tol)
+    assert abs(found - root) <= tol
+
+
+def test_safe_newton_bisects_where_newton_would_not_converge() -> None:
+    """Zero and misleading derivatives (a step out of the bracket, or a step not half the last) bisect:
+    a cube root's tangent overshoots and a flat plateau has no slope; both still end within the tolerance."""
+    def cube(x: float) -> tuple[float, float]:  # f = -cbrt(x - 0.3): Newton alone diverges from any start
+        d = x - 0.3
+        return -math.copysign(abs(d) ** (1 / 3), d), -(abs(d) ** (-2 / 3)) / 3 if d else -math.inf
+
+    def plateau(x: float) -> tuple[float, float]:  # the secant lands on a flat start (zero slope), root 0.7
+        return (1.0, 0.0) if x < 0.6 else (50.0 * (0.7 - x), -50.0)
+
+    for both, root in ((cube, 0.3), (plateau, 0.7)):
+        found = safe_newton(both, 0.0, 1.0, both(0.0)[0], both(1.0)[0], 1e-12)
+        assert abs(found - root) <= 1e-12, both.__name__
 
 
 def cam_force(doc: dict, t: np.ndarray) -> np.ndarray:
