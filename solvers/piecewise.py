@@ -239,15 +239,15 @@ class PiecewiseRun(ABC):
     def track_peaks(self, ss: StateSpace, values: np.ndarray, t: float) -> None:
         """Update the peak contact forces from monitor values (forces of the closed clearances) at t."""
         closed = (ss.mask & self.closed_bit) != 0
-        self.peak = np.where(closed, np.maximum(self.peak, values), self.peak)
+        np.maximum(self.peak, values, out=self.peak, where=closed)
         if t >= self.t_rev:
-            self.peak_late = np.where(closed, np.maximum(self.peak_late, values), self.peak_late)
+            np.maximum(self.peak_late, values, out=self.peak_late, where=closed)
 
     def raise_peaks(self, closed: np.ndarray, values: np.ndarray, t: float) -> None:
         """Raise the peaks of the closed clearances to ``values`` seen at (or, for a block, up to) t."""
-        self.peak = np.where(closed & (values > self.peak), values, self.peak)
+        np.copyto(self.peak, values, where=closed & (values > self.peak))  # (in place: fewer calls)
         if t >= self.t_rev:
-            self.peak_late = np.where(closed & (values > self.peak_late), values, self.peak_late)
+            np.copyto(self.peak_late, values, where=closed & (values > self.peak_late))
 
     def emit(self, ss: StateSpace, t: float, y: np.ndarray) -> None:
         x, v, a = self.full_state(ss, t, y)
