@@ -118,12 +118,12 @@ def safe_newton(both: Callable[[float], tuple[float, float]], low: float, high: 
 
     Newton's method from the secant point, kept inside a bracket that every
     evaluation narrows: a step that would leave it, or is not half the one
-    before (or a zero derivative), bisects instead. It stops at a step shorter than tol/4 (Newton's error then
-    lies far inside it) or a bracket narrower than tol. On a monitor of the
-    exact solution (smooth over a scan interval) it takes two or three
-    evaluations of f and f' together where Brent's method took about five
-    of f (1A: 124 against 288 for 54 roots, the roots within 2.3e-13 s of
-    each other)."""
+    before (or a zero derivative), bisects instead. It stops at a step
+    shorter than tol/4 (Newton's error then lies far inside it) or a bracket
+    narrower than tol. On a monitor of the exact solution (smooth over a
+    scan interval) it takes two or three evaluations of f and f' together
+    where Brent's method took about five of f (1A: 124 against 288 for 54
+    roots, the roots within 2.3e-13 s of each other)."""
     x = low + (high - low) * (f_low / (f_low - f_high))
     if not low < x < high:
         x = 0.5 * (low + high)

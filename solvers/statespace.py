@@ -324,7 +324,8 @@ class Propagator:
         if self._powers is None or self._powers.shape[1] < count:
             self._powers = np.exp(np.multiply.outer(self.lam, self.step * np.arange(1, max(count, 256) + 1)))
             # the same powers as real rows (Re p_j, -Im p_j) side by side, so that Re(rows h · powers) is
-            # one real product with (rows h) read as its (re, im) pairs: half the work of the complex one
+            # one real product with (rows h) read as its (re, im) pairs: half the arithmetic of the complex
+            # product (1A, 1024 samples: 25 against 30 µs, timeit)
             self._real_powers = np.empty((2 * self.lam.size, self._powers.shape[1]))
             self._real_powers[0::2] = self._powers.real
             self._real_powers[1::2] = -self._powers.imag
