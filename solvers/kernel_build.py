@@ -325,14 +325,22 @@ def collector_paused() -> Iterator[None]:
     repeated passes over them free little: ``benchmarks/bench_compile_collector.py``
     prints the collector's time and the peak memory of a one-process compile
     with it and paused; ``benchmarks/bench_compile_ab.py`` the two-process
-    compile's wall time against an earlier commit. One pass over what the
-    compile left follows when the collector is back on.
+    compile's wall time against an earlier commit.
+
+    What the compile made is then frozen (``gc.freeze``: never looked at
+    again by the collector) before the collector comes back. Else its next
+    pass went over all of it at once, inside the compile's wall time: 0.65 s
+    of 1A's 10 s, for 342,000 objects collected. numba keeps most of what
+    it made (types, code libraries) for the process's life; the garbage
+    among it, left in memory, is about 4 MB on 1A (the resident set 272 MB
+    frozen, 268 MB once unfrozen and collected), once per process.
     """
     enabled = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
+        gc.freeze()
         if enabled:
             gc.enable()
 

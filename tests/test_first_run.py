@@ -315,15 +315,19 @@ def test_a_new_install_runs_the_exact_back_end_without_waiting(tmp_path) -> None
 
 
 def test_the_collector_is_paused_during_a_compile_and_restored_after() -> None:
-    """kernel_build.collector_paused: off inside; after it, as it was before (also after an error)."""
+    """kernel_build.collector_paused: off inside; after it, as it was before (also after an error), with
+    what was made inside frozen (the collector's next pass does not go over it)."""
     import gc
 
     was = gc.isenabled()
     try:
         gc.enable()
+        frozen = gc.get_freeze_count()
         with kernel_build.collector_paused():
             assert not gc.isenabled()
+            made = [[index] for index in range(1000)]
         assert gc.isenabled()
+        assert gc.get_freeze_count() >= frozen + len(made)
         with pytest.raises(RuntimeError), kernel_build.collector_paused():
             raise RuntimeError("a failed compile")
         assert gc.isenabled()
