@@ -333,7 +333,10 @@ def collector_paused() -> Iterator[None]:
     of 1A's 10 s, for 342,000 objects collected. numba keeps most of what
     it made (types, code libraries) for the process's life; the garbage
     among it, left in memory, is about 4 MB on 1A (the resident set 272 MB
-    frozen, 268 MB once unfrozen and collected), once per process.
+    frozen, 268 MB once unfrozen and collected). What the process held
+    before is frozen with it: a compile comes once per process, in the
+    compiling mode or the background child (a run in the default mode only
+    loads what the child compiled, outside this block).
     """
     enabled = gc.isenabled()
     gc.disable()
