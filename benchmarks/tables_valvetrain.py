@@ -8,8 +8,9 @@ Run: ``python3 benchmarks/tables_valvetrain.py`` (about a minute on an idle
 * ``accuracy-worst`` in README.md: per setting, the worst case over the
   presets; ``accuracy-default``: the default setting, preset by preset;
 * ``speed`` in README.md and docs/valvetrain.md: warm wall time, steps and
-  events of the default run of every preset, the exact back end's time, and
-  a second process' start-up from the numba cache;
+  events of the default run of every preset, the exact back end's warm time
+  (both the best of five after a first run), and a second process' start-up
+  from the numba cache;
 * ``table-6-1`` in docs/valvetrain.md: example 1A's events beside the
   thesis' Table 6.1.
 
@@ -143,9 +144,9 @@ def speed_block(results: list[PresetStudy], second_process: tuple[float, float, 
     body = []
     for r in results:
         best, trace = warm_time(r.spec)
-        exact = r.rows[0]
+        exact_best, exact = warm_time(with_run(r.spec, backend="exact"))  # warm, as the 50 ms target is set
         body.append((best, [r.name, f"{best * 1e3:.1f}", str(trace.statistics.steps), str(trace.statistics.events),
-                            f"{exact.wall_time * 1e3:.0f}", str(exact.events)]))
+                            f"{exact_best * 1e3:.0f}", str(exact.statistics.events)]))
     body.sort(key=lambda item: -item[0])
     rows = [cells for _, cells in body]
     if second_process is not None:
@@ -155,7 +156,7 @@ def speed_block(results: list[PresetStudy], second_process: tuple[float, float, 
         rows.append([f"`vtool solve gnilka-1a` in a second process, median of five ({how})",
                      f"{solve_time * 1e3:.0f} in-process, {total * 1e3:.0f} with interpreter start-up", "", "", "", ""])
     head = ["preset (Newmark, the preset's dt, with refinement after events)", "warm wall time (ms)", "steps",
-            "events", "exact back end (ms)", "exact events"]
+            "events", "exact back end, warm (ms)", "exact events"]
     return table(head, rows)
 
 
