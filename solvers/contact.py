@@ -119,12 +119,9 @@ class ConfigurationTables:
         count = 2**ncl
         self.ci = np.zeros((count, layout.CI_HEAD + 3 * n), dtype=np.int64)
         self.cm = np.zeros((count, layout.CM_SIZE, n, n))
-        self.cp = np.zeros((count, layout.CP_SIZE, layout.PART_SIZE, 3 * max(n, ns), n))  # layout.CP_RAW
+        self.cp = np.zeros((count, layout.CP_SIZE, layout.PART_SIZE, 3 * max(n, ns), n + ncl))  # layout.CP_RAW
         self.mk = np.zeros((count, ncl, layout.MK_SIZE), dtype=np.int64)
         self.mon = np.zeros((count, ncl, 3 * n + 3 * ns + 1 + ncl))
-        # a force row's nonzero terms (layout.MK_TERMS): their columns of mon, their coefficients
-        self.mi = np.zeros((count, ncl, 3 * n + 3 * ns), dtype=np.int64)
-        self.mc = np.zeros((count, ncl, 3 * n + 3 * ns))
         self.layers: dict[int, OrderedLayer] = {}
         self.step: tuple[float, float, float, float] | None = None  # (dt, beta, gamma, fine) of the inverses
 
@@ -142,16 +139,54 @@ class ConfigurationTables:
             return
         dt, beta, gamma, fine = self.step
         nf = int(self.ci[mask, layout.CI_NF])
-        if not nf:
-            return
         cm = self.cm[mask]
-        M, C, K = cm[layout.CM_MFF, :nf, :nf], cm[layout.CM_CFF, :nf, :nf], cm[layout.CM_KFF, :nf, :nf]
-        cm[layout.CM_SINV, :nf, :nf] = np.linalg.inv(M + gamma * dt * C + beta * dt * dt * K)
-        cm[layout.CM_SINVF, :nf, :nf] = np.linalg.inv(M + gamma * fine * C + beta * fine * fine * K)
         cp = self.cp[mask]  # G = S⁻¹R, part by part, stored transposed as R is (see layout.CP_RAW)
-        raw = np.ascontiguousarray(np.swapaxes(cp[layout.CP_RAW, :, :, :nf], 1, 2))  # R's free rows
-        cp[layout.CP_STD, :, :, :nf] = np.swapaxes(cm[layout.CM_SINV, :nf, :nf] @ raw, 1, 2)
-        cp[layout.CP_FINE, :, :, :nf] = np.swapaxes(cm[layout.CM_SINVF, :nf, :nf] @ raw, 1, 2)
+        if nf:
+            M, C, K = cm[layout.CM_MFF, :nf, :nf], cm[layout.CM_CFF, :nf, :nf], cm[layout.CM_KFF, :nf, :nf]
+            cm[layout.CM_SINV, :nf, :nf] = np.linalg.inv(M + gamma * dt * C + beta * dt * dt * K)
+            cm[layout.CM_SINVF, :nf, :nf] = np.linalg.inv(M + gamma * fine * C + beta * fine * fine * K)
+            raw = np.ascontiguousarray(np.swapaxes(cp[layout.CP_RAW, :, :, :nf], 1, 2))  # R's free rows
+            cp[layout.CP_STD, :, :, :nf] = np.swapaxes(cm[layout.CM_SINV, :nf, :nf] @ raw, 1, 2)
+            cp[layout.CP_FINE, :, :, :nf] = np.swapaxes(cm[layout.CM_SINVF, :nf, :nf] @ raw, 1, 2)
+        self._force_rows(mask, beta, gamma, ((layout.CP_STD, dt), (layout.CP_FINE, fine)))
+
+    def _force_rows(self, mask: int, beta: float, gamma: float, planes: tuple[tuple[int, float], ...]) -> None:
+        """The force rows of the step operators (``layout.CP_RAW``): each closed rigid clearance's contact
+        force at a step's end, less its constant, from the step's predictor y = (ż̃_F, z̃_F, (z̈, ż, z)_P, src).
+
+        With the force row w = (w_z, w_ż, w_z̈, w_s, w_0) on the layer (``mon``) and a Newmark step of
+        length h, the free rows end at z_F = z̃_F + βh² z̈_F, ż_F = ż̃_F + γh z̈_F, with z̈_F = -G y;
+        the prescribed rows are y's own. So
+
+            F - w_0 = d·y + uᵀ z̈_F = (d - Gᵀu)·y,   u = βh² w_z,F + γh w_ż,F + w_z̈,F,
+
+        where d holds w's coefficients on y's entries (w_ż,F, w_z,F, then (w_z̈, w_ż, w_z)_P, w_s). The
+        kernel's product gives out = -R y for a stored row R, so the row stored is Gᵀu - d. The same
+        number as :func:`vtool.solvers.newmark_kernel.contact_force` of the step's end, up to round-off.
+        """
+        n, ns = self.n, self.ns
+        ci, cp = self.ci[mask], self.cp[mask]
+        nf, m = int(ci[layout.CI_NF]), int(ci[layout.CI_M])
+        np_ = m - nf
+        reads_sources = bool(ci[layout.CI_SRC])
+        for plane, h in planes:
+            bx, gv = beta * h * h, gamma * h
+            for k in range(self.ncl):
+                row = int(self.mk[mask, k, layout.MK_ROW])
+                if self.mk[mask, k, layout.MK_KIND] != layout.MK_FORCE or row < 0:
+                    continue
+                w = self.mon[mask, k]
+                wz, wzd, wzdd, ws = w[:n], w[n:2 * n], w[2 * n:3 * n], w[3 * n:3 * n + 3 * ns]
+                u = bx * wz[:nf] + gv * wzd[:nf] + wzdd[:nf]
+                d = np.zeros(cp.shape[1:3])
+                d[layout.PART_C, :nf], d[layout.PART_K, :nf] = wzd[:nf], wz[:nf]
+                d[layout.PART_P, 0:3 * np_:3] = wzdd[nf:m]
+                d[layout.PART_P, 1:3 * np_:3] = wzd[nf:m]
+                d[layout.PART_P, 2:3 * np_:3] = wz[nf:m]
+                d[layout.PART_S, :3 * ns] = ws
+                cp[plane, :, :, row] = cp[plane, :, :, :nf] @ u - d
+                reads_sources = reads_sources or bool(np.any(cp[plane, layout.PART_S, :, row]))
+        ci[layout.CI_SRCSTEP] = int(reads_sources)
 
     def build(self, mask: int) -> OrderedLayer:
         """Partition configuration ``mask`` and fill its rows (see the module doc)."""
@@ -175,6 +210,7 @@ class ConfigurationTables:
         S_o = (layer.T.T @ springs.S)[order]
         ci = self.ci[mask]
         ci[layout.CI_M], ci[layout.CI_NF] = m, nf
+        ci[layout.CI_ROWS] = nf  # and one more per closed rigid clearance (_monitors)
         head = layout.CI_HEAD
         ci[head:head + m] = kept
         ci[head + n:head + 2 * n] = group
@@ -193,6 +229,7 @@ class ConfigurationTables:
         raw[layout.PART_P, 2:3 * (m - nf):3, :nf] = K_o[:nf, nf:].T
         raw[layout.PART_S, :S_o.shape[1], :nf] = S_o[:nf].T
         ci[layout.CI_SRC] = int(bool(S_o[:nf].any()))
+        ci[layout.CI_SRCSTEP] = ci[layout.CI_SRC]  # and where a force row reads the sources (_force_rows)
         ci[layout.CI_HERTZ] = int(bool(springs.hertz))
         self._monitors(mask, part, group, m, springs)
         ordered = OrderedLayer(mask, M_o, C_o, K_o, nf, kept, group, source, S_o)
@@ -245,16 +282,13 @@ class ConfigurationTables:
                               frow[part_index * n:(part_index + 1) * n])
                 mon[3 * n:3 * n + 3 * ns] = frow[3 * n:]
                 kind = layout.MK_FORCE if c.rigid else layout.MK_OVERLAP
-                # the nonzero terms in kernel.contact_force's order: z_j, ż_j, z̈_j for each layer index j,
-                # then the sources
-                order = np.concatenate([np.arange(m)[:, None] + n * np.arange(3)[None, :], 3 * n + np.arange(3 * ns)],
-                                       axis=None)
-                columns = order[mon[order] != 0.0]
-                self.mi[mask, index, :columns.size] = columns
-                self.mc[mask, index, :columns.size] = mon[columns]
-                mk[:] = (kind, int(group[c.ahead - 1]), behind, m, columns.size)
+                row = -1
+                if c.rigid:  # its row in the step operators (see layout.CP_RAW), after the free rows
+                    row = int(self.ci[mask, layout.CI_ROWS])
+                    self.ci[mask, layout.CI_ROWS] = row + 1
+                mk[:] = (kind, int(group[c.ahead - 1]), behind, m, row)
             elif c.state == ENABLED:
-                mk[:] = (layout.MK_GAP, int(group[c.ahead - 1]), behind, m, 0)
+                mk[:] = (layout.MK_GAP, int(group[c.ahead - 1]), behind, m, -1)
 
 
 @dataclass(frozen=True)

@@ -290,7 +290,7 @@ def kernel_split(signature: tuple[Any, ...]) -> tuple[list[Job], list[Job]]:
     """
     from numba import types
 
-    (ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, out_F, out_c, ev_f, ev_i, peak,
+    (ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, ev_f, ev_i, peak,
      x, v, a, ist, fst, work, L, closing, hertz, momentum) = signature
     i8, f8, b1 = types.int64, types.float64, types.boolean
     vec, mat, ivec = types.Array(f8, 1, "C"), types.Array(f8, 2, "C"), types.Array(i8, 1, "C")
@@ -305,8 +305,8 @@ def kernel_split(signature: tuple[Any, ...]) -> tuple[list[Job], list[Job]]:
         ("layer_step", (ci, cm, cp, i8, f8, f8, f8, i8, mat, i8, *(vec,) * 9, cl, clf, mk, mon, hertz)),
     ]
     own: list[Job] = [
-        ("advance", (ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, out_F, out_c, peak, ist, fst,
-                     i8, *(vec,) * 14)),
+        ("advance", (ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist, fst,
+                     i8, *(vec,) * 13)),
         ("take_events", (ip, fp, cl, clf, mass, i8, f8, f8, vec, ivec, x, v, vec, ev_f, ev_i, ist, fst, momentum)),
         ("record_row", (ci, cl, clf, mk, mon, i8, i8, i8, i8, f8, f8, vec, vec, vec, vec, out_t, out_q, out_F, out_c,
                         i8, hertz)),

@@ -37,9 +37,11 @@ CLF_SIZE = 5
 LAW_MOMENTUM, LAW_LOCAL, LAW_THESIS = range(3)
 # event kinds
 EV_OPENED, EV_CLOSED, EV_RELEASED = np.int64(0), np.int64(1), np.int64(2)  # np.int64: add_event compiles once
-# configuration integer table: built, m, nf, source coupling, then kept[n], group[n], source of each z index[n]
-CI_BUILT, CI_M, CI_NF, CI_SRC, CI_HERTZ = range(5)
-CI_HEAD = 5
+# configuration integer table: built, m, nf, source coupling, closed Hertz contacts, the rows of the
+# standard and refined step operators (nf free rows, then the force rows: see CP_RAW), whether those
+# rows read the sources, then kept[n], group[n], source of each z index[n]
+CI_BUILT, CI_M, CI_NF, CI_SRC, CI_HERTZ, CI_ROWS, CI_SRCSTEP = range(7)
+CI_HEAD = 7
 # configuration matrices
 CM_MFF, CM_CFF, CM_KFF, CM_SINV, CM_SINVF, CM_MINVFF = range(6)
 CM_SIZE = 6
@@ -49,15 +51,19 @@ CM_SIZE = 6
 # sources' pull S (3 per source), so that the free rows' ΔP is R·(ż, z, (z̈, ż, z)_P, src); planes
 # CP_STD and CP_FINE hold G = S⁻¹R of the standard and the refined step, so that a step with a stored
 # inverse computes z̈_F = -G·(ż̃, z̃, …) in one product (see :func:`apply_operator`). Parts, not column
-# offsets: an index that is a loop counter needs no negative-index fix-up.
+# offsets: an index that is a loop counter needs no negative-index fix-up. The two step planes also
+# hold, after the nf free rows, one row per closed rigid clearance (its MK_ROW): the contact force at
+# the step's end less its constant, as the same product gives it from the step's predictor (the force
+# row w on (z, ż, z̈, sources) with the step's z̈_F = -G·y substituted), so that a quiet step gets its
+# force monitors from the vector pass it makes anyway (see ``ConfigurationTables._inverses``). The
+# last dimension is n + ncl.
 CP_RAW, CP_STD, CP_FINE = range(3)
 CP_SIZE = 3
 PART_C, PART_K, PART_P, PART_S = range(4)
 PART_SIZE = 4
 # monitor per (configuration, clearance): (kind, ahead z index, behind z index or -1 - source, m, and for
-# a force the number of its row's nonzero terms on (z, ż, z̈, sources): their columns of ``mon`` in
-# mi[c, k], in :func:`contact_force`'s order, their coefficients in mc[c, k]; :func:`advance` sums only those)
-MK_KIND, MK_AHEAD, MK_BEHIND, MK_M, MK_TERMS = range(5)
+# a closed rigid clearance its force's row in the step operators' output, else -1)
+MK_KIND, MK_AHEAD, MK_BEHIND, MK_M, MK_ROW = range(5)
 MK_SIZE = 5
 MK_NONE, MK_GAP, MK_FORCE, MK_OVERLAP = range(4)  # MK_OVERLAP: a closed compliant clearance
 # peak rows: contact force over the run, after the first revolution, overlap of compliant contacts
@@ -70,7 +76,7 @@ I_SIZE = 11  # I_SUB: refined steps taken since the grid point I_GRID (the refin
 F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
 F_SIZE = 4
 # run_chunk's float scratch ``work``: this many values per coordinate, per source and per clearance
-WORK_PER_N, WORK_PER_SOURCE, WORK_PER_CLEARANCE = 11, 9, 3
+WORK_PER_N, WORK_PER_SOURCE, WORK_PER_CLEARANCE = 11, 9, 4
 
 
 def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:

@@ -307,7 +307,6 @@ class KernelRun:
         problem, tables = self.problem, self.problem.tables
         return (self.ip, self.fp, problem.cl, problem.clf, problem.series.const, problem.series.cos,
                 problem.series.sin, problem.mass, tables.ci, tables.cm, tables.cp, tables.mk, tables.mon,
-                tables.mi, tables.mc,
                 self.out_t, self.out_q, self.out_F, self.out_c, self.ev_f, self.ev_i, self.peak,
                 self.x, self.v, self.a, self.ist, self.fst, self.work, self.L, self.closing, problem.hertz,
                 problem.momentum)

@@ -99,7 +99,9 @@ from vtool.solvers.kernel_layout import (  # the slots and codes: see that modul
     CI_HERTZ,
     CI_M,
     CI_NF,
+    CI_ROWS,
     CI_SRC,
+    CI_SRCSTEP,
     CL_AHEAD,
     CL_BEHIND,
     CL_BIT,
@@ -173,7 +175,7 @@ from vtool.solvers.kernel_layout import (  # the slots and codes: see that modul
     MK_KIND,
     MK_M,
     MK_OVERLAP,
-    MK_TERMS,
+    MK_ROW,
     NEED_CONFIG,
     OUTPUT_FULL,
     PART_C,
@@ -215,7 +217,7 @@ inner = _plain if PLAIN else njit(**_INNER)
 tiny = _plain if PLAIN else njit(**_INNER, inline="always")
 
 #: :func:`vtool.solvers.kernel_layout.fingerprint` of the layout this file was compiled with (see there).
-LAYOUT_FINGERPRINT = "b325a5b0283c51e3"
+LAYOUT_FINGERPRINT = "b28688b79d115aad"
 
 # how a step solves S z̈ = rhs (layer_step's ``which``): stored inverses of the standard and refined
 # steps, or a Cholesky factor. np.int64 values, not int literals: numba compiles a function once per
@@ -319,8 +321,9 @@ def set_prescribed(ci, c, n, src, z, zd, zdd):
 
 
 @tiny
-def apply_operator(cp, c, plane, nf, m, coupled, src, z, zd, zdd, out):
-    """out_F = -R·(ż_F, z_F, (z̈, ż, z)_P, src) for step operator R = cp[c, plane] (see ``CP_RAW``).
+def apply_operator(cp, c, plane, nf, nrows, m, coupled, src, z, zd, zdd, out):
+    """out[:nrows] = -R·(ż_F, z_F, (z̈, ż, z)_P, src) for step operator R = cp[c, plane] (see ``CP_RAW``):
+    the nf free rows, and in a step plane the force rows after them (``CI_ROWS``).
 
     Column by column: cp holds Rᵀ, each column's coefficients on the free rows side by side, so
     that every row's running sum takes the column's term in one pass over the rows, a loop the
@@ -328,8 +331,8 @@ def apply_operator(cp, c, plane, nf, m, coupled, src, z, zd, zdd, out):
     view of cp (an array rebound in the step loop) would cost a reference-count increment and
     decrement per step."""
     # the rows run on to a multiple of four where out and cp have room: a whole number of 4-row vectors,
-    # no row-by-row remainder; the rows past nf have zero coefficients, and nobody reads them from out
-    rows = min((nf + 3) // 4 * 4, out.shape[0], cp.shape[4])
+    # no row-by-row remainder; nobody reads the rows past nrows from out
+    rows = min((nrows + 3) // 4 * 4, out.shape[0], cp.shape[4])
     for f in range(rows):
         out[f] = 0.0
     for g in range(nf):
@@ -356,7 +359,7 @@ def apply_operator(cp, c, plane, nf, m, coupled, src, z, zd, zdd, out):
 def free_rhs(ci, cm, cp, c, n, src, z, zd, zdd, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
     right, and the sources' pull through closed compliant contacts (``CP_RAW``)."""
-    apply_operator(cp, c, CP_RAW, ci[c, CI_NF], ci[c, CI_M], ci[c, CI_SRC], src, z, zd, zdd, rhs)
+    apply_operator(cp, c, CP_RAW, ci[c, CI_NF], ci[c, CI_NF], ci[c, CI_M], ci[c, CI_SRC], src, z, zd, zdd, rhs)
 
 
 @inner
@@ -543,8 +546,8 @@ def layer_step(ci, cm, cp, c, beta, gamma, h, which, L, n, src1, z, zd, zdd, z1,
         free_rhs(ci, cm, cp, c, n, src1, z1, zd1, zdd1, rhs)
         cholesky_solve(nf, L, rhs, sol)
     else:  # z̈_F = S⁻¹ ΔP as one product with the stored G = S⁻¹R
-        apply_operator(cp, c, CP_STD if which == STANDARD else CP_FINE, nf, m, ci[c, CI_SRC], src1, z1, zd1, zdd1,
-                       sol)
+        apply_operator(cp, c, CP_STD if which == STANDARD else CP_FINE, nf, nf, m, ci[c, CI_SRC], src1, z1, zd1,
+                       zdd1, sol)
     for f in range(nf):
         zdd1[f] = sol[f]
         z1[f] += beta * h * h * sol[f]
@@ -579,9 +582,8 @@ def consistent_acceleration(ci, cm, cp, c, n, src, z, zd, zdd, rhs, cl, clf, mk,
 @inner
 def contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src):
     """Contact force of closed clearance k: its row on (z, ż, z̈, sources, 1), summed term by term in
-    the order z_0, ż_0, z̈_0, z_1, …, then the sources. A zero term adds exactly nothing, so
-    :func:`advance`, which sums only the nonzero terms (``MK_TERMS``) in the same order, gets the
-    same number to the last bit."""
+    the order z_0, ż_0, z̈_0, z_1, …, then the sources. (A quiet step in :func:`advance` takes the same
+    force, up to round-off, from its force row in the step's product: see ``CP_RAW``.)"""
     f = mon[c, k, 3 * n + 3 * ns]
     for j in range(mk[c, k, MK_M]):
         f += mon[c, k, j] * z[j]
@@ -1067,8 +1069,8 @@ def track_peaks(cl, clf, mk, mon, c, n, ns, ncl, gap_noise, after, phi, z, zd, z
 
 # ----- the hot loop -----
 @inner
-def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, out_F, out_c, peak, ist, fst, c,
-            z, zd, zdd, z1, zd1, zdd1, src1, y1, srco, zo, zdo, zddo, rhs, phi):
+def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak, ist, fst, c,
+            z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi):
     """Standard and refined steps in configuration c while nothing happens; returns the time reached.
 
     Everything a quiet step does is written out here, with no call that
@@ -1091,13 +1093,12 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, o
     fine = dt / refine
     m = ci[c, CI_M]
     nf = ci[c, CI_NF]
-    coupled = ci[c, CI_SRC]
+    nrows = ci[c, CI_ROWS]
+    coupled = ci[c, CI_SRCSTEP]
     rows = out_t.shape[0]
     # this configuration's monitor tables, taken once (inner loops then index two dimensions, not three)
     W = mon[c]
     kinds = mk[c]
-    columns = mi[c]
-    terms = mc[c]
     t = fst[F_T]
     # cos, sin of omega t, carried from step to step by the rotation through one step's angle (libm's
     # sincos took a seventh of a quiet step: 172 against 148 ns/step on 1A, bench_step_ab.py), and taken
@@ -1165,7 +1166,7 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, o
             z1[j] = src1[3 * sidx]
             zd1[j] = src1[3 * sidx + 1]
             zdd1[j] = src1[3 * sidx + 2]
-        apply_operator(cp, c, plane, nf, m, coupled, src1, z1, zd1, zdd1, rhs)
+        apply_operator(cp, c, plane, nf, nrows, m, coupled, src1, z1, zd1, zdd1, rhs)
         for f in range(nf):
             acc = rhs[f]
             zdd1[f] = acc
@@ -1182,10 +1183,8 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, o
                 value = (value if kind == MK_GAP else -value) + gap_noise
                 if value < 0.0:
                     return t
-            elif kind == MK_FORCE:  # the row's nonzero terms on y1 = (z1, ż1, z̈1, src1), in order
-                value = W[k, 3 * n + 3 * ns]
-                for j in range(kinds[k, MK_TERMS]):
-                    value += terms[k, j] * y1[columns[k, j]]
+            elif kind == MK_FORCE:  # its force row of the step's product, and the row's constant
+                value = W[k, 3 * n + 3 * ns] + rhs[kinds[k, MK_ROW]]
                 if value < 0.0 and cl[k, CL_MON]:
                     return t
             phi[k] = value
@@ -1353,7 +1352,7 @@ def arrive(ist, fst, target, grid_next, k_grid, j_target):
 
 # ----- the run loop -----
 @jit
-def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
+def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
               out_t, out_q, out_F, out_c, ev_f, ev_i, peak, x, v, a, ist, fst, work, L, closing, hertz, momentum):
     """Integrate from fst[F_T] until t_end, the chunk end, or something Python must do.
 
@@ -1391,18 +1390,17 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
     z = work[:n]
     zd = work[n:2 * n]
     zdd = work[2 * n:3 * n]
-    y1 = work[3 * n:6 * n + 3 * ns]  # a step's end (z1, ż1, z̈1, src1), laid out as a monitor row's columns
-    z1 = y1[:n]
-    zd1 = y1[n:2 * n]
-    zdd1 = y1[2 * n:3 * n]
-    src1 = y1[3 * n:]
+    z1 = work[3 * n:4 * n]  # a step's end
+    zd1 = work[4 * n:5 * n]
+    zdd1 = work[5 * n:6 * n]
+    src1 = work[6 * n:6 * n + 3 * ns]
     o = 6 * n + 3 * ns
     zo = work[o:o + n]
     zdo = work[o + n:o + 2 * n]
     zddo = work[o + 2 * n:o + 3 * n]
-    rhs = work[o + 3 * n:o + 4 * n]
-    sol = work[o + 4 * n:o + 5 * n]
-    o += 5 * n
+    rhs = work[o + 3 * n:o + 4 * n + ncl]  # the free rows, then the force rows of a quiet step's product
+    sol = work[o + 4 * n + ncl:o + 5 * n + ncl]
+    o += 5 * n + ncl
     src0 = work[o:o + 3 * ns]
     srco = work[o + 3 * ns:o + 6 * ns]
     o += 6 * ns
@@ -1457,8 +1455,8 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon, mi, mc,
             # on a point of the step grid (advance's own test): quiet steps may follow. Off it, after an
             # event, the call would return at once (and cost a reference-count pair per array argument)
             if t == (k_grid * dt + sub * fine if refined else k_grid * dt) and not (every or ci[c, CI_HERTZ]):
-                t_quiet = advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, mi, mc, out_t, out_q, out_F, out_c, peak,
-                                  ist, fst, c, z, zd, zdd, z1, zd1, zdd1, src1, y1, srco, zo, zdo, zddo, rhs, phi)
+                t_quiet = advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak,
+                                  ist, fst, c, z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi)
                 if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
                     t = t_quiet
                     sources(ns, nh, omega, sc, sa, sb, t, src0)
