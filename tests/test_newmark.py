@@ -156,6 +156,52 @@ def test_quiet_steps_cam_angle_by_rotation_equals_libm_every_step(monkeypatch) -
     assert not np.array_equal(rotated.q, exact.q)  # (the switch did change the arithmetic)
 
 
+@pytest.mark.parametrize("preset", ["gnilka-1a", "gnilka-2", "gnilka-3", "gnilka-1d"])
+def test_a_quiet_steps_force_rows_give_the_contact_force_at_the_steps_end(preset: str) -> None:
+    """A quiet step reads each closed rigid contact's force off its own product (the step operators'
+    force rows, ``ConfigurationTables._force_rows``); that number is the force row of the step's end
+    state (``contact_force``, term by term), in every configuration, standard and refined step, from
+    random states, to round-off."""
+    from vtool.solvers import kernel_build
+    from vtool.solvers import kernel_layout as layout
+
+    kernel = kernel_build.plain_kernel()
+    problem = ContactProblem(assemble(load_preset(preset)))
+    tables = problem.tables
+    dt, beta, gamma, fine = 1e-6, 0.25, 0.5, 1e-7
+    tables.use_step(dt, beta, gamma, fine)
+    n, ns, ncl = problem.n, problem.ns, problem.ncl
+    rng = np.random.default_rng(7)
+    checked = 0
+    for c in range(2**ncl):
+        tables.build(c)
+        nf, m = tables.ci[c, layout.CI_NF], tables.ci[c, layout.CI_M]
+        for plane, h in ((layout.CP_STD, dt), (layout.CP_FINE, fine)):
+            for _ in range(10):
+                z, zd, zdd = rng.normal(size=n) * 1e-2, rng.normal(size=n) * 10, rng.normal(size=n) * 1e4
+                src = rng.normal(size=3 * ns) * np.tile([1e-2, 10, 1e4], ns)
+                z1, zd1 = z + h * zd + h * h * (0.5 - beta) * zdd, zd + h * (1 - gamma) * zdd
+                zdd1 = zdd.copy()
+                kernel.set_prescribed(tables.ci, c, n, src, z1, zd1, zdd1)
+                out = np.zeros(n + ncl)
+                kernel.apply_operator(tables.cp, c, plane, nf, tables.ci[c, layout.CI_ROWS], m,
+                                      tables.ci[c, layout.CI_SRCSTEP], src, z1, zd1, zdd1, out)
+                zdd1[:nf] = out[:nf]
+                z1[:nf] += beta * h * h * out[:nf]
+                zd1[:nf] += gamma * h * out[:nf]
+                for k in range(ncl):
+                    if tables.mk[c, k, layout.MK_KIND] != layout.MK_FORCE:
+                        continue
+                    expected = kernel.contact_force(tables.mk, tables.mon, c, k, n, ns, z1, zd1, zdd1, src)
+                    row = tables.mk[c, k, layout.MK_ROW]
+                    assert nf <= row < tables.ci[c, layout.CI_ROWS]
+                    scale = np.abs(tables.mon[c, k, :3 * n + 3 * ns]).max() * 1e4
+                    assert tables.mon[c, k, 3 * n + 3 * ns] + out[row] == pytest.approx(expected, rel=1e-11,
+                                                                                          abs=1e-13 * scale)
+                    checked += 1
+    assert checked > 0
+
+
 def test_the_row_buffer_holds_a_run_at_its_output_interval_or_4096_rows() -> None:
     """KernelRun allocates its output rows per run (newmark.row_buffer): the rows at the output
     interval, the start's and a round-off's included, up to ROW_BUFFER; an every-step run takes the
