@@ -68,6 +68,20 @@ clearance uses that law: numba then prunes the branches under them before
 typing, so the Hertz iteration and the momentum-law LCP are compiled (and
 cached) only for mechanisms that use them.
 
+Reference counts: numba counts the references to every array a function
+holds, with an atomic increment and decrement per array argument at each
+call and per view it makes. The kernel's arrays all belong to the Python
+caller for the whole call (``run_chunk``'s arguments, and views of them), so
+``run_chunk`` and the ``@inner`` functions are compiled without numba's
+reference counting (``_nrt=False``): their calls pass the same arrays with
+no counting, and numba lowers and optimizes none of it (kernel 0.93 of the
+counted one per step on 1A, first compile 0.92: ``bench_step_ab.py``,
+``bench_compile_ab.py``). The functions that make arrays of their own (the
+Hertz iteration, the momentum law's impacts: ``@allocating``) keep it, set
+explicitly, since numba's default takes the caller's setting; what they make
+is freed before they return, and an array they are handed is counted up and
+down again inside them.
+
 The event rules the piecewise back ends call
 from Python (``settle``, ``impact``, ``fill_sources``, ``snap_shut``,
 ``relative_velocity``, ``hertz_law``) are entry points that only call an
@@ -208,11 +222,16 @@ def _plain(function: Any) -> Any:
 
 _OPTIONS: dict[str, Any] = {"cache": numba_cache.CACHE_ENABLED, "nogil": True, "error_model": "numpy"}
 _INNER: dict[str, Any] = {**_OPTIONS, "no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+_NO_NRT: dict[str, Any] = {**_INNER, "_nrt": False}  # no reference counting: see "Reference counts" above
 # entry points, callable from Python: the CPython wrapper only (numba's C-callable one went unused)
 _ENTRY: dict[str, Any] = {**_OPTIONS, "no_cfunc_wrapper": True}
 jit = _plain if PLAIN else njit(**_ENTRY)
 # Called only from compiled code: no CPython or C wrapper to build (about 0.07 s of compile each).
-inner = _plain if PLAIN else njit(**_INNER)
+inner = _plain if PLAIN else njit(**_NO_NRT)
+# An @inner function that makes arrays (np.zeros): counted, and said so (numba would take the caller's setting).
+allocating = _plain if PLAIN else njit(**_INNER, _nrt=True)
+# run_chunk: an entry point without reference counting (everything it touches is its arguments' memory).
+loop_entry = _plain if PLAIN else njit(**_ENTRY, _nrt=False)
 # Copied into the caller as numba IR, with no compile of its own (see "Compile time" above).
 tiny = _plain if PLAIN else njit(**_INNER, inline="always")
 
@@ -455,7 +474,7 @@ def compliant_force(cl, clf, mk, mon, c, k, n, ns, z, zd, zdd, src, hertz):
     return contact_force(mk, mon, c, k, n, ns, z, zd, zdd, src)
 
 
-@inner
+@allocating
 def hertz_correction(ci, cm, cl, clf, mk, mon, c, beta, gamma, h, which, L, n, ns, src1, z1, zd1, zdd1, sol):
     """Add the closed Hertz contacts' forces to a Newmark step whose linear part is done.
 
@@ -699,7 +718,7 @@ def solve_dense(A, b, out, na):
         out[r] = s / d
 
 
-@inner
+@allocating
 def solve_impulse_lcp(W, u, b, eq, scale, P, uplus):
     """Impulses P >= 0 with u + W P - b >= 0 and complementarity (equalities: = b).
 
@@ -741,7 +760,7 @@ def solve_impulse_lcp(W, u, b, eq, scale, P, uplus):
         uplus[r] = u[r]
 
 
-@inner
+@allocating
 def impact_momentum(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t):
     """Newton impact with restitution, impulses of all contacts together on the consistent mass matrix.
 
@@ -920,7 +939,7 @@ def relative_velocity(cl, k, v, src):
     return gap_velocity(cl, k, v, src)
 
 
-@inner
+@allocating
 def apply_impacts(ip, fp, cl, clf, mass, c, closing, src, x, v, stick, ev_f, ev_i, ist, t, momentum):
     """Apply the impact law of every closing clearance at t; returns the new configuration mask.
 
@@ -1351,7 +1370,7 @@ def arrive(ist, fst, target, grid_next, k_grid, j_target):
 
 
 # ----- the run loop -----
-@jit
+@loop_entry
 def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
               out_t, out_q, out_F, out_c, ev_f, ev_i, peak, x, v, a, ist, fst, work, L, closing, hertz, momentum):
     """Integrate from fst[F_T] until t_end, the chunk end, or something Python must do.
