@@ -346,9 +346,8 @@ def apply_operator(cp, c, plane, nf, nrows, m, coupled, src, z, zd, zdd, out):
 
     Column by column: cp holds Rᵀ, each column's coefficients on the free rows side by side, so
     that every row's running sum takes the column's term in one pass over the rows, a loop the
-    compiler runs on vectors of rows; each row is still summed in column order. Indexed in place: a
-    view of cp (an array rebound in the step loop) would cost a reference-count increment and
-    decrement per step."""
+    compiler runs on vectors of rows; each row is still summed in column order. Indexed in place,
+    with no view of cp made per step."""
     # the rows run on to a multiple of four where out and cp have room: a whole number of 4-row vectors,
     # no row-by-row remainder; nobody reads the rows past nrows from out
     rows = min((nrows + 3) // 4 * 4, out.shape[0], cp.shape[4])
@@ -1093,8 +1092,8 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
     """Standard and refined steps in configuration c while nothing happens; returns the time reached.
 
     Everything a quiet step does is written out here, with no call that
-    passes arrays (each such call costs a reference-count increment and
-    decrement per array, more than the step's arithmetic): the Newmark step
+    passes arrays (a call passes each array as its seven fields, and LLVM
+    then keeps less in registers): the Newmark step
     with the stored effective inverse, the sources (the cam angle's cos and
     sin by rotation, see ``ANCHOR_STEPS``), the monitors, the output rows at
     the output instants, the peaks. It stops, without taking it, at
@@ -1472,7 +1471,7 @@ def run_chunk(ip, fp, cl, clf, sc, sa, sb, mass, ci, cm, cp, mk, mon,
             sub = ist[I_SUB]
             refined = sub > 0 or t < fst[F_FINE_UNTIL]
             # on a point of the step grid (advance's own test): quiet steps may follow. Off it, after an
-            # event, the call would return at once (and cost a reference-count pair per array argument)
+            # event, the call would return at once
             if t == (k_grid * dt + sub * fine if refined else k_grid * dt) and not (every or ci[c, CI_HERTZ]):
                 t_quiet = advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, out_c, peak,
                                   ist, fst, c, z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi)
