@@ -1091,9 +1091,8 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             z, zd, zdd, z1, zd1, zdd1, src1, srco, zo, zdo, zddo, rhs, phi):
     """Standard and refined steps in configuration c while nothing happens; returns the time reached.
 
-    Everything a quiet step does is written out here, with no call that
-    passes arrays (a call passes each array as its seven fields, and LLVM
-    then keeps less in registers): the Newmark step
+    Everything a quiet step does is written out here, in one loop with no
+    call per step to another compiled function: the Newmark step
     with the stored effective inverse, the sources (the cam angle's cos and
     sin by rotation, see ``ANCHOR_STEPS``), the monitors, the output rows at
     the output instants, the peaks. It stops, without taking it, at
