@@ -161,8 +161,11 @@ class ConfigurationTables:
             F - w_0 = d·y + uᵀ z̈_F = (d - Gᵀu)·y,   u = βh² w_z,F + γh w_ż,F + w_z̈,F,
 
         where d holds w's coefficients on y's entries (w_ż,F, w_z,F, then (w_z̈, w_ż, w_z)_P, w_s). The
-        kernel's product gives out = -R y for a stored row R, so the row stored is Gᵀu - d. The same
-        number as :func:`vtool.solvers.newmark_kernel.contact_force` of the step's end, up to round-off.
+        kernel's product gives out = -R y for a stored row R, so the row stored is Gᵀu - d. The terms on a
+        source that a prescribed index follows are moved onto that index's columns (the same values), so
+        that the step reads the source columns only where a term is left (``CI_SRCSTEP``): on 1A the
+        quiet step was 0.91 of one that read them (``bench_step_ab.py``). The same number as
+        :func:`vtool.solvers.newmark_kernel.contact_force` of the step's end, up to round-off.
         """
         n, ns = self.n, self.ns
         ci, cp = self.ci[mask], self.cp[mask]
@@ -185,6 +188,13 @@ class ConfigurationTables:
                 d[layout.PART_P, 2:3 * np_:3] = wz[nf:m]
                 d[layout.PART_S, :3 * ns] = ws
                 cp[plane, :, :, row] = cp[plane, :, :, :nf] @ u - d
+                # a source that a prescribed z index follows is that index's (z, ż, z̈) already: its
+                # terms move onto the prescribed columns, and the step reads no source columns for them
+                for p in range(np_):
+                    s = int(ci[layout.CI_HEAD + 2 * n + nf + p])
+                    for q in range(3):  # the source's (x, v, a) onto the prescribed (z, ż, z̈): 3p + 2 - q
+                        cp[plane, layout.PART_P, 3 * p + 2 - q, row] += cp[plane, layout.PART_S, 3 * s + q, row]
+                        cp[plane, layout.PART_S, 3 * s + q, row] = 0.0
                 reads_sources = reads_sources or bool(np.any(cp[plane, layout.PART_S, :, row]))
         ci[layout.CI_SRCSTEP] = int(reads_sources)
 
