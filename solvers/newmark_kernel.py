@@ -1128,12 +1128,17 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
     c_fine = math.cos(omega * fine)
     s_fine = math.sin(omega * fine)
     rotated = 0
+    # the state at t and the step's end: the caller's (z, ż, z̈) and (z1, ż1, z̈1), which change places at
+    # each step taken (no copy); on return the state is in the caller's (z, ż, z̈)
+    za, zda, zdda = z, zd, zdd
+    zb, zdb, zddb = z1, zd1, zdd1
+    swapped = False
     while True:
         k_grid = ist[I_GRID]
         sub = ist[I_SUB]
         if sub > 0 or t < fst[F_FINE_UNTIL]:  # refined steps on their grid, on to the next grid point
             if t != k_grid * dt + sub * fine:
-                return t
+                break
             h = fine
             plane = CP_FINE
             t1 = (k_grid + 1) * dt if sub + 1 == refine else k_grid * dt + (sub + 1) * fine
@@ -1142,9 +1147,9 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
             plane = CP_STD
             t1 = (k_grid + 1) * dt
         else:
-            return t
+            break
         if t1 > t_end or t >= fst[F_CHUNK_END]:
-            return t
+            break
         # the sources at t + h (sources' arithmetic, written out: the quiet step's loop bounds stay local)
         if rotated == ANCHOR_STEPS:
             c1 = math.cos(omega * t1)
@@ -1176,38 +1181,44 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
         bx = beta * h * h
         gv = gamma * h
         for j in range(m):
-            z1[j] = z[j] + h * zd[j] + hx * zdd[j]
-            zd1[j] = zd[j] + hv * zdd[j]
+            zb[j] = za[j] + h * zda[j] + hx * zdda[j]
+            zdb[j] = zda[j] + hv * zdda[j]
         for j in range(nf, m):
             sidx = ci[c, CI_HEAD + 2 * n + j]
-            z1[j] = src1[3 * sidx]
-            zd1[j] = src1[3 * sidx + 1]
-            zdd1[j] = src1[3 * sidx + 2]
-        apply_operator(cp, c, plane, nf, nrows, m, coupled, src1, z1, zd1, zdd1, rhs)
+            zb[j] = src1[3 * sidx]
+            zdb[j] = src1[3 * sidx + 1]
+            zddb[j] = src1[3 * sidx + 2]
+        apply_operator(cp, c, plane, nf, nrows, m, coupled, src1, zb, zdb, zddb, rhs)
+        stop = False
         for f in range(nf):
             acc = rhs[f]
-            zdd1[f] = acc
-            z1[f] += bx * acc
-            zd1[f] += gv * acc
+            zddb[f] = acc
+            zb[f] += bx * acc
+            zdb[f] += gv * acc
+            if not (abs(zb[f]) <= x_limit):  # the divergence limit
+                stop = True
+        if stop:
+            break
         # monitors (see monitor_value): stop before a sign change
         for k in range(ncl):
             kind = kinds[k, MK_KIND]
             value = 0.0
             if kind == MK_GAP or kind == MK_OVERLAP:
                 behind = kinds[k, MK_BEHIND]
-                other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
-                value = z1[kinds[k, MK_AHEAD]] - other
+                other = zb[behind] if behind >= 0 else src1[3 * (-1 - behind)]
+                value = zb[kinds[k, MK_AHEAD]] - other
                 value = (value if kind == MK_GAP else -value) + gap_noise
                 if value < 0.0:
-                    return t
+                    stop = True
+                    break
             elif kind == MK_FORCE:  # its force row of the step's product, and the row's constant
                 value = W[k, 3 * n + 3 * ns] + rhs[kinds[k, MK_ROW]]
                 if value < 0.0 and cl[k, CL_MON]:
-                    return t
+                    stop = True
+                    break
             phi[k] = value
-        for j in range(nf):
-            if not (abs(z1[j]) <= x_limit):
-                return t
+        if stop:
+            break
         # output rows inside (t, t + h] (see run_chunk)
         while True:
             j_out = ist[I_NEXT_OUT]
@@ -1216,8 +1227,9 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
                 break
             row = ist[I_NOUT]
             if row >= rows:
-                return t
-            interpolate(nf, t_out - t, h, z, zd, zdd, zdd1, zo, zdo, zddo)
+                stop = True
+                break
+            interpolate(nf, t_out - t, h, za, zda, zdda, zddb, zo, zdo, zddo)
             sources(ns, nh, omega, sc, sa, sb, t_out, srco)
             set_prescribed(ci, c, n, srco, zo, zdo, zddo)
             out_t[row] = t_out
@@ -1238,6 +1250,8 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
                 out_F[row, k] = force
             ist[I_NOUT] = row + 1
             ist[I_NEXT_OUT] = j_out + 1
+        if stop:
+            break
         # accept: peaks, state, time
         after = t1 >= t_rev
         for k in range(ncl):
@@ -1248,17 +1262,17 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
                 if after and phi[k] > peak[PEAK_LATE, k]:
                     peak[PEAK_LATE, k] = phi[k]
             elif kind == MK_OVERLAP:
-                force = contact_force(mk, mon, c, k, n, ns, z1, zd1, zdd1, src1)
+                force = contact_force(mk, mon, c, k, n, ns, zb, zdb, zddb, src1)
                 if force > peak[PEAK_ALL, k]:
                     peak[PEAK_ALL, k] = force
                 if after and force > peak[PEAK_LATE, k]:
                     peak[PEAK_LATE, k] = force
                 if phi[k] - gap_noise > peak[PEAK_OVERLAP, k]:
                     peak[PEAK_OVERLAP, k] = phi[k] - gap_noise
-        for j in range(m):
-            z[j] = z1[j]
-            zd[j] = zd1[j]
-            zdd[j] = zdd1[j]
+        za, zb = zb, za  # the step's end is the state: the two buffers change places
+        zda, zdb = zdb, zda
+        zdda, zddb = zddb, zdda
+        swapped = not swapped
         ist[I_STEPS] += 1
         if plane == CP_STD or sub + 1 == refine:
             ist[I_GRID] = k_grid + 1
@@ -1270,7 +1284,12 @@ def advance(ip, fp, cl, sc, sa, sb, ci, cm, cp, mk, mon, out_t, out_q, out_F, ou
         c0 = c1
         s0 = s1
         rotated = 0 if rotated == ANCHOR_STEPS else rotated + 1
-
+    if swapped:  # the state is in the caller's step-end buffers: back into its state buffers
+        for j in range(m):
+            z[j] = za[j]
+            zd[j] = zda[j]
+            zdd[j] = zdda[j]
+    return t
 
 
 @inner
