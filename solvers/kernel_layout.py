@@ -55,7 +55,7 @@ CM_SIZE = 6
 # hold, after the nf free rows, one row per closed rigid clearance (its MK_ROW): the contact force at
 # the step's end less its constant, as the same product gives it from the step's predictor (the force
 # row w on (z, ż, z̈, sources) with the step's z̈_F = -G·y substituted), so that a quiet step gets its
-# force monitors from the vector pass it makes anyway (see ``ConfigurationTables._inverses``). The
+# force monitors from the vector pass it makes anyway (see ``ConfigurationTables._force_rows``). The
 # last dimension is n + ncl.
 CP_RAW, CP_STD, CP_FINE = range(3)
 CP_SIZE = 3

@@ -236,7 +236,7 @@ loop_entry = _plain if PLAIN else njit(**_ENTRY, _nrt=False)
 tiny = _plain if PLAIN else njit(**_INNER, inline="always")
 
 #: :func:`vtool.solvers.kernel_layout.fingerprint` of the layout this file was compiled with (see there).
-LAYOUT_FINGERPRINT = "b28688b79d115aad"
+LAYOUT_FINGERPRINT = "f7a77daca7814b8b"
 
 # how a step solves S z̈ = rhs (layer_step's ``which``): stored inverses of the standard and refined
 # steps, or a Cholesky factor. np.int64 values, not int literals: numba compiles a function once per
