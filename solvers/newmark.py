@@ -88,11 +88,11 @@ from vtool.solvers.model import Mechanism
 from vtool.solvers.spec import HERTZ, MOMENTUM, RIGID, RunSpec
 from vtool.solvers.trace import TraceBuilder
 
-#: first compile of the kernel on a 2-core machine, on its own: 8.9-10.5 s, median 9.5 (bench_compile_ab.py, 4 pairs);
-#: longer while a run shares the cores
+#: first compile of the kernel on a 2-core machine, on its own: 7.7-9.4 s, median 9.0 (bench_compile_ab.py, 6 pairs,
+#: 2026-11-26 evening; up to 10.4 s in the machine's slow phases); longer while a run shares the cores
 COMPILE_ESTIMATE_S = 10.0
 #: the same compile in the background beside a first run in plain Python, which shares the cores: in numba's
-#: cache 14.1-14.4 s after the run's start (bench_newmark.py, 2026-11-26)
+#: cache 13.9-14.4 s after the run's start (bench_newmark.py, 2026-11-26)
 BACKGROUND_COMPILE_ESTIMATE_S = 15.0
 RULES_COMPILE_ESTIMATE_S = 5.0  # of the event rules alone (impact, settle, fill_sources: the piecewise back ends)
 ROW_BUFFER = 4096  # output rows between flushes at most: memory stays bounded for any run length
