@@ -350,6 +350,13 @@ def collector_paused() -> Iterator[None]:
 
 #: How long (s) a compile waits for its helper process before going on without it.
 HELPER_WAIT_S = 300.0
+#: The callees of ``run_chunk`` that run once per event or output row, not per step: their machine code in
+#: the bundle is made for size (:mod:`vtool.numba_link`, "Made for size"), as is ``run_chunk``'s own (it
+#: takes the steps that are not quiet; :func:`~vtool.solvers.newmark_kernel.advance` takes the others).
+#: On 1A the bundle was ready about 0.6 s sooner and ``run_chunk``'s own machine code took half the
+#: time; the first compile 0.93 of before (``bench_compile_ab.py``, 8 pairs), the kernel per step 1.00
+#: (``bench_step_ab.py``, 8 pairs), its results the same to the last bit.
+RARE = ("release_pulling", "take_events", "record_row", "track_peaks", "monitors")
 #: How often (s) the two processes of a compile look for each other's marks (:func:`compile_kernel`).
 MARK_POLL_S = 0.01
 
@@ -422,7 +429,7 @@ def compile_kernel(signature: tuple[Any, ...]) -> None:
                 getattr(kernel(), name).compile(arg_types)
             (folder / "own").touch()  # the helper may now bundle these with its own
             _wait_for(folder / "share", lambda: helper.poll() is None, HELPER_WAIT_S)
-            with numba_link.expecting_bundle("run_chunk", _bundle_fetcher(folder, helper)):
+            with numba_link.expecting_bundle("run_chunk", _bundle_fetcher(folder, helper), entry_for_size=True):
                 kernel().run_chunk.compile(signature)
     finally:
         if helper is not None and helper.poll() is None:
@@ -461,7 +468,7 @@ def _part(payload: Any) -> None:
         dispatcher = getattr(kernel(), name)
         dispatcher.compile(signature)  # the compiling process's share: from the cache
         compiled.append((name, dispatcher.overloads[tuple(signature)]))
-    bundle = numba_link.build_bundle(compiled, secrets.token_hex(6))
+    bundle = numba_link.build_bundle(compiled, secrets.token_hex(6), for_size=RARE)
     partial = folder / "bundle.part"
     partial.write_bytes(pickle.dumps(bundle))
     partial.replace(folder / "bundle")

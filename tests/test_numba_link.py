@@ -122,26 +122,35 @@ import pytest
 
 from vtool import numba_link
 vec = types.Array(types.float64, 1, "C")
+sized = {sized!r}
 if {make!r}:
     toy2.twice.compile((vec, types.float64))
-    bundle = numba_link.build_bundle([("twice", toy2.twice.overloads[(vec, types.float64)])], "t0")
-    with numba_link.expecting_bundle("entry", lambda: bundle):
+    bundle = numba_link.build_bundle([("twice", toy2.twice.overloads[(vec, types.float64)])], "t0",
+                                     for_size=("twice",) if sized else ())
+    with numba_link.expecting_bundle("entry", lambda: bundle, entry_for_size=sized):
         value = toy2.entry(np.arange(5.0), 3.0)
+    library = toy2.entry.overloads[toy2.entry.signatures[0]].library
+    entry_sized = "optsize" in str(library._final_module)
 else:
     value = toy2.entry(np.arange(5.0), 3.0)
+    entry_sized = sized  # (not read back from the cache)
 library = toy2.entry.overloads[toy2.entry.signatures[0]].library
+assert entry_sized == sized, entry_sized
 print(repr(value), getattr(library, numba_link.BUNDLE, None) is not None, toy2.entry.stats.cache_hits.total())
 '''
 
 
-def test_an_entry_point_calls_its_callees_in_a_bundle_fresh_and_from_the_cache(tmp_path: Path) -> None:
+@pytest.mark.parametrize("sized", [False, True])
+def test_an_entry_point_calls_its_callees_in_a_bundle_fresh_and_from_the_cache(tmp_path: Path, sized: bool) -> None:
     """A bundle (the callees' machine code made apart, vtool.numba_link.build_bundle) gives the entry point
     numba's own result; numba's cache keeps the entry point with its bundle, and a second process loads
-    both and gets the same result again."""
+    both and gets the same result again. So too with the bundled callee and the entry point made for
+    size (their IR then carries LLVM's optsize attribute; the entry's is checked)."""
     (tmp_path / "toy2.py").write_text(textwrap.dedent(BUNDLE_MODULE))
 
     def bundle_run(env: dict[str, str], make: bool) -> str:
-        out = subprocess.run([sys.executable, "-c", BUNDLE_RUN.format(folder=str(tmp_path), make=make)],
+        code = BUNDLE_RUN.format(folder=str(tmp_path), make=make, sized=sized)
+        out = subprocess.run([sys.executable, "-c", code],
                              capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
         assert out.returncode == 0, out.stderr[-3000:]
         return out.stdout.strip()

@@ -57,6 +57,15 @@ numba's cache keeps such an entry point as its object code, its bitcode for
 linking and the bundle (kind ``"bundled"``); loading it adds the bundle to
 the JIT first.
 
+Made for size: LLVM's ``optsize`` (and ``minsize``) function attributes
+make its passes inline and unroll less inside a function and its code
+generator make less code of it. :func:`build_bundle` gives them to the
+bundled functions named in ``for_size`` (both), and :func:`expecting_bundle`
+to the entry point's own function with ``entry_for_size`` (``optsize``
+alone): code that runs rarely, such as a solver's event handling, compiles
+faster and runs a little slower. The hot functions keep LLVM's full
+optimization.
+
 Guard: it installs only on a numba whose internals have the shape it was
 written for (``CPUCodeLibrary.finalize``, ``serialize_using_object_code``,
 ``_unserialize``, ``CPUContext.get_executable``, ``JITCPUCodegen.set_env`` and
@@ -90,27 +99,42 @@ _expecting = threading.local()
 
 
 @contextlib.contextmanager
-def expecting_bundle(name: str, fetch: Callable[[], dict[str, Any] | None]) -> Iterator[None]:
+def expecting_bundle(name: str, fetch: Callable[[], dict[str, Any] | None],
+                     entry_for_size: bool = False) -> Iterator[None]:
     """Inside: the next JIT library named ``name`` to be finalized takes the bundle ``fetch()`` returns
     (called then; None: no bundle, the library is finalized as numba does it). Only the compiles of
-    this thread: another thread's compile of a library of that name goes on as numba does it."""
+    this thread: another thread's compile of a library of that name goes on as numba does it. With
+    ``entry_for_size``, the library's own functions (the entry point and its wrapper) are optimized for
+    size when it takes a bundle (see "Made for size" in the module doc)."""
     stack = _expected()
-    stack.append((name, fetch))
+    entry = (name, fetch, entry_for_size)
+    stack.append(entry)
     try:
         yield
     finally:
-        stack.remove((name, fetch))
+        stack.remove(entry)
 
 
-def _expected() -> list[tuple[str, Callable[[], dict[str, Any] | None]]]:
+def _expected() -> list[tuple[str, Callable[[], dict[str, Any] | None], bool]]:
     """This thread's :func:`expecting_bundle` blocks, innermost last."""
     if not hasattr(_expecting, "stack"):
         _expecting.stack = []
     return _expecting.stack  # type: ignore[no-any-return]
 
 
-def build_bundle(functions: list[tuple[str, Any]], tag: str) -> dict[str, Any]:
-    """One module of these compiled functions, ``(name, numba's CompileResult)``, made into machine code.
+#: The function attributes of a bundled function made for size, and of an entry point made for size.
+SIZE_ATTRIBUTES = ("optsize", "minsize")
+ENTRY_SIZE_ATTRIBUTES = ("optsize",)
+
+
+def _for_size(function: Any, attributes: tuple[str, ...]) -> None:
+    for attribute in attributes:
+        function.add_function_attribute(attribute)
+
+
+def build_bundle(functions: list[tuple[str, Any]], tag: str, for_size: tuple[str, ...] = ()) -> dict[str, Any]:
+    """One module of these compiled functions, ``(name, numba's CompileResult)``, made into machine code;
+    those whose name is in ``for_size`` optimized for size (see "Made for size" in the module doc).
 
     Returns the bundle: ``object`` (the machine code), ``exports`` (each
     function's symbol -> (its name in the bundle, ``name``)) and ``envs``
@@ -130,7 +154,10 @@ def build_bundle(functions: list[tuple[str, Any]], tag: str) -> dict[str, Any]:
     for name, compiled in functions:
         symbol = compiled.fndesc.mangled_name
         exports[symbol] = (f"{symbol}.{tag}", name)
-        module.get_function(symbol).name = exports[symbol][0]
+        function = module.get_function(symbol)
+        function.name = exports[symbol][0]
+        if name in for_size:
+            _for_size(function, SIZE_ATTRIBUTES)
     exported = {new for new, _ in exports.values()}
     for function in module.functions:
         if not function.is_declaration and function.name.startswith("_ZN") and function.name not in exported:
@@ -211,9 +238,14 @@ def install() -> bool:
         if not is_link_only(self):
             expected = _expected()
             if expected and isinstance(self, jit_library) and self.name == expected[-1][0]:
-                bundle = expected[-1][1]()
+                _, fetch, entry_for_size = expected[-1]
+                bundle = fetch()
                 if bundle is not None:
                     take_bundle(self, bundle)
+                    if entry_for_size:
+                        for function in self._final_module.functions:
+                            if not function.is_declaration:
+                                _for_size(function, ENTRY_SIZE_ATTRIBUTES)
             return finalize(self)
         self._raise_if_finalized()
         seen = set()
