@@ -242,6 +242,9 @@ def kernel_kind(module: ModuleType) -> str:
 #: Native modules whose build this process found failed, or could not start: each warm run on numba's
 #: kernel asked again (the build's lock file named and its failure note looked for: 0.25 ms a run).
 _no_native_build: set[str] = set()
+#: The argument types ``run_chunk`` is compiled or loaded for in this process, by their objects' ids: a
+#: warm run's check without hashing them (numba hashes its 32 types in about 25 µs, a hundredth of a run).
+_compiled_for: dict[tuple[int, ...], tuple[Any, ...]] = {}
 
 
 class KernelRun:
@@ -321,18 +324,23 @@ class KernelRun:
         if not kernel_build.jit_enabled():
             return  # NUMBA_DISABLE_JIT (the plain reference)
         signature = self.signature
+        key = tuple(map(id, signature))  # numba interns its types: equal types are one object
+        if key in _compiled_for:
+            return
         kernel = kernel_build.kernel()
-        if signature in kernel.run_chunk.signatures:
-            return  # compiled (or loaded) in this process already
-        started = wallclock.perf_counter()
-        if self.ready():
-            kernel.run_chunk.compile(signature)  # a load from the cache
-        else:  # on two processes; once, should another process be compiling the same kernel
-            kernel_build.compile_once(signature, self.ready)
-        self.compile_time += wallclock.perf_counter() - started
+        if signature not in kernel.run_chunk.signatures:  # (compiled or loaded in this process already)
+            started = wallclock.perf_counter()
+            if self.ready():
+                kernel.run_chunk.compile(signature)  # a load from the cache
+            else:  # on two processes; once, should another process be compiling the same kernel
+                kernel_build.compile_once(signature, self.ready)
+            self.compile_time += wallclock.perf_counter() - started
+        _compiled_for[key] = signature  # (the types kept alive: their ids stay theirs)
 
     def ready(self) -> bool:
         """True when ``run_chunk`` for these argument types is loaded in this process, or in numba's cache."""
+        if tuple(map(id, self.signature)) in _compiled_for:
+            return True
         kernel = kernel_build.kernel()
         return (self.signature in kernel.run_chunk.signatures
                 or kernel.is_cached(("run_chunk",), self.problem.hertz, self.problem.momentum))
