@@ -306,13 +306,19 @@ class KernelRun:
         self.ist[layout.I_NOUT] = 0
         self.ist[layout.I_NEV] = 0
 
-    def arguments(self) -> tuple:
+    @cached_property
+    def _arguments(self) -> tuple:
         problem, tables = self.problem, self.problem.tables
         return (self.ip, self.fp, problem.cl, problem.clf, problem.series.const, problem.series.cos,
                 problem.series.sin, problem.mass, tables.ci, tables.cm, tables.cp, tables.mk, tables.mon,
                 self.out_t, self.out_q, self.out_F, self.out_c, self.ev_f, self.ev_i, self.peak,
                 self.x, self.v, self.a, self.ist, self.fst, self.work, self.L, self.closing, problem.hertz,
                 problem.momentum)
+
+    def arguments(self) -> tuple:
+        """``run_chunk``'s arguments: arrays made once for the run (the kernel writes into them), so the
+        tuple is made once too."""
+        return self._arguments
 
     @cached_property
     def signature(self) -> tuple[Any, ...]:
