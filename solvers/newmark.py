@@ -325,13 +325,18 @@ class KernelRun:
         """numba's types of :meth:`arguments` (what ``run_chunk`` is compiled for; fixed for the run)."""
         return kernel_build.numba_types(self.arguments())
 
+    @cached_property
+    def signature_key(self) -> tuple[int, ...]:
+        """:attr:`signature` by its types' ids (numba interns its types: equal types are one object), the key
+        of ``_compiled_for``."""
+        return tuple(map(id, self.signature))
+
     def compile(self) -> None:
         """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""
         if not kernel_build.jit_enabled():
             return  # NUMBA_DISABLE_JIT (the plain reference)
         signature = self.signature
-        key = tuple(map(id, signature))  # numba interns its types: equal types are one object
-        if key in _compiled_for:
+        if self.signature_key in _compiled_for:
             return
         kernel = kernel_build.kernel()
         if signature not in kernel.run_chunk.signatures:  # (compiled or loaded in this process already)
@@ -341,11 +346,11 @@ class KernelRun:
             else:  # on two processes; once, should another process be compiling the same kernel
                 kernel_build.compile_once(signature, self.ready)
             self.compile_time += wallclock.perf_counter() - started
-        _compiled_for[key] = signature  # (the types kept alive: their ids stay theirs)
+        _compiled_for[self.signature_key] = signature  # (the types kept alive: their ids stay theirs)
 
     def ready(self) -> bool:
         """True when ``run_chunk`` for these argument types is loaded in this process, or in numba's cache."""
-        if tuple(map(id, self.signature)) in _compiled_for:
+        if self.signature_key in _compiled_for:
             return True
         kernel = kernel_build.kernel()
         return (self.signature in kernel.run_chunk.signatures
