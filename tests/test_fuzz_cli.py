@@ -27,6 +27,7 @@ from hypothesis import strategies as st
 
 from vtool.app.cli.main import cli
 from vtool.files import clean_stale_temporaries, finite_json, json_text, write_atomic
+from vtool.presets import PRESET_DIR
 
 CI_CASES = 120
 CASES = int(os.environ.get("VTOOL_FUZZ_CLI_CASES", CI_CASES))
@@ -249,16 +250,25 @@ def test_stale_temporaries_of_a_killed_write_are_cleaned_on_the_next_write(tmp_p
 
 
 def test_sigkill_during_a_run_leaves_the_existing_file_intact(tmp_path: Path) -> None:
+    # a run of 3.6e6 degrees (5.4e7 steps, a row every 100 degrees): seconds even on a fast machine; it is
+    # killed once its CSV is being written (the temporary file is there), and must still be running then
+    preset = tmp_path / "presets" / "long.toml"
+    preset.parent.mkdir()
+    text = (PRESET_DIR / "gnilka-1a.toml").read_text()
+    preset.write_text(text.replace("output_interval = 1.0 #", "output_interval = 100.0 #"))
     out = tmp_path / "out.csv"
     out.write_text("previous\n")
-    proc = subprocess.Popen([sys.executable, "-m", "vtool", "solve", "gnilka-1a", "--degrees", "2000000",
-                             "--csv", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    time.sleep(3.0)
+    proc = subprocess.Popen([sys.executable, "-m", "vtool", "solve", str(preset), "--degrees", "3600000",
+                             "--max-steps", "1e9", "--csv", str(out)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.perf_counter() + 60.0
+    while not list(tmp_path.glob(".out.csv.*.tmp")) and proc.poll() is None and time.perf_counter() < deadline:
+        time.sleep(0.01)
     proc.send_signal(signal.SIGKILL)
-    proc.wait(timeout=30)
-    assert out.read_text() == "previous\n"
+    assert proc.wait(timeout=30) == -signal.SIGKILL, "the run was not running when killed"
+    assert out.read_text() == "previous\n" and list(tmp_path.glob(".out.csv.*.tmp"))
     write_atomic(out, "next\n")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv", "presets"]
 
 
 def test_json_has_no_nan_or_infinity() -> None:

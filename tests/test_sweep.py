@@ -180,14 +180,15 @@ def test_cancel_leaves_a_valid_partial_file(tmp_path: Path) -> None:
 
 @pytest.mark.slow
 def test_resume_after_kill_gives_the_same_file(tmp_path: Path) -> None:
+    # points of 40000 degrees (tens of ms each even on a fast machine), so that the kill lands mid-sweep
     sweep = [sys.executable, "-m", "vtool", "sweep", "gnilka-1a", "--set", "run.rpm=9000:11000:100",
-             "--set", SHORT, "--workers", "1"]
+             "--set", "run.degrees=40000", "--set", "run.output_interval=50", "--workers", "1"]
     full, partial = tmp_path / "full.csv", tmp_path / "partial.csv"
     assert subprocess.run(sweep + ["--csv", str(full)], capture_output=True).returncode == 0
     process = subprocess.Popen(sweep + ["--csv", str(partial)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.time() + 120
     while time.time() < deadline and (not partial.exists() or partial.read_text().count("\n") < 4):
-        time.sleep(0.05)
+        time.sleep(0.005)
     os.kill(process.pid, signal.SIGKILL)
     process.wait()
     kept = partial.read_text().count("\n") - 1

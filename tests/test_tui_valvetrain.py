@@ -215,6 +215,17 @@ async def test_failed_runs_show_an_error_dialog_and_the_app_lives_on(monkeypatch
         assert app.screen is screen and diverged in str(screen.status.render())
 
 
+def slowed(report):  # type: ignore[no-untyped-def]
+    """A progress callback that sleeps 10 ms a report: a long run really runs, but a fast machine runs
+    400000 degrees in under a second, before a test has typed its keys; this keeps it going until cancelled."""
+
+    def report_and_wait(fraction: float) -> None:
+        report(fraction)
+        time.sleep(0.01)
+
+    return report_and_wait
+
+
 async def test_keys_work_during_a_long_run_and_cancel_stops_it(monkeypatch: pytest.MonkeyPatch) -> None:
     import vtool.solvers.run as run_module
 
@@ -223,6 +234,7 @@ async def test_keys_work_during_a_long_run_and_cancel_stops_it(monkeypatch: pyte
     outcome: list[BaseException | None] = []
 
     def watched(spec, **kwargs):  # type: ignore[no-untyped-def]
+        kwargs["progress"] = slowed(kwargs["progress"])
         try:
             trace = real(spec, **kwargs)
         except BaseException as exc:
@@ -239,7 +251,7 @@ async def test_keys_work_during_a_long_run_and_cancel_stops_it(monkeypatch: pyte
     async with app.run_test(size=(80, 24)) as pilot:
         await pilot.pause()
         screen = app.screen
-        await put(pilot, screen, "run.degrees", "400000")  # ~20 s of work if left alone
+        await put(pilot, screen, "run.degrees", "400000")  # 1-20 s of work by machine, 12 s more slowed
         await put(pilot, screen, "run.output_interval", "50")
         # keys go in as the terminal driver sends them (app.simulate_key, Key events); the Pilot's own
         # press waits for an idle CPU, which a busy solver thread never gives it
@@ -466,11 +478,17 @@ async def test_a_new_run_cancels_and_joins_the_old_one_before_it_starts(monkeypa
     log: list[str] = []
 
     def watched(spec, **kwargs):  # type: ignore[no-untyped-def]
-        log.append(f"start {spec.run.degrees:g}")
+        degrees = spec.run.degrees
+        log.append(f"start {degrees:g}")
+        if degrees == 400000:
+            kwargs["progress"] = slowed(kwargs["progress"])
         try:
-            return real(spec, **kwargs)
-        finally:
-            log.append(f"end {spec.run.degrees:g}")
+            trace = real(spec, **kwargs)
+        except Exception:  # the Newmark back end stops on a cancel with a RunError, assessments with Cancelled
+            log.append(f"{'cancelled' if kwargs['cancel']() else 'failed'} {degrees:g}")
+            raise
+        log.append(f"end {degrees:g}")
+        return trace
 
     monkeypatch.setattr(run_module, "simulate", watched)
     app = make_app("gnilka-1d")
@@ -483,7 +501,7 @@ async def test_a_new_run_cancels_and_joins_the_old_one_before_it_starts(monkeypa
         await put(pilot, screen, "run.degrees", "30")
         app.simulate_key("ctrl+r")
         assert await until(lambda: screen.results is not None, 60.0)
-        assert log == ["start 400000", "end 400000", "start 30", "end 30"]
+        assert log == ["start 400000", "cancelled 400000", "start 30", "end 30"]
         assert screen.results.spec.run.degrees == 30 and app.errors_shown == []
 
 
