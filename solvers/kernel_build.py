@@ -1,8 +1,8 @@
 """Compile the Newmark kernel into numba's cache in a child process, while the run goes on without it.
 
-A new install's first run would otherwise wait for the compile (about
-:data:`vtool.solvers.newmark.COMPILE_ESTIMATE_S` s on two cores) before its
-first step. Instead :func:`start` launches ``python -m
+A new install's first run would otherwise wait for the compile (seconds:
+:data:`vtool.solvers.newmark.COMPILE_REFERENCE_S` on the reference machine of
+:mod:`vtool.compile_estimate`) before its first step. Instead :func:`start` launches ``python -m
 vtool.solvers.kernel_build LOCK`` with the pickled jobs (here ``run_chunk`` and
 numba's types of its arguments) on its standard input and returns at once;
 the child compiles them (numba writes its cache as it compiles), removes the

@@ -78,7 +78,7 @@ from typing import Any
 
 import numpy as np
 
-from vtool import numba_cache
+from vtool import compile_estimate, numba_cache
 from vtool.errors import InputError, RunError
 from vtool.solvers import kernel_build, kernel_native
 from vtool.solvers import kernel_layout as layout
@@ -88,13 +88,15 @@ from vtool.solvers.model import Mechanism
 from vtool.solvers.spec import HERTZ, MOMENTUM, RIGID, RunSpec
 from vtool.solvers.trace import TraceBuilder
 
-#: first compile of the kernel on a 2-core machine, on its own: 7.7-9.4 s, median 9.0 (bench_compile_ab.py, 6 pairs,
-#: 2026-11-26 evening; up to 10.4 s in the machine's slow phases); longer while a run shares the cores
-COMPILE_ESTIMATE_S = 10.0
-#: the same compile in the background beside a first run in plain Python, which shares the cores: in numba's
-#: cache 13.9-14.4 s after the run's start (bench_newmark.py, 2026-11-26)
-BACKGROUND_COMPILE_ESTIMATE_S = 15.0
-RULES_COMPILE_ESTIMATE_S = 5.0  # of the event rules alone (impact, settle, fill_sources: the piecewise back ends)
+#: first compiles on the reference machine of :mod:`vtool.compile_estimate` (s), which scales them to the
+#: machine at hand for the notice (``python3 benchmarks/bench_compile_estimate.py`` measures them): the kernel
+#: in the run's own process (two processes compile: n = 2) ...
+COMPILE_REFERENCE_S = 2.8
+#: ... in a child beside a first run in plain Python, until it is in numba's cache (the run is a third
+#: process while it lasts: n = 3; the child's own start-up is in it) ...
+BACKGROUND_REFERENCE_S = 2.7
+#: ... and the event rules alone (impact, settle, fill_sources: the piecewise back ends; n = 1)
+RULES_REFERENCE_S = 1.6
 ROW_BUFFER = 4096  # output rows between flushes at most: memory stays bounded for any run length
 EVENT_BUFFER = 1024  # events between flushes
 
@@ -161,10 +163,11 @@ def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | Non
         if backend != "newmark":
             return None
         return (f"compiling the solver for these contact laws in the background, once (about "
-                f"{BACKGROUND_COMPILE_ESTIMATE_S:.0f} s on two cores); this run starts now in plain Python and "
-                "moves to the compiled solver when it is ready")
-    estimate = COMPILE_ESTIMATE_S if backend == "newmark" else RULES_COMPILE_ESTIMATE_S
-    return (f"compiling the solver for these contact laws, once (about {estimate:.0f} s on two cores); "
+                f"{compile_estimate.about(BACKGROUND_REFERENCE_S, 3)} s); this run starts now in plain Python "
+                "and moves to the compiled solver when it is ready")
+    estimate = (compile_estimate.about(COMPILE_REFERENCE_S, 2) if backend == "newmark"
+                else compile_estimate.about(RULES_REFERENCE_S, 1))
+    return (f"compiling the solver for these contact laws, once (about {estimate} s); "
             "later runs load it from the cache")
 
 

@@ -181,8 +181,9 @@ def write_rows(handle, values: np.ndarray, labels: list[str], label_of_row: np.n
         binary.write(piece)
 
 
-#: First compile of the formatter on a 2-core machine (s); later processes load it from numba's cache.
-COMPILE_ESTIMATE_S = 5.0
+#: First compile of the formatter on the reference machine of :mod:`vtool.compile_estimate` (s; one
+#: process), scaled to the machine at hand for the notice; later processes load it from numba's cache.
+COMPILE_REFERENCE_S = 2.6
 
 
 _cached: list[bool] = []  # the cache's answer, read once per process
@@ -201,5 +202,7 @@ def compile_notice() -> str | None:
             _cached.append(False)
     if _cached[0]:
         return None
-    return (f"compiling the CSV writer, once (about {COMPILE_ESTIMATE_S:.0f} s); "
+    from vtool import compile_estimate
+
+    return (f"compiling the CSV writer, once (about {compile_estimate.about(COMPILE_REFERENCE_S)} s); "
             "later runs load it from the cache")
