@@ -4,6 +4,10 @@ notices that show it."""
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
+import time
 
 import pytest
 
@@ -17,18 +21,29 @@ def test_the_probe_is_measured_once_per_process() -> None:
 
 
 @pytest.mark.parametrize(("cores", "running", "processes", "factor"), [
-    (2, [1, 1, 1, 1, 1], 2, 1.0),   # only this process: two idle cores for two compiling processes
-    (2, [2, 2, 2, 2, 2], 2, 1.5),   # one other busy process: (1 + 2) / 2
-    (2, [1, 1, 1, 1, 1], 3, 1.5),   # a first run beside a compile of two processes
-    (1, [1, 1, 1, 1, 1], 2, 2.0),   # one core for two processes
-    (8, [4, 4, 4, 4, 4], 2, 1.0),   # cores to spare
-    (2, [3, 2, 3, 2, 5], 2, 2.0),   # the mean of the five counts, less this process: L = 2, (2 + 2) / 2
+    (2, [0, 0, 0, 0, 0], 2, 1.0),   # nothing else: two idle cores for two compiling processes
+    (2, [1, 1, 1, 1, 1], 2, 1.5),   # one other busy process: (1 + 2) / 2
+    (2, [0, 0, 0, 0, 0], 3, 1.5),   # a first run beside a compile of two processes
+    (1, [0, 0, 0, 0, 0], 2, 2.0),   # one core for two processes
+    (8, [3, 3, 3, 3, 3], 2, 1.0),   # cores to spare
+    (2, [2, 1, 2, 1, 4], 2, 2.0),   # the mean of the five counts: L = 2, (2 + 2) / 2
 ])
 def test_the_load_factor_is_cores_wanted_over_cores(monkeypatch, cores, running, processes, factor) -> None:  # noqa: ANN001
     counts = iter(running)
     monkeypatch.setattr(compile_estimate, "_runnable", lambda: float(next(counts)))
     monkeypatch.setattr(compile_estimate.os, "cpu_count", lambda: cores)
     assert compile_estimate.load_factor(processes) == pytest.approx(factor)
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/loadavg"), reason="Linux only")
+def test_a_busy_process_is_counted() -> None:
+    spinner = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+    try:
+        time.sleep(0.3)  # (its interpreter started)
+        assert compile_estimate.others_running() >= 1.0
+    finally:
+        spinner.kill()
+        spinner.wait()
 
 
 def test_without_proc_the_load_average_counts(monkeypatch) -> None:  # noqa: ANN001

@@ -69,24 +69,34 @@ def probe() -> float:
 
 
 def _runnable() -> float | None:
-    """Processes running or ready to run now, this one included (Linux: ``/proc/loadavg``), or None."""
+    """Threads running or ready to run now that are not this process' (Linux: ``/proc/loadavg`` counts all
+    of them; this process' own are those of ``/proc/self/task`` in state R, such as BLAS threads still
+    spinning after a product), or None."""
     try:
         with open("/proc/loadavg", encoding="ascii") as handle:
-            return float(handle.read().split()[3].split("/")[0])
+            everyone = float(handle.read().split()[3].split("/")[0])
+        own = 0
+        for task in os.scandir("/proc/self/task"):
+            try:
+                with open(f"{task.path}/stat", encoding="ascii") as handle:
+                    own += handle.read().rpartition(")")[2].split()[0] == "R"
+            except OSError:  # (the thread ended meanwhile)
+                continue
+        return max(0.0, everyone - own)
     except (OSError, IndexError, ValueError):
         return None
 
 
 def others_running() -> float:
-    """L: the other processes that want a core now. On Linux the processes ready to run, counted at five
-    moments 1 ms apart, less this one; elsewhere the load average over the last minute (which still
-    counts work that ended up to a minute ago)."""
+    """L: the other processes that want a core now. On Linux the threads ready to run, counted at five
+    moments 1 ms apart, less this process' own; elsewhere the load average over the last minute (which
+    still counts work that ended up to a minute ago)."""
     counts = []
     for _ in range(5):
         count = _runnable()
         if count is None:
             break
-        counts.append(count - 1.0)
+        counts.append(count)
         time.sleep(1e-3)
     if counts:
         return max(0.0, sum(counts) / len(counts))
