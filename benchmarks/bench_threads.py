@@ -1,7 +1,8 @@
 """BLAS threads: the plate study on one thread (vtool's default) against the libraries' own threads.
 
-Run: ``python3 benchmarks/bench_threads.py [--rounds N]`` (N = 3; about 15 s a round on the 2-core
-machine). Prints figures, asserts nothing.
+Run: ``python3 benchmarks/bench_threads.py [--rounds N] [--write]`` (N = 3; 5-15 s a round on a
+2-core machine). Prints figures, asserts nothing; ``--write`` also writes them into the ``threads``
+block of docs/plate.md.
 
 Each round runs ``vtool plate study plate-table3`` alone, then with ``plate-table2`` beside it (two
 processes at once, as on a loaded machine or two test workers), once with vtool's default
@@ -13,10 +14,16 @@ to quote are the best of each over the rounds and their ratios.
 from __future__ import annotations
 
 import os
+import platform
 import resource
 import subprocess
 import sys
 import time
+from pathlib import Path
+
+from vtool.markdown import replace_block, table
+
+DOC = Path(__file__).resolve().parent.parent / "docs" / "plate.md"
 
 STUDIES = ("plate-table3", "plate-table2")
 
@@ -56,11 +63,21 @@ def main(argv: list[str]) -> None:
                 best[key] = min(best.get(key, (wall, cpu)), (wall, cpu))
                 print(f"  {label}, {' and '.join(STUDIES[:count])}: {wall:.2f} s wall, {cpu:.2f} s CPU", flush=True)
     one, lib = settings
+    rows = []
     for count in (1, 2):
         (w1, c1), (w0, c0) = best[(one, count)], best[(lib, count)]
-        print(f"{' and '.join(STUDIES[:count])} {'at once' if count == 2 else 'alone'}, best of {rounds}: one thread "
+        case = f"{' and '.join(STUDIES[:count])} {'at once' if count == 2 else 'alone'}"
+        print(f"{case}, best of {rounds}: one thread "
               f"{w1:.2f} s wall ({c1:.2f} s CPU), the libraries' threads {w0:.2f} s ({c0:.2f} s CPU); "
               f"ratio {w1 / w0:.2f} wall, {c1 / c0:.2f} CPU")
+        rows.append([f"`vtool plate study`: {case}", f"{w1:.2f}", f"{c1:.2f}", f"{w0:.2f}", f"{c0:.2f}",
+                     f"{w1 / w0:.2f}", f"{c1 / c0:.2f}"])
+    if "--write" in argv:
+        header = [f"case (best of {rounds}, {os.cpu_count() or 1} cores, {platform.machine()})",
+                  "one thread: wall (s)", "CPU (s)", "the libraries' threads: wall (s)", "CPU (s)",
+                  "ratio, wall", "ratio, CPU"]
+        replace_block(DOC, "threads", table(header, rows))
+        print(f"wrote the threads block of {DOC.name}")
 
 
 if __name__ == "__main__":
