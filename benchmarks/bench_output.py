@@ -1,6 +1,7 @@
 """Big-output benchmark: ``vtool solve gnilka-1a --degrees 36000 --every-step --csv``, ratios in one run.
 
-Run: ``python3 benchmarks/bench_output.py``. Prints figures, asserts nothing.
+Run: ``python3 benchmarks/bench_output.py [--write]``. Prints figures, asserts nothing; ``--write``
+also writes items 1 and 2 into the ``big-output`` block of docs/valvetrain.md.
 
 1. The whole command in a child process (warm numba cache, the same interpreter): wall time
    and peak resident memory (``os.wait4``'s rusage of that child), and their ratios to the
@@ -14,6 +15,7 @@ Run: ``python3 benchmarks/bench_output.py``. Prints figures, asserts nothing.
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -21,6 +23,10 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from vtool.markdown import replace_block, table
+
+DOC = Path(__file__).resolve().parent.parent / "docs" / "valvetrain.md"
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
@@ -70,7 +76,8 @@ def main() -> None:
         child(10.0, csv)  # warm the numba cache (kernel and formatter)
         wall, peak, said = child(36000.0, csv)
         size = csv.stat().st_size
-        short_wall, short_peak, _ = child(3600.0, csv)
+        short_wall, short_peak, short_said = child(3600.0, csv)
+        short_size = csv.stat().st_size
     print(f"  `vtool {' '.join(COMMAND)} --degrees 36000 --csv`: {wall:.2f} s wall "
           f"(ratio to the {TARGET_WALL_S:.0f} s target {wall / TARGET_WALL_S:.2f}), peak {peak:.0f} MB "
           f"(ratio to the {TARGET_PEAK_MB:.0f} MB target {peak / TARGET_PEAK_MB:.2f}); {said}, "
@@ -78,6 +85,19 @@ def main() -> None:
     print(f"  the same at 3600 degrees: {short_wall:.2f} s wall, peak {short_peak:.0f} MB; "
           f"peak at 36000 / peak at 3600 = {peak / short_peak:.2f} "
           "(rows stream to the file; the trace in memory grows like a per-degree run, not per step)")
+    if "--write" in sys.argv[1:]:
+        def rows(text: str) -> str:
+            found = re.search(r"wrote (\d+) rows", text)
+            return f"{int(found.group(1)):,}" if found else "?"
+
+        header = [f"`vtool {' '.join(COMMAND)} --csv`", "rows", "CSV (MB)", "wall time (s)",
+                  f"wall / {TARGET_WALL_S:.0f} s target", "peak memory (MB)", f"peak / {TARGET_PEAK_MB:.0f} MB target"]
+        replace_block(DOC, "big-output", table(header, [
+            ["--degrees 36000", rows(said), f"{size / 1e6:.0f}", f"{wall:.2f}", f"{wall / TARGET_WALL_S:.2f}",
+             f"{peak:.0f}", f"{peak / TARGET_PEAK_MB:.2f}"],
+            ["--degrees 3600", rows(short_said), f"{short_size / 1e6:.0f}", f"{short_wall:.2f}",
+             f"{short_wall / TARGET_WALL_S:.2f}", f"{short_peak:.0f}", f"{short_peak / TARGET_PEAK_MB:.2f}"]]))
+        print(f"  wrote the big-output block of {DOC.name}")
     kernel, python = formatter()
     print(f"  number formatter, 46 values per row: {kernel:.2f} us/row compiled, {python:.2f} us/row "
           f"Python '%.10g' (ratio {python / kernel:.1f}), identical text")
