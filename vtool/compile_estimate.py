@@ -10,8 +10,10 @@ is a time measured on a reference machine, scaled to this one:
 * p: a small interpreted probe here (:func:`probe`: objects, dict lookups,
   attribute access and calls, as a compiler makes; the best of five, about
   7 ms in all), p_ref = :data:`PROBE_REFERENCE_S` the same on the reference
-  machine. Machines measured differ about 3x in both the probe and the
-  compile; the probe's spread between processes on one machine is ~7 %.
+  machine. That the compile follows the probe from one machine to another
+  is assumed, not measured: the one machine before the reference took
+  8-9.4 s for the kernel's compile against 2.8-3.0 s here, and the probe
+  was not run there. Its spread between processes on one machine is ~7 %.
 * n: the compile's processes (2 for the Newmark kernel: a helper compiles
   part of its callees, :mod:`vtool.solvers.kernel_build`; 1 otherwise),
   c: the cores (``os.cpu_count()``), L: the processes already wanting a
@@ -22,8 +24,10 @@ is a time measured on a reference machine, scaled to this one:
 The probe runs once per process and only when a notice is shown (a cache
 miss): a first run pays about 7 ms for it. ``python3
 benchmarks/bench_compile_estimate.py`` measures each compile with empty
-caches and prints the estimate beside it; the reference times below are
-its figures on the reference machine (a 2-core AMD EPYC, 2026-11-26).
+caches and prints the estimate beside it; the reference times
+(``COMPILE_REFERENCE_S`` and alike in :mod:`vtool.solvers.newmark` and
+:mod:`vtool.csvrows`) are its figures on the reference machine (a 2-core
+AMD EPYC, 2026-11-26).
 """
 
 from __future__ import annotations
