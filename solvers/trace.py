@@ -342,8 +342,7 @@ class Trace:
         lines = [s["title"], f"back end {s['backend']}: " + ", ".join(f"{k} = {v}" for k, v in s["settings"].items())]
         compiling = (f" (+ {s['compile_time_s']:.1f} s compiling or loading the solver)"
                      if s["compile_time_s"] >= 0.5 else "")
-        plain = ("" if not s["plain_steps"] else " (all as plain Python)" if s["plain_steps"] == s["steps"]
-                 else f" ({s['plain_steps']} of them as plain Python)")
+        plain = plain_note(s["plain_steps"], s["steps"])
         lines.append(
             f"steps {s['steps']}{plain}, events {s['events']}, wall time {s['wall_time_s']:.3f} s{compiling}, "
             f"configurations built: {', '.join(s['configurations_built'])}"
@@ -398,6 +397,14 @@ def cam_angle_deg(time: np.ndarray | float, omega: float) -> np.ndarray | float:
     """Cam angle in degrees at time(s) t (s) for a cam speed omega (rad/s): an array for an array,
     a float for a float (with no array made for it: one per event)."""
     return time * omega * 180.0 / math.pi
+
+
+def plain_note(plain_steps: int, steps: int) -> str:
+    """" (all as plain Python)" or " (N of them as plain Python)" after a step count, or "" when every
+    step ran on the compiled kernel."""
+    if not plain_steps:
+        return ""
+    return " (all as plain Python)" if plain_steps == steps else f" ({plain_steps} of them as plain Python)"
 
 
 def csv_compile_notice() -> str | None:

@@ -23,6 +23,15 @@ class RunProgressed(Message):
         return isinstance(message, RunProgressed) and message.run_id == self.run_id
 
 
+class CompileAnnounced(Message):
+    """A run must compile the solver first (a new install's first run): the line the CLI prints."""
+
+    def __init__(self, run_id: int, text: str) -> None:
+        super().__init__()
+        self.run_id = run_id
+        self.text = text
+
+
 class SimulationFinished(Message):
     """A valve-train run returned its trace."""
 

@@ -18,7 +18,7 @@ from textual.worker import Worker, get_current_worker
 from vtool.app.tui.animation import MechanismAnimation
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, Field
-from vtool.app.tui.messages import SimulationFinished
+from vtool.app.tui.messages import CompileAnnounced, SimulationFinished
 from vtool.app.tui.sweep import SweepPane
 from vtool.app.tui.widgets import ChartView, TextPanel
 from vtool.solvers.spec import IMPACT_LAWS, START_VELOCITIES
@@ -214,13 +214,26 @@ class ValveTrainScreen(DomainScreen):
         from vtool.solvers.run import simulate
 
         worker = get_current_worker()
+
+        def announce() -> None:  # the input is checked: say so when a compile is to come, as the CLI does
+            from vtool.solvers.newmark import compile_notice, kernel_laws
+
+            notice = compile_notice(spec.run.backend, kernel_laws(spec))
+            if notice is not None:
+                self.post_message(CompileAnnounced(run_id, notice))
+
         with self.run_slot() as go:  # the cancelled run's thread has left before this one allocates
             if not go:
                 return
             trace = simulate(spec, progress=self.progress_reporter(run_id),
-                             cancel=lambda: worker.is_cancelled)
+                             cancel=lambda: worker.is_cancelled, before_run=announce)
         if not worker.is_cancelled:
             self.post_message(SimulationFinished(run_id, spec, trace))
+
+    def on_compile_announced(self, message: CompileAnnounced) -> None:
+        message.stop()
+        if message.run_id == self.run_id and self.running:
+            self.set_status(f"running... (escape cancels); {message.text}")
 
     def on_simulation_finished(self, message: SimulationFinished) -> None:
         message.stop()
@@ -230,8 +243,10 @@ class ValveTrainScreen(DomainScreen):
         self.results = trace
         self.show_trace(trace)
         stats = trace.statistics
-        self.set_status(f"done: {stats.steps} steps, {stats.events} events, {stats.wall_time:.2f} s "
-                        f"({stats.backend})")
+        from vtool.solvers.trace import plain_note
+
+        self.set_status(f"done: {stats.steps} steps{plain_note(stats.plain_steps, stats.steps)}, {stats.events} "
+                        f"events, {stats.wall_time:.2f} s ({stats.backend})")
 
     def show_trace(self, trace: Any) -> None:
         from vtool.app import valvetrain_charts as charts
