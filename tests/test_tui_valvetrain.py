@@ -19,7 +19,7 @@ import tomli_w
 from click.testing import CliRunner
 from textual import events
 
-from tests.tui_helpers import put, run_and_wait
+from tests.tui_helpers import put, run_and_wait, run_degrees
 from vtool.app import valvetrain_charts as charts
 from vtool.app.cli.main import cli
 from vtool.app.plots import shape_chart
@@ -350,10 +350,7 @@ async def test_save_then_load_round_trips_and_is_remembered(tmp_path) -> None:  
 async def test_animation_steps_through_the_deformed_mechanism() -> None:
     app = make_app("gnilka-1c")
     async with app.run_test(size=(100, 30)) as pilot:
-        await pilot.pause()
-        screen = app.screen
-        await put(pilot, screen, "run.degrees", "40")
-        await run_and_wait(pilot, app)
+        screen = await run_degrees(pilot, app, "40")
         screen.tabs.active = "tab-animation"
         await pilot.pause()
         animation = screen.animation
@@ -567,10 +564,7 @@ async def test_a_first_run_says_it_compiles_and_which_steps_ran_as_plain_python(
     monkeypatch.setenv("VTOOL_KERNEL", "plain")
     app = make_app("gnilka-1d")
     async with app.run_test(size=(80, 24)) as pilot:
-        await pilot.pause()
-        screen = app.screen
-        await put(pilot, screen, "run.degrees", "30")
-        await run_and_wait(pilot, app)
+        screen = await run_degrees(pilot, app, "30")
         assert "running... (escape cancels); compiling the solver (forced by the test)" in screen.status_log
         assert screen.results is not None and screen.results.statistics.plain_steps > 0
         assert screen.status_log[-1].startswith("done: ") and " steps (all as plain Python), " in screen.status_log[-1]

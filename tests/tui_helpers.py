@@ -14,3 +14,12 @@ async def run_and_wait(pilot, app) -> None:  # type: ignore[no-untyped-def]
     await pilot.pause()
     await app.workers.wait_for_complete()
     await pilot.pause()
+
+
+async def run_degrees(pilot, app, degrees: str):  # type: ignore[no-untyped-def]
+    """On a newly opened app: set the run's degrees, run, wait; returns the screen."""
+    await pilot.pause()
+    screen = app.screen
+    await put(pilot, screen, "run.degrees", degrees)
+    await run_and_wait(pilot, app)
+    return screen
