@@ -10,7 +10,7 @@ import math
 from collections.abc import Sequence
 
 from vtool.app.plots import line_chart
-from vtool.solvers.sweep import PointResult, format_value
+from vtool.solvers.studies.sweep import PointResult, format_value
 
 SHADES = " .:-=+*#%@"
 

@@ -18,8 +18,8 @@ import os
 import sys
 
 from vtool.presets import load_preset
-from vtool.solvers.accuracy import accuracy_study, compare, table_text, with_run
 from vtool.solvers.run import simulate
+from vtool.solvers.studies.accuracy import accuracy_study, compare, table_text, with_run
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 

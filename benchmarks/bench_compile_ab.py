@@ -30,7 +30,7 @@ SUBPACKAGES = ("app", "assessments", "presets", "solvers")  # folders the instal
 COMPILE = """
 from vtool.presets import load_preset
 from vtool.solvers.run import simulate
-import vtool.solvers.newmark_kernel as kernel
+import vtool.solvers.newmark.kernel as kernel
 trace = simulate(load_preset("gnilka-1a"))
 assert kernel.__file__.startswith({prefix!r}), kernel.__file__
 print(trace.statistics.compile_time)

@@ -26,7 +26,7 @@ os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp()
 sys.path.insert(0, {benchmarks!r})
 import bench_compile_phases
 types = bench_compile_phases.signature("gnilka-1a")
-from vtool.solvers import kernel_build
+from vtool.solvers.newmark import build as kernel_build
 kernel = kernel_build.kernel()
 spent = [0.0, 0]
 started = []

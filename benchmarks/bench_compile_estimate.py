@@ -14,7 +14,7 @@ fresh process, with a new numba cache folder):
 Each line gives the N of the notice's "about N s", the time taken and their ratio, and the
 reference time (:mod:`vtool.compile_estimate`) that this run implies: the time taken divided
 by this machine's probe ratio and load factor at the start of the command. The reference
-constants in ``solvers/newmark.py`` and ``vtool/csvrows.py`` are such figures.
+constants in ``solvers/newmark/backend.py`` and ``vtool/csvrows.py`` are such figures.
 """
 
 from __future__ import annotations

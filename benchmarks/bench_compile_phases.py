@@ -42,7 +42,7 @@ PHASES = ("typing", "lowering", "fpasses", "mpasses", "codegen", "other")
 def signature(preset: str) -> tuple[Any, ...]:
     """numba's types of ``run_chunk``'s arguments for ``preset`` (from a plain run's KernelRun)."""
     from vtool.presets import load_preset
-    from vtool.solvers import newmark
+    from vtool.solvers.newmark import backend as newmark
     from vtool.solvers.run import simulate
 
     seen: list[tuple[Any, ...]] = []
@@ -100,7 +100,7 @@ def main(argv: list[str]) -> None:
     with tempfile.TemporaryDirectory() as cache:
         os.environ["NUMBA_CACHE_DIR"] = cache  # before numba is imported (the plain run imports it): empty
         types = signature(preset)
-        from vtool.solvers import kernel_build
+        from vtool.solvers.newmark import build as kernel_build
 
         kernel = kernel_build.kernel()
         spent: dict[str, float] = collections.defaultdict(float)

@@ -22,9 +22,9 @@ from pathlib import Path
 
 from vtool.markdown import replace_block, table
 from vtool.presets import load_preset
-from vtool.solvers.exact import ExactBackend
-from vtool.solvers.model import assemble
-from vtool.solvers.newmark import NewmarkBackend
+from vtool.solvers.exact.backend import ExactBackend
+from vtool.solvers.model.mechanism import assemble
+from vtool.solvers.newmark.backend import NewmarkBackend
 from vtool.threads import limited
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")

@@ -38,8 +38,8 @@ import numpy as np
 from numba import njit
 
 from vtool.presets import load_preset
-from vtool.solvers.model import assemble
-from vtool.solvers.newmark import NewmarkBackend
+from vtool.solvers.model.mechanism import assemble
+from vtool.solvers.newmark.backend import NewmarkBackend
 from vtool.solvers.run import simulate
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
@@ -79,7 +79,7 @@ def dense_newmark(M, C, K, Sinv, h, beta, gamma, steps, x, v, a):  # noqa: N803 
 
 def kernel_seconds(backend, mechanism, options) -> float:  # noqa: ANN001
     """Seconds spent inside the kernel's calls (run_chunk) during one run, Python around it left out."""
-    from vtool.solvers import newmark_kernel
+    from vtool.solvers.newmark import kernel as newmark_kernel
 
     inner = newmark_kernel.run_chunk
     spent = [0.0]
@@ -150,7 +150,7 @@ elapsed = time.perf_counter() - started
 native = "numba" not in sys.modules
 misses = hits = 0
 if not native:  # (importing the kernel only to ask would import numba into a native run's process time)
-    from vtool.solvers import newmark_kernel
+    from vtool.solvers.newmark import kernel as newmark_kernel
     stats = newmark_kernel.run_chunk.stats
     misses, hits = sum(stats.cache_misses.values()), sum(stats.cache_hits.values())
 print(elapsed, misses, hits, int(native))

@@ -37,8 +37,8 @@ def surge_rows() -> tuple[list[str], list[list[str]]]:
     """Fixed-free bar (the valve spring alone, k = 254 lbf/in, wire mass), n elements."""
     import scipy.linalg
 
-    from vtool.solvers.assembly import assemble_full
-    from vtool.solvers.spec import BAR, MemberSpec
+    from vtool.solvers.model.assembly import assemble_full
+    from vtool.solvers.model.spec import BAR, MemberSpec
 
     k, m = 254.0, 0.283 / 386.0 * math.pi * 0.07**2 / 4 * 36.0
     exact = 0.5 * math.pi * math.sqrt(k / m)
@@ -56,7 +56,7 @@ def surge_rows() -> tuple[list[str], list[list[str]]]:
 
 
 def _one_member_spec(member, n_coordinates: int):  # type: ignore[no-untyped-def]
-    from vtool.solvers.spec import (
+    from vtool.solvers.model.spec import (
         CamSpec,
         ClearanceSpec,
         CoordinateSpec,
@@ -75,7 +75,7 @@ def _one_member_spec(member, n_coordinates: int):  # type: ignore[no-untyped-def
 
 def cam_rows(name: str) -> tuple[list[str], list[list[str]]]:
     from vtool.presets import load_preset
-    from vtool.solvers.cam import cam_report
+    from vtool.solvers.model.cam import cam_report
 
     r = cam_report(load_preset(name))
     u = r["length_unit"]
@@ -117,13 +117,13 @@ def table_vs_harmonic_rows() -> tuple[list[str], list[list[str]]]:
 
 def size_study_for(name: str, rpm: float):  # type: ignore[no-untyped-def]
     from vtool.presets import load_preset
-    from vtool.solvers.size import size_study
+    from vtool.solvers.studies.size import size_study
 
     return size_study(load_preset(name), rpm)
 
 
 def size_block(study) -> str:  # type: ignore[no-untyped-def]
-    from vtool.solvers.size import study_rows
+    from vtool.solvers.studies.size import study_rows
 
     header, rows = study_rows(study)
     parts = [f"{name} {n}" + ("" if ok else " (not converged)") for name, (n, ok) in study.elements.items()]

@@ -26,11 +26,11 @@ TIMING = """
 import sys
 sys.path.insert(0, {benchmarks!r})
 from bench_newmark import kernel_seconds
-import vtool.solvers.newmark_kernel as kernel
+import vtool.solvers.newmark.kernel as kernel
 assert kernel.__file__.startswith({prefix!r}), kernel.__file__
 from vtool.presets import load_preset
-from vtool.solvers.model import assemble
-from vtool.solvers.newmark import NewmarkBackend
+from vtool.solvers.model.mechanism import assemble
+from vtool.solvers.newmark.backend import NewmarkBackend
 spec = load_preset("gnilka-1a")
 mechanism = assemble(spec)
 backend = NewmarkBackend()
@@ -42,7 +42,7 @@ print(min(min(kernel_seconds(backend, mechanism, options) for _ in range(5)) for
 WHOLE = """
 import sys, time
 sys.path.insert(0, {benchmarks!r})
-import vtool.solvers.newmark_kernel as kernel
+import vtool.solvers.newmark.kernel as kernel
 assert kernel.__file__.startswith({prefix!r}), kernel.__file__
 from vtool.presets import load_preset
 from vtool.solvers.run import simulate

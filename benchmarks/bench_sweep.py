@@ -29,7 +29,7 @@ from vtool.markdown import replace_block, table
 from vtool.presets import load_preset
 from vtool.presets.paths import plan_sweep
 from vtool.solvers.run import simulate
-from vtool.solvers.sweep import DaskRunner, ProcessRunner, SerialRunner, run_points
+from vtool.solvers.studies.sweep import DaskRunner, ProcessRunner, SerialRunner, run_points
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 

@@ -17,8 +17,8 @@ from vtool.markdown import replace_block, table
 from vtool.presets import load_preset
 from vtool.presets.paths import plan_sweep
 from vtool.presets.valvetrain import with_run_overrides
-from vtool.solvers.metrics import metric_columns, seat_index
-from vtool.solvers.sweep import CRITERIA, SerialRunner, find_speed, make_runner, run_points
+from vtool.solvers.studies.metrics import metric_columns, seat_index
+from vtool.solvers.studies.sweep import CRITERIA, SerialRunner, find_speed, make_runner, run_points
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 

@@ -2,7 +2,7 @@
 
 Run: ``python3 benchmarks/tables_compare.py`` (``--check`` compares instead of writing
 and exits 1 when a committed table differs). Every number in the blocks comes from
-:func:`vtool.solvers.compare.compare`, the same code as ``vtool compare``.
+:func:`vtool.solvers.studies.compare.compare`, the same code as ``vtool compare``.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from pathlib import Path
 
 from vtool.markdown import read_block, replace_block, table
 from vtool.presets import load_preset
-from vtool.solvers.compare import cell, compare
-from vtool.solvers.compare import table as comparison
+from vtool.solvers.studies.compare import cell, compare
+from vtool.solvers.studies.compare import table as comparison
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 

@@ -2,7 +2,7 @@
 
 Run: ``python3 benchmarks/tables_compliant.py`` (``--check`` compares instead of writing and
 exits 1 when the committed table differs). Every number comes from
-:func:`vtool.solvers.compliance.study` (exact back end; the Newmark step search against it).
+:func:`vtool.solvers.studies.compliance.study` (exact back end; the Newmark step search against it).
 
 The check allows ``CHECK_REL`` relative on each number: at k = 1e8 and 1e9 the
 seat chatters for thousands of events, and the event count follows the last
@@ -18,7 +18,7 @@ from pathlib import Path
 
 from vtool.markdown import read_block, replace_block, table, table_differences
 from vtool.presets import load_preset
-from vtool.solvers.compliance import study
+from vtool.solvers.studies.compliance import study
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 

@@ -32,7 +32,9 @@ from pathlib import Path
 
 from vtool.markdown import replace_block, table
 from vtool.presets import load_preset
-from vtool.solvers.accuracy import (
+from vtool.solvers.model.spec import MechanismSpec
+from vtool.solvers.run import simulate
+from vtool.solvers.studies.accuracy import (
     SCIPY_RTOLS,
     AccuracyRow,
     accuracy_study,
@@ -41,8 +43,6 @@ from vtool.solvers.accuracy import (
     markdown_header,
     with_run,
 )
-from vtool.solvers.run import simulate
-from vtool.solvers.spec import MechanismSpec
 from vtool.solvers.trace import CLOSED, OPENED, Trace
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")

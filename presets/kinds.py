@@ -9,7 +9,7 @@ the CLI imports only the module of the kind it runs.
 =============  ==========================================  ================================  ==============================  ========================
 kind           spec type                                   loader (``load``/``dump``)        solve (``vtool solve``)         TUI screen module
 =============  ==========================================  ================================  ==============================  ========================
-valvetrain     vtool.solvers.spec:MechanismSpec            vtool.presets.valvetrain          vtool.app.cli.solve:run_valvetrain  vtool.app.tui.valvetrain
+valvetrain     vtool.solvers.model.spec:MechanismSpec            vtool.presets.valvetrain          vtool.app.cli.solve:run_valvetrain  vtool.app.tui.valvetrain
 boom_wall      vtool.assessments.sonic_boom.spec:BoomWallSpec   vtool.presets.boom           vtool.app.cli.boom:solve_preset     vtool.app.tui.boom
 boom_floor     vtool.assessments.sonic_boom.spec:BoomFloorSpec  vtool.presets.boom           vtool.app.cli.boom:solve_preset     vtool.app.tui.boom
 plate          vtool.presets.plate:PlateSpec               vtool.presets.plate               vtool.app.cli.plate:solve_preset    vtool.app.tui.plate
@@ -44,7 +44,7 @@ class Kind:
 
 KINDS: dict[str, Kind] = {
     "valvetrain": Kind("valvetrain", "valve-train dynamics (Gnilka 1971)",
-                       "vtool.solvers.spec:MechanismSpec", "vtool.presets.valvetrain",
+                       "vtool.solvers.model.spec:MechanismSpec", "vtool.presets.valvetrain",
                        "vtool.app.cli.solve:run_valvetrain", "vtool.app.tui.valvetrain",
                        ("--backend", "--dt", "--rpm", "--degrees", "--every-step", "--events",
                         "--max-steps")),

@@ -166,7 +166,7 @@ class SweepPlan:
     doc: dict[str, Any]
     spec: Any
     fields: tuple[tuple[str, str], ...]  # (path, unit)
-    points: tuple[Any, ...]  # vtool.solvers.sweep.Point
+    points: tuple[Any, ...]  # vtool.solvers.studies.sweep.Point
 
 
 def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> SweepPlan:
@@ -176,7 +176,7 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> Sweep
     InputError before any work starts.
     """
     from vtool.presets import find_preset, load_document, read_document
-    from vtool.solvers.sweep import Point, grid
+    from vtool.solvers.studies.sweep import Point, grid
 
     doc = read_document(find_preset(preset))
     spec = load_document(doc)

@@ -1,4 +1,4 @@
-"""Valve-train presets: TOML document <-> :class:`vtool.solvers.spec.MechanismSpec`.
+"""Valve-train presets: TOML document <-> :class:`vtool.solvers.model.spec.MechanismSpec`.
 
 ``load(doc)`` validates every field once, at this boundary, and raises
 :class:`vtool.errors.InputError` naming the field, value, allowed range and
@@ -30,8 +30,8 @@ from typing import Any
 from vtool.errors import InputError, PresetWarning
 from vtool.presets.fields import Table, as_float
 from vtool.presets.lift_table import read_lift_table
-from vtool.solvers.assembly import split_members, unsplit_members
-from vtool.solvers.spec import (
+from vtool.solvers.model.assembly import split_members, unsplit_members
+from vtool.solvers.model.spec import (
     BAR,
     BEAM,
     CONTACT_LAWS,
@@ -57,7 +57,7 @@ from vtool.solvers.spec import (
     RunSpec,
     SeatSpec,
 )
-from vtool.solvers.units import UNIT_SYSTEMS, UnitSystem
+from vtool.solvers.model.units import UNIT_SYSTEMS, UnitSystem
 
 STATIC_START = "static-start"
 MAX_DAMPING_RATIO = 1.0
@@ -147,7 +147,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     )
     spec = split_members(spec)
     if seat is not None and seat.lash is not None:
-        from vtool.solvers.lash import seat_position
+        from vtool.solvers.model.lash import seat_position
 
         spec = replace(spec, seat=replace(spec.seat, position=float(seat_position(spec, seat.lash))))
     return spec
@@ -274,8 +274,8 @@ def _cam(t: Table, n: int, units: UnitSystem, folder: Path | None = None) -> Cam
 
 
 def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
-    """A lift table (file or inline arrays) and its fit setting; see solvers/cam.py."""
-    from vtool.solvers.cam import fit_table, junction_warning, normalize_table
+    """A lift table (file or inline arrays) and its fit setting; see solvers/model/cam.py."""
+    from vtool.solvers.model.cam import fit_table, junction_warning, normalize_table
 
     lift_table = t.string("lift_table", default="") or None
     if lift_table is not None:

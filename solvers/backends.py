@@ -13,7 +13,7 @@ The contract every back end follows (subclass :class:`Backend`)
    settings a user can fix (time step beyond the stability limit, tolerances
    out of range), before any work.
 4. ``integrate(problem, options, builder, progress, cancel) -> dict``: run
-   the :class:`~vtool.solvers.contact.ContactProblem` from its static start to
+   the :class:`~vtool.solvers.model.contact.ContactProblem` from its static start to
    the end, adding rows and events to the
    :class:`~vtool.solvers.trace.TraceBuilder`; apply the shared event rules
    (kernel functions ``impact`` and ``settle``); return the statistics
@@ -45,9 +45,9 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from vtool.errors import InputError
 
 if TYPE_CHECKING:
-    from vtool.solvers.contact import ContactProblem
-    from vtool.solvers.model import Mechanism
-    from vtool.solvers.spec import RunSpec
+    from vtool.solvers.model.contact import ContactProblem
+    from vtool.solvers.model.mechanism import Mechanism
+    from vtool.solvers.model.spec import RunSpec
     from vtool.solvers.trace import CsvStream, Trace, TraceBuilder
 
 ENTRY_POINT_GROUP = "vtool.backends"
@@ -100,7 +100,7 @@ class Backend(ABC):
 
     def simulate(self, mechanism: Mechanism, options: Any = None, progress: Progress | None = None,
                  cancel: Cancel | None = None, stream: CsvStream | None = None) -> Trace:
-        from vtool.solvers.contact import ContactProblem, EventRules
+        from vtool.solvers.model.contact import ContactProblem, EventRules
         from vtool.solvers.trace import RunStatistics, TraceBuilder
         from vtool.threads import limited
 

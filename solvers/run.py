@@ -4,7 +4,7 @@ The CLI, the TUI, the benchmarks and a user's own script all go through
 :func:`simulate`, so they share one code path. Before the back end starts,
 the run's cost is estimated and refused above the limits
 (:mod:`vtool.solvers.cost`), and a seat the valve never reaches is a
-:class:`vtool.errors.PresetWarning` (:mod:`vtool.solvers.preflight`). A
+:class:`vtool.errors.PresetWarning` (:mod:`vtool.solvers.model.preflight`). A
 numerical failure inside the run (a singular matrix, an overflow, a
 non-finite result) is a :class:`vtool.errors.RunError` naming what failed.
 """
@@ -21,9 +21,9 @@ import numpy as np
 
 from vtool.errors import PresetWarning, RunError
 from vtool.solvers import backends, cost
-from vtool.solvers.model import Mechanism, assemble
-from vtool.solvers.preflight import seat_reach_warning
-from vtool.solvers.spec import MechanismSpec, RunSpec
+from vtool.solvers.model.mechanism import Mechanism, assemble
+from vtool.solvers.model.preflight import seat_reach_warning
+from vtool.solvers.model.spec import MechanismSpec, RunSpec
 from vtool.solvers.trace import CsvStream, Trace
 from vtool.threads import limited
 

@@ -18,14 +18,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vtool.files import open_atomic
-from vtool.solvers import kernel_layout as layout
-from vtool.solvers.configurations import closed_names, configuration_label, thesis_number
-from vtool.solvers.spec import EXTERNAL, MechanismSpec
+from vtool.solvers.model.configurations import closed_names, configuration_label, thesis_number
+from vtool.solvers.model.spec import EXTERNAL, MechanismSpec
+from vtool.solvers.newmark import layout
 
 OPENED = "opened"
 CLOSED = "closed"
 RELEASED = "released"  # a persistent contact pulled apart by another contact's impact
-#: the kernels' event codes (:mod:`vtool.solvers.kernel_layout`) to the kinds above
+#: the kernels' event codes (:mod:`vtool.solvers.newmark.layout`) to the kinds above
 EVENT_KINDS: dict[int, str] = {int(layout.EV_OPENED): OPENED, int(layout.EV_CLOSED): CLOSED,
                               int(layout.EV_RELEASED): RELEASED}
 
@@ -177,7 +177,7 @@ class Trace:
         already); ``header=False`` leaves out the header row (a block of a streamed run).
         """
         from vtool.csvrows import write_rows
-        from vtool.solvers.kernel_native import csv_writer
+        from vtool.solvers.newmark.native import csv_writer
 
         native = csv_writer()  # a native module's formatter: no numba
         names, columns = self.csv_columns(quantities)
@@ -410,9 +410,9 @@ def plain_note(plain_steps: int, steps: int) -> str:
 def csv_compile_notice() -> str | None:
     """The line to show before an every-step CSV's number formatter compiles
     (:func:`vtool.csvrows.compile_notice`), or None; None at once, with no numba imported, when a native
-    module carries the formatter (:func:`vtool.solvers.kernel_native.csv_writer`)."""
+    module carries the formatter (:func:`vtool.solvers.newmark.native.csv_writer`)."""
     from vtool import csvrows
-    from vtool.solvers.kernel_native import csv_writer
+    from vtool.solvers.newmark.native import csv_writer
 
     return None if csv_writer() is not None else csvrows.compile_notice()
 
@@ -530,7 +530,7 @@ class TraceBuilder:
                             np.array(F, dtype=float, copy=how), np.array(cfg, dtype=np.int64, copy=how)))
 
     def add_events(self, floats: np.ndarray, ints: np.ndarray) -> None:
-        """Take the rows of a kernel's event buffers (:mod:`vtool.solvers.kernel_layout`): ``floats`` holds
+        """Take the rows of a kernel's event buffers (:mod:`vtool.solvers.newmark.layout`): ``floats`` holds
         (time, relative velocity), ``ints`` (clearance, event code, configuration before, after). Equal to
         :meth:`add_event` row by row, with less Python around each :class:`Event`."""
         if not len(ints):

@@ -8,7 +8,7 @@ run's other paths (``auto``, ``plain``) have their own tests, which set the
 variable themselves (tests/test_first_run.py).
 
 ``VTOOL_NATIVE=0``: no run builds or uses the kernel's native module
-(:mod:`vtool.solvers.kernel_native`), so that a test in ``auto`` mode starts no
+(:mod:`vtool.solvers.newmark.native`), so that a test in ``auto`` mode starts no
 native build in the background; the native module's own tests set it to 1.
 
 The suite runs on pytest-xdist workers (``-n auto``, at most four: see
@@ -72,8 +72,8 @@ def _compile_run(backend: str = "newmark", impact: str | None = None, hertz: boo
     """A run of one degree (its kernel compiled, or loaded from numba's cache: VTOOL_KERNEL=compiled)."""
     from vtool.presets import load_preset
     from vtool.presets.valvetrain import with_run_overrides
-    from vtool.solvers.compare import with_model
     from vtool.solvers.run import simulate
+    from vtool.solvers.studies.compare import with_model
 
     if hertz:
         from tests.test_compliant import hertz_doc

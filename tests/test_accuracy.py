@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from vtool.solvers.pairing import pair_events
+from vtool.solvers.studies.pairing import pair_events
 from vtool.solvers.trace import Event
 
 PERIOD = 60.0 / 11000.0  # s per cam revolution at 11,000 rev/min
@@ -96,7 +96,7 @@ def test_pairing_invariants(ref_items: list, other_items: list) -> None:
     assert pair_events(ref, ref).unmatched == 0
 
 
-@pytest.mark.parametrize("module", ["vtool.solvers.accuracy", "vtool.solvers.pairing"])
+@pytest.mark.parametrize("module", ["vtool.solvers.studies.accuracy", "vtool.solvers.studies.pairing"])
 def test_solvers_do_not_import_presets(module: str) -> None:
     import subprocess
     import sys

@@ -22,10 +22,10 @@ from vtool.errors import InputError
 from vtool.presets import load_preset
 from vtool.presets.valvetrain import with_run_overrides
 from vtool.solvers import backends
-from vtool.solvers.model import assemble
-from vtool.solvers.newmark import NewmarkBackend, NewmarkOptions
+from vtool.solvers.model.mechanism import assemble
+from vtool.solvers.newmark.backend import NewmarkBackend, NewmarkOptions
 from vtool.solvers.run import simulate
-from vtool.solvers.scipy_backend import ScipyBackend, ScipyOptions
+from vtool.solvers.scipy.backend import ScipyBackend, ScipyOptions
 
 #: every installed back end (entry points ``vtool.backends``): a plugged-in one meets the same closed forms
 INSTALLED = backends.available()
@@ -50,8 +50,8 @@ def normalized_error(values: np.ndarray, reference: np.ndarray) -> float:
 
 def test_registry_lists_without_importing_and_names_the_installed_ones() -> None:
     code = ("import sys\nfrom vtool.solvers import backends\nnames = backends.available()\n"
-            "print(names, [m for m in ('vtool.solvers.exact', 'vtool.solvers.scipy_backend',"
-            " 'vtool.solvers.newmark') if m in sys.modules])")
+            "print(names, [m for m in ('vtool.solvers.exact.backend', 'vtool.solvers.scipy.backend',"
+            " 'vtool.solvers.newmark.backend') if m in sys.modules])")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "['exact', 'newmark', 'scipy'] []"
     with pytest.raises(InputError, match="one of the installed back ends: exact, newmark, scipy"):
@@ -172,7 +172,7 @@ def test_three_back_ends_agree_on_every_thesis_preset(name: str) -> None:
 @pytest.mark.parametrize("name", ["gnilka-1a", "gnilka-1b", "gnilka-1c", "gnilka-1d", "gnilka-2", "gnilka-3"])
 def test_exact_events_converge_with_the_event_tolerance(name: str) -> None:
     """Halving the exact back end's event tolerance moves no event by more than 1e-6 degrees."""
-    from vtool.solvers.exact import ExactBackend, ExactOptions
+    from vtool.solvers.exact.backend import ExactBackend, ExactOptions
 
     mechanism = assemble(load_preset(name))
     coarse = ExactBackend().simulate(mechanism, ExactOptions(time_tolerance=1e-12))

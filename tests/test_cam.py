@@ -1,4 +1,4 @@
-"""Cam lift tables: Fourier fit, derivatives, ramp-junction check, loader (solvers/cam.py).
+"""Cam lift tables: Fourier fit, derivatives, ramp-junction check, loader (solvers/model/cam.py).
 
 Sources: a trigonometric polynomial sampled at 2K + 1 or more points is
 reproduced exactly by the least-squares fit of degree >= K (the basis is
@@ -20,7 +20,7 @@ from vtool.errors import InputError
 from vtool.presets import PRESET_DIR, load_preset, read_document
 from vtool.presets.ramped_cam import CSV, table_text
 from vtool.presets.valvetrain import dump, load
-from vtool.solvers.cam import acceleration_jumps, cam_fit, derivatives, fit_table, lift_series
+from vtool.solvers.model.cam import acceleration_jumps, cam_fit, derivatives, fit_table, lift_series
 
 A = 0.5  # in, gnilka-1a
 

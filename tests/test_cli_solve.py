@@ -102,7 +102,7 @@ def test_a_failed_run_exits_1_and_leaves_an_existing_file_untouched(tmp_path: Pa
     import tomli_w
 
     from tests.test_newmark import free_mechanism_doc
-    from vtool.solvers import newmark
+    from vtool.solvers.newmark import backend as newmark
 
     doc = free_mechanism_doc(beta=1 / 6)
     doc["run"]["degrees"] = 400.0

@@ -21,7 +21,7 @@ import pytest
 from tests.valvetrain_cases import SDOF_MASS, SDOF_STIFFNESS, sdof_doc, spec_from
 from vtool.errors import InputError
 from vtool.solvers import backends
-from vtool.solvers.model import assemble
+from vtool.solvers.model.mechanism import assemble
 from vtool.solvers.trace import CLOSED, OPENED
 
 K_CONTACT = 1.0e6  # lbf/in
@@ -112,10 +112,10 @@ def test_contact_keys_are_checked_in_one_line() -> None:
         spec_from(doc)
 
 
-# ----- gnilka-1a with every clearance linear (vtool.solvers.compliance; docs/contact.md) -----
+# ----- gnilka-1a with every clearance linear (vtool.solvers.studies.compliance; docs/contact.md) -----
 def test_stiffer_contacts_approach_the_rigid_momentum_run() -> None:
     from vtool.presets import load_preset
-    from vtool.solvers.compliance import figures, with_contacts
+    from vtool.solvers.studies.compliance import figures, with_contacts
 
     spec = load_preset("gnilka-1a")
     rigid = figures(with_contacts(spec, None, impact="momentum"))
@@ -137,8 +137,8 @@ def test_exact_and_newmark_agree_on_a_compliant_run() -> None:
     import dataclasses
 
     from vtool.presets import load_preset
-    from vtool.solvers.compliance import with_contacts
     from vtool.solvers.run import simulate
+    from vtool.solvers.studies.compliance import with_contacts
 
     spec = with_contacts(load_preset("gnilka-1a"), 1e7, 1.0)
     exact = simulate(dataclasses.replace(spec, run=dataclasses.replace(spec.run, backend="exact")))
@@ -297,7 +297,7 @@ def test_bad_input_is_one_line_even_when_a_compile_is_due(tmp_path, monkeypatch,
     from click.testing import CliRunner
 
     from vtool.app.cli.main import cli
-    from vtool.solvers import newmark
+    from vtool.solvers.newmark import backend as newmark
 
     monkeypatch.setattr(newmark, "compile_notice", lambda *args: "compiling the solver (forced by the test)")
     refused, good = tmp_path / "exact.toml", tmp_path / "newmark.toml"
@@ -326,9 +326,9 @@ def test_kernel_law_switches_follow_the_clearances() -> None:
     import dataclasses
 
     from vtool.presets import load_preset
-    from vtool.solvers import kernel_layout
-    from vtool.solvers.contact import ContactProblem
-    from vtool.solvers.newmark import kernel_laws
+    from vtool.solvers.model.contact import ContactProblem
+    from vtool.solvers.newmark import layout as kernel_layout
+    from vtool.solvers.newmark.backend import kernel_laws
 
     thesis = load_preset("gnilka-1a")
     momentum = dataclasses.replace(thesis, contact=dataclasses.replace(thesis.contact, impact="momentum"))
@@ -341,7 +341,7 @@ def test_kernel_law_switches_follow_the_clearances() -> None:
 
 def test_a_kernel_is_cached_per_law_switch_pair() -> None:
     from vtool.presets import load_preset
-    from vtool.solvers import newmark_kernel as kernel
+    from vtool.solvers.newmark import kernel
     from vtool.solvers.run import simulate
 
     if not hasattr(kernel.run_chunk, "signatures"):
@@ -359,9 +359,9 @@ def test_a_rerun_of_a_hertz_mechanism_equals_its_first_run_to_the_last_bit() -> 
     run three times in one process, and once more on a mechanism assembled afresh, gives the same run
     to the last bit; a rerun at the same speed with another length runs its own length."""
     from tests.valvetrain_cases import spec_from
-    from vtool.solvers.contact import ContactProblem
-    from vtool.solvers.model import assemble
-    from vtool.solvers.newmark import NewmarkBackend
+    from vtool.solvers.model.contact import ContactProblem
+    from vtool.solvers.model.mechanism import assemble
+    from vtool.solvers.newmark.backend import NewmarkBackend
     from vtool.solvers.run import simulate
 
     doc = hertz_doc(restitution=0.5)

@@ -7,8 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vtool.presets import load_preset
-from vtool.solvers.assembly import assemble_full, member_properties
-from vtool.solvers.elements import bar_matrices, beam_matrices
+from vtool.solvers.model.assembly import assemble_full, member_properties
+from vtool.solvers.model.elements import bar_matrices, beam_matrices
 
 positive = st.floats(min_value=1e-3, max_value=1e3, allow_nan=False)
 

@@ -1,4 +1,4 @@
-"""Members split into equal elements (solvers/assembly.py: sub_elements, split_members).
+"""Members split into equal elements (solvers/model/assembly.py: sub_elements, split_members).
 
 Sources: a fixed-free uniform bar of stiffness k = EA/L and mass m has
 ω_1 = (π/2) sqrt(k/m); consistent-mass linear bar elements over-estimate it
@@ -19,8 +19,8 @@ import scipy.linalg
 
 from vtool.presets import PRESET_DIR, load_document, load_preset, read_document
 from vtool.presets.valvetrain import dump, load
-from vtool.solvers.assembly import assemble_full
-from vtool.solvers.model import assemble
+from vtool.solvers.model.assembly import assemble_full
+from vtool.solvers.model.mechanism import assemble
 
 K_SPRING, M_SPRING = 254.0, 1.0e-4  # lbf/in, lbf s²/in
 

@@ -28,12 +28,12 @@ from tests.test_backends import base_excited_doc
 from tests.valvetrain_cases import base_excited_response, spec_from
 from vtool.errors import InputError, RunError
 from vtool.presets import load_preset
-from vtool.solvers.contact import ContactProblem
-from vtool.solvers.exact import ExactOptions, _ExactRun, peak_brackets, safe_newton
-from vtool.solvers.model import assemble
-from vtool.solvers.scipy_backend import ScipyBackend, ScipyOptions
-from vtool.solvers.sources import SourceSeries
-from vtool.solvers.statespace import state_space
+from vtool.solvers.exact.backend import ExactOptions, _ExactRun, peak_brackets, safe_newton
+from vtool.solvers.exact.statespace import state_space
+from vtool.solvers.model.contact import ContactProblem
+from vtool.solvers.model.mechanism import assemble
+from vtool.solvers.model.sources import SourceSeries
+from vtool.solvers.scipy.backend import ScipyBackend, ScipyOptions
 from vtool.solvers.trace import TraceBuilder
 from vtool.threads import ENVIRONMENT, limited, thread_limit
 
@@ -155,7 +155,7 @@ def test_particular_solution_of_a_fourier_series_satisfies_the_equations(harmoni
 
 
 def _source(series: SourceSeries, t: float) -> tuple[float, float, float]:
-    from vtool.solvers.sources import evaluate
+    from vtool.solvers.model.sources import evaluate
 
     x, v, a = evaluate(series, 0, t)
     return float(x), float(v), float(a)
@@ -228,7 +228,7 @@ def test_a_peak_force_between_steps_is_found_to_1e_6(backend: str) -> None:
     if backend == "scipy":
         trace = ScipyBackend().simulate(mechanism, ScipyOptions(rtol=1e-9))
     else:
-        from vtool.solvers.exact import ExactBackend
+        from vtool.solvers.exact.backend import ExactBackend
 
         trace = ExactBackend().simulate(mechanism)
     assert not trace.events
@@ -277,7 +277,7 @@ def test_the_documented_1a_figures_are_regenerated() -> None:
     from pathlib import Path
 
     from vtool.markdown import read_block
-    from vtool.solvers.exact import ExactBackend
+    from vtool.solvers.exact.backend import ExactBackend
 
     block = read_block(Path(__file__).resolve().parent.parent / "docs" / "valvetrain.md", "exact-1a")
     first = [cell.strip() for cell in block.splitlines()[2].strip().strip("|").split("|")]

@@ -35,9 +35,14 @@ import pytest
 from tests.valvetrain_cases import spec_from, thesis_doc
 from vtool.errors import InputError, RunError
 from vtool.presets.valvetrain import with_run_overrides
-from vtool.solvers.configurations import clearance_bit, mask_of
-from vtool.solvers.model import Mechanism, assemble
-from vtool.solvers.newmark import NewmarkBackend, NewmarkOptions, highest_frequency, stability_limit
+from vtool.solvers.model.configurations import clearance_bit, mask_of
+from vtool.solvers.model.mechanism import Mechanism, assemble
+from vtool.solvers.newmark.backend import (
+    NewmarkBackend,
+    NewmarkOptions,
+    highest_frequency,
+    stability_limit,
+)
 from vtool.solvers.run import simulate
 from vtool.solvers.trace import CLOSED, OPENED, RELEASED, Event, Trace
 

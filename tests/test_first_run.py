@@ -24,8 +24,9 @@ from vtool.app.cli.main import cli
 from vtool.errors import InputError
 from vtool.presets import load_preset
 from vtool.presets.valvetrain import with_run_overrides
-from vtool.solvers import kernel_build, newmark
-from vtool.solvers import newmark_kernel as kernel
+from vtool.solvers.newmark import backend as newmark
+from vtool.solvers.newmark import build as kernel_build
+from vtool.solvers.newmark import kernel
 from vtool.solvers.run import simulate
 
 needs_jit = pytest.mark.skipif(not kernel_build.jit_enabled(), reason="NUMBA_DISABLE_JIT: nothing is compiled")
@@ -43,12 +44,12 @@ def wait_until_cached(env: dict, names: tuple[str, ...]) -> None:
 
     A probe process imports numba (about a second of CPU, taken from the compile it waits for), so one
     starts only once each name has an index file in ``env``'s cache folder; the probe then decides."""
-    probe = ("import sys; from vtool.solvers import newmark_kernel as k; "
+    probe = ("import sys; from vtool.solvers.newmark import kernel as k; "
              f"sys.exit(0 if k.is_cached({names!r}, None, None) else 1)")
     folder = Path(env["NUMBA_CACHE_DIR"])
     deadline = time.monotonic() + 600
     while True:
-        if (all(any(folder.rglob(f"newmark_kernel.{name}-*.nbi")) for name in names)
+        if (all(any(folder.rglob(f"kernel.{name}-*.nbi")) for name in names)
                 and subprocess.run([sys.executable, "-c", probe], env=env).returncode == 0):
             return
         assert time.monotonic() < deadline, f"the background compile of {names} did not reach the cache in 600 s"
@@ -212,7 +213,7 @@ def test_compiled_runs_compile_a_kernel_once_between_processes(tmp_path, monkeyp
 def test_a_failed_child_leaves_its_error_and_no_lock(tmp_path, monkeypatch) -> None:  # noqa: ANN001
     lock = tmp_path / "kernel.lock"
     lock.write_text("")
-    child = subprocess.run([sys.executable, "-m", "vtool.solvers.kernel_build", str(lock)], input=b"not a pickle",
+    child = subprocess.run([sys.executable, "-m", "vtool.solvers.newmark.build", str(lock)], input=b"not a pickle",
                            capture_output=True)
     assert child.returncode != 0
     assert not lock.exists()
@@ -224,7 +225,7 @@ def test_a_failed_child_leaves_its_error_and_no_lock(tmp_path, monkeypatch) -> N
 
 @needs_jit
 def test_the_split_compiles_helper_writes_its_jobs_into_the_cache(tmp_path) -> None:  # noqa: ANN001
-    """``python -m vtool.solvers.kernel_build --part`` (compile_kernel's helper) compiles the pickled
+    """``python -m vtool.solvers.newmark.build --part`` (compile_kernel's helper) compiles the pickled
     jobs into numba's cache and exits 0; another process then finds them there."""
     import pickle
 
@@ -233,10 +234,10 @@ def test_the_split_compiles_helper_writes_its_jobs_into_the_cache(tmp_path) -> N
     vec, mat = types.Array(types.float64, 1, "C"), types.Array(types.float64, 2, "C")
     jobs = [("fill_sources", (types.int64, types.int64, types.float64, vec, mat, mat, types.float64, vec))]
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
-    helper = subprocess.run([sys.executable, "-m", "vtool.solvers.kernel_build", "--part"], input=pickle.dumps(jobs),
+    helper = subprocess.run([sys.executable, "-m", "vtool.solvers.newmark.build", "--part"], input=pickle.dumps(jobs),
                             env=env, capture_output=True, timeout=600)
     assert helper.returncode == 0, helper.stderr.decode()
-    probe = ("import sys; from vtool.solvers import newmark_kernel as k; "
+    probe = ("import sys; from vtool.solvers.newmark import kernel as k; "
              "sys.exit(0 if k.is_cached(('fill_sources',)) else 1)")
     assert subprocess.run([sys.executable, "-c", probe], env=env, timeout=600).returncode == 0
 

@@ -9,8 +9,8 @@ import pytest
 
 from vtool.presets import PRESET_DIR, load_document, load_preset, read_document
 from vtool.presets.valvetrain import dump
-from vtool.solvers.layers import possible_layers
-from vtool.solvers.model import assemble
+from vtool.solvers.model.layers import possible_layers
+from vtool.solvers.model.mechanism import assemble
 
 
 def four_clearance_doc(stem_state: str) -> dict:

@@ -240,7 +240,7 @@ def test_a_duplicated_damping_layer_is_refused() -> None:
 
 
 def test_an_ill_conditioned_mass_matrix_is_a_run_error_not_a_linalg_error() -> None:
-    from vtool.solvers.damping import undamped_modes
+    from vtool.solvers.model.damping import undamped_modes
 
     with pytest.raises(RunError, match="mass matrix is not positive definite"):
         undamped_modes(__import__("numpy").diag([1.0, -1.0]), __import__("numpy").eye(2))
@@ -251,7 +251,7 @@ def test_stiffness_and_mass_that_overflow_the_reduced_problem_are_a_run_error_no
     infinities: one line, never NaN frequencies passed on to the run."""
     import numpy as np
 
-    from vtool.solvers.damping import undamped_modes
+    from vtool.solvers.model.damping import undamped_modes
 
     for M, K in [(np.eye(2), 1e308 * np.array([[1.0, -1.0], [-1.0, 1.0]])),
                  (np.diag([1e300, 1e-300]), 1e300 * np.eye(2))]:
@@ -294,8 +294,8 @@ def test_a_missing_damping_section_is_a_warning_with_the_default() -> None:
 
 def test_a_seat_never_reached_is_a_warning() -> None:
     from vtool.presets import load_preset
-    from vtool.solvers.model import assemble
-    from vtool.solvers.preflight import seat_reach_warning
+    from vtool.solvers.model.mechanism import assemble
+    from vtool.solvers.model.preflight import seat_reach_warning
 
     assert seat_reach_warning(assemble(load_preset("gnilka-1a"))) is None
     doc = base_doc("gnilka-1a")

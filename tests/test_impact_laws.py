@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from tests.valvetrain_cases import spec_from
-from vtool.solvers.contact import ContactProblem
-from vtool.solvers.model import assemble
+from vtool.solvers.model.contact import ContactProblem
+from vtool.solvers.model.mechanism import assemble
 
 BAR = {"element": "bar", "length": 2.0, "area": 0.1, "modulus": 3.0e7, "density": 7.3e-4}
 SPRING = {"element": "bar", "length": 1.0, "stiffness": 500.0, "mass": 1.0e-3, "area": 1.0}

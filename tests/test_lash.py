@@ -1,4 +1,4 @@
-"""Valve lash as an alternative to the seat position (solvers/lash.py).
+"""Valve lash as an alternative to the seat position (solvers/model/lash.py).
 
 Sources: the thesis' printed start for example 1A, XZERO = 0.88245022 in with
 A = 0.5 in, so the base circle puts the follower at XZERO - A; the rocker arms
@@ -15,7 +15,7 @@ import pytest
 from vtool.errors import InputError
 from vtool.presets import PRESET_DIR, load_document, load_preset, read_document
 from vtool.presets.valvetrain import dump, load
-from vtool.solvers.lash import base_and_ratio, lash_of
+from vtool.solvers.model.lash import base_and_ratio, lash_of
 
 XZERO, A, CLEAR = 0.88245022, 0.5, 0.7
 

@@ -1,4 +1,4 @@
-"""Per-run metrics (solvers/metrics.py) on a hand-built trace whose answers follow from its construction,
+"""Per-run metrics (solvers/studies/metrics.py) on a hand-built trace whose answers follow from its construction,
 and on real runs where only the definitions' structure is checked."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ import pytest
 
 from vtool.presets import load_preset
 from vtool.presets.valvetrain import with_run_overrides
-from vtool.solvers.metrics import failed_metrics, metric_columns, run_metrics
 from vtool.solvers.run import simulate
+from vtool.solvers.studies.metrics import failed_metrics, metric_columns, run_metrics
 from vtool.solvers.trace import CLOSED, OPENED, RELEASED, Event, RunStatistics, Trace
 
 CAM_BIT = 0b100  # 1A: cam, rocker, seat; the cam clearance is the leading bit

@@ -1,4 +1,4 @@
-"""The kernel's native module (:mod:`vtool.solvers.kernel_native`): built in the background after the
+"""The kernel's native module (:mod:`vtool.solvers.newmark.native`): built in the background after the
 first compile, then used by every default-mode run, which imports no numba and gets the JIT kernel's
 results to the last bit."""
 
@@ -18,8 +18,9 @@ import pytest
 from tests.test_first_run import needs_jit, wait_until_cached
 from vtool.presets import load_preset
 from vtool.presets.valvetrain import with_run_overrides
-from vtool.solvers import kernel_layout, kernel_native
-from vtool.solvers import newmark_kernel as kernel
+from vtool.solvers.newmark import kernel
+from vtool.solvers.newmark import layout as kernel_layout
+from vtool.solvers.newmark import native as kernel_native
 from vtool.solvers.run import simulate
 
 # one worker, scheduled first with the other groups (see conftest.py): two native builds, 40-65 s
@@ -134,7 +135,7 @@ assert "numba" not in sys.modules, "numba was imported"
 
 BUNDLED_PROBE = """
 from vtool import numba_link
-from vtool.solvers import newmark_kernel as kernel
+from vtool.solvers.newmark import kernel
 types = kernel.cached_signatures("run_chunk")[0]
 kernel.run_chunk.compile(types)
 library = kernel.run_chunk.overloads[tuple(types)].library
@@ -163,7 +164,7 @@ def test_a_new_install_runs_at_once_then_compiled_then_native(tmp_path) -> None:
     bundled = subprocess.run([sys.executable, "-c", BUNDLED_PROBE], env=env, capture_output=True, text=True,
                              timeout=600)
     assert bundled.stdout.strip() == "bundled", bundled.stderr  # the child's compile made its callees' bundle
-    probe = "import sys; from vtool.solvers import kernel_native as k; sys.exit(0 if k.exists((None, None)) else 1)"
+    probe = "import sys; from vtool.solvers.newmark import native as k; sys.exit(0 if k.exists((None, None)) else 1)"
     deadline = time.monotonic() + 600
     while subprocess.run([sys.executable, "-c", probe], env=env).returncode != 0:
         assert time.monotonic() < deadline, "no native module 600 s after the first run"
@@ -196,9 +197,9 @@ def test_a_hertz_contact_runs_on_its_own_module_to_the_last_bit(monkeypatch, tmp
     the Hertz iteration, and equal to the JIT kernel's run bit for bit (the drop test on a Hertz seat)."""
     from tests.test_compliant import hertz_doc
     from tests.valvetrain_cases import spec_from
-    from vtool.solvers.contact import ContactProblem
-    from vtool.solvers.model import assemble
-    from vtool.solvers.newmark import KernelRun, NewmarkOptions
+    from vtool.solvers.model.contact import ContactProblem
+    from vtool.solvers.model.mechanism import assemble
+    from vtool.solvers.newmark.backend import KernelRun, NewmarkOptions
     from vtool.solvers.trace import TraceBuilder
 
     spec = spec_from(hertz_doc())
@@ -226,8 +227,8 @@ def test_the_digest_reads_the_files_the_module_is_built_from() -> None:
 
     files = kernel_native.sources()
     assert all(file.is_file() for file in files)
-    assert {file.name for file in files} == {"newmark_kernel.py", "kernel_layout.py", "csvrows_kernel.py",
-                                              "kernel_native.py"}
+    assert {file.name for file in files} == {"kernel.py", "layout.py", "csvrows_kernel.py",
+                                              "native.py"}
     assert files[0] == Path(kernel.__file__).resolve()
     assert files[2].parent == Path(csvrows.__file__).parent  # beside the CSV writer, whatever the install
 
@@ -236,7 +237,8 @@ def test_the_digest_reads_the_files_the_module_is_built_from() -> None:
 def test_a_failed_native_build_is_not_asked_again_by_every_run(monkeypatch) -> None:  # noqa: ANN001
     """Default mode, the kernel in numba's cache, its native module's build failed (no C compiler, say):
     the first run finds the failure, later runs of the process go on numba's kernel without asking."""
-    from vtool.solvers import kernel_build, newmark
+    from vtool.solvers.newmark import backend as newmark
+    from vtool.solvers.newmark import build as kernel_build
 
     asked: list[list] = []
 

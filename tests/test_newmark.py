@@ -15,9 +15,9 @@ from tests.valvetrain_cases import SDOF_OMEGA, sdof_doc, spec_from, thesis_doc
 from vtool.errors import InputError, RunError
 from vtool.presets import load_preset
 from vtool.presets.valvetrain import with_run_overrides
-from vtool.solvers.contact import ContactProblem
-from vtool.solvers.model import assemble
-from vtool.solvers.newmark import NewmarkBackend, NewmarkOptions, stability_limit
+from vtool.solvers.model.contact import ContactProblem
+from vtool.solvers.model.mechanism import assemble
+from vtool.solvers.newmark.backend import NewmarkBackend, NewmarkOptions, stability_limit
 from vtool.solvers.run import simulate
 
 
@@ -141,7 +141,7 @@ def test_quiet_steps_cam_angle_by_rotation_equals_libm_every_step(monkeypatch) -
     ANCHOR_STEPS steps (kernel.advance); with ANCHOR_STEPS = 0 they take libm's at every step. Over
     1A (59 events, refined steps after each) the two runs agree to the reference test's tolerances
     (measured: 2e-10 of the displacements, 2.5e-12 s on the event times)."""
-    from vtool.solvers import kernel_build
+    from vtool.solvers.newmark import build as kernel_build
 
     monkeypatch.setenv("VTOOL_KERNEL", "plain")
     plain = kernel_build.plain_kernel()
@@ -162,8 +162,8 @@ def test_a_quiet_steps_force_rows_give_the_contact_force_at_the_steps_end(preset
     force rows, ``ConfigurationTables._force_rows``); that number is the force row of the step's end
     state (``contact_force``, term by term), in every configuration, standard and refined step, from
     random states, to round-off."""
-    from vtool.solvers import kernel_build
-    from vtool.solvers import kernel_layout as layout
+    from vtool.solvers.newmark import build as kernel_build
+    from vtool.solvers.newmark import layout
 
     kernel = kernel_build.plain_kernel()
     problem = ContactProblem(assemble(load_preset(preset)))
@@ -206,7 +206,7 @@ def test_the_row_buffer_holds_a_run_at_its_output_interval_or_4096_rows() -> Non
     """KernelRun allocates its output rows per run (newmark.row_buffer): the rows at the output
     interval, the start's and a round-off's included, up to ROW_BUFFER; an every-step run takes the
     cap (the kernel flushes a full buffer and goes on, so any size is correct, only slower)."""
-    from vtool.solvers.newmark import ROW_BUFFER, row_buffer
+    from vtool.solvers.newmark.backend import ROW_BUFFER, row_buffer
 
     assert row_buffer(850.0, 1.0, every_step=False) == 853  # 1A: 851 rows at 1 degree (0 to 850)
     assert row_buffer(850.0 * (1 + 1e-15), 1.0, every_step=False) == 853

@@ -77,7 +77,7 @@ def run(folder: Path, env: dict[str, str], x: float | int) -> str:
 def test_link_only_is_installed_on_this_numba() -> None:
     """The kernel module installs it on import; a numba whose internals changed shape makes this fail (the
     compile then runs as numba ships it: slower, still right)."""
-    import vtool.solvers.newmark_kernel  # noqa: F401
+    import vtool.solvers.newmark.kernel  # noqa: F401
 
     assert numba_link.installed()
 

@@ -49,7 +49,7 @@ def run(env: dict[str, str]) -> str:
 def test_memo_is_installed_on_this_numba() -> None:
     """The kernel module installs it on import; a numba whose ``BaseFunction.get_call_type`` changed
     shape makes this fail (the compile then runs as numba ships it: slower, still right)."""
-    import vtool.solvers.newmark_kernel  # noqa: F401
+    import vtool.solvers.newmark.kernel  # noqa: F401
 
     assert numba_typing.installed()
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from vtool.presets import load_preset
-from vtool.solvers.model import assemble
-from vtool.solvers.shapes import deformed_members
+from vtool.solvers.model.mechanism import assemble
+from vtool.solvers.model.shapes import deformed_members
 
 
 def test_member_ends_follow_the_system_coordinates_at_the_static_start() -> None:

@@ -1,4 +1,4 @@
-"""The model sized to the question (solvers/size.py, `vtool size`) and the docs' generated blocks.
+"""The model sized to the question (solvers/studies/size.py, `vtool size`) and the docs' generated blocks.
 
 Sources: Newmark's stability limit for γ = 1/2, β < 1/4 is Ω = ω Δt <
 1/sqrt(γ/2 - β) (2 sqrt 3 for β = 1/6; Newmark 1959); the fixed-free bar's
@@ -19,9 +19,9 @@ from click.testing import CliRunner
 from vtool.app.cli.main import cli
 from vtool.markdown import read_block, table_differences
 from vtool.presets import load_preset
-from vtool.solvers.assembly import unsplit_members
-from vtool.solvers.model import assemble
-from vtool.solvers.size import (
+from vtool.solvers.model.assembly import unsplit_members
+from vtool.solvers.model.mechanism import assemble
+from vtool.solvers.studies.size import (
     relative_change,
     size_study,
     stable_time_step,

@@ -21,9 +21,9 @@ from vtool.errors import InputError
 from vtool.presets import find_preset, load_preset, read_document
 from vtool.presets.paths import get_field, parse_values, plan_sweep, set_field
 from vtool.presets.valvetrain import with_run_overrides
-from vtool.solvers.metrics import run_metrics
 from vtool.solvers.run import simulate
-from vtool.solvers.sweep import (
+from vtool.solvers.studies.metrics import run_metrics
+from vtool.solvers.studies.sweep import (
     DaskRunner,
     ProcessRunner,
     SerialRunner,

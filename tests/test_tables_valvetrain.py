@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from vtool.markdown import read_block
-from vtool.solvers.accuracy import library_versions
+from vtool.solvers.studies.accuracy import library_versions
 
 ROOT = Path(__file__).resolve().parents[1]
 HINT = "the committed table differs: regenerate with `python3 benchmarks/tables_valvetrain.py`"

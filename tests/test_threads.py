@@ -74,7 +74,8 @@ def test_a_valve_train_run_runs_on_one_blas_thread(monkeypatch: pytest.MonkeyPat
     import dataclasses
 
     from vtool.presets.valvetrain import with_run_overrides
-    from vtool.solvers import contact, run
+    from vtool.solvers import run
+    from vtool.solvers.model import contact
 
     spec = with_run_overrides(load_preset("gnilka-1a"), degrees=5.0)
     member = dataclasses.replace(spec.members[0], length=spec.members[0].length * 1.000123)  # a new mechanism

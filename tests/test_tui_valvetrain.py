@@ -30,8 +30,8 @@ from vtool.app.tui.valvetrain import ValveTrainScreen
 from vtool.errors import InputError, RunError
 from vtool.presets import load_preset, valvetrain
 from vtool.presets.valvetrain import with_run_overrides
+from vtool.solvers.model.shapes import deformed_members
 from vtool.solvers.run import simulate
-from vtool.solvers.shapes import deformed_members
 
 pytestmark = pytest.mark.asyncio
 
@@ -536,7 +536,7 @@ async def test_the_sweep_tab_makes_its_widgets_when_first_opened_for_the_preset_
     from textual.widgets import Button, Input, Select
 
     from vtool.app.tui.sweep import SweepPane
-    from vtool.solvers.metrics import metric_columns
+    from vtool.solvers.studies.metrics import metric_columns
 
     app = make_app("gnilka-1a")
     async with app.run_test(size=(120, 40)) as pilot:
@@ -558,7 +558,7 @@ async def test_the_sweep_tab_makes_its_widgets_when_first_opened_for_the_preset_
 async def test_a_first_run_says_it_compiles_and_which_steps_ran_as_plain_python(monkeypatch) -> None:  # type: ignore[no-untyped-def]
     """The CLI's compile notice shows in the status line while the run goes; the end says how many
     steps ran as plain Python (a new install's first run does not wait for the compile)."""
-    import vtool.solvers.newmark as newmark
+    import vtool.solvers.newmark.backend as newmark
 
     monkeypatch.setattr(newmark, "compile_notice", lambda backend, laws: "compiling the solver (forced by the test)")
     monkeypatch.setenv("VTOOL_KERNEL", "plain")

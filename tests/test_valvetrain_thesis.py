@@ -7,7 +7,7 @@ import pytest
 
 from tests import thesis_data as thesis
 from vtool.presets import load_preset
-from vtool.solvers.model import assemble
+from vtool.solvers.model.mechanism import assemble
 
 
 def agrees_to_printed_digits(ours: np.ndarray, printed: np.ndarray, scale: float) -> np.ndarray:
@@ -72,7 +72,7 @@ def test_rocker_open_damping_matches_figs_6_13_to_6_16(mechanism_1a) -> None:
 
 def test_prose_damping_rule_does_not_reproduce_the_printed_matrix(mechanism_1a) -> None:
     """The prose's rule (0.5 on the fundamental) is not what the thesis printed."""
-    from vtool.solvers.damping import modal_damping
+    from vtool.solvers.model.damping import modal_damping
 
     layer = mechanism_1a.layer({"rocker"})
     prose = np.full(layer.size, 0.1)
@@ -116,7 +116,7 @@ def test_modes_by_cholesky_reduction_match_lapack_generalized_eigh(name: str) ->
     relative of the highest, mass-normalised shapes (Φᵀ M Φ = I) up to sign."""
     import scipy.linalg
 
-    from vtool.solvers.damping import undamped_modes
+    from vtool.solvers.model.damping import undamped_modes
 
     mechanism = assemble(load_preset(name))
     spec = mechanism.spec

@@ -6,7 +6,7 @@ import copy
 import math
 
 from vtool.presets import PRESET_DIR, load_document, read_document
-from vtool.solvers.spec import MechanismSpec
+from vtool.solvers.model.spec import MechanismSpec
 
 SDOF_STIFFNESS = 1000.0  # lbf/in
 SDOF_MASS = 3.0e-3  # lbf s^2/in, member total; consistent mass puts m/3 at the free end

@@ -15,7 +15,7 @@ is a time measured on a reference machine, scaled to this one:
   8-9.4 s for the kernel's compile against 2.8-3.0 s here, and the probe
   was not run there. Its spread between processes on one machine is ~7 %.
 * n: the compile's processes (2 for the Newmark kernel: a helper compiles
-  part of its callees, :mod:`vtool.solvers.kernel_build`; 1 otherwise),
+  part of its callees, :mod:`vtool.solvers.newmark.build`; 1 otherwise),
   c: the cores (``os.cpu_count()``), L: the processes already wanting a
   core (:func:`others_running`). The reference machine
   had two idle cores, where the factor is 1. With one of its two cores
@@ -25,7 +25,7 @@ The probe runs once per process and only when a notice is shown (a cache
 miss): a first run pays about 7 ms for it. ``python3
 benchmarks/bench_compile_estimate.py`` measures each compile with empty
 caches and prints the estimate beside it; the reference times
-(``COMPILE_REFERENCE_S`` and alike in :mod:`vtool.solvers.newmark` and
+(``COMPILE_REFERENCE_S`` and alike in :mod:`vtool.solvers.newmark.backend` and
 :mod:`vtool.csvrows`) are its figures on the reference machine (a 2-core
 AMD EPYC, 2026-11-26).
 """

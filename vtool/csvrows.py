@@ -26,7 +26,7 @@ plain Python (the reference).
 
 The kernel itself is :mod:`vtool.csvrows_kernel` (numba). This module imports
 no numba: a caller may hand in the same kernel from a native module (the
-valve-train kernel's, :mod:`vtool.solvers.kernel_native`), and otherwise numba
+valve-train kernel's, :mod:`vtool.solvers.newmark.native`), and otherwise numba
 is imported only when its kernel is worth it (:func:`choose`).
 """
 

@@ -3,7 +3,7 @@
 The method, and why the text is Python's to the last character, are in
 :mod:`vtool.csvrows`, which chooses between this kernel (numba's, or the same
 source compiled into the valve-train kernel's native module, see
-:mod:`vtool.solvers.kernel_native`) and Python's own formatting.
+:mod:`vtool.solvers.newmark.native`) and Python's own formatting.
 ``NUMBA_DISABLE_JIT=1`` runs the same source as plain Python (the reference).
 
 Everything the kernel uses is in this file (numba's cache is stamped by it

@@ -64,7 +64,7 @@ def configure(package_dir: str | os.PathLike[str] | None = None) -> str:
     if os.environ.get("NUMBA_CACHE_DIR"):
         _configured = f"NUMBA_CACHE_DIR={os.environ['NUMBA_CACHE_DIR']} (set by the user)"
         return _configured
-    here = Path(package_dir) if package_dir else Path(__file__).resolve().parent.parent / "solvers"
+    here = Path(package_dir) if package_dir else Path(__file__).resolve().parent.parent / "solvers" / "newmark"
     if os.access(here, os.W_OK) and _writable(here / "__pycache__"):
         _configured = f"numba default (beside the package, {here / '__pycache__'})"
         return _configured

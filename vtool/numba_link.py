@@ -41,7 +41,7 @@ Bundles: the callees' machine code made in another process. An entry
 point's library makes machine code for everything linked into it, after its
 own function is lowered: for the Newmark kernel's ``run_chunk`` that last
 stage was half the compile's wall time, on one core. :func:`build_bundle`
-(run by the helper process of :func:`vtool.solvers.kernel_build.compile_kernel`)
+(run by the helper process of :func:`vtool.solvers.newmark.build.compile_kernel`)
 links some compiled functions' libraries into one module, with each of them
 exported under a new name (``<symbol>.<tag>``, a tag per bundle, so that two
 bundles never define the same symbol) and everything else internal, runs the

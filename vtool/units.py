@@ -17,7 +17,7 @@ domain has its own table of the one class:
 * :data:`PLATE_UNIT_SYSTEMS` (plate): the valve train's system names, density
   named per length^4 (``lbf*s^2/in^4``) and SI pressure in Pa.
 
-The valve-train solver reads it through :mod:`vtool.solvers.units`, the boom
+The valve-train solver reads it through :mod:`vtool.solvers.model.units`, the boom
 through :mod:`vtool.assessments.sonic_boom.spec`, the plate through
 :mod:`vtool.assessments.plate.spec` (same objects). The SI factors
 (``metres_per_length``, ``pascals_per_pressure``, ``newtons_per_force``) let a

@@ -19,7 +19,12 @@ def accuracy(preset: str, degrees: float | None, csv_path: Path | None, markdown
     from vtool.presets import load_preset
     from vtool.presets.kinds import require_kind
     from vtool.presets.valvetrain import with_run_overrides
-    from vtool.solvers.accuracy import accuracy_study, table_markdown, table_text, write_table_csv
+    from vtool.solvers.studies.accuracy import (
+        accuracy_study,
+        table_markdown,
+        table_text,
+        write_table_csv,
+    )
 
     spec = load_preset(preset)
     require_kind(spec, "valvetrain", "`vtool accuracy`")

@@ -20,7 +20,7 @@ def show(preset: str, plot: bool, as_json: bool) -> None:
     """Fit error, velocity/acceleration/jerk extremes at the preset's speed, the
     acceleration spectrum, and warnings where a lift table's acceleration jumps."""
     from vtool.presets import load_preset
-    from vtool.solvers.cam import cam_report, report_text
+    from vtool.solvers.model.cam import cam_report, report_text
 
     spec = load_preset(preset)
     from vtool.presets.kinds import require_kind
@@ -28,7 +28,7 @@ def show(preset: str, plot: bool, as_json: bool) -> None:
     require_kind(spec, "valvetrain", "`vtool cam`")
     report = cam_report(spec)
     if spec.seat is not None:
-        from vtool.solvers.lash import lash_of
+        from vtool.solvers.model.lash import lash_of
 
         report["seat_position"], report["lash"] = spec.seat.position, lash_of(spec)
     if as_json:
@@ -48,7 +48,7 @@ def _charts(spec) -> str:  # type: ignore[no-untyped-def]
     import numpy as np
 
     from vtool.app.plots import line_chart
-    from vtool.solvers.cam import cam_fit, derivatives
+    from vtool.solvers.model.cam import cam_fit, derivatives
 
     fit = cam_fit(spec.cam)
     u = spec.unit_system.length

@@ -29,8 +29,8 @@ def compare(preset: str, impacts: tuple[str, ...], starts: tuple[str, ...] | Non
     from vtool.files import write_atomic
     from vtool.markdown import table as markdown_table
     from vtool.presets import load_preset
-    from vtool.solvers.compare import cell, table
-    from vtool.solvers.compare import compare as run_compare
+    from vtool.solvers.studies.compare import cell, table
+    from vtool.solvers.studies.compare import compare as run_compare
 
     spec = load_preset(preset)
     from vtool.presets.kinds import require_kind

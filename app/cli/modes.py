@@ -18,8 +18,8 @@ def modes(preset: str, as_json: bool) -> None:
     contact layer, with the static start (cam offset XZERO, follower force FZERO)."""
     from vtool.presets import load_preset
     from vtool.presets.kinds import require_kind
-    from vtool.solvers.assembly import surge_labels
-    from vtool.solvers.model import assemble
+    from vtool.solvers.model.assembly import surge_labels
+    from vtool.solvers.model.mechanism import assemble
     from vtool.solvers.run import NUMERICAL_FAILURES
 
     spec = load_preset(preset)
@@ -54,7 +54,7 @@ def modes(preset: str, as_json: bool) -> None:
             }
         )
     if spec.seat is not None:
-        from vtool.solvers.lash import lash_of
+        from vtool.solvers.model.lash import lash_of
 
         report["seat_position"] = {"value": spec.seat.position, "unit": units.length}
         report["lash"] = {"value": lash_of(spec), "unit": units.length}

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from vtool.solvers.spec import IMPACT_LAWS, START_VELOCITIES
+from vtool.solvers.model.spec import IMPACT_LAWS, START_VELOCITIES
 
 
 def _choices(field: str, allowed: tuple[str, ...]):  # type: ignore[no-untyped-def]

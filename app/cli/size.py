@@ -18,7 +18,7 @@ def size(preset: str, rpm_max: float, tolerance: float, max_elements: int) -> No
     than the tolerance; every row is a measured run with its cost."""
     from vtool.errors import InputError
     from vtool.presets import load_preset
-    from vtool.solvers.size import size_study, study_text
+    from vtool.solvers.studies.size import size_study, study_text
 
     spec = load_preset(preset)
     from vtool.presets.kinds import require_kind

@@ -89,7 +89,7 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
         resolve(kind.solve)(spec, csv_file, plot, as_json)
         return
     if impact is not None or start is not None:
-        from vtool.solvers.compare import with_model
+        from vtool.solvers.studies.compare import with_model
 
         spec = with_model(spec, impact, start)
     run_valvetrain(spec, backend, dt, rpm, degrees, csv_file, every_step, plot, as_json, show_events,
@@ -143,7 +143,7 @@ def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()
     """One line on stderr before a run that must first compile the solver (a new install's first run, or
     the first with Hertz contacts or momentum-law impacts), and one before the first every-step CSV
     compiles its number formatter (a few seconds, once). ``impacts``: further impact laws to be run."""
-    from vtool.solvers.newmark import compile_notice, kernel_laws
+    from vtool.solvers.newmark.backend import compile_notice, kernel_laws
 
     notice = compile_notice(spec.run.backend, kernel_laws(spec, impacts))
     if notice:

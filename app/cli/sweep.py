@@ -72,8 +72,14 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     """
     from vtool.errors import InputError, RunError
     from vtool.presets.paths import plan_sweep
-    from vtool.solvers.metrics import metric_columns, seat_index
-    from vtool.solvers.sweep import SweepFile, make_runner, results_json, results_table, run_points
+    from vtool.solvers.studies.metrics import metric_columns, seat_index
+    from vtool.solvers.studies.sweep import (
+        SweepFile,
+        make_runner,
+        results_json,
+        results_table,
+        run_points,
+    )
 
     if resume and csv_path is None:
         raise InputError("--resume", True, "a --csv file to resume")
@@ -139,7 +145,7 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
     """One speed search per grid point of the fields other than run.rpm."""
     from vtool.files import write_atomic
     from vtool.presets.valvetrain import with_run_overrides
-    from vtool.solvers.sweep import find_speed, format_value
+    from vtool.solvers.studies.sweep import find_speed, format_value
 
     scan = sorted({dict(p.values)["run.rpm"] for p in plan.points})
     others = [f for f in plan.fields if f[0] != "run.rpm"]

@@ -1,7 +1,7 @@
 """The deformed mechanism against cam angle, frame by frame over a trace's rows.
 
 Members are drawn from their element shape functions by
-:func:`vtool.solvers.shapes.deformed_members` (displacements times a scale,
+:func:`vtool.solvers.model.shapes.deformed_members` (displacements times a scale,
 as the thesis' graphics display did); the frame limits are fixed over the
 whole run at the current scale so the picture does not jump.
 
@@ -86,7 +86,7 @@ class MechanismAnimation(Static, can_focus=True):
         return self.trace.q[row, :n]
 
     def shapes(self, row: int) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        from vtool.solvers.shapes import deformed_members
+        from vtool.solvers.model.shapes import deformed_members
 
         return deformed_members(self.trace.spec, self.elastic_q(row), self.scale)
 

@@ -110,7 +110,7 @@ class SweepPane(Widget):
         """The preset's metrics (its own force labels), or a default list if it does not load."""
         from vtool.errors import InputError
         from vtool.presets import load_preset
-        from vtool.solvers.metrics import metric_columns
+        from vtool.solvers.studies.metrics import metric_columns
 
         try:
             return tuple(name for name, _ in metric_columns(load_preset(self.preset)))
@@ -165,7 +165,7 @@ class SweepPane(Widget):
 
     @work(thread=True, exclusive=True, exit_on_error=False, group="sweep")
     def _work(self, plan: Any) -> None:
-        from vtool.solvers.sweep import make_runner, run_points
+        from vtool.solvers.studies.sweep import make_runner, run_points
 
         worker = get_current_worker()
         runner = make_runner(self.sweep_workers)
@@ -183,7 +183,7 @@ class SweepPane(Widget):
 
     def export_csv(self, path: str | Path | None = None) -> None:
         from vtool.files import write_atomic
-        from vtool.solvers.sweep import results_csv
+        from vtool.solvers.studies.sweep import results_csv
 
         if self.outcome is None or not self.outcome.results:
             self.status.update("error: nothing to export (run a sweep first)")
@@ -229,8 +229,8 @@ class SweepPane(Widget):
             self.status.update(f"error: {event.worker.error}")
 
     def _draw(self) -> None:
-        from vtool.solvers.metrics import metric_columns
-        from vtool.solvers.sweep import results_table
+        from vtool.solvers.studies.metrics import metric_columns
+        from vtool.solvers.studies.sweep import results_table
 
         if self.outcome is None or not self.outcome.results or self.plan is None:
             return

@@ -21,7 +21,7 @@ from vtool.app.tui.form import CHOICE, Field
 from vtool.app.tui.messages import CompileAnnounced, SimulationFinished
 from vtool.app.tui.sweep import SweepPane
 from vtool.app.tui.widgets import ChartView, TextPanel
-from vtool.solvers.spec import IMPACT_LAWS, START_VELOCITIES
+from vtool.solvers.model.spec import IMPACT_LAWS, START_VELOCITIES
 
 DEFAULT_PLOTTED = 4  # displacement quantities ticked after a load (all are in the list)
 
@@ -216,7 +216,7 @@ class ValveTrainScreen(DomainScreen):
         worker = get_current_worker()
 
         def announce() -> None:  # the input is checked: say so when a compile is to come, as the CLI does
-            from vtool.solvers.newmark import compile_notice, kernel_laws
+            from vtool.solvers.newmark.backend import compile_notice, kernel_laws
 
             notice = compile_notice(spec.run.backend, kernel_laws(spec))
             if notice is not None:

@@ -1,0 +1,300 @@
+"""The valve-train mechanism as data: frozen specs built from a preset.
+
+A :class:`MechanismSpec` says everything the solver needs and nothing about
+how it is solved: the system coordinates, the members and how their element
+coordinates map onto system coordinates (the thesis' beta matrix, Gnilka
+1971 eq. 3.4, given row by row as signed coordinate numbers), the cam and
+the seat (prescribed coordinates), the clearances, the modal damping per
+contact layer, the static start and the run settings.
+
+Specs are built and validated by :mod:`vtool.presets.valvetrain`; nothing
+here reads files. All numbers are in the preset's unit system
+(:mod:`vtool.solvers.model.units`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from vtool.solvers.model.units import UNIT_SYSTEMS, UnitSystem
+
+BAR = "bar"
+BEAM = "beam"
+ELEMENT_SIZE = {BAR: 2, BEAM: 4}
+
+EXTERNAL = "external"
+INTERNAL = "internal"
+
+ENABLED = "enabled"
+PINNED = "pinned"
+REMOVED = "removed"
+
+#: Impact laws (see :mod:`vtool.solvers.newmark.kernel`): the thesis' local law (eq. 3.53),
+#: the thesis' SCALE at internal clearances (eq. 3.54), one LCP on the consistent mass matrix.
+LOCAL = "local"
+THESIS = "thesis"
+MOMENTUM = "momentum"
+IMPACT_LAWS = (LOCAL, THESIS, MOMENTUM)
+
+#: Contact laws of a clearance (see :mod:`vtool.solvers.model.contact`): rigid (impact laws, ties and
+#: prescribed coordinates), a linear spring-dashpot acting while the parts overlap, or Hertz's
+#: k delta^n with Hunt-Crossley damping (Newmark and scipy back ends).
+RIGID = "rigid"
+LINEAR = "linear"
+HERTZ = "hertz"
+CONTACT_LAWS = (RIGID, LINEAR, HERTZ)
+
+#: Start velocities (see :mod:`vtool.solvers.model.initial`).
+THESIS_START = "thesis"
+QUASI_STATIC_START = "quasi-static"
+START_VELOCITIES = (THESIS_START, QUASI_STATIC_START)
+
+
+@dataclass(frozen=True)
+class CoordinateSpec:
+    """One elastic system coordinate q_i (1-based ``number``)."""
+
+    number: int
+    name: str
+    motion: str  # "translation" (length) or "rotation" (rad)
+
+
+@dataclass(frozen=True)
+class MemberSpec:
+    """One finite element: an axial bar (2 DOF) or an Euler–Bernoulli beam (4 DOF).
+
+    ``coordinates`` maps element coordinates to system coordinates, one signed
+    number per element coordinate: ``+i`` is q_i, ``-i`` is -q_i, ``0`` is a
+    grounded (fixed) end. Element coordinate order follows the thesis: bar
+    (u_a, u_b); beam (w_a, w_b, theta_a, theta_b).
+
+    The section is given by ``diameter`` (solid circle) or by ``area`` (and
+    ``inertia`` for beams). The mass per volume by ``specific_weight`` (divided
+    by g) or ``density``. ``stiffness`` (bars: axial stiffness) and ``mass``
+    (total member mass), when given, override the values from the section,
+    as the valve spring needs. ``position`` and ``direction`` place the member
+    in the plane for drawings and animations only (bars move along their axis,
+    beams deflect at +90 degrees to it); they do not enter the dynamics.
+    """
+
+    name: str
+    element: str
+    length: float
+    coordinates: tuple[int, ...]
+    modulus: float | None = None
+    diameter: float | None = None
+    area: float | None = None
+    inertia: float | None = None
+    specific_weight: float | None = None
+    density: float | None = None
+    stiffness: float | None = None
+    mass: float | None = None
+    position: tuple[float, float] | None = None  # drawing only: end a in the plane (length units)
+    direction: float = 0.0  # drawing only: axis from end a to end b, degrees from +x
+    elements: int = 1  # equal elements the member is split into (see solvers.assembly.sub_elements)
+    nodes: tuple[int, ...] = ()  # internal coordinates of a split member, node by node (beams: w, theta)
+
+
+@dataclass(frozen=True)
+class ClearanceSpec:
+    """A clearance between two coordinates.
+
+    The gap is ``q[ahead] - q[behind]``: positive while open, contact when it
+    reaches zero. ``kind`` is ``external`` when ``behind`` is a prescribed
+    coordinate (cam, seat) and ``internal`` between two elastic coordinates,
+    where the contact force acts equal and opposite on the pair. ``state``:
+    ``enabled`` (opens and closes), ``pinned`` (always closed: the pair is one
+    coordinate) or ``removed`` (never closes, not monitored).
+
+    ``contact``: ``rigid`` (a closed clearance ties its pair or prescribes its
+    ahead coordinate; closing is an impact) or ``linear`` (while the parts
+    overlap, δ = -gap > 0, a spring ``contact_stiffness`` k and a dashpot c act
+    between them: F = k δ + c δ̇; piecewise linear, so every back end applies).
+    The dashpot is ``contact_damping`` c, or ``contact_damping_ratio`` ζ with
+    c = 2 ζ √(k m), m the diagonal mass of the ahead coordinate (internal:
+    the two diagonal masses in series), the masses the local impact law uses.
+    A linear contact acts while the parts overlap (Kelvin–Voigt): near the
+    end of a contact its dashpot may pull (F < 0), a known property of the
+    model; the overlap, not the force, decides when the contact ends.
+    ``hertz``: F = k δⁿ (1 + 3(1 - e)/2 · δ̇/v⁻), n = ``contact_exponent``,
+    with the Hunt–Crossley damping of the clearance's restitution e at the
+    approach velocity v⁻ of the contact's closing; it never pulls. Nonlinear:
+    the Newmark back end iterates, scipy integrates it, exact refuses it.
+    """
+
+    name: str
+    ahead: int
+    behind: int
+    kind: str
+    state: str = ENABLED
+    restitution: float = 0.0
+    impact: str | None = None  # impact law; None: the mechanism's default (ContactSpec.impact)
+    contact: str = RIGID
+    contact_stiffness: float = 0.0  # force/length
+    contact_damping: float | None = None  # force*time/length
+    contact_damping_ratio: float | None = None  # of critical, on the local masses
+    contact_exponent: float = 1.5  # hertz
+
+    @property
+    def rigid(self) -> bool:
+        return self.contact == RIGID
+
+    @property
+    def ties(self) -> bool:
+        """A closed rigid internal clearance: its pair is one coordinate of the layer."""
+        return self.kind == INTERNAL and self.contact == RIGID
+
+
+@dataclass(frozen=True)
+class CamSpec:
+    """The cam: q_cam = base + L(omega t) (see :mod:`vtool.solvers.model.cam`).
+
+    ``profile = "harmonic"``: the thesis' cam, L = A + A sin(omega t), A =
+    ``amplitude``. ``profile = "table"``: a lift table (``angles`` in deg from
+    the preset's angle zero, ``lifts`` in length units) fitted by a Fourier
+    series of ``harmonics`` terms, or of the fewest terms that meet
+    ``tolerance`` (length); ``lift_table`` is the CSV file it was read from,
+    as written in the preset. ``amplitude`` of a table cam is half its lift.
+    ``offset = None`` applies the thesis' static-start rule (XZERO, see
+    :mod:`vtool.solvers.model.initial`).
+    """
+
+    coordinate: int
+    amplitude: float
+    offset: float | None = None
+    name: str = "cam"
+    profile: str = "harmonic"
+    angles: tuple[float, ...] = ()
+    lifts: tuple[float, ...] = ()
+    harmonics: int | None = None
+    tolerance: float | None = None
+    lift_table: str | None = field(default=None, compare=False)  # provenance only
+
+
+@dataclass(frozen=True)
+class SeatSpec:
+    """A fixed seat: q_seat = position (thesis CLEAR)."""
+
+    coordinate: int
+    position: float
+    name: str = "seat"
+    lash: float | None = None  # when the preset gave the lash, position was computed from it
+
+
+@dataclass(frozen=True)
+class InitialSpec:
+    """The static start at omega t = 0 (thesis INITAL).
+
+    ``closed`` names the clearances in contact at the start (thesis:
+    configuration VII, cam and rocker). ``spring_preload`` is the valve-spring
+    force with the cam on its base circle, ``lever_ratio`` the follower force
+    per unit spring force (the rocker arm ratio).
+    """
+
+    closed: tuple[str, ...]
+    spring_preload: float
+    lever_ratio: float
+    velocities: str = THESIS_START
+
+
+@dataclass(frozen=True)
+class ContactSpec:
+    """The impact law every clearance uses unless it names its own, and the thesis' SCALE.
+
+    ``rocker_scale`` is SCALE of Gnilka eq. 3.54 (the ``thesis`` law at an
+    internal clearance: the tied pair takes SCALE times the ahead coordinate's
+    velocity; the thesis chose it "from 1.0 to 2.0").
+    """
+
+    impact: str = LOCAL
+    rocker_scale: float = 1.0
+
+
+@dataclass(frozen=True)
+class LayerDampingSpec:
+    """Modal damping ratios of one contact layer.
+
+    A layer is named by the internal clearances closed in it. ``mode_ratios``
+    overrides the ratio of single modes, numbered 1, 2, ... in ascending
+    natural frequency (rigid-body modes included, and always undamped).
+    """
+
+    closed: tuple[str, ...]
+    default_ratio: float
+    mode_ratios: tuple[tuple[int, float], ...] = ()
+
+
+@dataclass(frozen=True)
+class DampingSpec:
+    """Modal damping (thesis section III.C) and the global factor (thesis COFD)."""
+
+    factor: float = 1.0
+    default_ratio: float = 0.1
+    layers: tuple[LayerDampingSpec, ...] = ()
+
+    def for_layer(self, closed: frozenset[str]) -> LayerDampingSpec:
+        for layer in self.layers:
+            if frozenset(layer.closed) == closed:
+                return layer
+        return LayerDampingSpec(tuple(sorted(closed)), self.default_ratio)
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Run settings: cam speed, length of run, time step, back end, output."""
+
+    rpm: float
+    degrees: float
+    time_step: float
+    backend: str = "newmark"
+    output_interval: float = 1.0  # degrees of cam rotation between output rows
+    beta: float = 1.0 / 6.0
+    gamma: float = 0.5
+    quantities: tuple[str, ...] = ()  # extra CSV/plot columns: "q7", "q1-q9", "F2"
+
+
+@dataclass(frozen=True)
+class MechanismSpec:
+    """A whole valve-train study: mechanism, clearances, damping, start and run."""
+
+    title: str
+    units: str
+    gravity: float
+    coordinates: tuple[CoordinateSpec, ...]
+    members: tuple[MemberSpec, ...]
+    cam: CamSpec
+    seat: SeatSpec | None
+    clearances: tuple[ClearanceSpec, ...]
+    initial: InitialSpec
+    damping: DampingSpec
+    run: RunSpec
+    notes: str = ""
+    contact: ContactSpec = field(default_factory=ContactSpec)
+    kind: str = field(default="valvetrain", init=False)
+
+    def impact_law(self, clearance: ClearanceSpec) -> str:
+        """The impact law of a clearance: its own, or the mechanism's default."""
+        return clearance.impact or self.contact.impact
+
+    @property
+    def unit_system(self) -> UnitSystem:
+        return UNIT_SYSTEMS[self.units]
+
+    @property
+    def n_coordinates(self) -> int:
+        return len(self.coordinates)
+
+    def clearance(self, name: str) -> ClearanceSpec:
+        for c in self.clearances:
+            if c.name == name:
+                return c
+        raise KeyError(name)
+
+    def coordinate_name(self, number: int) -> str:
+        if 1 <= number <= self.n_coordinates:
+            return self.coordinates[number - 1].name
+        if number == self.cam.coordinate:
+            return self.cam.name
+        if self.seat is not None and number == self.seat.coordinate:
+            return self.seat.name
+        raise KeyError(number)

@@ -1,0 +1,99 @@
+"""The layout of the Newmark kernel's arrays: slot numbers, codes and the law switches (no numba).
+
+:mod:`vtool.solvers.model.contact` builds the tables in this layout,
+:mod:`vtool.solvers.newmark.backend` reads the kernel's state and status codes in
+it, and :mod:`vtool.solvers.newmark.kernel` computes on them. They live
+here, apart from the kernel, so that a run whose compiled kernel is a native
+module (:mod:`vtool.solvers.newmark.native`) imports no numba at all.
+
+numba freezes these values into the compiled code, and its cache is stamped
+by ``newmark_kernel.py`` alone: a change here must change that file too.
+``newmark_kernel.LAYOUT_FINGERPRINT`` holds this file's digest
+(:func:`fingerprint`), and a test fails until it is updated, so that the
+edit that changes a slot also invalidates every cached kernel.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+
+# ----- slots of the integer and float parameter vectors -----
+IP_N, IP_NCL, IP_NS, IP_NH, IP_EVERY, IP_ZSTICK, IP_ZSTOP = range(7)
+IP_SIZE = 8
+(FP_BETA, FP_GAMMA, FP_DT, FP_TEND, FP_OUTDT, FP_OMEGA, FP_TTOL, FP_ZWIN, FP_XLIM, FP_VREST,
+ FP_GAPNOISE, FP_REFINE, FP_REFWIN, FP_FTOL, FP_TREV) = range(15)
+FP_SIZE = 16
+# clearance table columns (int) and float columns
+CL_AHEAD, CL_BEHIND, CL_SRC, CL_MON, CL_PIN, CL_BIT, CL_LAW, CL_SOFT = range(8)
+CL_SIZE = 8  # CL_SOFT: SOFT_LINEAR or SOFT_HERTZ for a compliant clearance (no impact, no tie), else 0
+SOFT_LINEAR, SOFT_HERTZ = 1, 2
+# float columns: restitution, SCALE; Hertz stiffness and exponent; approach velocity of the contact
+CLF_E, CLF_SCALE, CLF_HK, CLF_HN, CLF_HV = range(5)
+CLF_SIZE = 5
+# impact laws
+LAW_MOMENTUM, LAW_LOCAL, LAW_THESIS = range(3)
+# event kinds
+EV_OPENED, EV_CLOSED, EV_RELEASED = np.int64(0), np.int64(1), np.int64(2)  # np.int64: add_event compiles once
+# configuration integer table: built, m, nf, source coupling, closed Hertz contacts, the rows of the
+# standard and refined step operators (nf free rows, then the force rows: see CP_RAW), whether those
+# rows read the sources, then kept[n], group[n], source of each z index[n]
+CI_BUILT, CI_M, CI_NF, CI_SRC, CI_HERTZ, CI_ROWS, CI_SRCSTEP = range(7)
+CI_HEAD = 7
+# configuration matrices
+CM_MFF, CM_CFF, CM_KFF, CM_SINV, CM_SINVF, CM_MINVFF = range(6)
+CM_SIZE = 6
+# step operators, transposed: cp[c, plane, part, :, f] for free z index f (each column's coefficients
+# on the free rows side by side: see :func:`apply_operator`); plane CP_RAW holds R, whose parts are
+# C_FF, K_FF, the (M, C, K) columns of each prescribed z index p (at 3p, 3p + 1, 3p + 2) and the
+# sources' pull S (3 per source), so that the free rows' ΔP is R·(ż, z, (z̈, ż, z)_P, src); planes
+# CP_STD and CP_FINE hold G = S⁻¹R of the standard and the refined step, so that a step with a stored
+# inverse computes z̈_F = -G·(ż̃, z̃, …) in one product (see :func:`apply_operator`). Parts, not column
+# offsets: an index that is a loop counter needs no negative-index fix-up. The two step planes also
+# hold, after the nf free rows, one row per closed rigid clearance (its MK_ROW): the contact force at
+# the step's end less its constant, as the same product gives it from the step's predictor (the force
+# row w on (z, ż, z̈, sources) with the step's z̈_F = -G·y substituted), so that a quiet step gets its
+# force monitors from the vector pass it makes anyway (see ``ConfigurationTables._force_rows``). The
+# last dimension is n + ncl.
+CP_RAW, CP_STD, CP_FINE = range(3)
+CP_SIZE = 3
+PART_C, PART_K, PART_P, PART_S = range(4)
+PART_SIZE = 4
+# monitor per (configuration, clearance): (kind, ahead z index, behind z index or -1 - source, m, and for
+# a closed rigid clearance its force's row in the step operators' output, else -1)
+MK_KIND, MK_AHEAD, MK_BEHIND, MK_M, MK_ROW = range(5)
+MK_SIZE = 5
+MK_NONE, MK_GAP, MK_FORCE, MK_OVERLAP = range(4)  # MK_OVERLAP: a closed compliant clearance
+# peak rows: contact force over the run, after the first revolution, overlap of compliant contacts
+PEAK_ALL, PEAK_LATE, PEAK_OVERLAP = range(3)
+# run status
+FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED, CHATTER = range(1, 7)
+# integer and float state slots
+I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_SETTLE, I_WANT_CFG, I_STARTED, I_SUB = range(11)
+I_SIZE = 11  # I_SUB: refined steps taken since the grid point I_GRID (the refined steps' own grid)
+F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
+F_SIZE = 4
+# run_chunk's float scratch ``work``: this many values per coordinate, per source and per clearance
+WORK_PER_N, WORK_PER_SOURCE, WORK_PER_CLEARANCE = 11, 9, 4
+
+
+def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:
+    """The ``hertz`` and ``momentum`` switches of the kernel's entry points for clearance table ``cl``.
+
+    Each is True when some clearance uses that law and None when none does.
+    numba prunes the branches under ``if hertz is not None`` (``momentum``)
+    before typing when the switch is None, so a mechanism without Hertz
+    contacts (momentum-law impacts) compiles and caches a kernel without
+    that code, and one with them compiles its own. The plain-Python
+    reference takes the same branches.
+    """
+    hertz = bool(np.any(cl[:, CL_SOFT] == SOFT_HERTZ))
+    momentum = bool(np.any((cl[:, CL_LAW] == LAW_MOMENTUM) & (cl[:, CL_SOFT] == 0)))
+    return (True if hertz else None), (True if momentum else None)
+
+
+def fingerprint() -> str:
+    """The first 16 hex digits of this file's SHA-256 (see the module doc)."""
+    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:16]

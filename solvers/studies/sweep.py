@@ -1,0 +1,609 @@
+"""Speed sweeps and design maps: many valve-train runs, one metrics row each.
+
+A sweep is a list of :class:`Point` (an index, the swept values, a validated
+spec; :mod:`vtool.presets.paths` builds them from a preset and ``--set``
+assignments). This module evaluates them and keeps the results:
+
+* :func:`evaluate_point` is the one point evaluation: spec -> run -> metrics
+  (:func:`vtool.solvers.studies.metrics.run_metrics`), the same calls as
+  :func:`vtool.solvers.run.simulate`, so a point equals ``vtool solve`` at the
+  same settings. A faster path (warm kernel, reuse across RPM) replaces this
+  one function.
+* Points are grouped by model (the spec without its ``[run]`` settings) and cut
+  into chunks; a worker evaluates a chunk in order and reuses the assembled
+  model (matrices and contact layers, which do not depend on the run
+  settings) from one point to the next.
+* Chunks run serially, on local processes (``workers > 1``, a forkserver pool
+  so that a thread-holding caller such as the TUI can use it safely), or on a
+  Dask cluster (``scheduler = "tcp://HOST:PORT"``, ``"local:N"``: a
+  ``distributed.LocalCluster`` with N worker processes, ``"local-threads:N"``:
+  N threads in this process).
+* Results go to a :class:`SweepFile` as they arrive (one CSV line each,
+  flushed), so a killed sweep keeps what it finished and a resumed one skips
+  it; when the sweep ends (or is stopped) the file is rewritten in point
+  order, atomically, so every execution path gives the same bytes.
+* :func:`find_speed` brackets and bisects the cam speed at which a criterion
+  (follower leaves the cam; valve bounces on its seat) first holds.
+"""
+
+from __future__ import annotations
+
+import csv
+import functools
+import io
+import logging
+import math
+import os
+import signal
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from vtool.errors import InputError, RunError
+from vtool.files import exists, write_atomic
+from vtool.solvers import backends
+from vtool.solvers.model.mechanism import Mechanism, assemble
+from vtool.solvers.model.spec import MechanismSpec
+from vtool.solvers.studies.metrics import (
+    TIMING_METRICS,
+    failed_metrics,
+    metric_columns,
+    run_metrics,
+)
+
+OK = "ok"
+
+
+@dataclass(frozen=True)
+class Point:
+    """One sweep point: its index in the grid, the swept values (path -> value), its spec."""
+
+    index: int
+    values: tuple[tuple[str, Any], ...]
+    spec: MechanismSpec
+
+
+@dataclass(frozen=True)
+class PointResult:
+    """Metrics of one point; ``status`` is ``"ok"`` or the failed run's one-line message."""
+
+    index: int
+    values: tuple[tuple[str, Any], ...]
+    metrics: dict[str, float]
+    status: str = OK
+
+    @property
+    def ok(self) -> bool:
+        return self.status == OK
+
+
+def grid(fields: Sequence[tuple[str, Sequence[Any]]]) -> list[tuple[tuple[str, Any], ...]]:
+    """The cartesian product of the swept fields, the first field varying fastest.
+
+    ``[("run.rpm", [1, 2]), ("damping.factor", [a, b])]`` gives
+    (1, a), (2, a), (1, b), (2, b): each value of the second field is one line
+    of the chart against the first.
+    """
+    points: list[tuple[tuple[str, Any], ...]] = [()]
+    for path, values in fields:
+        points = [p + ((path, v),) for v in values for p in points]
+    order = [path for path, _ in fields]
+    return [tuple(sorted(p, key=lambda pv: order.index(pv[0]))) for p in points]
+
+
+# ----- point evaluation -----
+
+def _model_key(spec: MechanismSpec) -> MechanismSpec:
+    """The spec without its run settings: points with equal keys share one assembled model."""
+    return replace(spec, run=None)  # type: ignore[arg-type]
+
+
+def _mechanism(spec: MechanismSpec, previous: Mechanism | None) -> Mechanism:
+    """An assembled mechanism for ``spec``, reusing ``previous``'s matrices and layers when only [run] differs."""
+    if previous is None or _model_key(previous.spec) != _model_key(spec):
+        return assemble(spec)
+    return previous.with_run(spec.run)  # shares M, K, the contact layers and configuration tables
+
+
+@functools.cache
+def _backend_class(name: str) -> Any:
+    """The back-end class, looked up once per process (an entry-point scan costs tens of ms)."""
+    return backends.get(name)
+
+
+def evaluate_point(spec: MechanismSpec, *, every_step: bool = False, previous: Mechanism | None = None,
+                   cancel: Callable[[], bool] | None = None) -> tuple[dict[str, float], str, Mechanism | None]:
+    """Run one point and return (metrics, status, mechanism for reuse by the next point).
+
+    A run that fails (RunError: divergence, chattering) or that the back end
+    rejects (InputError: e.g. a time step beyond the stability limit at this
+    point) is a point result with NaN metrics and the message as status, not
+    the end of the sweep.
+    """
+    mechanism = None
+    try:
+        mechanism = _mechanism(spec, previous)
+        backend = _backend_class(spec.run.backend)()
+        options = backend.options_from_run(spec.run, every_step)
+        trace = backend.simulate(mechanism, options, progress=None,
+                                 cancel=cancel if backend.supports_cancel else None)
+    except (RunError, InputError) as exc:
+        return failed_metrics(spec), str(exc).replace("\n", " "), mechanism
+    return run_metrics(trace), OK, mechanism
+
+
+def evaluate_chunk(chunk: Sequence[Point], every_step: bool = False) -> list[PointResult]:
+    """Evaluate points in order, reusing the model across points that differ only in [run]."""
+    results = []
+    previous: Mechanism | None = None
+    for point in chunk:
+        metrics, status, previous = evaluate_point(point.spec, every_step=every_step, previous=previous)
+        results.append(PointResult(point.index, point.values, metrics, status))
+    return results
+
+
+def chunks(points: Sequence[Point], workers: int, per_worker: int = 4, largest: int = 25) -> list[list[Point]]:
+    """Points grouped by model, in index order, cut into about ``per_worker`` chunks per worker."""
+    groups: dict[Any, list[Point]] = {}
+    for point in sorted(points, key=lambda p: p.index):
+        groups.setdefault(_model_key(point.spec), []).append(point)
+    size = max(1, min(largest, math.ceil(len(points) / max(1, workers * per_worker))))
+    result = []
+    for group in groups.values():
+        result += [group[i:i + size] for i in range(0, len(group), size)]
+    return result
+
+
+# ----- execution -----
+
+def _ignore_interrupt() -> None:
+    """Worker initializer: Ctrl+C is handled by the parent, which stops the pool cleanly."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def parse_scheduler(text: str) -> tuple[str, int]:
+    """``tcp://HOST:PORT`` -> ("tcp", 0); ``local:N`` / ``local-threads:N`` -> (kind, N)."""
+    for kind in ("local-threads", "local"):
+        if text.startswith(kind + ":"):
+            count = text[len(kind) + 1:]
+            if not count.isdigit() or int(count) < 1:
+                break
+            return kind, int(count)
+    else:
+        if "://" in text:
+            return "address", 0
+    raise InputError("--scheduler", text, "tcp://HOST:PORT of a running Dask scheduler, local:N or local-threads:N")
+
+
+class DaskRunner:
+    """A Dask client (to an existing scheduler or a LocalCluster it starts); connect before any output."""
+
+    def __init__(self, scheduler: str, timeout: float = 3.0) -> None:
+        kind, count = parse_scheduler(scheduler)
+        from distributed import Client, LocalCluster
+
+        self.cluster = None
+        try:
+            if kind == "address":
+                self.client = Client(scheduler, timeout=timeout)
+            else:
+                self.cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=kind == "local",
+                                            dashboard_address=None, silence_logs=logging.ERROR)
+                self.client = Client(self.cluster)
+        except (OSError, TimeoutError) as exc:
+            raise InputError("--scheduler", scheduler,
+                             f"a reachable Dask scheduler ({type(exc).__name__}: {str(exc).splitlines()[0][:80]})"
+                             ) from None
+        self.workers = max(1, len(self.client.scheduler_info().get("workers", {})) or count or 1)
+
+    def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
+            cancel: Callable[[], bool]) -> bool:
+        from distributed import as_completed
+
+        futures = [self.client.submit(evaluate_chunk, b, every_step, pure=False) for b in batches]
+        try:
+            for future in as_completed(futures):
+                on_results(future.result())
+                if cancel():
+                    self.client.cancel(futures)
+                    return False
+        except BaseException:
+            self.client.cancel(futures)
+            raise
+        return True
+
+    def close(self) -> None:
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+class ProcessRunner:
+    """A forkserver process pool of ``workers`` processes that ignore Ctrl+C (the parent stops them)."""
+
+    def __init__(self, workers: int) -> None:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload(["vtool.solvers.studies.sweep", "vtool.solvers.newmark.backend"])
+        self.workers = workers
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt)
+
+    def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
+            cancel: Callable[[], bool]) -> bool:
+        from concurrent.futures import FIRST_COMPLETED, wait
+
+        pending = {self.pool.submit(evaluate_chunk, b, every_step) for b in batches}
+        try:
+            while pending:
+                done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+                for future in done:
+                    on_results(future.result())
+                if cancel():
+                    for future in pending:
+                        future.cancel()
+                    return False
+        except BaseException:
+            for future in pending:
+                future.cancel()
+            raise
+        return True
+
+    def close(self) -> None:
+        self.pool.shutdown(wait=True, cancel_futures=True)
+
+
+class SerialRunner:
+    """Chunks in this process, one after the other (cancel is checked between points too)."""
+
+    workers = 1
+
+    def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
+            cancel: Callable[[], bool]) -> bool:
+        for batch in batches:
+            previous = None
+            for point in batch:
+                if cancel():
+                    return False
+                metrics, status, previous = evaluate_point(point.spec, every_step=every_step, previous=previous,
+                                                           cancel=cancel)
+                if cancel() and status != OK:
+                    return False
+                on_results([PointResult(point.index, point.values, metrics, status)])
+        return True
+
+    def close(self) -> None:
+        pass
+
+
+def make_runner(workers: int | None = None, scheduler: str | None = None) -> Any:
+    """The runner for these settings; a Dask scheduler is connected here (InputError if unreachable)."""
+    if scheduler:
+        return DaskRunner(scheduler)
+    if workers is not None and workers < 1:
+        raise InputError("--workers", workers, "an integer >= 1")
+    count = workers or os.cpu_count() or 1
+    return SerialRunner() if count == 1 else ProcessRunner(count)
+
+
+@dataclass
+class SweepOutcome:
+    """What a sweep produced: results in point order, whether it ran to the end, its wall time."""
+
+    results: list[PointResult]
+    complete: bool
+    wall_time: float
+    skipped: int = 0
+    total: int = 0
+    extra: dict = field(default_factory=dict)
+
+
+def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False,
+               sink: SweepFile | None = None, progress: Callable[[int, int], None] | None = None,
+               cancel: Callable[[], bool] | None = None) -> SweepOutcome:
+    """Evaluate ``points`` with ``runner``; results go to ``sink`` as they arrive.
+
+    Points already in ``sink`` (a resumed sweep) are skipped. KeyboardInterrupt
+    stops the workers, leaves the sink in point order and propagates.
+    """
+    cancel = cancel or (lambda: False)
+    started = time.perf_counter()
+    if sink is not None:
+        sink.open(points)
+    finished = sink.finished if sink is not None else set()
+    todo = [p for p in points if p.index not in finished]
+    results: dict[int, PointResult] = {}
+    done = len(points) - len(todo)
+
+    def collect(batch: list[PointResult]) -> None:
+        nonlocal done
+        for result in batch:
+            results[result.index] = result
+            if sink is not None:
+                sink.append(result)
+        done += len(batch)
+        if progress is not None:
+            progress(done, len(points))
+
+    if progress is not None:
+        progress(done, len(points))
+    complete = False
+    try:
+        complete = runner.run(chunks(todo, runner.workers), every_step, collect, cancel)
+    finally:
+        if sink is not None:
+            sink.finish()
+    if sink is not None:
+        results = sink.finished_results(points) | results
+    ordered = [results[i] for i in sorted(results)]
+    return SweepOutcome(ordered, complete, time.perf_counter() - started, len(points) - len(todo), len(points))
+
+
+# ----- output -----
+
+def format_value(value: Any) -> str:
+    """CSV text of one value: integers as integers, floats to 10 significant digits, NaN empty."""
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return ""
+        return f"{value:.10g}"
+    return str(value)
+
+
+def _parse_cell(text: str) -> float:
+    """Inverse of :func:`format_value` for metrics: empty is NaN, integers stay integers."""
+    if not text:
+        return math.nan
+    return int(text) if text.lstrip("-").isdigit() else float(text)
+
+
+def column_title(name: str, unit: str) -> str:
+    return f"{name} ({unit})" if unit else name
+
+
+def csv_header(fields: Sequence[tuple[str, str]], spec: MechanismSpec, timing: bool = False) -> list[str]:
+    """Swept fields (with units), ``status``, then every metric (with units)."""
+    return ([column_title(f, u) for f, u in fields] + ["status"]
+            + [column_title(n, u) for n, u in report_columns(spec, timing)])
+
+
+def csv_row(result: PointResult, metrics: Sequence[tuple[str, str]]) -> list[str]:
+    return ([format_value(v) for _, v in result.values] + [result.status]
+            + [format_value(result.metrics[n]) for n, _ in metrics])
+
+
+def csv_lines(rows: Iterable[list[str]]) -> str:
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="\n").writerows(rows)
+    return buffer.getvalue()
+
+
+def results_csv(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], spec: MechanismSpec,
+                timing: bool = False) -> str:
+    """The whole sweep as CSV text (the same bytes as a finished :class:`SweepFile`)."""
+    metrics = report_columns(spec, timing)
+    return csv_lines([csv_header(fields, spec, timing)] + [csv_row(r, metrics) for r in results])
+
+
+class SweepFile:
+    """A CSV written as points finish, kept valid and resumable; see the module doc.
+
+    Header: the swept fields (with units), ``status``, then the metrics (with
+    units); ``timing=False`` leaves out machine-dependent columns (wall time)
+    so that files from different execution paths compare byte for byte.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], fields: Sequence[tuple[str, str]], spec: MechanismSpec,
+                 *, resume: bool = False, timing: bool = False) -> None:
+        self.path = Path(path)
+        self.fields = [f for f, _ in fields]
+        self.metrics = report_columns(spec, timing)
+        self.spec = spec
+        self.header = csv_header(fields, spec, timing)
+        self.keys: dict[tuple[str, ...], int] = {}
+        self.rows: list[list[str]] = []
+        if resume and exists(self.path):
+            self._read_partial()
+        elif resume:
+            raise InputError("--resume", str(self.path), "an existing partial sweep file (none found)")
+        self.finished: set[int] = set()
+        self.index_of: dict[tuple[str, ...], int] = {}
+        self.handle: io.TextIOWrapper | None = None
+
+    def _read_partial(self) -> None:
+        text = self.path.read_text(encoding="utf-8")
+        lines = text.split("\n")
+        complete = lines[:-1]  # the last piece has no newline: empty, or a line cut by a kill
+        rows = list(csv.reader(complete))
+        if not rows or rows[0] != self.header:
+            raise InputError("--resume", str(self.path), "a partial file of this same sweep (its header differs)")
+        self.rows = [r for r in rows[1:] if len(r) == len(self.header)]
+
+    def open(self, points: Sequence[Point]) -> None:
+        """Start (or continue) the file; marks the points already in it as finished."""
+        index_of = {tuple(format_value(v) for _, v in p.values): p.index for p in points}
+        kept = []
+        for row in self.rows:
+            key = tuple(row[: len(self.fields)])
+            if key in index_of and index_of[key] not in self.finished:
+                self.finished.add(index_of[key])
+                kept.append(row)
+        self.rows = kept
+        self.index_of = index_of
+        write_atomic(self.path, self._text([self.header] + kept))
+        self.handle = self.path.open("a", encoding="utf-8", newline="")
+
+    def finished_results(self, points: Sequence[Point]) -> dict[int, PointResult]:
+        """The points read back from a resumed file (numbers parsed; empty cells NaN)."""
+        by_index = {p.index: p for p in points}
+        results = {}
+        for row in self.rows:
+            index = self.index_of.get(tuple(row[: len(self.fields)]))
+            if index is None or index not in self.finished:
+                continue
+            cells = row[len(self.fields) + 1:]
+            metrics = failed_metrics(self.spec)  # NaN for the columns the file leaves out (wall time)
+            metrics.update({name: _parse_cell(cell) for (name, _), cell in zip(self.metrics, cells, strict=True)})
+            results[index] = PointResult(index, by_index[index].values, metrics, row[len(self.fields)])
+        return results
+
+    def row(self, result: PointResult) -> list[str]:
+        return csv_row(result, self.metrics)
+
+    @staticmethod
+    def _text(rows: Iterable[list[str]]) -> str:
+        return csv_lines(rows)
+
+    def append(self, result: PointResult) -> None:
+        assert self.handle is not None
+        row = self.row(result)
+        self.rows.append(row)
+        self.handle.write(self._text([row]))
+        self.handle.flush()
+
+    def finish(self) -> None:
+        """Close, and rewrite the file atomically in point order."""
+        if self.handle is not None:
+            self.handle.close()
+            self.handle = None
+        rows = sorted(self.rows, key=lambda r: self.index_of.get(tuple(r[: len(self.fields)]), -1))
+        write_atomic(self.path, self._text([self.header] + rows))
+
+
+# ----- derived speeds -----
+
+#: criterion name -> (metric, test, words)
+CRITERIA: dict[str, tuple[str, Callable[[float], bool], str]] = {
+    "jump-speed": ("cam_separations", lambda v: v >= 1, "the follower leaves the cam above mid-stroke"),
+    "bounce-speed": ("seat_bounces", lambda v: v >= 1, "the valve bounces on its seat"),
+}
+
+
+@dataclass(frozen=True)
+class Bracket:
+    """One step of a speed search: the speed tried and whether the criterion held."""
+
+    rpm: float
+    holds: bool
+    value: float
+    stage: str  # "scan" or "bisect"
+    status: str = OK
+
+
+@dataclass(frozen=True)
+class SpeedResult:
+    criterion: str
+    speed: float | None  # rev/min: lowest speed found where the criterion holds; None if not bracketed
+    history: tuple[Bracket, ...]
+    message: str
+
+
+def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan: Sequence[float],
+               runner: Any, *, tolerance: float = 1.0, every_step: bool = False,
+               report: Callable[[Bracket], None] | None = None,
+               cancel: Callable[[], bool] | None = None) -> SpeedResult:
+    """The lowest cam speed (to ``tolerance`` rev/min) at which ``criterion`` holds.
+
+    The speeds ``scan`` (ascending) are run together on ``runner``; the first
+    one where the criterion holds and the one before it bracket the answer,
+    which is then bisected (integer speeds for tolerance 1). The answer is the
+    first crossing on the scan: a criterion that holds, stops and holds again
+    with speed is reported at its lowest bracketed crossing.
+    """
+    if criterion not in CRITERIA:
+        raise InputError("--find", criterion, f"one of: {', '.join(CRITERIA)}")
+    metric, test, words = CRITERIA[criterion]
+    history: list[Bracket] = []
+
+    def note(rpm: float, result: PointResult, stage: str) -> bool:
+        if not result.ok:
+            raise RunError(f"{criterion}: the run at {rpm:g} rev/min failed: {result.status}")
+        value = result.metrics[metric]
+        entry = Bracket(rpm, bool(test(value)), value, stage)
+        history.append(entry)
+        if report is not None:
+            report(entry)
+        return entry.holds
+
+    scan = sorted(scan)
+    points = [Point(i, (("run.rpm", rpm),), make_spec(rpm)) for i, rpm in enumerate(scan)]
+    outcome = run_points(points, runner, every_step=every_step, cancel=cancel)
+    if not outcome.complete:
+        raise RunError(f"{criterion}: stopped during the scan")
+    holds = [note(rpm, r, "scan") for rpm, r in zip(scan, outcome.results, strict=True)]
+    if not any(holds):
+        return SpeedResult(criterion, None, tuple(history), f"{words} at none of the scanned speeds "
+                                                            f"(up to {scan[-1]:g} rev/min)")
+    first = holds.index(True)
+    if first == 0:
+        return SpeedResult(criterion, None, tuple(history),
+                           f"{words} already at the lowest scanned speed ({scan[0]:g} rev/min): scan lower")
+    low, high = scan[first - 1], scan[first]
+    serial = SerialRunner()
+    while high - low > tolerance:
+        if cancel is not None and cancel():
+            raise RunError(f"{criterion}: stopped while bisecting between {low:g} and {high:g} rev/min")
+        mid = math.floor((low + high) / 2) if tolerance >= 1 else (low + high) / 2
+        if mid <= low:
+            mid = (low + high) / 2
+        result = run_points([Point(0, (("run.rpm", mid),), make_spec(mid))], serial, every_step=every_step)
+        if note(mid, result.results[0], "bisect"):
+            high = mid
+        else:
+            low = mid
+    return SpeedResult(criterion, high, tuple(history),
+                       f"{words} from {high:g} rev/min (not at {low:g})")
+
+
+# ----- reports -----
+
+def report_columns(spec: MechanismSpec, timing: bool = True) -> list[tuple[str, str]]:
+    return [(n, u) for n, u in metric_columns(spec) if timing or n not in TIMING_METRICS]
+
+
+def results_table(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], spec: MechanismSpec) -> str:
+    """A plain text table: one row per point, units on a second header line."""
+    columns = [(f, u) for f, u in fields] + report_columns(spec)
+    header = [name for name, _ in columns] + ["status"]
+    units = [f"({u})" if u else "" for _, u in columns] + [""]
+    rows = []
+    for r in results:
+        cells = [format_value(v) for _, v in r.values]
+        for name, _ in report_columns(spec):
+            value = r.metrics[name]
+            cells.append("-" if isinstance(value, float) and math.isnan(value)
+                         else f"{value:.4g}" if isinstance(value, float) else str(value))
+        rows.append(cells + [r.status])
+    widths = [max(len(h), len(u), *(len(row[i]) for row in rows)) for i, (h, u) in enumerate(zip(header, units,
+                                                                                                 strict=True))]
+    lines = ["  ".join(h.rjust(w) for h, w in zip(header, widths, strict=True)).rstrip(),
+             "  ".join(u.rjust(w) for u, w in zip(units, widths, strict=True)).rstrip()]
+    lines += ["  ".join(c.rjust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows]
+    return "\n".join(lines)
+
+
+def _json_value(value: Any) -> Any:
+    return None if isinstance(value, float) and math.isnan(value) else value
+
+
+def results_json(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], spec: MechanismSpec,
+                 preset: str) -> dict:
+    """The sweep as a JSON-ready dict: units as ``*_unit`` keys, NaN as null."""
+    columns = report_columns(spec)
+    units = {f"{f}_unit": u for f, u in fields} | {f"{n}_unit": u for n, u in columns}
+    return {
+        "preset": preset,
+        "title": spec.title,
+        "fields": [f for f, _ in fields],
+        "metrics": [n for n, _ in columns],
+        "units": units,
+        "points": [dict(r.values) | {"status": r.status} | {n: _json_value(r.metrics[n]) for n, _ in columns}
+                   for r in results],
+    }
