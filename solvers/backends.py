@@ -16,9 +16,9 @@ The contract every back end follows (subclass :class:`Backend`)
    the :class:`~vtool.solvers.model.contact.ContactProblem` from its static start to
    the end, adding rows and events to the
    :class:`~vtool.solvers.trace.TraceBuilder`; apply the shared event rules
-   (kernel functions ``impact`` and ``settle``); return the statistics
+   (kernel functions ``apply_impacts`` and ``release_pulling``); return the statistics
    (``steps``, ``peak``, ``peak_late``, ``peak_overlap``, ``configurations``, ``settings``; optionally
-   ``compile_time``, ``plain_steps`` and ``kernel``, see :class:`~vtool.solvers.trace.RunStatistics`).
+   ``compile_time``, see :class:`~vtool.solvers.trace.RunStatistics`).
    ``progress(f)`` is called with the fraction done (0..1) between chunks,
    ``cancel()`` polled between chunks (a true answer stops the run).
 5. Errors: a run that cannot be completed (divergence, endless chattering,
@@ -126,7 +126,6 @@ class Backend(ABC):
             settings["contact"] = {c.name: c.contact for c in spec.clearances if not c.rigid}
         statistics = RunStatistics(self.name, int(stats["steps"]), len(builder.events), wall,
                                    tuple(sorted(stats.get("configurations", problem.tables.layers))), settings,
-                                   compile_time=compile_time, plain_steps=int(stats.get("plain_steps", 0)),
-                                   kernel=str(stats.get("kernel", "")))
+                                   compile_time=compile_time)
         return builder.build(stats["peak"], statistics, stats.get("peak_late"), sort=stats.get("sort", False),
                              peak_overlap=stats.get("peak_overlap"))

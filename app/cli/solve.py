@@ -108,7 +108,8 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
     progress = DelayedProgress(f"{spec.run.backend} {spec.run.degrees:g} deg")
 
     def before_run() -> None:  # the input is checked: announce a compile, if one is to come
-        announce_compile(spec, csv=csv_path is not None and every_step)
+        if announce_compile(spec, csv=csv_path is not None and every_step):
+            progress.tick()  # elapsed seconds on a terminal until the run's first progress
 
     try:
         if csv_path is None:
@@ -139,18 +140,19 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
         click.echo(all_charts(trace))
 
 
-def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()) -> None:
+def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()) -> bool:
     """One line on stderr before a run that must first compile the solver (a new install's first run, or
     the first with Hertz contacts or momentum-law impacts), and one before the first every-step CSV
-    compiles its number formatter (a few seconds, once). ``impacts``: further impact laws to be run."""
+    compiles its number formatter (a few seconds, once). ``impacts``: further impact laws to be run.
+    True when a line was shown."""
     from vtool.solvers.newmark.backend import compile_notice, kernel_laws
 
-    notice = compile_notice(spec.run.backend, kernel_laws(spec, impacts))
-    if notice:
-        click.echo(notice, err=True)
+    notices = [compile_notice(spec.run.backend, kernel_laws(spec, impacts))]
     if csv:
-        from vtool.solvers.trace import csv_compile_notice
+        from vtool.csvrows import compile_notice as csv_notice
 
-        notice = csv_compile_notice()
+        notices.append(csv_notice())
+    for notice in notices:
         if notice:
             click.echo(notice, err=True)
+    return any(notices)

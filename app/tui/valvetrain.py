@@ -185,6 +185,7 @@ class ValveTrainScreen(DomainScreen):
         return valvetrain_fields(spec, doc)
 
     def after_load(self) -> None:
+        self.compile_solver(self.spec)
         quantities = displacement_quantities(self.spec)
         selection = self.quantity_list
         selection.clear_options()
@@ -203,6 +204,15 @@ class ValveTrainScreen(DomainScreen):
         self.query_one("#summary", TextPanel).set_text("no run yet")
         self.query_one("#side-panel", TextPanel).set_text("")
         self.animation.clear()
+
+    @work(thread=True, exclusive=True, exit_on_error=False, group="compile")
+    def compile_solver(self, spec: Any) -> None:
+        """Compile the solver for this preset's contact laws (or load it from numba's cache) while the
+        screen is read, so that the first Run need not wait for it (a Run meanwhile waits for the same
+        compile, its status line saying so)."""
+        from vtool.solvers.newmark.backend import compile_solver
+
+        compile_solver(spec)
 
     # ----- run -----
     def start_run(self, spec: Any, run_id: int) -> Worker[Any]:
@@ -243,10 +253,7 @@ class ValveTrainScreen(DomainScreen):
         self.results = trace
         self.show_trace(trace)
         stats = trace.statistics
-        from vtool.solvers.trace import plain_note
-
-        self.set_status(f"done: {stats.steps} steps{plain_note(stats.plain_steps, stats.steps)}, {stats.events} "
-                        f"events, {stats.wall_time:.2f} s ({stats.backend})")
+        self.set_status(f"done: {stats.steps} steps, {stats.events} events, {stats.wall_time:.2f} s ({stats.backend})")
 
     def show_trace(self, trace: Any) -> None:
         from vtool.app import valvetrain_charts as charts
