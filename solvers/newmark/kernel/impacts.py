@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from vtool.jit import jit
+from vtool.jit import jit, jit_inline
 from vtool.solvers.newmark.kernel.algebra import solve_dense
 from vtool.solvers.newmark.kernel.forces import rigid_force
 from vtool.solvers.newmark.kernel.step import (
@@ -55,7 +55,7 @@ from vtool.solvers.newmark.layout import (
 )
 
 
-@jit
+@jit_inline
 def add_event(O, S, t, k, kind, u, c_from, c_to):
     """Event row: time, relative velocity; clearance, kind, configuration before and after."""
     row = S.ist[I_NEV]
@@ -210,7 +210,7 @@ def impact_momentum(prob, c, closing, src, S, stick, O, t):
     return mask
 
 
-@jit
+@jit_inline
 def prescribed_velocity(cl, c, ncl, coordinate, src):
     """Velocity of the source a coordinate is tied to in configuration c, or nan if it is free."""
     for k in range(ncl):

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from vtool.jit import jit
+from vtool.jit import jit, jit_inline
 from vtool.solvers.newmark.kernel.algebra import factor_effective
 from vtool.solvers.newmark.kernel.forces import monitor_value, monitors
 from vtool.solvers.newmark.kernel.impacts import release_pulling, take_events
@@ -104,7 +104,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
     return lo
 
 
-@jit
+@jit_inline
 def step_to(prob, C, W, t, h, hertz):
     """A step of any length h from W.now at t into W.end: sources at t + h, S(h) factored by Cholesky."""
     sources(prob, t + h, W.src1)
@@ -112,7 +112,7 @@ def step_to(prob, C, W, t, h, hertz):
     layer_step(prob, C, W, h, CHOLESKY, hertz)
 
 
-@jit
+@jit_inline
 def copy_state(m, y, src, y_to, src_to):
     """The first m entries of y, and the sources, into y_to and src_to."""
     for j in range(m):
@@ -123,7 +123,7 @@ def copy_state(m, y, src, y_to, src_to):
         src_to[j] = src[j]
 
 
-@jit
+@jit_inline
 def arrive(S, target, grid_next, k_grid, j_target):
     """Now at ``target``: the next standard grid point, or point ``j_target`` of the refined grid."""
     if target == grid_next:
@@ -135,7 +135,7 @@ def arrive(S, target, grid_next, k_grid, j_target):
     return target
 
 
-@jit
+@jit_inline
 def clear(W):
     """The scratch zeroed, as fresh arrays would be (each call of :func:`run_chunk` starts so)."""
     for y in (W.now, W.end, W.out):
@@ -148,7 +148,7 @@ def clear(W):
     W.closing[:] = 0
 
 
-@jit
+@jit_inline
 def start(prob, C, W, S, O, hertz):
     """The run's first row (the start is an output row and counts for the peaks); False when the
     output buffer is full."""
@@ -165,7 +165,7 @@ def start(prob, C, W, S, O, hertz):
     return True
 
 
-@jit
+@jit_inline
 def step_length(prob, S, t, c_hertz):
     """The next step from t: (h, target, grid_next, j_target, quiet), quiet when the quiet loop may take it
     (on a point of the step grid, not every-step mode, no closed Hertz contact)."""
@@ -196,7 +196,7 @@ def step_length(prob, S, t, c_hertz):
     return h, target, grid_next, j_target, quiet
 
 
-@jit
+@jit_inline
 def event_step(prob, C, W, t, h, hertz):
     """After a step of length h whose monitors W.phi changed sign: locate every sign change, take the
     earliest (tau in W.tau) and redo the step to it. Returns the step taken."""

@@ -47,7 +47,7 @@ from vtool.solvers.newmark.records import Config
 STANDARD, REFINED, CHOLESKY = np.int64(0), np.int64(1), np.int64(2)
 
 
-@jit
+@jit_inline
 def find_slot(index, mask):
     """The slot of configuration ``mask`` in the tables, or -1 when it is not built (see
     :func:`vtool.solvers.newmark.records.mask_hash`: the same first probe, then the next entries)."""
@@ -63,7 +63,7 @@ def find_slot(index, mask):
     return -1
 
 
-@jit
+@jit_inline
 def configuration(T, mask, slot):
     """Configuration ``mask``'s operators (views of its slot)."""
     return Config(mask, T.ci[slot], T.cm[slot], T.cp[slot], T.mk[slot], T.mon[slot])
@@ -98,7 +98,7 @@ def sources(prob, t, src):
     harmonics(prob, math.cos(omega * t), math.sin(omega * t), src)
 
 
-@jit
+@jit_inline
 def gather(C, n, S, y):
     """The layer state y of the full state (S.x, S.v, S.a)."""
     for j in range(C.ci[CI_M]):
@@ -108,7 +108,7 @@ def gather(C, n, S, y):
         y.zdd[j] = S.a[i]
 
 
-@jit
+@jit_inline
 def scatter(C, n, y, S):
     """The full state (S.x, S.v, S.a) of the layer state y."""
     for i in range(n):
@@ -151,7 +151,7 @@ def correct(nf, h, beta, gamma, acc, y1):
         y1.zd[f] += gv * acc[f]
 
 
-@jit
+@jit_inline
 def free_rhs(C, src, y, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
     right, and the sources' pull through closed compliant contacts (``layout.CP_RAW``)."""
@@ -201,7 +201,7 @@ def consistent_acceleration(prob, C, src, y, rhs, hertz):
         y.zdd[f] = s
 
 
-@jit
+@jit_inline
 def interpolate(nf, s_out, h, y, zdd1, out):
     """The free coordinates at s_out into a step of length h from y whose end acceleration is z̈1: the
     linear-acceleration interpolant (exact for beta = 1/6; thesis eqs. B.3-B.5)."""
