@@ -555,16 +555,14 @@ async def test_the_sweep_tab_makes_its_widgets_when_first_opened_for_the_preset_
         assert pane.status_text == ""
 
 
-async def test_a_first_run_says_it_compiles_and_which_steps_ran_as_plain_python(monkeypatch) -> None:  # type: ignore[no-untyped-def]
-    """The CLI's compile notice shows in the status line while the run goes; the end says how many
-    steps ran as plain Python (a new install's first run does not wait for the compile)."""
+async def test_a_first_run_says_it_compiles(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """The CLI's compile notice shows in the status line while the run goes (a run that finds the
+    compile the screen started on opening still under way waits for it, and says so)."""
     import vtool.solvers.newmark.backend as newmark
 
     monkeypatch.setattr(newmark, "compile_notice", lambda backend, laws: "compiling the solver (forced by the test)")
-    monkeypatch.setenv("VTOOL_KERNEL", "plain")
     app = make_app("gnilka-1d")
     async with app.run_test(size=(80, 24)) as pilot:
         screen = await run_degrees(pilot, app, "30")
         assert "running... (escape cancels); compiling the solver (forced by the test)" in screen.status_log
-        assert screen.results is not None and screen.results.statistics.plain_steps > 0
-        assert screen.status_log[-1].startswith("done: ") and " steps (all as plain Python), " in screen.status_log[-1]
+        assert screen.status_log[-1].startswith("done: ")
