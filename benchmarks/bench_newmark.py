@@ -52,8 +52,8 @@ def floor_loop(G, nf, nrows, m, source_of, sc, sa, sb, omega, h, beta, gamma, ga
     gaps ``gaps[i] = (ahead, behind)`` checked. Returns the number of gap checks that failed (0)."""
     ns, nh = sc.shape[0], sa.shape[1]
     src = np.zeros(3 * ns)
-    out = np.zeros(G.shape[3])
-    rows = min((nrows + 3) // 4 * 4, G.shape[3])
+    out = np.zeros(G.shape[2])
+    rows = min((nrows + 3) // 4 * 4, G.shape[2])
     c0, s0 = 1.0, 0.0
     c_dt, s_dt = math.cos(omega * h), math.sin(omega * h)
     failed = 0

@@ -194,9 +194,10 @@ def test_a_quiet_steps_force_rows_give_the_contact_force_at_the_steps_end(preset
                 z, zd, zdd = rng.normal(size=n) * 1e-2, rng.normal(size=n) * 10, rng.normal(size=n) * 1e4
                 src = rng.normal(size=3 * ns) * np.tile([1e-2, 10, 1e4], ns)
                 end = Motion(z + h * zd + h * h * (0.5 - beta) * zdd, zd + h * (1 - gamma) * zdd, zdd.copy())
-                plain(step.set_prescribed)(C, n, src, end)
+                plain(step.prescribed)(C.ci, n, src, end.z, end.zd, end.zdd)
                 out = np.zeros(n + ncl)
-                plain(algebra.apply_operator)(C, plane, C.ci[layout.CI_ROWS], C.ci[layout.CI_SRCSTEP], src, end, out)
+                plain(algebra.apply_operator)(C.cp, C.ci, plane, C.ci[layout.CI_ROWS], C.ci[layout.CI_SRCSTEP], src,
+                                              end.z, end.zd, end.zdd, out)
                 end.zdd[:nf] = out[:nf]
                 end.z[:nf] += beta * h * h * out[:nf]
                 end.zd[:nf] += gamma * h * out[:nf]

@@ -21,18 +21,18 @@ from vtool.solvers.newmark.layout import (
 
 
 @jit_inline
-def apply_operator(C, plane, nrows, coupled, src, y, out):
-    """out[:nrows] = -R·(ż_F, z_F, (z̈, ż, z)_P, src) for step operator R = C.cp[plane] (see
-    ``layout.CP_RAW``) and layer state y: the nf free rows, and in a step plane the force rows after them.
+def apply_operator(cp, ci, plane, nrows, coupled, src, z, zd, zdd, out):
+    """out[:nrows] = -R·(ż_F, z_F, (z̈, ż, z)_P, src) for step operator R = cp[plane] of the configuration
+    whose integer row is ci (see ``layout.CP_RAW``) and layer state (z, ż, z̈): the nf free rows, and in
+    a step plane the force rows after them.
 
     Column by column: cp holds Rᵀ, each column's coefficients on the free rows side by side, so that
     every row's running sum takes the column's term in one pass over the rows, a loop the compiler runs
     on vectors of rows; each row is still summed in column order. The rows run on to a multiple of four
-    where out and cp have room (nobody reads the rows past nrows)."""
-    cp = C.cp
-    nf = C.ci[CI_NF]
-    m = C.ci[CI_M]
-    z, zd, zdd = y.z, y.zd, y.zdd
+    where out and cp have room (nobody reads the rows past nrows). Plain arrays, no records: in the
+    quiet loop a record's field read is a reference count taken and dropped at every step."""
+    nf = ci[CI_NF]
+    m = ci[CI_M]
     rows = min((nrows + 3) // 4 * 4, out.shape[0], cp.shape[3])
     for f in range(rows):
         out[f] = 0.0

@@ -104,13 +104,10 @@ def compliant_force(prob, C, k, y, src, hertz):
 
 
 @jit_inline
-def gap_value(C, k, z, src, gap_noise):
-    """Monitor of an open clearance (its gap) or a closed compliant one (its overlap), plus the
-    round-off allowance: negative past the event."""
-    kind = C.mk[k, MK_KIND]
-    behind = C.mk[k, MK_BEHIND]
-    other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
-    gap = z[C.mk[k, MK_AHEAD]] - other
+def signed_gap(kind, gap, gap_noise):
+    """The monitor of an open clearance (its gap) or a closed compliant one (its overlap, -gap), plus
+    the round-off allowance: negative past the event. Scalars only: an inline helper handed arrays
+    takes and drops a reference count of each at every call, and this one runs per clearance and step."""
     return (gap if kind == MK_GAP else -gap) + gap_noise
 
 
@@ -123,7 +120,9 @@ def monitor_value(prob, C, k, y, src, gap_noise, hertz):
     """
     kind = C.mk[k, MK_KIND]
     if kind == MK_GAP or kind == MK_OVERLAP:
-        return gap_value(C, k, y.z, src, gap_noise)
+        behind = C.mk[k, MK_BEHIND]
+        other = y.z[behind] if behind >= 0 else src[3 * (-1 - behind)]
+        return signed_gap(kind, y.z[C.mk[k, MK_AHEAD]] - other, gap_noise)
     if kind == MK_FORCE:
         if hertz is None:  # the linear row alone
             return contact_force(prob, C, k, y, src)

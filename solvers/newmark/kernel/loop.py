@@ -235,7 +235,7 @@ def steps(prob, C, W, S, O, hertz):
             return CHUNK_END, False, h
         h, target, grid_next, j_target, quiet = step_length(prob, S, t, C.ci[CI_HERTZ])
         if quiet:  # quiet steps may follow; off the grid, after an event, the call would return at once
-            t_quiet = advance(prob, C, W, S, O, W.now, W.end, hertz)
+            t_quiet = advance(prob, C, W, S, O, hertz)
             if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
                 t = t_quiet
                 sources(prob, t, W.src0)

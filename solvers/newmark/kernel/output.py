@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from vtool.jit import jit
 from vtool.solvers.newmark.kernel.forces import compliant_force, rigid_force
-from vtool.solvers.newmark.kernel.step import interpolate, set_prescribed, sources
+from vtool.solvers.newmark.kernel.step import interpolate, prescribed, sources
 from vtool.solvers.newmark.layout import (
     CI_HEAD,
     CI_NF,
@@ -67,7 +67,7 @@ def step_rows(prob, C, t, h, y, zdd1, W, O, S, hertz):
             return False
         interpolate(C.ci[CI_NF], t_out - t, h, y, zdd1, W.out)
         sources(prob, t_out, W.srco)
-        set_prescribed(C, n, W.srco, W.out)
+        prescribed(C.ci, n, W.srco, W.out.z, W.out.zd, W.out.zdd)
         record_row(prob, C, t_out, W.out, W.srco, O, ist[I_NOUT], hertz)
         ist[I_NOUT] += 1
         ist[I_NEXT_OUT] = j_out + 1

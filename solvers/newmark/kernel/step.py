@@ -33,8 +33,6 @@ from vtool.solvers.newmark.layout import (
     FP_GAMMA,
     FP_OMEGA,
     IP_N,
-    IP_NH,
-    IP_NS,
     MK_KIND,
     MK_OVERLAP,
     SOFT_HERTZ,
@@ -70,12 +68,12 @@ def configuration(T, mask, slot):
 
 
 @jit_inline
-def harmonics(prob, c1, s1, src):
-    """src[3s : 3s + 3] = (x, v, a) of every source s at the angle whose cos and sin are c1, s1
-    (harmonics by angle addition)."""
-    ns, nh, omega = prob.ip[IP_NS], prob.ip[IP_NH], prob.fp[FP_OMEGA]
+def harmonics(sc, sa, sb, omega, c1, s1, src):
+    """src[3s : 3s + 3] = (x, v, a) of every source s (constants sc, cosine and sine coefficients sa,
+    sb) at the angle whose cos and sin are c1, s1 (harmonics by angle addition)."""
+    ns, nh = sa.shape[0], sa.shape[1]
     for s in range(ns):
-        src[3 * s] = prob.sc[s]
+        src[3 * s] = sc[s]
         src[3 * s + 1] = 0.0
         src[3 * s + 2] = 0.0
     ck = 1.0
@@ -84,8 +82,8 @@ def harmonics(prob, c1, s1, src):
         ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1  # cos, sin of (k + 1) omega t
         wk = (k + 1) * omega
         for s in range(ns):
-            a = prob.sa[s, k]
-            b = prob.sb[s, k]
+            a = sa[s, k]
+            b = sb[s, k]
             src[3 * s] += a * ck + b * sk
             src[3 * s + 1] += wk * (b * ck - a * sk)
             src[3 * s + 2] -= wk * wk * (a * ck + b * sk)
@@ -95,7 +93,7 @@ def harmonics(prob, c1, s1, src):
 def sources(prob, t, src):
     """src = (x, v, a) of every source at t."""
     omega = prob.fp[FP_OMEGA]
-    harmonics(prob, math.cos(omega * t), math.sin(omega * t), src)
+    harmonics(prob.sc, prob.sa, prob.sb, omega, math.cos(omega * t), math.sin(omega * t), src)
 
 
 @jit_inline
@@ -119,43 +117,43 @@ def scatter(C, n, y, S):
 
 
 @jit_inline
-def set_prescribed(C, n, src, y):
-    """The prescribed entries of y (z indices nf..m-1) from their sources."""
-    for j in range(C.ci[CI_NF], C.ci[CI_M]):
-        s = C.ci[CI_HEAD + 2 * n + j]
-        y.z[j] = src[3 * s]
-        y.zd[j] = src[3 * s + 1]
-        y.zdd[j] = src[3 * s + 2]
+def prescribed(ci, n, src, z, zd, zdd):
+    """The prescribed entries of (z, ż, z̈) (z indices nf..m-1 of the configuration whose integer row
+    is ci) from their sources."""
+    for j in range(ci[CI_NF], ci[CI_M]):
+        s = ci[CI_HEAD + 2 * n + j]
+        z[j] = src[3 * s]
+        zd[j] = src[3 * s + 1]
+        zdd[j] = src[3 * s + 2]
 
 
 @jit_inline
-def predict(C, n, h, beta, gamma, src1, y, y1):
-    """Newmark's predictor from y into y1 (z̃ = z + h ż + h²(1/2 - beta) z̈, ż̃ = ż + h(1 - gamma) z̈),
-    the prescribed entries from the sources at the step's end."""
+def predict(m, h, beta, gamma, z, zd, zdd, z1, zd1):
+    """Newmark's predictor of the first m entries: z̃ = z + h ż + h²(1/2 - beta) z̈ into z1,
+    ż̃ = ż + h(1 - gamma) z̈ into ż1."""
     hx = h * h * (0.5 - beta)
     hv = h * (1.0 - gamma)
-    for j in range(C.ci[CI_M]):
-        y1.z[j] = y.z[j] + h * y.zd[j] + hx * y.zdd[j]
-        y1.zd[j] = y.zd[j] + hv * y.zdd[j]
-    set_prescribed(C, n, src1, y1)
+    for j in range(m):
+        z1[j] = z[j] + h * zd[j] + hx * zdd[j]
+        zd1[j] = zd[j] + hv * zdd[j]
 
 
 @jit_inline
-def correct(nf, h, beta, gamma, acc, y1):
-    """Newmark's corrector: the free accelerations ``acc`` into y1 (z += beta h² z̈, ż += gamma h z̈)."""
+def correct(nf, h, beta, gamma, acc, z1, zd1, zdd1):
+    """Newmark's corrector: the free accelerations ``acc`` into z̈1, z1 += beta h² z̈, ż1 += gamma h z̈."""
     bx = beta * h * h
     gv = gamma * h
     for f in range(nf):
-        y1.zdd[f] = acc[f]
-        y1.z[f] += bx * acc[f]
-        y1.zd[f] += gv * acc[f]
+        zdd1[f] = acc[f]
+        z1[f] += bx * acc[f]
+        zd1[f] += gv * acc[f]
 
 
 @jit_inline
 def free_rhs(C, src, y, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
     right, and the sources' pull through closed compliant contacts (``layout.CP_RAW``)."""
-    apply_operator(C, CP_RAW, C.ci[CI_NF], C.ci[CI_SRC], src, y, rhs)
+    apply_operator(C.cp, C.ci, CP_RAW, C.ci[CI_NF], C.ci[CI_SRC], src, y.z, y.zd, y.zdd, rhs)
 
 
 @jit
@@ -167,14 +165,17 @@ def layer_step(prob, C, W, h, which, hertz):
     are added by Newton iteration (:func:`~vtool.solvers.newmark.kernel.forces.hertz_correction`).
     """
     beta, gamma = prob.fp[FP_BETA], prob.fp[FP_GAMMA]
-    nf = C.ci[CI_NF]
-    predict(C, prob.ip[IP_N], h, beta, gamma, W.src1, W.now, W.end)
+    ci, y, y1 = C.ci, W.now, W.end
+    nf = ci[CI_NF]
+    predict(ci[CI_M], h, beta, gamma, y.z, y.zd, y.zdd, y1.z, y1.zd)
+    prescribed(ci, prob.ip[IP_N], W.src1, y1.z, y1.zd, y1.zdd)
     if which == CHOLESKY:
-        free_rhs(C, W.src1, W.end, W.rhs)
+        free_rhs(C, W.src1, y1, W.rhs)
         cholesky_solve(nf, W.L, W.rhs, W.sol)
     else:  # z̈_F = S⁻¹ ΔP as one product with the stored G = S⁻¹R
-        apply_operator(C, CP_STD if which == STANDARD else CP_FINE, nf, C.ci[CI_SRC], W.src1, W.end, W.sol)
-    correct(nf, h, beta, gamma, W.sol, W.end)
+        apply_operator(C.cp, ci, CP_STD if which == STANDARD else CP_FINE, nf, ci[CI_SRC], W.src1, y1.z, y1.zd,
+                       y1.zdd, W.sol)
+    correct(nf, h, beta, gamma, W.sol, y1.z, y1.zd, y1.zdd)
     if hertz is not None:
         if C.ci[CI_HERTZ]:
             hertz_correction(prob, C, W, h, which)
@@ -183,7 +184,7 @@ def layer_step(prob, C, W, h, which, hertz):
 @jit
 def consistent_acceleration(prob, C, src, y, rhs, hertz):
     """Free accelerations of configuration C from its equations of motion (prescribed set from src)."""
-    set_prescribed(C, prob.ip[IP_N], src, y)
+    prescribed(C.ci, prob.ip[IP_N], src, y.z, y.zd, y.zdd)
     free_rhs(C, src, y, rhs)
     nf = C.ci[CI_NF]
     if hertz is not None:
