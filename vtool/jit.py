@@ -32,8 +32,7 @@ from numba import njit  # noqa: E402 (after the cache folder is chosen)
 
 _OPTIONS: dict[str, Any] = {"cache": numba_cache.CACHE_ENABLED, "nogil": True, "error_model": "numpy"}
 jit = njit(**_OPTIONS)
-import os
-jit_inline = njit(**_OPTIONS) if os.environ.get("X_NOINLINE") else njit(**_OPTIONS, inline="always")
+jit_inline = njit(**_OPTIONS, inline="always")
 
 #: A first compile's length when none was measured yet on this machine (s; the 2-core development
 #: machine took 9-14 s for 1A's kernel with other work running).
