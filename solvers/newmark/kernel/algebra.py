@@ -56,11 +56,10 @@ def apply_operator(cp, ci, plane, nrows, coupled, src, z, zd, zdd, out):
                 out[f] -= cp[plane, PART_S, j, f] * a
 
 
-@jit
-def factor_effective(C, beta, gamma, h, L):
-    """Cholesky factor (lower, in place in L) of S = M_FF + gamma h C_FF + beta h² K_FF."""
-    cm = C.cm
-    nf = C.ci[CI_NF]
+@jit_inline
+def factor_effective(cm, nf, beta, gamma, h, L):
+    """Cholesky factor (lower, in place in L) of S = M_FF + gamma h C_FF + beta h² K_FF (the nf free
+    rows of a configuration's matrices cm)."""
     for f in range(nf):
         for g in range(f + 1):
             s = cm[CM_MFF, f, g] + gamma * h * cm[CM_CFF, f, g] + beta * h * h * cm[CM_KFF, f, g]
@@ -72,7 +71,7 @@ def factor_effective(C, beta, gamma, h, L):
                 L[f, g] = s / L[g, g]
 
 
-@jit
+@jit_inline
 def cholesky_solve(nf, L, rhs, out):
     for f in range(nf):
         s = rhs[f]

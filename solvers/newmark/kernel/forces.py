@@ -62,21 +62,26 @@ def overlap_and_rate(prob, C, k, y, src):
     return delta, rate
 
 
+@jit_inline
+def linear_force(mon, k, n, ns, count, z, zd, zdd, src):
+    """Contact force of closed clearance k from its monitor row mon[k] on (z, ż, z̈, sources, 1) (the
+    first ``count`` z indices), summed term by term in the order z_0, ż_0, z̈_0, z_1, …, then the
+    sources. (A quiet step takes the same force, up to round-off, from its force row in the step's
+    product: see ``layout.CP_RAW``.)"""
+    f = mon[k, 3 * n + 3 * ns]
+    for j in range(count):
+        f += mon[k, j] * z[j]
+        f += mon[k, n + j] * zd[j]
+        f += mon[k, 2 * n + j] * zdd[j]
+    for j in range(3 * ns):
+        f += mon[k, 3 * n + j] * src[j]
+    return f
+
+
 @jit
 def contact_force(prob, C, k, y, src):
-    """Contact force of closed clearance k: its row on (z, ż, z̈, sources, 1), summed term by term in
-    the order z_0, ż_0, z̈_0, z_1, …, then the sources. (A quiet step takes the same force, up to
-    round-off, from its force row in the step's product: see ``layout.CP_RAW``.)"""
-    n, ns = prob.ip[IP_N], prob.ip[IP_NS]
-    row = C.mon[k]
-    f = row[3 * n + 3 * ns]
-    for j in range(C.mk[k, MK_M]):
-        f += row[j] * y.z[j]
-        f += row[n + j] * y.zd[j]
-        f += row[2 * n + j] * y.zdd[j]
-    for j in range(3 * ns):
-        f += row[3 * n + j] * src[j]
-    return f
+    """:func:`linear_force` of closed clearance k in configuration C, layer state y."""
+    return linear_force(C.mon, k, prob.ip[IP_N], prob.ip[IP_NS], C.mk[k, MK_M], y.z, y.zd, y.zdd, src)
 
 
 @jit
@@ -132,9 +137,20 @@ def monitor_value(prob, C, k, y, src, gap_noise, hertz):
 
 @jit
 def monitors(prob, C, y, src, gap_noise, phi, hertz):
-    """phi[k] = :func:`monitor_value` of every clearance k: one call for all of them."""
+    """phi[k] = :func:`monitor_value` of every clearance k: one call for all of them (gaps and linear
+    forces on arrays taken out of the records once; see step_rows)."""
+    n, ns = prob.ip[IP_N], prob.ip[IP_NS]
+    mk, mon, z, zd, zdd = C.mk, C.mon, y.z, y.zd, y.zdd
     for k in range(prob.cl.shape[0]):
-        phi[k] = monitor_value(prob, C, k, y, src, gap_noise, hertz)
+        kind = mk[k, MK_KIND]
+        if kind == MK_GAP or kind == MK_OVERLAP:
+            behind = mk[k, MK_BEHIND]
+            other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
+            phi[k] = signed_gap(kind, z[mk[k, MK_AHEAD]] - other, gap_noise)
+        elif kind == MK_FORCE and hertz is None:
+            phi[k] = linear_force(mon, k, n, ns, mk[k, MK_M], z, zd, zdd, src)
+        else:
+            phi[k] = monitor_value(prob, C, k, y, src, gap_noise, hertz)
 
 
 @jit

@@ -2,9 +2,17 @@
 
 from __future__ import annotations
 
+import math
+
 from vtool.jit import jit, jit_inline
-from vtool.solvers.newmark.kernel.algebra import factor_effective
-from vtool.solvers.newmark.kernel.forces import monitor_value, monitors
+from vtool.solvers.newmark.kernel.algebra import apply_operator, cholesky_solve, factor_effective
+from vtool.solvers.newmark.kernel.forces import (
+    hertz_correction,
+    linear_force,
+    monitor_value,
+    monitors,
+    signed_gap,
+)
 from vtool.solvers.newmark.kernel.impacts import release_pulling, take_events
 from vtool.solvers.newmark.kernel.output import record_row, step_rows, track_peaks
 from vtool.solvers.newmark.kernel.quiet import advance
@@ -13,9 +21,13 @@ from vtool.solvers.newmark.kernel.step import (
     REFINED,
     STANDARD,
     configuration,
+    correct,
     find_slot,
     gather,
+    harmonics,
     layer_step,
+    predict,
+    prescribed,
     scatter,
     sources,
 )
@@ -23,8 +35,11 @@ from vtool.solvers.newmark.layout import (
     CHATTER,
     CHUNK_END,
     CI_HERTZ,
+    CI_M,
     CI_NF,
+    CI_SRC,
     CL_MON,
+    CP_RAW,
     DIVERGED,
     F_CHUNK_END,
     F_FINE_UNTIL,
@@ -34,6 +49,7 @@ from vtool.solvers.newmark.layout import (
     FP_DT,
     FP_GAMMA,
     FP_GAPNOISE,
+    FP_OMEGA,
     FP_OUTDT,
     FP_REFINE,
     FP_REFWIN,
@@ -53,6 +69,14 @@ from vtool.solvers.newmark.layout import (
     I_WANT_CFG,
     IP_EVERY,
     IP_N,
+    IP_NS,
+    MK_AHEAD,
+    MK_BEHIND,
+    MK_FORCE,
+    MK_GAP,
+    MK_KIND,
+    MK_M,
+    MK_OVERLAP,
     NEED_CONFIG,
     OUTPUT_FULL,
     PEAK_ALL,
@@ -68,10 +92,20 @@ def locate_event(prob, C, W, k, t, h, hertz):
     W.phi[k], with a bisection whenever two iterations have not halved the
     bracket; returns the left end of the final bracket (the monitor still
     non-negative), within the time tolerance of the crossing. Each trial
-    factors S(tau) by Cholesky.
+    factors S(tau) by Cholesky. The trials are :func:`step_to`'s step written
+    with the shared inline helpers on arrays taken out of the records once (a
+    call handed records takes and drops a reference count of each of their
+    arrays: in this loop, most of an event's cost).
     """
-    fp = prob.fp
-    tol, gap_noise = fp[FP_TTOL], fp[FP_GAPNOISE]
+    fp, ip = prob.fp, prob.ip
+    beta, gamma, omega, tol, gap_noise = fp[FP_BETA], fp[FP_GAMMA], fp[FP_OMEGA], fp[FP_TTOL], fp[FP_GAPNOISE]
+    n, ns = ip[IP_N], ip[IP_NS]
+    sc, sa, sb = prob.sc, prob.sa, prob.sb
+    ci, cm, cp, mk, mon = C.ci, C.cm, C.cp, C.mk, C.mon
+    z, zd, zdd, z1, zd1, zdd1 = W.now.z, W.now.zd, W.now.zdd, W.end.z, W.end.zd, W.end.zdd
+    src1, rhs, sol, L = W.src1, W.rhs, W.sol, W.L
+    m, nf, coupled, closed_hertz = ci[CI_M], ci[CI_NF], ci[CI_SRC], ci[CI_HERTZ]
+    kind = mk[k, MK_KIND]
     lo, hi = 0.0, h
     flo, fhi = W.phi_start[k], W.phi[k]
     side = 0
@@ -89,8 +123,26 @@ def locate_event(prob, C, W, k, t, h, hertz):
         else:
             tau = (lo * fhi - hi * flo) / (fhi - flo)
         tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
-        step_to(prob, C, W, t, tau, hertz)
-        f = monitor_value(prob, C, k, W.end, W.src1, gap_noise, hertz)
+        # step_to(prob, C, W, t, tau, hertz), on the arrays
+        harmonics(sc, sa, sb, omega, math.cos(omega * (t + tau)), math.sin(omega * (t + tau)), src1)
+        factor_effective(cm, nf, beta, gamma, tau, L)
+        predict(m, tau, beta, gamma, z, zd, zdd, z1, zd1)
+        prescribed(ci, n, src1, z1, zd1, zdd1)
+        apply_operator(cp, ci, CP_RAW, nf, coupled, src1, z1, zd1, zdd1, rhs)
+        cholesky_solve(nf, L, rhs, sol)
+        correct(nf, tau, beta, gamma, sol, z1, zd1, zdd1)
+        if hertz is not None:
+            if closed_hertz:
+                hertz_correction(prob, C, W, tau, CHOLESKY)
+        # monitor_value(prob, C, k, W.end, src1, gap_noise, hertz), on the arrays
+        if kind == MK_GAP or kind == MK_OVERLAP:
+            behind = mk[k, MK_BEHIND]
+            other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
+            f = signed_gap(kind, z1[mk[k, MK_AHEAD]] - other, gap_noise)
+        elif kind == MK_FORCE and hertz is None:
+            f = linear_force(mon, k, n, ns, mk[k, MK_M], z1, zd1, zdd1, src1)
+        else:
+            f = monitor_value(prob, C, k, W.end, src1, gap_noise, hertz)
         if f < 0.0:
             hi, fhi = tau, f
             if side == -1:
@@ -108,7 +160,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
 def step_to(prob, C, W, t, h, hertz):
     """A step of any length h from W.now at t into W.end: sources at t + h, S(h) factored by Cholesky."""
     sources(prob, t + h, W.src1)
-    factor_effective(C, prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
+    factor_effective(C.cm, C.ci[CI_NF], prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
     layer_step(prob, C, W, h, CHOLESKY, hertz)
 
 
@@ -225,6 +277,7 @@ def steps(prob, C, W, S, O, hertz):
     event), h the event's located step."""
     fp, ist, fst = prob.fp, S.ist, S.fst
     dt, t_end, out_dt, x_limit, t_rev = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_XLIM], fp[FP_TREV]
+    omega, sc, sa, sb, src0, src1 = fp[FP_OMEGA], prob.sc, prob.sa, prob.sb, W.src0, W.src1
     n = prob.ip[IP_N]
     t = fst[F_T]
     h = 0.0
@@ -238,19 +291,19 @@ def steps(prob, C, W, S, O, hertz):
             t_quiet = advance(prob, C, W, S, O, hertz)
             if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
                 t = t_quiet
-                sources(prob, t, W.src0)
+                harmonics(sc, sa, sb, omega, math.cos(omega * t), math.sin(omega * t), src0)
                 continue
         if h <= 1e-9 * dt:  # at a grid point but for round-off
             t = arrive(S, target, grid_next, ist[I_GRID], j_target)
             continue
-        sources(prob, t + h, W.src1)
+        harmonics(sc, sa, sb, omega, math.cos(omega * (t + h)), math.sin(omega * (t + h)), src1)
         which = STANDARD
         if h != dt:
             if h == dt / int(fp[FP_REFINE] + 0.5):
                 which = REFINED
             else:
                 which = CHOLESKY
-                factor_effective(C, fp[FP_BETA], fp[FP_GAMMA], h, W.L)
+                factor_effective(C.cm, C.ci[CI_NF], fp[FP_BETA], fp[FP_GAMMA], h, W.L)
         layer_step(prob, C, W, h, which, hertz)
         monitors(prob, C, W.end, W.src1, fp[FP_GAPNOISE], W.phi, hertz)
         fired = False

@@ -203,12 +203,14 @@ def consistent_acceleration(prob, C, src, y, rhs, hertz):
 
 
 @jit_inline
-def interpolate(nf, s_out, h, y, zdd1, out):
-    """The free coordinates at s_out into a step of length h from y whose end acceleration is z̈1: the
-    linear-acceleration interpolant (exact for beta = 1/6; thesis eqs. B.3-B.5)."""
+def interpolate(nf, s_out, h, z, zd, zdd, zdd1, out):
+    """The free coordinates at s_out into a step of length h from (z, ż, z̈) whose end acceleration is
+    z̈1, into the layer state ``out``: the linear-acceleration interpolant (exact for beta = 1/6;
+    thesis eqs. B.3-B.5)."""
+    zo, zdo, zddo = out.z, out.zd, out.zdd
     r = s_out / h
     for j in range(nf):
-        da = zdd1[j] - y.zdd[j]
-        out.zdd[j] = y.zdd[j] + da * r
-        out.zd[j] = y.zd[j] + y.zdd[j] * s_out + da * s_out * r / 2.0
-        out.z[j] = y.z[j] + y.zd[j] * s_out + y.zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
+        da = zdd1[j] - zdd[j]
+        zddo[j] = zdd[j] + da * r
+        zdo[j] = zd[j] + zdd[j] * s_out + da * s_out * r / 2.0
+        zo[j] = z[j] + zd[j] * s_out + zdd[j] * s_out * s_out / 2.0 + da * s_out * s_out * r / 6.0
