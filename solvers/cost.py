@@ -34,6 +34,8 @@ from vtool.errors import InputError
 
 #: Default largest number of steps (or samples) of one run.
 MAX_STEPS = 5e7
+#: Largest --max-steps a user may ask for.
+LARGEST_MAX_STEPS = 1e12
 #: Default largest memory of one run's output (bytes).
 MAX_BYTES = 2e9
 #: Samples per period of the highest natural frequency (exact, scipy).
@@ -92,8 +94,10 @@ class CostError(InputError):
             return (f"run too short: {c.t_end:.3g} s of motion is less than one time step ({c.backend}); "
                     "to proceed: more --degrees or a smaller --dt")
         if self.what == "steps":
+            allow = (f", or --max-steps {math.ceil(c.steps):d}" if c.steps <= LARGEST_MAX_STEPS
+                     else f" (more than the largest --max-steps, {LARGEST_MAX_STEPS:.0e})")
             limit = (f"more than the limit of {self.max_steps:.3g} steps; to proceed: fewer --degrees, "
-                     f"a higher --rpm, a larger --dt (newmark), or --max-steps {math.ceil(c.steps):d}")
+                     f"a higher --rpm, a larger --dt (newmark){allow}")
         else:
             limit = (f"more than the limit of {self.max_bytes / 1e9:g} GB of output; to proceed: fewer "
                      "--degrees, a larger run.output_interval, or no --every-step")

@@ -14,6 +14,7 @@ from typing import Any
 
 import click
 
+from vtool.app.cli.options import OUTPUT, json_alone
 from vtool.errors import InputError
 
 PULSE_CHOICES = ("N", "P", "Q", "R", "T")
@@ -68,7 +69,7 @@ def _summary_lines(res: Any, quantity: str) -> list[str]:
 @click.option("--damping", type=float, default=0.0, show_default=True, help="Damping ratio zeta, [0, 1).")
 @click.option("--range", "grid", default="0:2.5:0.01", show_default=True, callback=_parse_range,
               help="tau/T values start:stop:step (inclusive).")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+@click.option("--csv", "csv_path", type=OUTPUT, default=None,
               help="Write the DAF curves to this CSV file.")
 @click.option("--json", "as_json", is_flag=True, help="Print the DAF curves as JSON (units named).")
 @click.option("--plot", is_flag=True, help="Draw the DAF curves in the terminal.")
@@ -81,6 +82,7 @@ def daf_command(kind: str, s: float, r1: float, r2: float | None, alpha: float |
 
     from vtool.assessments.sonic_boom import fourier, pulses, report, response, spectra
 
+    json_alone(as_json, plot=plot)
     response.check_damping(damping)
     ratio = spectra.ratio_grid(*grid)
     lines: list[str] = []
@@ -148,6 +150,7 @@ def _write(path: Path, text: str) -> None:
 
 def _preset_command(expected: str, name: str, preset: str, csv_path: Path | None, plot: bool,
                     as_json: bool) -> None:
+    json_alone(as_json, plot=plot)
     from vtool.presets import boom as boom_presets
     from vtool.presets import find_preset, kind_of, load_document, read_document
 
@@ -164,7 +167,7 @@ def _preset_command(expected: str, name: str, preset: str, csv_path: Path | None
 
 _preset_options = [
     click.argument("preset"),
-    click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+    click.option("--csv", "csv_path", type=OUTPUT, default=None,
                  help="Write the allowable-pressure table to this CSV file."),
     click.option("--plot", is_flag=True, help="Draw the DAF and design curves in the terminal."),
     click.option("--json", "as_json", is_flag=True, help="Print the results as JSON."),

@@ -19,9 +19,11 @@ def cam() -> None:
 def show(preset: str, plot: bool, as_json: bool) -> None:
     """Fit error, velocity/acceleration/jerk extremes at the preset's speed, the
     acceleration spectrum, and warnings where a lift table's acceleration jumps."""
+    from vtool.app.cli.options import json_alone
     from vtool.presets import load_preset
     from vtool.solvers.model.cam import cam_report, report_text
 
+    json_alone(as_json, plot=plot)
     spec = load_preset(preset)
     from vtool.presets.kinds import require_kind
 

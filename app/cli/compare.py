@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from vtool.app.cli.options import impact_laws_option, start_option
+from vtool.app.cli.options import OUTPUT, impact_laws_option, start_option
 
 
 @click.command()
@@ -15,7 +15,7 @@ from vtool.app.cli.options import impact_laws_option, start_option
 @impact_laws_option
 @start_option
 @click.option("--degrees", type=float, help="Degrees of cam rotation; default: the preset's.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), help="Also write the table as CSV.")
+@click.option("--csv", "csv_path", type=OUTPUT, help="Also write the table as CSV.")
 @click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
 @click.option("--markdown", is_flag=True, help="Print the table as Markdown (for reports).")
 def compare(preset: str, impacts: tuple[str, ...], starts: tuple[str, ...] | None, degrees: float | None,

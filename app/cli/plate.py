@@ -15,6 +15,7 @@ from typing import Any
 
 import click
 
+from vtool.app.cli.options import OUTPUT, json_alone
 from vtool.errors import InputError
 
 RK4_LIMIT = 2.8  # thesis eq. 44; kept here so --help needs no numerics
@@ -50,7 +51,7 @@ def _width() -> int:
     return max(60, min(shutil.get_terminal_size((100, 24)).columns, 140))
 
 
-csv_option = click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+csv_option = click.option("--csv", "csv_path", type=OUTPUT,
                           help="Also write the results to this CSV file (header names units).")
 json_option = click.option("--json", "as_json", is_flag=True, help="Print JSON instead of tables.")
 
@@ -131,7 +132,7 @@ def transient(preset: str, case_name: str | None, load: str, scheme: str, wh: fl
     from vtool.assessments.plate.report import case_run_dict, case_run_text, response_csv
     from vtool.assessments.plate.study import run_case
 
-    spec = _load_plate_spec(preset)
+    spec = _load_plate_spec(preset)  # with --json, the histories are not drawn (--plot is on by default)
     settings = spec.study.transient
     case = _cases(spec, case_name)[0]
     run = run_case(spec.study.plate, case, load, scheme, wh, periods or settings.periods,
@@ -169,6 +170,7 @@ def _write(path: Path, text: str) -> None:
 @json_option
 def study(preset: str, transient: bool, plot: bool, csv_path: Path | None, as_json: bool) -> None:
     """The thesis' Tables 2-5 regenerated: every case, its KS, errors and cost."""
+    json_alone(as_json, plot=plot)
     spec = _load_plate_spec(preset)
     solve_preset(spec, csv_path, plot, as_json, transient=transient)
 

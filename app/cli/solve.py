@@ -16,7 +16,7 @@ from typing import Any
 
 import click
 
-from vtool.app.cli.options import impact_option, start_velocities_option
+from vtool.app.cli.options import OUTPUT, impact_option, json_alone, start_velocities_option
 from vtool.errors import InputError
 from vtool.solvers.backends import available
 from vtool.solvers.cost import MAX_STEPS
@@ -52,7 +52,7 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
               help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's.")
 @click.option("--max-steps", type=float, callback=_max_steps,
               help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}).")
-@click.option("--csv", "csv_path", type=click.Path(),  # a str: '' stays '' in the error
+@click.option("--csv", "csv_path", type=OUTPUT,
               help="Write the response as CSV (per output interval, or per step with --every-step).")
 @click.option("--every-step", is_flag=True, help="CSV rows at every time step (and event) instead of per degree.")
 @click.option("--plot", is_flag=True, help="Draw force, displacement and configuration charts (not with --json).")
@@ -61,7 +61,7 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @impact_option
 @start_velocities_option
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
-          max_steps: float | None, csv_path: str | None, every_step: bool, plot: bool, as_json: bool,
+          max_steps: float | None, csv_path: Path | None, every_step: bool, plot: bool, as_json: bool,
           show_events: bool, impact: str | None, start: str | None) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
@@ -69,13 +69,11 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
     peak forces, valve seating velocities, bounces per revolution, run
     statistics). Files are written only when the run succeeds.
     """
-    from vtool.files import check_output_path
     from vtool.presets import load_preset
     from vtool.presets.kinds import KINDS, resolve
 
-    if as_json and plot:
-        raise InputError("--plot", "with --json", "one of --json (machine-readable stdout) or --plot")
-    csv_file = None if csv_path is None else Path(check_output_path(csv_path, "--csv") and csv_path)
+    json_alone(as_json, plot=plot)
+    csv_file = csv_path  # checked when the command line was read (options.OUTPUT)
     spec = load_preset(preset)
     kind = KINDS[spec.kind]
     if spec.kind != "valvetrain":
