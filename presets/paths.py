@@ -159,6 +159,36 @@ def field_unit(doc: dict[str, Any], path: str) -> str:
     return ""
 
 
+def parse_assignments(sets: list[str] | tuple[str, ...], max_points: int = 100_000) -> list[tuple[str, list[Any]]]:
+    """``FIELD=VALUES`` texts (``--set`` of ``vtool sweep`` and ``vtool solve``) -> (path, values), in order;
+    each field once."""
+    fields: list[tuple[str, list[Any]]] = []
+    for text in sets:
+        path, sep, values = text.partition("=")
+        path = path.strip()
+        if not sep or not path:
+            raise InputError("--set", text, "FIELD=VALUES, e.g. run.rpm=9000:12000:250 or damping.factor=0.5,1,2")
+        if any(path == p for p, _ in fields):
+            raise InputError("--set", path, "each field set once")
+        parse_path(path)
+        fields.append((path, parse_values(path, values, max_points)))
+    return fields
+
+
+def load_with_sets(preset: str, sets: list[str] | tuple[str, ...]) -> Any:
+    """The preset with ``FIELD=VALUE`` assignments (one value each), validated by its loader
+    (``vtool solve --set``: the same paths and values as a sweep's, a single point)."""
+    from vtool.presets import load_preset
+
+    assignments = {}
+    for path, values in parse_assignments(sets, max_points=1_000):
+        if len(values) != 1:
+            raise InputError(f"--set {path}", ",".join(str(v) for v in values),
+                             "one value (a range or list is a sweep: vtool sweep)")
+        assignments[path] = values[0]
+    return load_preset(preset, edit=lambda doc: set_fields(doc, assignments))
+
+
 @dataclass(frozen=True)
 class SweepPlan:
     """A validated sweep: the base document and spec, the swept fields with units, every point."""
@@ -182,16 +212,7 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> Sweep
     spec = load_document(doc)
     if spec.kind != "valvetrain":
         raise InputError("preset", preset, f"a valvetrain preset (this one is {spec.kind})")
-    fields: list[tuple[str, list[Any]]] = []
-    for text in sets:
-        path, sep, values = text.partition("=")
-        path = path.strip()
-        if not sep or not path:
-            raise InputError("--set", text, "FIELD=VALUES, e.g. run.rpm=9000:12000:250 or damping.factor=0.5,1,2")
-        if any(path == p for p, _ in fields):
-            raise InputError("--set", path, "each field set once")
-        parse_path(path)
-        fields.append((path, parse_values(path, values, max_points)))
+    fields = parse_assignments(sets, max_points)
     count = math.prod(len(v) for _, v in fields)
     if count > max_points:
         raise InputError("--set", count, f"a grid of at most {max_points} points")

@@ -71,7 +71,7 @@ def plate() -> None:
 def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path | None, as_json: bool) -> None:
     """Lowest natural frequencies of each case against the exact ones (eq. 40), and omega_max."""
     from vtool.assessments.plate.model import build_model
-    from vtool.assessments.plate.report import modes_csv, modes_text
+    from vtool.assessments.plate.report import cases_modes_csv, modes_text
     from vtool.assessments.plate.vibration import free_vibration
 
     spec = _load_plate_spec(preset)
@@ -87,10 +87,7 @@ def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path 
     else:
         click.echo("\n\n".join(modes_text(f, c) for c, f in results))
     if csv_path is not None:
-        text = "case,KS," + modes_csv(results[0][1]).splitlines()[0] + "\n"
-        for c, f in results:
-            text += "".join(f"{c.name},{f.size},{line}\n" for line in modes_csv(f).splitlines()[1:])
-        _write(csv_path, text)
+        _write(csv_path, cases_modes_csv([(c.name, f) for c, f in results]))
         click.echo(f"wrote {csv_path}", err=True)
 
 

@@ -60,9 +60,12 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @click.option("--events", "show_events", is_flag=True, help="Also print the event list.")
 @impact_option
 @start_velocities_option
+@click.option("--set", "sets", multiple=True, metavar="FIELD=VALUE",
+              help="Set a preset field for this run (dotted path as in `vtool sweep`, e.g. "
+                   "members.valve_spring.stiffness=300 or clearances[2].restitution=0.5); checked by the preset's loader.")
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
           max_steps: float | None, csv_path: Path | None, every_step: bool, plot: bool, as_json: bool,
-          show_events: bool, impact: str | None, start: str | None) -> None:
+          show_events: bool, impact: str | None, start: str | None, sets: tuple[str, ...] = ()) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
@@ -74,7 +77,12 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
 
     json_alone(as_json, plot=plot)
     csv_file = csv_path  # checked when the command line was read (options.OUTPUT)
-    spec = load_preset(preset)
+    if sets:
+        from vtool.presets.paths import load_with_sets
+
+        spec = load_with_sets(preset, sets)
+    else:
+        spec = load_preset(preset)
     kind = KINDS[spec.kind]
     if spec.kind != "valvetrain":
         given = {"--backend": backend, "--dt": dt, "--rpm": rpm, "--degrees": degrees,

@@ -42,6 +42,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from vtool.csvrows import csv_text
 from vtool.errors import InputError, RunError
 from vtool.files import check_output_path, exists, open_no_follow, write_atomic
 from vtool.solvers import backends
@@ -487,9 +488,7 @@ def csv_row(result: PointResult, metrics: Sequence[tuple[str, str]]) -> list[str
 
 
 def csv_lines(rows: Iterable[list[str]]) -> str:
-    buffer = io.StringIO()
-    csv.writer(buffer, lineterminator="\n").writerows(rows)
-    return buffer.getvalue()
+    return csv_text(rows)
 
 
 def results_csv(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], spec: MechanismSpec,
