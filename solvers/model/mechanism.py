@@ -9,7 +9,6 @@ pinned clearance never produces a layer in which it is open.
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Callable, Hashable
 from functools import cached_property
 from typing import Any, TypeVar
@@ -80,7 +79,7 @@ class Mechanism:
     @property
     def omega(self) -> float:
         """Cam speed in rad/s."""
-        return self.spec.run.rpm * math.pi / 30.0
+        return self.spec.run.omega
 
     def layer(self, closed: frozenset[str] | set[str] | tuple[str, ...]) -> Layer:
         """The layer with these internal clearances closed (pinned ones always are)."""
