@@ -98,21 +98,41 @@ def loader_for(kind: str) -> Any:
     return importlib.import_module(kind_named(kind).loader)
 
 
-def load_document(doc: dict[str, Any], folder: Path | None = None) -> Any:
+@dataclass(frozen=True)
+class Override:
+    """A value for a preset field given outside the file (``vtool solve --rpm``: ``run.rpm``, named
+    ``--rpm`` in an error). The loader reads it like the file's own value: checked once, there."""
+
+    path: str
+    value: Any
+    source: str = ""
+
+
+def load_document(doc: dict[str, Any], folder: Path | None = None, overrides: tuple[Override, ...] = ()) -> Any:
     """Validate a parsed preset document and return its frozen spec; a file it names (a cam lift table,
-    a boom pulse CSV) is found in ``folder`` (default: the working folder)."""
+    a boom pulse CSV) is found in ``folder`` (default: the working folder). ``overrides`` are set into the
+    document first (the loader's ``with_overrides``); an error on one names its source."""
     if not isinstance(doc, dict):
         raise InputError("<preset>", type(doc).__name__, "a TOML document (a table)")
+    loader = loader_for(kind_of(doc))
+    if overrides:
+        doc = loader.with_overrides(doc, {o.path: o.value for o in overrides})
     try:
-        return loader_for(kind_of(doc)).load(doc, folder)
+        return loader.load(doc, folder)
     except RecursionError:
         raise InputError("<preset>", "values nested too deep", "the fields of a preset") from None
+    except InputError as exc:
+        source = next((o.source for o in overrides if o.path == exc.field and o.source), None)
+        if source is None:
+            raise
+        raise InputError(source, exc.value, exc.expected, exc.unit) from None
 
 
-def load_preset(name_or_path: str | os.PathLike[str]) -> Any:
-    """Find, parse and validate a preset; returns the spec for its kind."""
+def load_preset(name_or_path: str | os.PathLike[str], overrides: tuple[Override, ...] = ()) -> Any:
+    """Find, parse and validate a preset (with ``overrides`` of some of its fields); returns the spec
+    for its kind."""
     path = find_preset(name_or_path)
-    return load_document(read_document(path), folder=path.parent)
+    return load_document(read_document(path), path.parent, overrides)
 
 
 def preset_info(path: Path) -> PresetInfo:

@@ -9,9 +9,11 @@ Every number is finite and within a stated physical range (:data:`BOUNDS`,
 :data:`RUN_LIMITS`, the counts below), checked before any numerics, so no
 preset can reach the solver with values its floating-point arithmetic cannot
 carry. The ranges are wide (the same numbers in either unit system) and are
-listed in ``docs/limits.md``. The [run] settings are checked by
-:func:`check_run`, which also checks ``--rpm``, ``--dt``, ``--degrees`` and
-``--backend`` overrides (:func:`with_run_overrides`).
+listed in ``docs/limits.md``. The [run] settings are read by one function,
+:func:`_run`, whatever gave them: the preset, ``vtool solve``'s ``--rpm``,
+``--dt``, ``--degrees`` and ``--backend`` (set into the document by
+:func:`with_overrides` before the load), a TUI field, or a study's
+:func:`with_run_overrides`.
 
 A missing [damping] section loads with the default (ratio 0.1 on every mode,
 factor 1) and a :class:`vtool.errors.PresetWarning` saying so.
@@ -19,8 +21,8 @@ factor 1) and a :class:`vtool.errors.PresetWarning` saying so.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
-import math
 import re
 import warnings
 from dataclasses import replace
@@ -28,17 +30,19 @@ from pathlib import Path
 from typing import Any
 
 from vtool.errors import InputError, PresetWarning
-from vtool.presets.fields import Table, as_float
+from vtool.presets.fields import Table
 from vtool.presets.lift_table import read_lift_table
-from vtool.solvers.backends import DEFAULT
+from vtool.solvers.backends import DEFAULT, available
 from vtool.solvers.model.assembly import split_members, unsplit_members
 from vtool.solvers.model.spec import (
     BAR,
     BEAM,
+    BETA_RANGE,
     CONTACT_LAWS,
     ELEMENT_SIZE,
     ENABLED,
     EXTERNAL,
+    GAMMA_RANGE,
     HERTZ,
     IMPACT_LAWS,
     INTERNAL,
@@ -498,6 +502,8 @@ RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta",
 
 
 def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
+    """The [run] table: every value checked here, once (ranges :data:`RUN_LIMITS`, Newmark's
+    ``BETA_RANGE``/``GAMMA_RANGE``, the installed back ends); below the loader a RunSpec is trusted."""
     t.check_unknown(RUN_KEYS)
     def limited(key: str, default: float | None = None) -> float:
         low, high, unit = RUN_LIMITS[key]
@@ -506,50 +512,13 @@ def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
     rpm = limited("rpm")
     degrees = limited("degrees")
     time_step = limited("time_step")
-    backend = t.string("backend", default=DEFAULT)
+    backend = t.string("backend", default=DEFAULT, choices=tuple(available()))
     output_interval = limited("output_interval", 1.0)
-    beta = t.number("beta", default=1.0 / 6.0)
-    gamma = t.number("gamma", default=0.5)
+    beta = t.number("beta", default=1.0 / 6.0, min_exclusive=BETA_RANGE[0], max_value=BETA_RANGE[1])
+    gamma = t.number("gamma", default=0.5, min_value=GAMMA_RANGE[0], max_value=GAMMA_RANGE[1])
     quantities = _quantities(t, *names)
     t.finish()
-    return check_run(RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities))
-
-
-def check_run_value(key: str, value: Any, field: str | None = None) -> Any:
-    """One [run] setting checked against :data:`RUN_LIMITS` (and beta, gamma, backend); returns it.
-
-    ``field`` names it in the error (default ``run.KEY``; the CLI passes ``--rpm``).
-    """
-    field = field or f"run.{key}"
-    if key == "backend":
-        from vtool.solvers.backends import available
-
-        if value not in available():
-            raise InputError(field, value, f"one of the installed back ends: {', '.join(available())}")
-        return value
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise InputError(field, value, "a number")
-    number = as_float(value)
-    if key == "beta":
-        low, high, unit, text = 0.0, 0.5, "", "> 0 and <= 0.5"
-        ok = math.isfinite(number) and low < number <= high
-    elif key == "gamma":
-        low, high, unit, text = 0.5, 1.0, "", ">= 0.5 and <= 1"
-        ok = math.isfinite(number) and low <= number <= high
-    else:
-        low, high, unit = RUN_LIMITS[key]
-        text = f">= {low:g} and <= {high:g}"
-        ok = math.isfinite(number) and low <= number <= high
-    if not ok:
-        raise InputError(field, value, text, unit)
-    return number
-
-
-def check_run(run: RunSpec) -> RunSpec:
-    """The [run] settings checked by :func:`check_run_value`, field by field; returns ``run``."""
-    for key in ("rpm", "degrees", "time_step", "output_interval", "beta", "gamma", "backend"):
-        check_run_value(key, getattr(run, key))
-    return run
+    return RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities)
 
 
 def dump(spec: MechanismSpec) -> dict[str, Any]:
@@ -613,13 +582,16 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         damping["layers"] = layers
     doc["damping"] = damping
     r = spec.run
-    doc["run"] = {
-        "rpm": r.rpm, "degrees": r.degrees, "time_step": r.time_step, "backend": r.backend,
-        "output_interval": r.output_interval, "beta": r.beta, "gamma": r.gamma,
-    }
-    if r.quantities:
-        doc["run"]["quantities"] = list(r.quantities)
+    doc["run"] = _dump_run(r)
     return doc
+
+
+def _dump_run(r: RunSpec) -> dict[str, Any]:
+    run: dict[str, Any] = {"rpm": r.rpm, "degrees": r.degrees, "time_step": r.time_step, "backend": r.backend,
+                           "output_interval": r.output_interval, "beta": r.beta, "gamma": r.gamma}
+    if r.quantities:
+        run["quantities"] = list(r.quantities)
+    return run
 
 
 RPM_IN_TITLE = re.compile(r"\b\d{1,3}(?:,\d{3})*(?:\.\d+)?\s*RPM\b|\b\d+(?:\.\d+)?\s*RPM\b", re.IGNORECASE)
@@ -635,7 +607,7 @@ def rpm_title(title: str, rpm: float) -> str:
 
 
 def with_run_overrides(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
-    """The spec with some [run] settings changed, checked by :func:`check_run` as the loader does.
+    """The spec with some [run] settings changed, read by the loader's own [run] reader (:func:`_run`).
 
     ``changes`` uses the preset's [run] keys (rpm, degrees, time_step, backend,
     output_interval, beta, gamma); ``None`` values are ignored. A changed speed
@@ -645,8 +617,30 @@ def with_run_overrides(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
     unknown = sorted(set(given) - set(RUN_KEYS))
     if unknown:
         raise InputError(f"run.{unknown[0]}", given[unknown[0]], f"one of: {', '.join(RUN_KEYS)}")
-    run = check_run(dataclasses.replace(spec.run, **given))
+    names = _quantity_names(spec.coordinates, spec.cam, spec.seat, spec.clearances)
+    run = _run(Table(_dump_run(spec.run) | given, "run"), names)
     title = spec.title
     if "rpm" in given and run.rpm != spec.run.rpm:
         title = rpm_title(title, run.rpm)
     return dataclasses.replace(spec, run=run, title=title)
+
+
+def with_overrides(doc: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
+    """The preset document with values given outside it (``vtool solve``'s flags, by field path:
+    ``run.rpm``, ``contact.impact``, ...) set, for the loader to check once like any other field. An impact
+    law for the mechanism (``contact.impact``) applies to every clearance, dropping their own; a changed
+    speed is written into the title as :func:`with_run_overrides` does."""
+    result = copy.deepcopy(doc)
+    for path, value in overrides.items():
+        table, _, key = path.rpartition(".")
+        if not isinstance(result.get(table), dict):
+            result[table] = {}
+        result[table][key] = value
+    if "contact.impact" in overrides:
+        for clearance in result.get("clearances", []):
+            if isinstance(clearance, dict):
+                clearance.pop("impact", None)
+    rpm = overrides.get("run.rpm")
+    if rpm is not None and isinstance(result.get("title", ""), str) and rpm != doc.get("run", {}).get("rpm"):
+        result["title"] = rpm_title(result.get("title", ""), float(rpm))
+    return result
