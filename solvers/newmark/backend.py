@@ -84,7 +84,15 @@ from vtool.errors import InputError, RunError
 from vtool.solvers.backends import AccuracyKnobs, AccuracySetting, Backend, Cancel, Progress
 from vtool.solvers.model.contact import ContactProblem
 from vtool.solvers.model.mechanism import Mechanism
-from vtool.solvers.model.spec import BETA_RANGE, GAMMA_RANGE, HERTZ, MOMENTUM, RIGID, MechanismSpec, RunSpec
+from vtool.solvers.model.spec import (
+    BETA_RANGE,
+    GAMMA_RANGE,
+    HERTZ,
+    MOMENTUM,
+    RIGID,
+    MechanismSpec,
+    RunSpec,
+)
 from vtool.solvers.newmark import build as kernel_build
 from vtool.solvers.newmark import layout
 from vtool.solvers.newmark import native as kernel_native
