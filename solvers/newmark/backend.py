@@ -81,7 +81,14 @@ import numpy as np
 
 from vtool import compile_estimate, numba_cache
 from vtool.errors import InputError, RunError
-from vtool.solvers.backends import AccuracyKnobs, AccuracySetting, Backend, Cancel, Progress
+from vtool.solvers.backends import (
+    AccuracyKnobs,
+    AccuracySetting,
+    Backend,
+    Cancel,
+    Progress,
+    RunStats,
+)
 from vtool.solvers.model.contact import ContactProblem
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.spec import (
@@ -256,15 +263,15 @@ class NewmarkBackend(Backend):
         check_settings(mechanism, options)
 
     def integrate(self, problem: ContactProblem, options: NewmarkOptions, builder: TraceBuilder,
-                  progress: Progress | None, cancel: Cancel | None) -> dict[str, Any]:
+                  progress: Progress | None, cancel: Cancel | None) -> RunStats:
         run = KernelRun(problem, options, builder)
         run.execute(progress, cancel)
         o = options
-        return {"steps": int(run.ist[layout.I_STEPS]), "peak": run.peak[layout.PEAK_ALL].copy(),
-                "peak_late": run.peak[layout.PEAK_LATE].copy(), "peak_overlap": run.peak[layout.PEAK_OVERLAP].copy(),
-                "compile_time": run.compile_time, "plain_steps": run.plain_steps, "kernel": run.kernel,
-                "settings": {"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
-                             "refine_after_events": o.refine}}
+        return RunStats(int(run.ist[layout.I_STEPS]), run.peak[layout.PEAK_ALL].copy(),
+                        run.peak[layout.PEAK_LATE].copy(), run.peak[layout.PEAK_OVERLAP].copy(),
+                        compile_time=run.compile_time, plain_steps=run.plain_steps, kernel=run.kernel,
+                        settings={"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
+                                  "refine_after_events": o.refine})
 
 
 def kernel_kind(module: ModuleType) -> str:
