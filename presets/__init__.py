@@ -98,12 +98,13 @@ def loader_for(kind: str) -> Any:
     return importlib.import_module(kind_named(kind).loader)
 
 
-def load_document(doc: dict[str, Any]) -> Any:
-    """Validate a parsed preset document and return its frozen spec."""
+def load_document(doc: dict[str, Any], folder: Path | None = None) -> Any:
+    """Validate a parsed preset document and return its frozen spec; a file it names (a cam lift table,
+    a boom pulse CSV) is found in ``folder`` (default: the working folder)."""
     if not isinstance(doc, dict):
         raise InputError("<preset>", type(doc).__name__, "a TOML document (a table)")
     try:
-        return loader_for(kind_of(doc)).load(doc)
+        return loader_for(kind_of(doc)).load(doc, folder)
     except RecursionError:
         raise InputError("<preset>", "values nested too deep", "the fields of a preset") from None
 
@@ -111,10 +112,7 @@ def load_document(doc: dict[str, Any]) -> Any:
 def load_preset(name_or_path: str | os.PathLike[str]) -> Any:
     """Find, parse and validate a preset; returns the spec for its kind."""
     path = find_preset(name_or_path)
-    doc = read_document(path)
-    if kind_of(doc) == "valvetrain":  # resolves a cam lift_table file against the preset's folder
-        return loader_for("valvetrain").load(doc, folder=path.parent)
-    return load_document(doc)
+    return load_document(read_document(path), folder=path.parent)
 
 
 def preset_info(path: Path) -> PresetInfo:

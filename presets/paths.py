@@ -176,12 +176,13 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> Sweep
     InputError before any work starts.
     """
     from vtool.presets import find_preset, load_document, read_document
+    from vtool.presets.kinds import require_kind
     from vtool.solvers.studies.sweep import Point, grid
 
+    folder = find_preset(preset).parent
     doc = read_document(find_preset(preset))
-    spec = load_document(doc)
-    if spec.kind != "valvetrain":
-        raise InputError("preset", preset, f"a valvetrain preset (this one is {spec.kind})")
+    spec = load_document(doc, folder)
+    require_kind(spec, "valvetrain", "a sweep")
     fields: list[tuple[str, list[Any]]] = []
     for text in sets:
         path, sep, values = text.partition("=")
@@ -197,6 +198,6 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> Sweep
         raise InputError("--set", count, f"a grid of at most {max_points} points")
     points = []
     for index, assignment in enumerate(grid(fields)):
-        points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)))))
+        points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)), folder)))
     units = tuple((path, field_unit(doc, path)) for path, _ in fields)
     return SweepPlan(doc, spec, units, tuple(points))

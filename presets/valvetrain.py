@@ -30,6 +30,7 @@ from typing import Any
 from vtool.errors import InputError, PresetWarning
 from vtool.presets.fields import Table, as_float
 from vtool.presets.lift_table import read_lift_table
+from vtool.solvers.backends import DEFAULT
 from vtool.solvers.model.assembly import split_members, unsplit_members
 from vtool.solvers.model.spec import (
     BAR,
@@ -505,7 +506,7 @@ def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
     rpm = limited("rpm")
     degrees = limited("degrees")
     time_step = limited("time_step")
-    backend = t.string("backend", default="newmark")
+    backend = t.string("backend", default=DEFAULT)
     output_interval = limited("output_interval", 1.0)
     beta = t.number("beta", default=1.0 / 6.0)
     gamma = t.number("gamma", default=0.5)

@@ -43,7 +43,6 @@ def show(preset: str, plot: bool, as_json: bool) -> None:
 
 
 def _charts(spec) -> str:  # type: ignore[no-untyped-def]
-    import math
 
     import numpy as np
 
@@ -52,7 +51,7 @@ def _charts(spec) -> str:  # type: ignore[no-untyped-def]
 
     fit = cam_fit(spec.cam)
     u = spec.unit_system.length
-    omega = spec.run.rpm * math.pi / 30.0
+    omega = spec.run.omega
     angles = np.linspace(0.0, 360.0, 721)
     rows = derivatives(fit.c0, fit.a, fit.b, np.radians(angles))
     names = [f"lift ({u})", f"velocity ({u}/s)", f"acceleration ({u}/s^2)", f"jerk ({u}/s^3)"]

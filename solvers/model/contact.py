@@ -320,7 +320,7 @@ class ContactProblem:
         self.spec = spec
         self.rules = rules
         self.n, self.ncl = spec.n_coordinates, len(spec.clearances)
-        self.tables = mechanism.configuration_tables()
+        self.tables = mechanism.shared(ConfigurationTables, lambda: ConfigurationTables(mechanism))
         self.series = source_series(mechanism)
         self.ns, self.nh = self.series.n_sources, self.series.n_harmonics
         self.source_numbers = self.series.numbers

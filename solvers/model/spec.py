@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from vtool.solvers.model.units import UNIT_SYSTEMS, UnitSystem
+from vtool.units import cam_speed
 
 BAR = "bar"
 BEAM = "beam"
@@ -239,6 +240,11 @@ class DampingSpec:
         return LayerDampingSpec(tuple(sorted(closed)), self.default_ratio)
 
 
+#: The back end a run uses when its settings name none (the registry's default,
+#: :data:`vtool.solvers.backends.DEFAULT`; the one place outside the registry a back end is named).
+DEFAULT_BACKEND = "newmark"
+
+
 @dataclass(frozen=True)
 class RunSpec:
     """Run settings: cam speed, length of run, time step, back end, output."""
@@ -246,11 +252,16 @@ class RunSpec:
     rpm: float
     degrees: float
     time_step: float
-    backend: str = "newmark"
+    backend: str = DEFAULT_BACKEND
     output_interval: float = 1.0  # degrees of cam rotation between output rows
     beta: float = 1.0 / 6.0
     gamma: float = 0.5
     quantities: tuple[str, ...] = ()  # extra CSV/plot columns: "q7", "q1-q9", "F2"
+
+    @property
+    def omega(self) -> float:
+        """Cam speed in rad/s (:func:`vtool.units.cam_speed`)."""
+        return cam_speed(self.rpm)
 
 
 @dataclass(frozen=True)

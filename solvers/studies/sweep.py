@@ -228,7 +228,7 @@ class ProcessRunner:
         from concurrent.futures import ProcessPoolExecutor
 
         context = multiprocessing.get_context("forkserver")
-        context.set_forkserver_preload(["vtool.solvers.studies.sweep", "vtool.solvers.newmark.backend"])
+        context.set_forkserver_preload(["vtool.solvers.studies.sweep", backends.module_of(backends.DEFAULT)])
         self.workers = workers
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt)
 
