@@ -63,3 +63,36 @@ async def test_a_path_typed_in_the_open_dialog_is_what_opens(tmp_path: Path) -> 
         await pilot.pause()
         await pilot.pause()
         assert not isinstance(app.screen, OpenDialog) and app.screen.source != str(preset.resolve())
+
+
+async def _shot_after_run(preset: str, tabs: int) -> tuple[object, str]:
+    from vtool.app.tui.screenshots import svg_text
+
+    app = make_app(preset)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        if preset.startswith("gnilka"):
+            app.screen.form.row("run.degrees").editor.value = "200"
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        await pilot.press(*["ctrl+t"] * tabs)
+        await pilot.pause(0.2)
+        return app.screen.results, svg_text(app.export_screenshot(), 120)
+
+
+async def test_at_120x40_with_the_form_the_peak_forces_and_plate_errors_are_in_view() -> None:
+    """Beside the 50-column form the valve-train summary's peak-force column and every error of
+    the plate's frequency table were cut at the right edge."""
+    trace, text = await _shot_after_run("gnilka-1a", 4)  # Summary
+    assert "cam speed" in text  # the form is shown
+    for clearance, force in zip(trace.spec.clearances, trace.peak_force, strict=True):
+        assert any(line.rstrip().endswith(f" {force:.6g}") and f"▕{clearance.name} " in line
+                   for line in text.splitlines()), (clearance.name, force)
+    run, text = await _shot_after_run("plate-table2", 0)  # Frequencies
+    assert "side a (x)" in text  # the form is shown
+    for free in run.study.free:
+        line = next(line for line in text.splitlines() if f"▕{free.case} " in line)
+        for error in free.errors_pct:
+            assert f"{error:.3f}" in line, (free.case, error, line)
