@@ -27,6 +27,7 @@ import copy
 import math
 import re
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from vtool.errors import InputError
@@ -147,12 +148,12 @@ def parse_values(field: str, text: str, max_points: int = 100_000) -> list[Any]:
     return values
 
 
-def field_unit(doc: dict[str, Any], path: str) -> str:
+def field_unit(doc: dict[str, Any], path: str, folder: Path | None = None) -> str:
     """The unit the loader states for ``path`` (asked by offering it a non-number), or ``""``."""
     from vtool.presets import load_document
 
     try:
-        load_document(set_field(doc, path, "?"))
+        load_document(set_field(doc, path, "?"), folder)
     except InputError as exc:
         if exc.field == path:
             return exc.unit
@@ -178,8 +179,10 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> Sweep
     from vtool.presets import find_preset, load_document, read_document
     from vtool.solvers.studies.sweep import Point, grid
 
-    doc = read_document(find_preset(preset))
-    spec = load_document(doc)
+    found = find_preset(preset)
+    folder = found.parent  # a lift table or pulse file the preset names sits beside it
+    doc = read_document(found)
+    spec = load_document(doc, folder)
     if spec.kind != "valvetrain":
         raise InputError("preset", preset, f"a valvetrain preset (this one is {spec.kind})")
     fields: list[tuple[str, list[Any]]] = []
@@ -197,6 +200,6 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> Sweep
         raise InputError("--set", count, f"a grid of at most {max_points} points")
     points = []
     for index, assignment in enumerate(grid(fields)):
-        points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)))))
-    units = tuple((path, field_unit(doc, path)) for path, _ in fields)
+        points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)), folder)))
+    units = tuple((path, field_unit(doc, path, folder)) for path, _ in fields)
     return SweepPlan(doc, spec, units, tuple(points))

@@ -305,7 +305,8 @@ def _seat(t: Table, n: int, cam: CamSpec, units: UnitSystem) -> SeatSpec:
     if coordinate == cam.coordinate:
         raise InputError(t.field("coordinate"), coordinate, f"a number other than the cam's ({cam.coordinate})")
     name = t.string("name", default="seat")
-    lash = t.number("lash", unit=units.length, required=False)
+    # a negative lash would be an interference: the valve held off its seat on the base circle
+    lash = t.number("lash", unit=units.length, required=False, min_value=0.0)
     if (lash is not None) == t.has("position"):
         raise InputError(t.field("position"), t.raw("position"), "either position or lash, not both", units.length)
     low, high = BOUNDS["position"]
