@@ -31,6 +31,7 @@ from vtool.errors import InputError, PresetWarning
 from vtool.presets.fields import Table, as_float
 from vtool.presets.lift_table import read_lift_table
 from vtool.solvers.model.assembly import split_members, unsplit_members
+from vtool.solvers.model.hertz import MIN_RESTITUTION, check_restitution
 from vtool.solvers.model.spec import (
     BAR,
     BEAM,
@@ -400,6 +401,10 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int,
         restitution = t.number("restitution", default=0.0, min_value=0.0, max_value=1.0)
         impact = t.string("impact", choices=IMPACT_LAWS) if t.raw("impact") is not None else None
         contact = _compliance(t, state, units)
+        if contact.get("contact") == HERTZ and not check_restitution(restitution):
+            raise InputError(t.field("restitution"), restitution,
+                             f">= {MIN_RESTITUTION} and <= 1 for a hertz contact (Hunt-Crossley damping gives e = 0 "
+                             f"only at infinite damping; a rigid contact takes 0)")
         t.finish()
         result.append(ClearanceSpec(name, ahead, behind, kind, state, restitution, impact, **contact))
     if sum(c.behind == cam_coordinate for c in result) != 1:
