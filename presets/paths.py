@@ -28,6 +28,7 @@ import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from vtool.errors import InputError
@@ -148,12 +149,12 @@ def parse_values(field: str, text: str, max_points: int = 100_000) -> list[Any]:
     return values
 
 
-def field_unit(doc: dict[str, Any], path: str) -> str:
+def field_unit(doc: dict[str, Any], path: str, folder: Path | None = None) -> str:
     """The unit the loader states for ``path`` (asked by offering it a non-number), or ``""``."""
     from vtool.presets import load_document
 
     try:
-        load_document(set_field(doc, path, "?"))
+        load_document(set_field(doc, path, "?"), folder)
     except InputError as exc:
         if exc.field == path:
             return exc.unit
@@ -212,5 +213,5 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000, *,
         points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)), folder)))
         if progress is not None:
             progress(index + 1, count)
-    units = tuple((path, field_unit(doc, path)) for path, _ in fields)
+    units = tuple((path, field_unit(doc, path, folder)) for path, _ in fields)
     return SweepPlan(doc, spec, units, tuple(points))

@@ -32,6 +32,7 @@ from vtool.presets.fields import Table, as_float
 from vtool.presets.lift_table import read_lift_table
 from vtool.solvers.backends import DEFAULT
 from vtool.solvers.model.assembly import split_members, unsplit_members
+from vtool.solvers.model.hertz import MIN_RESTITUTION, check_restitution
 from vtool.solvers.model.spec import (
     BAR,
     BEAM,
@@ -306,7 +307,8 @@ def _seat(t: Table, n: int, cam: CamSpec, units: UnitSystem) -> SeatSpec:
     if coordinate == cam.coordinate:
         raise InputError(t.field("coordinate"), coordinate, f"a number other than the cam's ({cam.coordinate})")
     name = t.string("name", default="seat")
-    lash = t.number("lash", unit=units.length, required=False)
+    # a negative lash would be an interference: the valve held off its seat on the base circle
+    lash = t.number("lash", unit=units.length, required=False, min_value=0.0)
     if (lash is not None) == t.has("position"):
         raise InputError(t.field("position"), t.raw("position"), "either position or lash, not both", units.length)
     low, high = BOUNDS["position"]
@@ -400,6 +402,10 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int,
         restitution = t.number("restitution", default=0.0, min_value=0.0, max_value=1.0)
         impact = t.string("impact", choices=IMPACT_LAWS) if t.raw("impact") is not None else None
         contact = _compliance(t, state, units)
+        if contact.get("contact") == HERTZ and not check_restitution(restitution):
+            raise InputError(t.field("restitution"), restitution,
+                             f">= {MIN_RESTITUTION} and <= 1 for a hertz contact (Hunt-Crossley damping gives e = 0 "
+                             f"only at infinite damping; a rigid contact takes 0)")
         t.finish()
         result.append(ClearanceSpec(name, ahead, behind, kind, state, restitution, impact, **contact))
     if sum(c.behind == cam_coordinate for c in result) != 1:

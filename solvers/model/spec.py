@@ -117,10 +117,14 @@ class ClearanceSpec:
     A linear contact acts while the parts overlap (Kelvin–Voigt): near the
     end of a contact its dashpot may pull (F < 0), a known property of the
     model; the overlap, not the force, decides when the contact ends.
-    ``hertz``: F = k δⁿ (1 + 3(1 - e)/2 · δ̇/v⁻), n = ``contact_exponent``,
-    with the Hunt–Crossley damping of the clearance's restitution e at the
-    approach velocity v⁻ of the contact's closing; it never pulls. Nonlinear:
-    the Newmark back end iterates, scipy integrates it, exact refuses it.
+    ``hertz``: F = k δⁿ (1 + a δ̇/v⁻), n = ``contact_exponent``, with
+    Hunt–Crossley damping at the approach velocity v⁻ of the contact's
+    closing; it never pulls. ``restitution`` is the rebound of a lone mass:
+    a is the root of a (1 + e) = ln((1 + a)/(1 - a e)), exact for any n
+    (:mod:`vtool.solvers.model.hertz`; Hunt and Crossley's 3(1 - e)/2 is its
+    expansion near e = 1), and a Hertz contact takes 0.01 <= e <= 1 (e = 0
+    would need infinite damping). Nonlinear: the Newmark back end iterates,
+    scipy integrates it, exact refuses it.
     """
 
     name: str
