@@ -130,7 +130,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
             stacklevel=2)
     damping = _damping(damping_table, names)
     contact = _contact(top.table("contact", required=False))
-    run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances))  # type: ignore[arg-type]
+    run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)  # type: ignore[arg-type]
     top.finish()
     spec = MechanismSpec(
         title=title,
@@ -500,10 +500,46 @@ def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...
     return tuple(value)
 
 
-RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta", "gamma", "quantities")
+RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta", "gamma", "quantities",
+            "cycles", "steady", "jump_angle", "jump_gap", "bounce_lift")
+#: [run] cycle-by-cycle and criteria ranges: key -> (min, max, unit)
+CYCLE_LIMITS: dict[str, tuple[float, float, str]] = {
+    "cycles": (1, 10_000, "cam cycles"),
+    "max_cycles": (2, 10_000, "cam cycles"),
+    "tolerance": (1e-12, 1.0, "(relative change per cycle)"),
+    "jump_angle": (0.0, 360.0, "deg"),
+}
 
 
-def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
+def _cycles(t: Table, units: Any) -> dict[str, Any]:
+    """run.cycles, run.steady = { tolerance, max_cycles } and the speed criteria (vtool.solvers.studies.steady,
+    vtool.solvers.studies.metrics); run.steady = {} takes the defaults."""
+    from vtool.solvers.studies.steady import DEFAULT_MAX_CYCLES, DEFAULT_TOLERANCE
+
+    def integer(table: Table, key: str, default: int) -> int:
+        low, high, _ = CYCLE_LIMITS[key]
+        return table.integer(key, default=default, min_value=int(low), max_value=int(high)) if table.has(key) \
+            else default
+
+    values: dict[str, Any] = {"cycles": integer(t, "cycles", 0)}
+    steady = t.table("steady", required=False)
+    if steady is not None:
+        if values["cycles"]:
+            raise InputError("run.steady", "with run.cycles", "one of run.cycles (a fixed count) or run.steady")
+        low, high, unit = CYCLE_LIMITS["tolerance"]
+        values["steady_tolerance"] = steady.number("tolerance", default=DEFAULT_TOLERANCE, min_value=low,
+                                                   max_value=high)
+        values["steady_max_cycles"] = integer(steady, "max_cycles", DEFAULT_MAX_CYCLES)
+        steady.finish()
+    low, high, unit = CYCLE_LIMITS["jump_angle"]
+    values["jump_angle"] = t.number("jump_angle", unit=unit, default=1.0, min_value=low, max_value=high)
+    for key in ("jump_gap", "bounce_lift"):
+        if t.has(key):
+            values[key] = t.number(key, unit=units.length, min_value=0.0, max_value=1e4)
+    return values
+
+
+def _run(t: Table, names: tuple[set[int], set[int]], units: Any) -> RunSpec:
     t.check_unknown(RUN_KEYS)
     def limited(key: str, default: float | None = None) -> float:
         low, high, unit = RUN_LIMITS[key]
@@ -517,8 +553,9 @@ def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
     beta = t.number("beta", default=1.0 / 6.0)
     gamma = t.number("gamma", default=0.5)
     quantities = _quantities(t, *names)
+    cycles = _cycles(t, units)
     t.finish()
-    return check_run(RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities))
+    return check_run(RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities, **cycles))
 
 
 def check_run_value(key: str, value: Any, field: str | None = None) -> Any:
@@ -625,6 +662,15 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
     }
     if r.quantities:
         doc["run"]["quantities"] = list(r.quantities)
+    if r.cycles:
+        doc["run"]["cycles"] = r.cycles
+    if r.steady_tolerance:
+        doc["run"]["steady"] = {"tolerance": r.steady_tolerance, "max_cycles": r.steady_max_cycles}
+    if r.jump_angle != 1.0:
+        doc["run"]["jump_angle"] = r.jump_angle
+    for key in ("jump_gap", "bounce_lift"):
+        if getattr(r, key) is not None:
+            doc["run"][key] = getattr(r, key)
     return doc
 
 

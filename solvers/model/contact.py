@@ -359,6 +359,8 @@ class ContactProblem:
         kept = mechanism.kept(("contact problem", mechanism.omega, rules), lambda: cls(mechanism, rules))
         problem = copy.copy(kept)
         problem.mechanism, problem.spec, problem.clf = mechanism, mechanism.spec, kept.clf.copy()
+        if mechanism.start_mask is not None:  # a carried start (Mechanism.with_start)
+            problem.start_mask = mechanism.start_mask
         return problem
 
     def velocity_scale(self) -> float:

@@ -261,6 +261,19 @@ class RunSpec:
     beta: float = 1.0 / 6.0
     gamma: float = 0.5
     quantities: tuple[str, ...] = ()  # extra CSV/plot columns: "q7", "q1-q9", "F2"
+    # cycle by cycle (vtool.solvers.studies.steady): a fixed number of cam cycles (0: run ``degrees``), or
+    # until the cycle's start state and metrics change by less than steady_tolerance (0: off), at most
+    # steady_max_cycles; ``degrees`` is then unused
+    cycles: int = 0
+    steady_tolerance: float = 0.0
+    steady_max_cycles: int = 0
+    # speed criteria (vtool.solvers.studies.metrics): the follower leaves the cam when the cam contact is
+    # open during the lift event for more than jump_angle (deg) with a gap above jump_gap (length); the
+    # valve bounces when it re-opens after seating by more than bounce_lift (length); None: the default
+    # share of the cam's lift (metrics.GAP_FRACTION)
+    jump_angle: float = 1.0
+    jump_gap: float | None = None
+    bounce_lift: float | None = None
 
     @property
     def omega(self) -> float:
