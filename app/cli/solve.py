@@ -16,7 +16,12 @@ from typing import Any
 
 import click
 
-from vtool.app.cli.options import impact_option, start_velocities_option
+from vtool.app.cli.options import (
+    figure_option,
+    impact_option,
+    start_velocities_option,
+    write_figure,
+)
 from vtool.errors import InputError
 from vtool.solvers.backends import available
 from vtool.solvers.cost import MAX_STEPS
@@ -56,13 +61,14 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
               help="Write the response as CSV (per output interval, or per step with --every-step).")
 @click.option("--every-step", is_flag=True, help="CSV rows at every time step (and event) instead of per degree.")
 @click.option("--plot", is_flag=True, help="Draw force, displacement and configuration charts (not with --json).")
+@figure_option
 @click.option("--json", "as_json", is_flag=True, help="Print the summary (with the event list) as JSON.")
 @click.option("--events", "show_events", is_flag=True, help="Also print the event list.")
 @impact_option
 @start_velocities_option
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
           max_steps: float | None, csv_path: str | None, every_step: bool, plot: bool, as_json: bool,
-          show_events: bool, impact: str | None, start: str | None) -> None:
+          show_events: bool, impact: str | None, start: str | None, figure_path: Path | None) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
@@ -86,19 +92,20 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
             if value is not None:
                 raise InputError(flag, value, f"no {flag} for {preset}: it is a {spec.kind} preset "
                                  f"({flag} applies to valvetrain presets)")
-        resolve(kind.solve)(spec, csv_file, plot, as_json)
+        resolve(kind.solve)(spec, csv_file, plot, as_json, figure=figure_path)
         return
     if impact is not None or start is not None:
         from vtool.solvers.studies.compare import with_model
 
         spec = with_model(spec, impact, start)
     run_valvetrain(spec, backend, dt, rpm, degrees, csv_file, every_step, plot, as_json, show_events,
-                   max_steps=max_steps)
+                   max_steps=max_steps, figure=figure_path)
 
 
 def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float | None,
                    degrees: float | None, csv_path: Path | None, every_step: bool, plot: bool,
-                   as_json: bool, show_events: bool, *, max_steps: float | None = None) -> None:
+                   as_json: bool, show_events: bool, *, max_steps: float | None = None,
+                   figure: Path | None = None) -> None:
     from vtool.app.cli.progress import DelayedProgress
     from vtool.files import json_text
     from vtool.presets.valvetrain import with_run_overrides
@@ -137,6 +144,10 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
         from vtool.app.valvetrain_charts import all_charts
 
         click.echo(all_charts(trace))
+    if figure is not None:
+        from vtool.presets.charts import trace_charts
+
+        write_figure(trace_charts(trace), figure)
 
 
 def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()) -> None:
