@@ -178,8 +178,10 @@ def _transient(t: Table | None, cases: tuple[Case, ...], plate: Plate) -> Transi
 
 
 def load(doc: dict[str, Any], folder: Path | None = None) -> PlateSpec:
-    """Validate a parsed plate preset and return its frozen spec (echoed values cut short); a plate preset
-    names no file, so ``folder`` (the kinds table's loader signature) is not read."""
+    """Validate a parsed plate preset and return its frozen spec (echoed values cut short).
+
+    ``folder`` (the preset's folder) is accepted like every loader's; a plate preset names no file.
+    """
     try:
         return _load(doc)
     except InputError as exc:

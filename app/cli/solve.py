@@ -18,6 +18,7 @@ from typing import Any
 
 import click
 
+from vtool.app.cli.options import figure_option, write_figure
 from vtool.errors import InputError
 from vtool.solvers.backends import available
 from vtool.solvers.cost import MAX_STEPS
@@ -43,13 +44,14 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
               help="Write the response as CSV (per output interval, or per step with --every-step).")
 @click.option("--every-step", is_flag=True, help="CSV rows at every time step (and event) instead of per degree.")
 @click.option("--plot", is_flag=True, help="Draw force, displacement and configuration charts (not with --json).")
+@figure_option
 @click.option("--json", "as_json", is_flag=True, help="Print the summary (with the event list) as JSON.")
 @click.option("--events", "show_events", is_flag=True, help="Also print the event list.")
 @click.option("--impact", help=f"Impact law for every clearance ({', '.join(IMPACT_LAWS)}); default: the preset's.")
 @click.option("--start", help=f"Start velocities ({', '.join(START_VELOCITIES)}); default: the preset's.")
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
           max_steps: float | None, csv_path: str | None, every_step: bool, plot: bool, as_json: bool,
-          show_events: bool, impact: str | None, start: str | None) -> None:
+          show_events: bool, impact: str | None, start: str | None, figure_path: Path | None) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
@@ -79,7 +81,7 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
     spec = load_document(doc, path.parent, overrides)
     flags = {FLAG_ARGUMENTS[flag]: value for flag, value in given.items()
              if flag in kind.run_options and flag not in fields and value is not None}
-    resolve(kind.solve)(spec, csv_file, plot, as_json, **flags)
+    resolve(kind.solve)(spec, csv_file, plot, as_json, figure=figure_path, **flags)
 
 
 #: ``vtool solve``'s run flags and the keyword that carries each to a kind's solve function
@@ -96,7 +98,7 @@ def applies_to(flag: str) -> list[str]:
 
 
 def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *, every_step: bool = False,
-                   show_events: bool = False, max_steps: float | None = None) -> None:
+                   show_events: bool = False, max_steps: float | None = None, figure: Path | None = None) -> None:
     """``vtool solve`` for a valvetrain preset (its flags that are preset fields already in ``spec``): the
     run and its summary."""
     from vtool.app.cli.progress import DelayedProgress
@@ -135,6 +137,10 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
         from vtool.app.valvetrain_charts import all_charts
 
         click.echo(all_charts(trace))
+    if figure is not None:
+        from vtool.presets.charts import trace_charts
+
+        write_figure(trace_charts(trace), figure)
 
 
 def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()) -> None:

@@ -306,7 +306,8 @@ class PlateScreen(DomainScreen):
         for element in dict.fromkeys(cases[f.case].element for f in study.free):
             free = [f for f in study.free if cases[f.case].element == element]
             tables.append(frequency_table(free, cases, f"{ELEMENT_TITLES.get(element, element)}: "
-                                                       "percentage errors of the lowest natural frequencies"))
+                                                       "percentage errors of the lowest natural frequencies",
+                                          masters_last=True))
         self.query_one("#frequencies", TextPanel).set_text("\n\n".join(tables))
         self.query_one("#case-text", TextPanel).set_text(case_text(run))
         self.query_one("#study-text", TextPanel).set_text(study_text(study))

@@ -33,6 +33,7 @@ class Mechanism:
 
     def __init__(self, spec: MechanismSpec, _shared: Mechanism | None = None) -> None:
         self.spec = spec
+        self.start_mask: int | None = None  # a carried start's configuration (with_start); None: the preset's
         if _shared is None:
             self.M, self.K = assemble_full(spec)
             self._layers: dict[frozenset[str], Layer] = {}
@@ -61,6 +62,20 @@ class Mechanism:
         if key not in self._lasting:
             self._lasting[key] = make()
         return self._lasting[key]  # type: ignore[no-any-return]  # the value make() returned for this key
+
+    def with_start(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, mask: int) -> Mechanism:
+        """This mechanism started from a given state (full elastic coordinates, cam angle zero) in
+        configuration ``mask`` instead of its static start: the next cam cycle of a run, whose state at
+        the cycle's end it is (the cam is periodic in 360 deg). The cam's offset and the force scales
+        stay the static start's, so the sources and tolerances are those of the first cycle. Every back
+        end starts from ``start`` and the contact problem's start mask (see ContactProblem.for_run)."""
+        static = self.start
+        other = Mechanism(self.spec, _shared=self)
+        other.__dict__["start"] = StaticStart(static.cam_offset, static.follower_force, static.follower_stiffness,
+                                              np.array(q, dtype=float), np.array(qd, dtype=float),
+                                              np.array(qdd, dtype=float))
+        other.start_mask = int(mask)
+        return other
 
     @cached_property
     def highest_frequency(self) -> float:
