@@ -309,16 +309,6 @@ class Trace:
             opened_at = e.cam_angle
         return result
 
-    def per_revolution(self, angles: list[float]) -> list[int]:
-        """Counts of the given angles in each whole cam revolution after the first."""
-        revolutions = int(self.cam_angle[-1] // 360.0) if len(self.cam_angle) else 0
-        counts = [0] * max(revolutions - 1, 0)
-        for angle in angles:
-            index = int(angle // 360.0) - 1
-            if 0 <= index < len(counts):
-                counts[index] += 1
-        return counts
-
     def summary(self) -> dict:
         """Counts, peaks and seating velocities per clearance, and the run statistics."""
         units = self.spec.unit_system

@@ -418,7 +418,9 @@ class ContactProblem:
     def sources_at(self, t: float) -> np.ndarray:
         """(x, v, a) of every source at t, as the kernel's src vector."""
         src = np.zeros(3 * self.ns)
-        from vtool.solvers.newmark import kernel  # numba: only the back ends that call it load it (lazy)
+        from vtool.solvers.newmark import (
+            kernel,  # numba: only the back ends that call it load it (lazy)
+        )
 
         s = self.series
         kernel.fill_sources(self.ns, self.nh, s.omega, s.const, s.cos, s.sin, t, src)
