@@ -122,8 +122,13 @@ def load_document(doc: dict[str, Any], folder: str | os.PathLike[str] | None = N
     """
     if not isinstance(doc, dict):
         raise InputError("<preset>", type(doc).__name__, "a TOML document (a table)")
-    loader = loader_for(kind_of(doc))
+    kind = kind_named(kind_of(doc))
+    loader = importlib.import_module(kind.loader)
     if overrides:
+        taken = {path for _, path in kind.overrides}  # the fields this kind takes from outside the file
+        for o in overrides:
+            if o.path not in taken:
+                raise InputError(o.source or o.path, o.value, f"no {o.source or o.path} for a {kind.name} preset")
         doc = loader.with_overrides(doc, {o.path: o.value for o in overrides})
     try:
         return loader.load(doc, None if folder is None else Path(folder))
