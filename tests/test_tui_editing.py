@@ -96,3 +96,28 @@ async def test_at_120x40_with_the_form_the_peak_forces_and_plate_errors_are_in_v
         line = next(line for line in text.splitlines() if f"▕{free.case} " in line)
         for error in free.errors_pct:
             assert f"{error:.3f}" in line, (free.case, error, line)
+
+
+async def test_the_sweep_tabs_inputs_are_labelled_and_readable_beside_the_form() -> None:
+    """The sweep tab's four inputs and its metric had no labels (a placeholder vanishes with a
+    value), and at 120 x 40 beside the form the values input showed "9000:12"."""
+    from textual.widgets import Input, Label, Select
+
+    from vtool.app.tui.screenshots import svg_text
+    from vtool.app.tui.sweep import SweepPane
+
+    app = make_app()
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        app.screen.tabs.active = "tab-sweep"
+        await pilot.pause()
+        await pilot.pause(0.2)
+        pane = app.screen.query_one(SweepPane)
+        for editor in [*pane.query(Input), *pane.query(Select)]:
+            siblings = list(editor.parent.children)
+            before = siblings[siblings.index(editor) - 1]
+            assert isinstance(before, Label), editor.id
+        text = svg_text(app.export_screenshot(), 120)
+        for shown in ("field run.rpm", "values 9000:12000:250", "metric spring_margin", "CSV file sweep.csv"):
+            assert shown in text, shown
+        assert "fixed " in text

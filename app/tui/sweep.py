@@ -35,7 +35,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.message import Message
 from textual.widget import Widget
-from textual.widgets import Button, Input, ProgressBar, Select, Static
+from textual.widgets import Button, Input, Label, ProgressBar, Select, Static
 from textual.worker import Worker, WorkerState, get_current_worker
 
 from vtool.app.tui.widgets import ChartView, ChoiceSelect, TextPanel
@@ -103,10 +103,11 @@ class SweepPane(Widget):
 
     DEFAULT_CSS = """
     SweepPane { height: 1fr; }
-    SweepPane Horizontal { height: auto; }
+    SweepPane .sweep-row { height: 1; }
+    SweepPane .sweep-label { width: auto; padding: 0 1; color: $text-muted; }
     SweepPane Input { width: 1fr; }
-    SweepPane #sweep-metric { width: 30; }
-    SweepPane Button { min-width: 10; }
+    SweepPane #sweep-metric { width: 28; }
+    SweepPane Button { width: auto; min-width: 0; margin-right: 1; }
     SweepPane #sweep-status { height: auto; }
     SweepPane ChartView { height: 2fr; }
     SweepPane TextPanel { height: 1fr; }
@@ -130,19 +131,28 @@ class SweepPane(Widget):
         if not self.composed:
             return
         field, values, fixed, metric = self._initial
+        csv = "sweep.csv"
         with Vertical():
-            with Horizontal():
-                yield Input(field, placeholder="field, e.g. run.rpm", id="sweep-field")
-                yield Input(values, placeholder="start:stop:step or a,b,c", id="sweep-values")
-                yield Input(fixed, placeholder="fixed settings, e.g. run.degrees=460", id="sweep-fixed")
+            # each input has its label on its left; compact widgets, one line each (the chart gets the height)
+            with Horizontal(classes="sweep-row"):
+                yield Label("field", classes="sweep-label")
+                yield Input(field, placeholder="e.g. run.rpm", id="sweep-field", compact=True)
+                yield Label("values", classes="sweep-label")
+                yield Input(values, placeholder="start:stop:step or a,b,c", id="sweep-values", compact=True)
+            with Horizontal(classes="sweep-row"):
+                yield Label("fixed", classes="sweep-label")
+                yield Input(fixed, placeholder="e.g. run.degrees=460; damping.factor=2", id="sweep-fixed",
+                            compact=True)
+                yield Label("metric", classes="sweep-label")
                 names = self._metric_names()
                 yield ChoiceSelect([(m, m) for m in names], value=metric if metric in names else names[0],
-                                   allow_blank=False, id="sweep-metric")
-            with Horizontal():
-                yield Button("Run", id="sweep-run", variant="primary")
-                yield Button("Cancel", id="sweep-cancel")
-                yield Input("sweep.csv", placeholder="CSV file", id="sweep-csv")
-                yield Button("Export CSV", id="sweep-export")
+                                   allow_blank=False, compact=True, id="sweep-metric")
+            with Horizontal(classes="sweep-row"):
+                yield Button("Run", id="sweep-run", variant="primary", compact=True)
+                yield Button("Cancel", id="sweep-cancel", compact=True)
+                yield Label("CSV file", classes="sweep-label")
+                yield Input(csv, placeholder="e.g. sweep.csv", id="sweep-csv", compact=True)
+                yield Button("Export CSV", id="sweep-export", compact=True)
             yield ProgressBar(total=1, show_eta=True, id="sweep-progress")
             yield Static("", id="sweep-status", markup=False)
             yield ChartView("run a sweep to see the chart", id="sweep-chart")
@@ -276,10 +286,13 @@ class SweepPane(Widget):
 
     def on_sweep_progressed(self, message: SweepProgressed) -> None:
         self.query_one("#sweep-progress", ProgressBar).update(total=message.total, progress=message.done)
-        if message.checking and message.done == 1:
-            self.status.update(f"checking {message.total} points ... (Cancel stops)")
-        elif not message.checking and message.done == 0:
-            self.status.update(f"running {message.total} points ...")
+        if not self.running:
+            return  # a late message of a stopped worker
+        # (every message says it: progress messages collapse, so a particular one may never arrive)
+        if message.checking:
+            self.status.update(f"checking {message.total} points: {message.done} valid ... (Cancel stops)")
+        else:
+            self.status.update(f"running {message.total} points ... (Cancel stops)")
 
     def on_sweep_finished(self, message: SweepFinished) -> None:
         if message.outcome is None:  # refused or stopped before any point ran
