@@ -121,3 +121,39 @@ async def test_the_sweep_tabs_inputs_are_labelled_and_readable_beside_the_form()
         for shown in ("field run.rpm", "values 9000:12000:250", "metric spring_margin", "CSV file sweep.csv"):
             assert shown in text, shown
         assert "fixed " in text
+
+
+async def test_a_table_cam_preset_saved_from_the_tui_has_its_table_inline(tmp_path: Path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Saved from the presets folder, the copy kept ``lift_table = "ramped-cam.csv"``, a path the
+    copy's own folder does not have (docs/cams.md: a saved preset writes the table inline)."""
+    import tomllib
+
+    from vtool.app.tui.dialogs import PathDialog
+    from vtool.presets import find_preset, load_preset, valvetrain
+
+    shipped = Path(find_preset("ramped-cam"))
+    monkeypatch.chdir(shipped.parent)  # where the relative reference still loads
+    app = make_app("ramped-cam", config_dir=tmp_path)
+    target = tmp_path / "elsewhere" / "mine.toml"
+    target.parent.mkdir()
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        app.screen.form.row("run.rpm").editor.value = "5000"
+        await pilot.pause()
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        assert isinstance(app.screen, PathDialog)
+        app.screen.query_one("#path-input").value = str(target)
+        await pilot.press("enter")
+        await pilot.pause()
+        assert app.screen.status_log[-1].startswith(f"saved {target} (comments kept"), app.screen.status_log[-1]
+    text = target.read_text()
+    cam = tomllib.loads(text)["cam"]
+    assert "lift_table" not in cam and len(cam["angles"]) == len(cam["lifts"]) > 10
+    assert 'inline copy of lift_table = "ramped-cam.csv"' in text
+    assert "# Prescribed coordinates." in text  # the file's own comments stay
+    monkeypatch.chdir(tmp_path)
+    saved = load_preset(str(target))
+    expected = valvetrain.dump(load_preset("ramped-cam"))
+    expected["run"]["rpm"] = 5000
+    assert valvetrain.dump(saved) == expected
