@@ -72,6 +72,20 @@ def descriptor_stderr() -> Iterator[None]:
                 sys.stderr = replaced
 
 
+def failure_text(error: BaseException | None) -> str:
+    """A failed sweep in one line: a bad input or a failed run as it says itself; anything else
+    (a failure of the program, not of the input) says the sweep could not be completed."""
+    from vtool.errors import InputError, RunError
+
+    if isinstance(error, InputError):
+        return error.one_line()
+    lines = str(error).strip().splitlines() if error is not None else []
+    text = lines[0].strip() if lines else ""
+    if isinstance(error, RunError):
+        return text or "a run failed"
+    return f"the sweep could not be completed: {text or type(error).__name__}"
+
+
 class SweepProgressed(Message):
     """``done`` of ``total`` points are finished (``checking``: validated, before any runs)."""
 
@@ -123,6 +137,7 @@ class SweepPane(Widget):
         self.plan: Any = None
         self.outcome: Any = None
         self.worker: Worker[Any] | None = None
+        self.status_log: list[str] = []  # every status message, in order (tests read them)
         # lazy: the widgets are made when the pane is first shown (a tab not yet opened costs the screen's
         # start nothing: the valve-train screen's Sweep tab was 25 of its widgets)
         self.composed = not lazy
@@ -186,6 +201,12 @@ class SweepPane(Widget):
     def status_text(self) -> str:
         return str(self.status.content)
 
+    def set_status(self, text: str, log: bool = True) -> None:
+        """Show ``text`` on the pane's status line; every message but progress is kept in ``status_log``."""
+        if log:
+            self.status_log.append(text)
+        self.status.update(text)
+
     @property
     def chart(self) -> ChartView:
         return self.query_one("#sweep-chart", ChartView)
@@ -212,7 +233,7 @@ class SweepPane(Widget):
         """Start the worker: it checks every point (errors on the status line), then runs them."""
         self.plan = None
         self.query_one("#sweep-progress", ProgressBar).update(total=None, progress=0)
-        self.status.update("checking the points ... (Cancel stops)")
+        self.set_status("checking the points ... (Cancel stops)")
         self.worker = self._work(self.preset, self.assignments())
 
     @work(thread=True, exclusive=True, exit_on_error=False, group="sweep")
@@ -249,22 +270,29 @@ class SweepPane(Widget):
     def cancel(self) -> None:
         if self.running and self.worker is not None:
             self.worker.cancel()
-            self.status.update("stopping ...")
+            self.set_status("stopping ...")
 
     def export_csv(self, path: str | Path | None = None) -> None:
+        from vtool.errors import InputError
         from vtool.files import write_atomic
         from vtool.solvers.studies.sweep import results_csv
 
         if self.outcome is None or not self.outcome.results:
-            self.status.update("error: nothing to export (run a sweep first)")
+            self.set_status("error: nothing to export (run a sweep first)")
             return
         target = Path(path or self._input("csv").value.strip() or "sweep.csv")
         try:
             write_atomic(target, results_csv(self.outcome.results, self.plan.fields, self.plan.spec))
-        except OSError as exc:
-            self.status.update(f"error: {target}: {exc.strerror}")
+        except InputError as exc:
+            self.set_status(f"error: {exc.one_line()}")
             return
-        self.status.update(f"wrote {len(self.outcome.results)} rows to {target}")
+        except OSError as exc:
+            self.set_status(f"error: {target}: {exc.strerror}")
+            return
+        except ValueError:  # a NUL in the path
+            self.set_status(f"error: {InputError('CSV file', str(target), 'a file path without NUL').one_line()}")
+            return
+        self.set_status(f"wrote {len(self.outcome.results)} rows to {target}")
 
     # ----- handlers -----
     @on(Button.Pressed, "#sweep-run")
@@ -290,25 +318,25 @@ class SweepPane(Widget):
             return  # a late message of a stopped worker
         # (every message says it: progress messages collapse, so a particular one may never arrive)
         if message.checking:
-            self.status.update(f"checking {message.total} points: {message.done} valid ... (Cancel stops)")
+            self.set_status(f"checking {message.total} points: {message.done} valid ... (Cancel stops)", log=False)
         else:
-            self.status.update(f"running {message.total} points ... (Cancel stops)")
+            self.set_status(f"running {message.total} points ... (Cancel stops)", log=message.done == 0)
 
     def on_sweep_finished(self, message: SweepFinished) -> None:
         if message.outcome is None:  # refused or stopped before any point ran
-            self.status.update(f"error: {message.error}" if message.error else
+            self.set_status(f"error: {message.error}" if message.error else
                                f"stopped while checking the points ({message.checked} checked): nothing ran")
             return
         self.plan = message.plan
         self.outcome = message.outcome
         done = len(message.outcome.results)
         state = "finished" if message.outcome.complete else "stopped"
-        self.status.update(f"{state}: {done} of {message.outcome.total} points in {message.outcome.wall_time:.2f} s")
+        self.set_status(f"{state}: {done} of {message.outcome.total} points in {message.outcome.wall_time:.2f} s")
         self._draw()
 
     def on_worker_state_changed(self, event: Worker.StateChanged) -> None:
         if event.worker is self.worker and event.state == WorkerState.ERROR:
-            self.status.update(f"error: {event.worker.error}")
+            self.set_status(f"error: {failure_text(event.worker.error)}")
 
     def _draw(self) -> None:
         from vtool.solvers.studies.metrics import metric_columns
