@@ -119,6 +119,8 @@ class ValveTrainScreen(DomainScreen):
     MODE = "valvetrain"
     DEFAULT_PRESET = "gnilka-1a"
     TITLE_TEXT = "VALVE TRAIN"
+    # a table cam's file is written inline (docs/cams.md): a saved copy must not depend on its folder
+    FILE_REFERENCES = ((("cam",), "lift_table", ("angles", "lifts")),)
 
     def result_panes(self) -> list[TabPane]:
         """The result tabs, in order: a new tab is one more pane in this list."""
