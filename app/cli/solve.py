@@ -19,7 +19,7 @@ import click
 from vtool.app.cli.options import impact_option, start_velocities_option
 from vtool.errors import InputError
 from vtool.solvers.backends import available
-from vtool.solvers.cost import MAX_STEPS
+from vtool.solvers.cost import MAX_SCIPY_STEPS, MAX_STEPS
 
 
 def _run_flag(key: str) -> Any:
@@ -51,7 +51,7 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @click.option("--degrees", type=float, callback=_run_flag("degrees"),
               help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's.")
 @click.option("--max-steps", type=float, callback=_max_steps,
-              help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}).")
+              help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}; scipy {MAX_SCIPY_STEPS:.0e}).")
 @click.option("--csv", "csv_path", type=click.Path(),  # a str: '' stays '' in the error
               help="Write the response as CSV (per output interval, or per step with --every-step).")
 @click.option("--every-step", is_flag=True, help="CSV rows at every time step (and event) instead of per degree.")
