@@ -140,9 +140,11 @@ class Trace:
             row = int(np.argmin(self.contact_force[:, k]))
             named.append(f"{self.force_label(int(k))} ({self.spec.clearances[k].name}) {tensile[k]:.4g} {unit} "
                          f"at {self.cam_angle[row]:.1f} deg")
+        backend = self.statistics.backend
+        remedy = {"scipy": "a tighter rtol, or the exact back end", "newmark": "a smaller time step, or the exact "
+                  "back end"}.get(backend, "another back end to compare")
         return (f"contact forces of the wrong sign: {', '.join(named)}: a closed contact pulled, a release "
-                f"the {self.statistics.backend} back end missed; the events and peaks after it are not to be "
-                f"trusted (a tighter rtol, or the newmark or exact back end)")
+                f"the {backend} back end missed; the events and peaks after it are not to be trusted ({remedy})")
 
     # ----- columns by the engineer's names -----
     def coordinate(self, number: int, rows: slice = slice(None)) -> np.ndarray:

@@ -99,7 +99,7 @@ def _chart(resp: Any, exact: Any, quantity: str, label: str) -> str:
     from vtool.app.plots import line_chart
 
     series = {f"{resp.case} {resp.scheme}": getattr(resp, quantity)}
-    if exact is not None and not (quantity == "acceleration" and not exact.acceleration_converged):
+    if exact is not None and not (quantity == "acceleration" and not exact.acceleration_defined):
         series["exact"] = np.interp(resp.tau, exact.tau, getattr(exact, quantity))
     return line_chart(resp.tau, series, title=f"centre {quantity}, {resp.load} step load",
                       xlabel="t / T (exact fundamental period)", ylabel=label, width=_width(), height=18)
