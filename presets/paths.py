@@ -26,6 +26,7 @@ from __future__ import annotations
 import copy
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -160,6 +161,10 @@ def field_unit(doc: dict[str, Any], path: str, folder: Path | None = None) -> st
     return ""
 
 
+class SweepCancelled(Exception):
+    """:func:`plan_sweep` stopped because its ``cancel`` said so (nothing was planned)."""
+
+
 @dataclass(frozen=True)
 class SweepPlan:
     """A validated sweep: the base document and spec, the swept fields with units, every point."""
@@ -170,21 +175,24 @@ class SweepPlan:
     points: tuple[Any, ...]  # vtool.solvers.studies.sweep.Point
 
 
-def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> SweepPlan:
+def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000, *,
+               progress: Callable[[int, int], None] | None = None,
+               cancel: Callable[[], bool] | None = None) -> SweepPlan:
     """Parse ``FIELD=VALUES`` assignments and validate every grid point with the preset loader.
 
     Nothing runs: a bad field, range or value raises the loader's own one-line
-    InputError before any work starts.
+    InputError before any work starts. Validating a point costs about 10 ms, so a
+    large grid takes minutes: ``progress(done, total)`` is called as points are
+    checked and ``cancel()`` between them (True raises :class:`SweepCancelled`).
     """
     from vtool.presets import find_preset, load_document, read_document
+    from vtool.presets.kinds import require_kind
     from vtool.solvers.studies.sweep import Point, grid
 
-    found = find_preset(preset)
-    folder = found.parent  # a lift table or pulse file the preset names sits beside it
-    doc = read_document(found)
+    folder = find_preset(preset).parent
+    doc = read_document(find_preset(preset))
     spec = load_document(doc, folder)
-    if spec.kind != "valvetrain":
-        raise InputError("preset", preset, f"a valvetrain preset (this one is {spec.kind})")
+    require_kind(spec, "valvetrain", "a sweep")
     fields: list[tuple[str, list[Any]]] = []
     for text in sets:
         path, sep, values = text.partition("=")
@@ -200,6 +208,10 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> Sweep
         raise InputError("--set", count, f"a grid of at most {max_points} points")
     points = []
     for index, assignment in enumerate(grid(fields)):
+        if cancel is not None and cancel():
+            raise SweepCancelled
         points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)), folder)))
+        if progress is not None:
+            progress(index + 1, count)
     units = tuple((path, field_unit(doc, path, folder)) for path, _ in fields)
     return SweepPlan(doc, spec, units, tuple(points))

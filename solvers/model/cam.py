@@ -338,7 +338,7 @@ def cam_report(spec, points: int = 3600, top: int = 8) -> dict:  # type: ignore[
     units = spec.unit_system
     cam = spec.cam
     fit = cam_fit(cam)
-    omega = spec.run.rpm * math.pi / 30.0
+    omega = spec.run.omega
     theta = np.linspace(0.0, 2 * math.pi, points, endpoint=False)
     L, v, acc, jerk = derivatives(fit.c0, fit.a, fit.b, theta)
     lift_amplitude, acc_amplitude = spectrum(fit.a, fit.b)

@@ -321,7 +321,7 @@ class ContactProblem:
         self.spec = spec
         self.rules = rules
         self.n, self.ncl = spec.n_coordinates, len(spec.clearances)
-        self.tables = mechanism.configuration_tables()
+        self.tables = mechanism.shared(ConfigurationTables, lambda: ConfigurationTables(mechanism))
         self.series = source_series(mechanism)
         self.ns, self.nh = self.series.n_sources, self.series.n_harmonics
         self.source_numbers = self.series.numbers
@@ -359,6 +359,8 @@ class ContactProblem:
         kept = mechanism.kept(("contact problem", mechanism.omega, rules), lambda: cls(mechanism, rules))
         problem = copy.copy(kept)
         problem.mechanism, problem.spec, problem.clf = mechanism, mechanism.spec, kept.clf.copy()
+        if mechanism.start_mask is not None:  # a carried start (Mechanism.with_start)
+            problem.start_mask = mechanism.start_mask
         return problem
 
     def velocity_scale(self) -> float:
