@@ -226,7 +226,7 @@ PLATE_QUANTITIES = ("displacement", "velocity", "acceleration")
 def plate_response_chart(resp: Any, exact: Any, quantity: str, subject: str = "") -> Chart:
     """One centre history of a transient run against the exact modal solution (dimensionless)."""
     curves = [curve(f"{resp.case} {resp.scheme}", resp.tau, getattr(resp, quantity))]
-    if exact is not None and not (quantity == "acceleration" and not exact.acceleration_converged):
+    if exact is not None and not (quantity == "acceleration" and not exact.acceleration_defined):
         curves.append(curve("exact", resp.tau, np.interp(resp.tau, exact.tau, getattr(exact, quantity))))
     return Chart(f"centre {quantity}, {resp.load} step load", "t / T (exact fundamental period) (-)",
                  (Panel(tuple(curves), PLATE_LABELS[quantity]),), subject)

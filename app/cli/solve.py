@@ -21,7 +21,7 @@ import click
 from vtool.app.cli.options import figure_option, write_figure
 from vtool.errors import InputError
 from vtool.solvers.backends import available
-from vtool.solvers.cost import MAX_STEPS
+from vtool.solvers.cost import MAX_SCIPY_STEPS, MAX_STEPS
 from vtool.solvers.model.spec import IMPACT_LAWS, START_VELOCITIES
 
 
@@ -39,7 +39,7 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @click.option("--degrees", type=float,
               help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's run.degrees.")
 @click.option("--max-steps", type=float, callback=_max_steps,
-              help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}).")
+              help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}; scipy {MAX_SCIPY_STEPS:.0e}).")
 @click.option("--csv", "csv_path", type=click.Path(),  # a str: '' stays '' in the error
               help="Write the response as CSV (per output interval, or per step with --every-step).")
 @click.option("--every-step", is_flag=True, help="CSV rows at every time step (and event) instead of per degree.")
