@@ -58,11 +58,14 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @click.option("--plot", is_flag=True, help="Draw force, displacement and configuration charts (not with --json).")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary (with the event list) as JSON.")
 @click.option("--events", "show_events", is_flag=True, help="Also print the event list.")
+@click.option("--orders", "orders", metavar="QUANTITY",
+              help="Also print the cam-order spectrum of QUANTITY (q7, q1-q9, F7) over the evaluated cycles: "
+                   "a table, and with --plot a chart with the natural frequencies marked.")
 @impact_option
 @start_velocities_option
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
           max_steps: float | None, csv_path: str | None, every_step: bool, plot: bool, as_json: bool,
-          show_events: bool, impact: str | None, start: str | None) -> None:
+          show_events: bool, orders: str | None, impact: str | None, start: str | None) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
@@ -81,7 +84,7 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
     if spec.kind != "valvetrain":
         given = {"--backend": backend, "--dt": dt, "--rpm": rpm, "--degrees": degrees,
                  "--max-steps": max_steps, "--every-step": every_step or None,
-                 "--events": show_events or None, "--impact": impact, "--start": start}
+                 "--events": show_events or None, "--impact": impact, "--start": start, "--orders": orders}
         for flag, value in given.items():
             if value is not None:
                 raise InputError(flag, value, f"no {flag} for {preset}: it is a {spec.kind} preset "
@@ -93,12 +96,13 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
 
         spec = with_model(spec, impact, start)
     run_valvetrain(spec, backend, dt, rpm, degrees, csv_file, every_step, plot, as_json, show_events,
-                   max_steps=max_steps)
+                   max_steps=max_steps, orders=orders)
 
 
 def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float | None,
                    degrees: float | None, csv_path: Path | None, every_step: bool, plot: bool,
-                   as_json: bool, show_events: bool, *, max_steps: float | None = None) -> None:
+                   as_json: bool, show_events: bool, *, max_steps: float | None = None,
+                   orders: str | None = None) -> None:
     from vtool.app.cli.progress import DelayedProgress
     from vtool.files import json_text
     from vtool.presets.valvetrain import with_run_overrides
@@ -124,10 +128,26 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
                                  stream=stream, before_run=before_run)
     finally:
         progress.close()
+    from vtool.solvers.studies.metrics import evaluation_summary
+
+    evaluation = evaluation_summary(trace)
+    spectrum = None
+    if orders is not None:
+        from vtool.solvers.studies.orders import spectrum as order_spectrum
+
+        spectrum = order_spectrum(trace, orders)
     if as_json:
-        click.echo(json_text(trace.summary()))
+        summary = trace.summary() | {"evaluation": evaluation}
+        if spectrum is not None:
+            summary["orders"] = spectrum.as_dict()
+        click.echo(json_text(summary))
     else:
         click.echo(trace.summary_text())
+        click.echo("")
+        click.echo("\n".join(evaluation["lines"]))
+        if spectrum is not None:
+            click.echo("")
+            click.echo(spectrum.table())
         if show_events:
             click.echo("")
             click.echo(trace.event_table())
@@ -137,6 +157,11 @@ def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float 
         from vtool.app.valvetrain_charts import all_charts
 
         click.echo(all_charts(trace))
+        if spectrum is not None:
+            from vtool.app.order_charts import order_chart
+            from vtool.solvers.studies.orders import natural_frequencies
+
+            click.echo(order_chart(spectrum, natural_frequencies(trace)))
 
 
 def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()) -> None:

@@ -446,3 +446,31 @@ def failed_metrics(spec: MechanismSpec) -> dict[str, float]:
     """All metrics NaN (a run that failed), with the same keys."""
     return {name: NAN for name, _ in metric_columns(spec)}
 
+
+def evaluation_summary(trace: Trace) -> dict:
+    """What a run's summary adds: the window, the criteria, and the window's and the start-up's metrics,
+    as lines of text and as JSON-ready values (units as ``*_unit`` keys, NaN as None)."""
+    spec = trace.spec
+    units = dict(metric_columns(spec))
+    metrics = run_metrics(trace)
+    criteria = Criteria.of(spec)
+    start, end = evaluation_window(trace)
+
+    def shown(name: str) -> str:
+        value = metrics[name]
+        text = "-" if isinstance(value, float) and math.isnan(value) else f"{value:.6g}"
+        return f"{name} {text}{' ' + units[name] if units[name] else ''}"
+
+    window = ["cam_separations", "cam_separation_angle", "cam_separation_duration", "seat_bounces",
+              "seating_velocity_max", "lift_loss"] + [n for n in units if n.startswith("peak_")]
+    lines = [window_text(trace), criteria.text(spec.unit_system.length),
+             "in the window: " + ", ".join(shown(n) for n in window),
+             "start-up shock (first revolution): " + ", ".join(shown(n) for n in ("startup_peak_force",
+                                                                               "startup_seating_velocity"))]
+    values = {n: (None if isinstance(v, float) and math.isnan(v) else v) for n, v in metrics.items()
+              if n != "wall_time"}
+    return {"lines": lines, "window_deg": [start, end], "text": lines[0],
+            "settled": None if trace.cycles is None else trace.cycles.settled,
+            "criteria": criteria.as_dict(spec.unit_system.length),
+            "metrics": values | {f"{n}_unit": units[n] for n in values if units.get(n)}}
+
