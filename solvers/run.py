@@ -22,7 +22,7 @@ import numpy as np
 from vtool.errors import PresetWarning, RunError
 from vtool.solvers import backends, cost
 from vtool.solvers.model.mechanism import Mechanism, assemble
-from vtool.solvers.model.preflight import seat_reach_warning
+from vtool.solvers.model.preflight import run_warnings
 from vtool.solvers.model.spec import MechanismSpec, RunSpec
 from vtool.solvers.studies.steady import is_cyclic, run_degrees, simulate_cycles
 from vtool.solvers.trace import CsvStream, Trace
@@ -141,9 +141,8 @@ def simulate(
     mechanism = _assemble(spec)
     in_memory_every_step = every_step and not (stream is not None and stream.thin)
     cost.check(run_cost(mechanism, in_memory_every_step), max_steps, max_bytes)
-    reach = seat_reach_warning(mechanism)
-    if reach is not None:
-        warnings.warn(PresetWarning(reach), stacklevel=2)
+    for message in run_warnings(mechanism):
+        warnings.warn(PresetWarning(message), stacklevel=2)
     if options is None:
         options = backend.options_from_run(spec.run, every_step)
     if before_run is not None:

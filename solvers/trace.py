@@ -199,6 +199,15 @@ class Trace:
         for expression in quantities:
             header.append(f"{expression} ({self.quantity_unit(expression)})")
             columns.append(lambda rows, expression=expression: self.quantity(expression, rows))
+        if self.spec.follower is not None:  # cam contact stress at each row (solvers/model/camstress.py)
+            from vtool.solvers.model.camstress import row_unit, stress_rows
+
+            cam = next(i for i, c in enumerate(self.spec.clearances) if c.behind == self.spec.cam.coordinate)
+            names = list(stress_rows(self.spec, self.cam_angle[:1], self.contact_force[:1, cam]))
+            for name in names:
+                header.append(f"cam_{name} ({row_unit(self.spec, name)})")
+                columns.append(lambda rows, name=name: stress_rows(
+                    self.spec, self.cam_angle[rows], self.contact_force[rows, cam])[name])
         return header + ["configuration", "closed"], columns
 
     def configuration_csv(self, mask: int) -> str:
@@ -372,7 +381,21 @@ class Trace:
                 for e in self.events
             ],
             "clearances": clearances,
-        }
+        } | self.follower_summary()
+
+    def follower_summary(self) -> dict:
+        """The cam contact's stress extremes (with a [follower]) and the [checks] judged (with limits)."""
+        result: dict = {}
+        if self.spec.follower is not None:
+            from vtool.solvers.model.camstress import stress_summary
+
+            cam = next(c.name for c in self.spec.clearances if c.behind == self.spec.cam.coordinate)
+            result["contact_stress"] = stress_summary(self.spec, self.cam_angle, self.force(cam))
+        if self.spec.checks:
+            from vtool.solvers.studies.checks import evaluate
+
+            result["checks"] = [c.as_dict() for c in evaluate(self.spec, self)]
+        return result
 
     def summary_text(self) -> str:
         s = self.summary()
@@ -414,6 +437,14 @@ class Trace:
                 if any(heights):
                     lines.append(f"{c['clearance']} largest bounce height per revolution ({c['bounce_height_unit']}, "
                                  f"at the output interval): " + ", ".join(f"{h:.4g}" for h in heights))
+        if "contact_stress" in s:
+            from vtool.solvers.model.camstress import stress_text
+
+            lines += stress_text(s["contact_stress"])
+        if "checks" in s:
+            from vtool.solvers.studies.checks import checks_text
+
+            lines += checks_text(s["checks"])
         if not s["success"]:
             lines.append(f"run stopped: {s['message']}")
         return "\n".join(lines)

@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import click
+
+from vtool.app.cli.options import figure_option, write_figure
 
 
 @click.group()
@@ -16,7 +19,8 @@ def cam() -> None:
 @click.argument("preset")
 @click.option("--plot", is_flag=True, help="Draw lift, velocity, acceleration and jerk against cam angle.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
-def show(preset: str, plot: bool, as_json: bool) -> None:
+@figure_option
+def show(preset: str, plot: bool, as_json: bool, figure_path: Path | None) -> None:
     """Fit error, velocity/acceleration/jerk extremes at the preset's speed, the
     acceleration spectrum, and warnings where a lift table's acceleration jumps."""
     from vtool.presets import load_preset
@@ -38,31 +42,11 @@ def show(preset: str, plot: bool, as_json: bool) -> None:
         if spec.seat is not None:
             u = spec.unit_system.length
             click.echo(f"seat position {report['seat_position']:.6g} {u}, lash {report['lash']:.6g} {u}")
-    if plot:
-        click.echo(_charts(spec))
+    if plot or figure_path is not None:
+        from vtool.app.plots import chart_text
+        from vtool.presets.charts import cam_charts
 
-
-def _charts(spec) -> str:  # type: ignore[no-untyped-def]
-    import math
-
-    import numpy as np
-
-    from vtool.app.plots import line_chart
-    from vtool.solvers.model.cam import cam_fit, derivatives
-
-    fit = cam_fit(spec.cam)
-    u = spec.unit_system.length
-    omega = spec.run.rpm * math.pi / 30.0
-    angles = np.linspace(0.0, 360.0, 721)
-    rows = derivatives(fit.c0, fit.a, fit.b, np.radians(angles))
-    names = [f"lift ({u})", f"velocity ({u}/s)", f"acceleration ({u}/s^2)", f"jerk ({u}/s^3)"]
-    charts = []
-    for power, (name, values) in enumerate(zip(names, rows, strict=True)):
-        series = {"Fourier series": values * omega**power}
-        x = angles
-        if power == 0 and spec.cam.angles:
-            charts.append(line_chart(np.array(spec.cam.angles), {"table": np.array(spec.cam.lifts)},
-                                     title=f"lift table ({u})", xlabel="cam angle (deg)", height=14))
-        charts.append(line_chart(x, series, title=f"{name} at {spec.run.rpm:g} rpm",
-                                 xlabel="cam angle (deg)", height=14))
-    return "\n".join(charts)
+        charts = cam_charts(spec)
+        if plot:
+            click.echo("\n".join(chart_text(chart, height=14) for chart in charts))
+        write_figure(charts, figure_path)

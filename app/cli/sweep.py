@@ -8,6 +8,8 @@ from pathlib import Path
 
 import click
 
+from vtool.app.cli.options import figure_option, write_figure
+
 DEFAULT_SCAN = "1000:20000:1000"
 
 
@@ -53,13 +55,14 @@ class CountProgress:
 @click.option("--resume", is_flag=True, help="Continue the sweep in the --csv file, skipping finished points.")
 @click.option("--timing", is_flag=True, help="Also write each point's wall time to the CSV (not reproducible).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON instead of a table.")
-@click.option("--plot", is_flag=True, help="Chart --metric against the first swept field.")
+@click.option("--plot", is_flag=True, help="Chart --metric against the first swept field (--figure: also as a figure file).")
 @click.option("--map", "as_map", is_flag=True, help="Character heat map of --metric over two swept fields.")
 @click.option("--metric", default="spring_margin", show_default=True, help="Metric for --plot and --map.")
 @click.option("--every-step", is_flag=True, help="Metrics from every time step instead of the output rows.")
+@figure_option
 def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | None, scheduler: str | None,
           csv_path: Path | None, resume: bool, timing: bool, as_json: bool, plot: bool, as_map: bool,
-          metric: str, every_step: bool) -> None:
+          metric: str, every_step: bool, figure_path: Path | None) -> None:
     """Run a valve-train preset over a grid of field values and report per-point metrics.
 
     \b
@@ -87,8 +90,9 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     if find is not None:
         if not any(s.partition("=")[0].strip() == "run.rpm" for s in sets):
             sets = (f"run.rpm={DEFAULT_SCAN}",) + sets
-        if resume or plot or as_map:
-            raise InputError("--find", find, "no --resume, --plot or --map (a search prints its bracket history)")
+        if resume or plot or as_map or figure_path:
+            raise InputError("--find", find, "no --resume, --plot, --map or --figure (a search prints its bracket "
+                             "history)")
     elif not sets:
         raise InputError("--set", None, "at least one FIELD=VALUES (or --find jump-speed)")
     plan = plan_sweep(preset, list(sets))
@@ -100,7 +104,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     axes = [f for f in plan.fields if len({dict(p.values)[f[0]] for p in plan.points}) > 1]
     if as_map and len(axes) != 2:
         raise InputError("--map", len(axes), "exactly two swept fields with more than one value")
-    if plot and not axes:
+    if (plot or figure_path) and not axes:
         raise InputError("--plot", plan.fields[0][0] if plan.fields else None, "a swept field with two or more values")
     runner = make_runner(workers, scheduler)  # a Dask scheduler is reached here, before any file is written
     try:
@@ -140,6 +144,13 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
             click.echo(metric_chart(results, axes, metric, names[metric]))
         if as_map:
             click.echo(metric_map(results, axes, metric, names[metric]))
+    if results and figure_path is not None:  # the --plot chart, and the --map as a grey map
+        from vtool.presets.charts import sweep_chart, sweep_map
+
+        items: list = [sweep_chart(results, axes, metric, names[metric], plan.spec.title)]
+        if as_map:
+            items.append(sweep_map(results, axes, metric, names[metric], plan.spec.title))
+        write_figure(items, figure_path)
 
 
 def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # type: ignore[no-untyped-def]

@@ -163,9 +163,14 @@ def chunks(points: Sequence[Point], workers: int, per_worker: int = 4, largest: 
 
 # ----- execution -----
 
-def _ignore_interrupt() -> None:
-    """Worker initializer: Ctrl+C is handled by the parent, which stops the pool cleanly."""
+def _ignore_interrupt(stderr: str | None = None) -> None:
+    """Worker initializer: Ctrl+C is handled by the parent, which stops the pool cleanly; with
+    ``stderr`` (a file path), the worker's standard error (descriptor 2) is that file."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if stderr is not None:
+        target = os.open(stderr, os.O_WRONLY | os.O_APPEND)
+        os.dup2(target, 2)
+        os.close(target)
 
 
 def parse_scheduler(text: str) -> tuple[str, int]:
@@ -226,16 +231,21 @@ class DaskRunner:
 
 
 class ProcessRunner:
-    """A forkserver process pool of ``workers`` processes that ignore Ctrl+C (the parent stops them)."""
+    """A forkserver process pool of ``workers`` processes that ignore Ctrl+C (the parent stops them).
 
-    def __init__(self, workers: int) -> None:
+    ``stderr``: a file the workers write their standard error to instead of the parent's (the TUI
+    passes os.devnull: its terminal is Textual's screen).
+    """
+
+    def __init__(self, workers: int, stderr: str | None = None) -> None:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
         context = multiprocessing.get_context("forkserver")
-        context.set_forkserver_preload(["vtool.solvers.studies.sweep", "vtool.solvers.newmark.backend"])
+        context.set_forkserver_preload(["vtool.solvers.studies.sweep", backends.module_of(backends.DEFAULT)])
         self.workers = workers
-        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt)
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt,
+                                        initargs=(stderr,))
 
     def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
             cancel: Callable[[], bool]) -> bool:
@@ -284,14 +294,17 @@ class SerialRunner:
         pass
 
 
-def make_runner(workers: int | None = None, scheduler: str | None = None) -> Any:
-    """The runner for these settings; a Dask scheduler is connected here (InputError if unreachable)."""
+def make_runner(workers: int | None = None, scheduler: str | None = None, *, stderr: str | None = None) -> Any:
+    """The runner for these settings; a Dask scheduler is connected here (InputError if unreachable).
+
+    ``stderr``: where local worker processes write their standard error (see :class:`ProcessRunner`).
+    """
     if scheduler:
         return DaskRunner(scheduler)
     if workers is not None and workers < 1:
         raise InputError("--workers", workers, "an integer >= 1")
     count = workers or os.cpu_count() or 1
-    return SerialRunner() if count == 1 else ProcessRunner(count)
+    return SerialRunner() if count == 1 else ProcessRunner(count, stderr)
 
 
 @dataclass
