@@ -87,6 +87,11 @@ Metrics (also in docs/sweep.md):
 ``wall_time`` (s)
     Wall time of the back end's run (not deterministic: kept out of files
     that are compared).
+``<quantity>_order_<k>`` (the quantity's unit)
+    For each quantity in ``run.orders`` (``F7``, ``q7``, ``q1-q9``): its
+    amplitude at cam order k = 1 .. ``run.highest_order`` (default 24) over
+    the whole cycles of the window (:mod:`vtool.solvers.studies.orders`;
+    NaN above the Nyquist order of the output interval).
 """
 
 from __future__ import annotations
@@ -97,11 +102,14 @@ from functools import lru_cache
 
 import numpy as np
 
+from vtool.errors import InputError
 from vtool.solvers.model.configurations import clearance_bit
 from vtool.solvers.model.spec import EXTERNAL, REMOVED, CamSpec, MechanismSpec
+from vtool.solvers.studies.orders import order_column, quantity_unit, spectrum
+from vtool.solvers.studies.window import REVOLUTION, evaluation_window, window_text
 from vtool.solvers.trace import CLOSED, Trace
 
-REVOLUTION = 360.0
+__all__ = ["evaluation_window", "window_text"]  # (the window is shared with vtool.solvers.studies.orders)
 NAN = float("nan")
 #: the lift event: lift above the base circle by more than this share of the total lift
 LIFT_EVENT_FRACTION = 5e-3
@@ -234,28 +242,6 @@ class Criteria:
                 "lift_event_start_deg": self.lift_event[0], "lift_event_end_deg": self.lift_event[1]}
 
 
-# ----- the window -----
-
-def evaluation_window(trace: Trace) -> tuple[float, float]:
-    """The cam angles (deg) the metrics cover: see the module doc."""
-    if trace.cycles is not None:
-        return trace.cycles.window
-    end = float(trace.cam_angle[-1]) if len(trace.cam_angle) else 0.0
-    return (REVOLUTION, end) if end > REVOLUTION else (0.0, end)
-
-
-def window_text(trace: Trace) -> str:
-    """One line: which cycles the metrics cover, and whether they settled."""
-    if trace.cycles is not None:
-        return trace.cycles.text()
-    start, end = evaluation_window(trace)
-    if start == 0.0:
-        return (f"evaluated: the whole run (cam angle 0-{end:g} deg), start-up shock included: not a steady "
-                "state (set run.cycles or run.steady)")
-    return (f"evaluated: after the first revolution (cam angle {start:g}-{end:g} deg), not checked for a "
-            "steady state (set run.cycles or run.steady)")
-
-
 def metric_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
     """(name, unit) of every metric, in report order; ``""`` for counts."""
     u = spec.unit_system
@@ -273,7 +259,13 @@ def metric_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
     columns += [(f"peak_{force_label(spec, i)}", u.force) for i in range(len(spec.clearances))]
     columns += [("spring_margin", u.force), ("startup_peak_force", u.force), ("startup_seating_velocity", u.velocity),
                 ("cycles", ""), ("cycle_change", ""), ("events", ""), ("wall_time", "s")]
-    return columns
+    return columns + order_columns(spec)
+
+
+def order_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
+    """The amplitude of every ``run.orders`` quantity at cam orders 1..``run.highest_order`` (its unit)."""
+    return [(order_column(q, k), quantity_unit(spec, q)) for q in spec.run.orders
+            for k in range(1, spec.run.highest_order + 1)]
 
 
 # ----- intervals -----
@@ -439,6 +431,14 @@ def run_metrics(trace: Trace, window: tuple[float, float] | None = None) -> dict
     metrics["cycle_change"] = trace.cycles.change if trace.cycles is not None else NAN
     metrics["events"] = trace.statistics.events
     metrics["wall_time"] = trace.statistics.wall_time
+    for quantity in spec.run.orders:  # over the whole cycles of the evaluated window (NaN: none to analyse)
+        try:
+            orders = spectrum(trace, quantity)
+        except InputError:
+            orders = None
+        for k in range(1, spec.run.highest_order + 1):
+            metrics[order_column(quantity, k)] = (orders.amplitude_of(k) if orders is not None
+                                                  and k <= orders.nyquist else NAN)
     return metrics
 
 
