@@ -28,7 +28,10 @@ PRESETS = (("gnilka-1a", "1A: three clearances, valve seat"),
            ("gnilka-1b", "1B: three clearances, no valve seat"),
            ("gnilka-1c", "1C: two clearances (rocker pinned), valve seat"),
            ("gnilka-2", "example 2 (and 3): three clearances, valve seat"),
-           ("ramped-cam", "1A's mechanism on a dwell-and-ramps cam with lash"))
+           ("ramped-cam", "1A's mechanism on a dwell-and-ramps cam with lash"),
+           ("ohv-pushrod-1a", "the train-type preset (ohv-pushrod) of 1A's data"))
+CAMPBELL = (("gnilka-1a", "F7"), ("ramped-cam", "F7"))  # the seat force's orders against speed
+CAMPBELL_RPM = list(range(2000, 16001, 500))
 SCAN = list(range(1000, 16001, 1000))  # rev/min
 CHART_RPM = "run.rpm=6000:14000:250"
 SPRING = "members.valve_spring.stiffness=150:350:50"
@@ -86,10 +89,26 @@ def chart_blocks(runner) -> dict[str, str]:  # type: ignore[no-untyped-def]
     return blocks
 
 
+def campbell_block(runner, name: str, quantity: str) -> str:  # type: ignore[no-untyped-def]
+    """``vtool sweep NAME --set run.rpm=2000:16000:500 --steady --campbell QUANTITY``'s map."""
+    from vtool.app.sweep_charts import campbell_map
+    from vtool.solvers.studies.orders import campbell, with_orders
+    from vtool.solvers.studies.sweep import Point
+
+    spec = with_steady(with_orders(load_preset(name), (quantity,)))
+    points = [Point(i, (("run.rpm", rpm),), with_run_overrides(spec, rpm=rpm)) for i, rpm in enumerate(CAMPBELL_RPM)]
+    results = run_points(points, runner).results
+    data = campbell([(float(dict(r.values)["run.rpm"]), r.metrics) for r in results if r.ok], spec, quantity)
+    return "```text\n" + campbell_map(data) + "\n```\n"
+
+
 def deterministic_blocks(runner=None) -> dict[str, str]:  # type: ignore[no-untyped-def]
-    """The tables a test regenerates (no wall times in them)."""
+    """The tables and maps a test regenerates (no wall times in them)."""
     runner = runner or SerialRunner()
-    return {"sweep-speeds": speeds_table(runner), "sweep-spring": spring_table(runner)}
+    blocks = {"sweep-speeds": speeds_table(runner), "sweep-spring": spring_table(runner)}
+    for name, quantity in CAMPBELL:
+        blocks[f"sweep-campbell-{name}"] = campbell_block(runner, name, quantity)
+    return blocks
 
 
 def main() -> None:
