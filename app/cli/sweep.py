@@ -140,11 +140,19 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     results = outcome.results
     if sink is not None and outcome.skipped:
         click.echo(f"resumed: {outcome.skipped} of {outcome.total} points were already in {csv_path}", err=True)
+    from vtool.solvers.studies.metrics import Criteria
+    from vtool.solvers.studies.steady import steady_text
+
+    length = plan.spec.unit_system.length
     if as_json:
-        click.echo(json.dumps(results_json(results, plan.fields, plan.spec, preset), indent=2))
+        click.echo(json.dumps(results_json(results, plan.fields, plan.spec, preset)
+                              | {"evaluation": steady_text(plan.spec),
+                                 "criteria": Criteria.of(plan.spec).as_dict(length)}, indent=2))
     else:
         if results:
             click.echo(results_table(results, plan.fields, plan.spec))
+        click.echo(steady_text(plan.spec))  # which cycles the metrics cover, and by which criteria
+        click.echo(Criteria.of(plan.spec).text(length))
         n = len(results)
         click.echo(f"{n} points in {outcome.wall_time:.2f} s ({1000 * outcome.wall_time / max(n, 1):.1f} ms per "
                    f"point, {runner.workers} worker{'s' if runner.workers > 1 else ''})")
