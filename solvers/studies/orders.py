@@ -52,6 +52,16 @@ def order_column(quantity: str, order: int) -> str:
     return f"{quantity.replace(' ', '')}_order_{order}"
 
 
+def default_quantity(spec: MechanismSpec) -> str:
+    """The quantity a run's spectrum shows by default: ``run.orders``' first, else the force at the valve seat
+    (the valve spring's end on it), else at the cam."""
+    if spec.run.orders:
+        return spec.run.orders[0]
+    seat = next((c for c in spec.clearances if spec.seat is not None and c.behind == spec.seat.coordinate), None)
+    cam = next(c for c in spec.clearances if c.behind == spec.cam.coordinate)
+    return f"F{(seat or cam).ahead}"
+
+
 def with_orders(spec: MechanismSpec, quantities: tuple[str, ...], field: str = "--orders") -> MechanismSpec:
     """The spec with ``quantities`` added to ``run.orders`` (checked: ``qN``, ``qN-qM`` over the coordinates, cam
     and seat, or ``FN`` with N the coordinate ahead of a clearance)."""
