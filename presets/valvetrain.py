@@ -515,13 +515,13 @@ def _quantity_names(coordinates, cam, seat, clearances) -> tuple[set[int], set[i
 QUANTITY = re.compile(r"q(\d+)(?:-q(\d+))?|F(\d+)")
 
 
-def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...]:
-    value = t.raw("quantities", [])
+def _quantities(t: Table, numbers: set[int], forces: set[int], key: str = "quantities") -> tuple[str, ...]:
+    value = t.raw(key, [])
     expected = (f"a list of 'q<i>', 'q<i>-q<j>' (i, j in {sorted(numbers)}) or 'F<i>' "
                 f"(i in {sorted(forces)})")
     if not isinstance(value, list):
-        raise InputError(t.field("quantities"), value, expected)
-    _count(t.field("quantities"), value, MAX_QUANTITIES, "quantities")
+        raise InputError(t.field(key), value, expected)
+    _count(t.field(key), value, MAX_QUANTITIES, "quantities")
     for item in value:
         match = QUANTITY.fullmatch(item) if isinstance(item, str) else None
         ok = match is not None and (
@@ -529,18 +529,19 @@ def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...
             or (match[1] is not None and int(match[1]) in numbers and (match[2] is None or int(match[2]) in numbers))
         )
         if not ok:
-            raise InputError(t.field("quantities"), item, expected)
+            raise InputError(t.field(key), item, expected)
     return tuple(value)
 
 
 RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta", "gamma", "quantities",
-            "cycles", "steady", "jump_angle", "jump_gap", "bounce_lift")
+            "cycles", "steady", "jump_angle", "jump_gap", "bounce_lift", "orders", "highest_order")
 #: [run] cycle-by-cycle and criteria ranges: key -> (min, max, unit)
 CYCLE_LIMITS: dict[str, tuple[float, float, str]] = {
     "cycles": (1, 10_000, "cam cycles"),
     "max_cycles": (2, 10_000, "cam cycles"),
     "tolerance": (1e-12, 1.0, "(relative change per cycle)"),
     "jump_angle": (0.0, 360.0, "deg"),
+    "highest_order": (1, 1000, "cam orders"),
 }
 
 
@@ -589,6 +590,9 @@ def _run(t: Table, names: tuple[set[int], set[int]], units: Any) -> RunSpec:
     gamma = t.number("gamma", default=0.5, min_value=GAMMA_RANGE[0], max_value=GAMMA_RANGE[1])
     quantities = _quantities(t, *names)
     cycles = _cycles(t, units)
+    cycles["orders"] = _quantities(t, *names, key="orders")
+    low, high, _ = CYCLE_LIMITS["highest_order"]
+    cycles["highest_order"] = t.integer("highest_order", default=24, min_value=int(low), max_value=int(high))
     t.finish()
     return RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities, **cycles)
 
@@ -670,6 +674,10 @@ def _dump_run(r: RunSpec) -> dict[str, Any]:
     for key in ("jump_gap", "bounce_lift"):
         if getattr(r, key) is not None:
             run[key] = getattr(r, key)
+    if r.orders:
+        run["orders"] = list(r.orders)
+    if r.highest_order != 24:
+        run["highest_order"] = r.highest_order
     return run
 
 

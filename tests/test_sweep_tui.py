@@ -176,5 +176,34 @@ async def test_a_metric_with_no_value_at_any_point_is_said_not_drawn() -> None:
         pane = app.query_one(SweepPane)
         await _run(pilot, pane)
         assert pane.status_text.startswith("finished: 2 of 2 points"), pane.status_text
-        assert pane.chart.function is None and "no point has a value of seating_velocity_max" in str(pane.chart.content)
+        assert pane.chart.function is None
+        assert "no point has a value of seating_velocity_max" in str(pane.chart.content)
     assert app._exception is None
+
+
+async def test_a_speed_sweep_shows_the_intervals_and_a_two_field_sweep_the_map() -> None:
+    """1A at 5,000, 6,000 and 7,000 rev/min (850 deg): the intervals where the follower leaves the cam and the
+    valve bounces are those of the library's metrics at those speeds; a second swept field puts the map
+    (sweep_charts.metric_map) above the table."""
+    from vtool.app.sweep_charts import metric_map
+    from vtool.solvers.studies.metrics import metric_columns
+    from vtool.solvers.studies.sweep import scan_intervals
+
+    app = PaneApp(values="5000,6000,7000", metric="cam_separations")
+    async with app.run_test(size=(140, 50)) as pilot:
+        pane = app.query_one(SweepPane)
+        await _run(pilot, pane)
+        results = pane.outcome.results
+        jumps = scan_intervals(results, "run.rpm", "jump-speed")
+        assert jumps and jumps[0][1] == 7000  # (in contact during lift at 5,000: 1A leaves the cam from 5,391)
+        text = str(pane.intervals.content)
+        assert text.startswith(f"the follower leaves the cam during lift: {jumps[0][0]:g}-7000 rev/min; the valve "
+                               "bounces on its seat: ") and "vtool sweep --find bisects the edges" in text
+        pane.query_one("#sweep-fixed", Input).value = "damping.factor=0.5,1"
+        await _run(pilot, pane)
+        plan, results = pane.plan, pane.outcome.results
+        axes = [f for f in plan.fields if f[0] in ("run.rpm", "damping.factor")]
+        units = dict(metric_columns(plan.spec))
+        assert pane.table.text.startswith(metric_map(results, axes, "cam_separations", units["cam_separations"]))
+        assert str(pane.intervals.content) == ""  # two fields: no speed intervals
+

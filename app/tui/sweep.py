@@ -170,6 +170,7 @@ class SweepPane(Widget):
                 yield Button("Export CSV", id="sweep-export", compact=True)
             yield ProgressBar(total=1, show_eta=True, id="sweep-progress")
             yield Static("", id="sweep-status", markup=False)
+            yield Static("", id="sweep-intervals", markup=False)
             yield ChartView("run a sweep to see the chart", id="sweep-chart")
             yield TextPanel("", id="sweep-table")
 
@@ -338,6 +339,26 @@ class SweepPane(Widget):
         if event.worker is self.worker and event.state == WorkerState.ERROR:
             self.set_status(f"error: {failure_text(event.worker.error)}")
 
+    @property
+    def intervals(self) -> Static:
+        return self.query_one("#sweep-intervals", Static)
+
+    @staticmethod
+    def _intervals_text(results: Any, axes: list) -> str:  # type: ignore[type-arg]
+        """The speed intervals of a one-field sweep over run.rpm where the follower leaves the cam or the valve
+        bounces, on the scanned speeds (``vtool sweep --find`` bisects their edges)."""
+        from vtool.solvers.studies.sweep import CRITERIA, scan_intervals
+
+        if len(axes) != 1 or axes[0][0] != "run.rpm":
+            return ""
+        parts = []
+        for criterion in CRITERIA:
+            words = CRITERIA[criterion][2]
+            found = scan_intervals(results, "run.rpm", criterion)
+            spans = ", ".join(f"{a:g}-{b:g}" if a != b else f"{a:g}" for a, b in found) or "at no scanned speed"
+            parts.append(f"{words}: {spans}" + (" rev/min" if found else ""))
+        return "; ".join(parts) + " (scanned speeds; vtool sweep --find bisects the edges)"
+
     def _draw(self) -> None:
         from vtool.solvers.studies.metrics import metric_columns
         from vtool.solvers.studies.sweep import results_table
@@ -346,11 +367,17 @@ class SweepPane(Widget):
             return
         results, plan, metric = self.outcome.results, self.plan, self.metric
         units = dict(metric_columns(plan.spec))
-        self.table.set_text(results_table(results, plan.fields, plan.spec))
+        axes = [f for f in plan.fields if len({dict(r.values)[f[0]] for r in results}) > 1]
+        self.intervals.update(self._intervals_text(results, axes))
+        table = results_table(results, plan.fields, plan.spec)
+        if len(axes) == 2 and metric in units:  # a grid of two fields: the map above the table
+            from vtool.app.sweep_charts import metric_map
+
+            table = metric_map(results, axes, metric, units[metric]) + "\n\n" + table
+        self.table.set_text(table)
         if metric not in units:
             self.chart.plot(None)
             return
-        axes = [f for f in plan.fields if len({dict(r.values)[f[0]] for r in results}) > 1]
         values = [r.metrics.get(metric) for r in results]
         if not axes or not any(isinstance(v, int | float) and math.isfinite(v) for v in values):
             self.chart.placeholder = (f"no point has a value of {metric}" if axes else

@@ -279,6 +279,9 @@ class RunSpec:
     jump_angle: float = 1.0
     jump_gap: float | None = None
     bounce_lift: float | None = None
+    # quantities whose cam-order amplitudes (orders 1..highest_order over the evaluated cycles) are metrics
+    orders: tuple[str, ...] = ()
+    highest_order: int = 24
 
     @property
     def omega(self) -> float:
