@@ -22,8 +22,9 @@ Parts (each table's numbers in the preset's unit system):
   (``lift``: L = lift/2 (1 + sin θ), the thesis' cam), ``"table"`` (the
   [cam] keys ``angles``/``lifts`` or ``lift_table``, ``harmonics`` or
   ``tolerance``) or ``"polydyne"`` (``lift``, ``ramp_height``, ``ramp_deg``,
-  ``flank_deg``: the ramped polydyne of :mod:`vtool.presets.ramped_cam`,
-  sampled every ``step_deg`` and fitted to ``tolerance``); ``angle_basis =
+  ``flank_deg``, the nose at ``nose_deg``: the ramped polydyne of
+  :mod:`vtool.presets.ramped_cam`, sampled every ``step_deg`` and fitted to
+  ``tolerance``); ``angle_basis =
   "crank"`` reads every angle of the table as crank degrees (halved: the cam
   turns once per two crank turns);
 * ``[train.seat]``: ``lash`` (the follower clearance on the base circle, in
@@ -128,9 +129,10 @@ def polydyne_table(t: Table, units: UnitSystem) -> tuple[list[float], list[float
     flank_deg = scale * t.number("flank_deg", unit="deg", min_exclusive=0.0, max_value=180.0)
     if ramp_deg + flank_deg >= 180.0:
         raise InputError(t.field("flank_deg"), flank_deg / scale, "ramp_deg + flank_deg < 180 cam degrees", "deg")
+    nose = t.number("nose_deg", unit="deg", default=0.0, min_value=-360.0, max_value=360.0)
     step = t.number("step_deg", unit="deg", default=MODEL_STEP_DEG, min_value=0.05, max_value=5.0)
     angles = np.arange(0.0, 360.0, step)
-    lifts = ramped_lift(angles, lift=lift, ramp_height=ramp, ramp_deg=ramp_deg, flank_deg=flank_deg)
+    lifts = ramped_lift(angles - nose, lift=lift, ramp_height=ramp, ramp_deg=ramp_deg, flank_deg=flank_deg)
     return angles.tolist(), lifts.tolist()
 
 

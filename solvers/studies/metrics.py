@@ -10,7 +10,8 @@ and units for a spec. ``vtool sweep`` reports them per point, and a single
 ``cam_separations``
     Largest number, over the revolutions after the first, of cam-clearance
     separation episodes (``Trace.episodes``: a burst of events that leaves
-    the clearance open) that start above mid-stroke: cam angle mod 360 in
+    the clearance open) that start above mid-stroke (a lift table's cam: where
+    its lift is above half its stroke): cam angle mod 360 in
     (0, 180) deg, where the harmonic cam q_cam = A sin(theta) + offset is
     above its offset and decelerating the follower. One or more means the
     follower leaves the cam (jump).
@@ -44,7 +45,7 @@ and units for a spec. ``vtool sweep`` reports them per point, and a single
     clearance).
 ``spring_margin`` (force)
     Smallest cam contact force on the output rows after the first revolution
-    over the nose (cam angle mod 360 in (0, 180) deg) while the cam clearance
+    over the nose (above mid-stroke, as for ``cam_separations``) while the cam clearance
     is closed: how much spring force is left before the follower leaves the
     cam (NaN when it is never in contact there).
 ``events``
@@ -57,11 +58,13 @@ and units for a spec. ``vtool sweep`` reports them per point, and a single
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
+from vtool.solvers.model.cam import derivatives, lift_series
 from vtool.solvers.model.configurations import clearance_bit
-from vtool.solvers.model.spec import EXTERNAL, REMOVED, MechanismSpec
+from vtool.solvers.model.spec import EXTERNAL, REMOVED, CamSpec, MechanismSpec
 from vtool.solvers.trace import CLOSED, SEPARATION, Trace
 
 REVOLUTION = 360.0
@@ -106,8 +109,29 @@ def metric_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
     return columns
 
 
-def _above_mid_stroke(angle: float) -> bool:
-    return 0.0 < angle % REVOLUTION < 180.0
+def _above_mid_stroke(cam: CamSpec, angle: float) -> bool:
+    """The cam's lift above the middle of its stroke at ``angle`` (deg): for the harmonic cam
+    q_cam = A sin(theta) + offset exactly 0 < angle mod 360 < 180; for a lift table the same rule on
+    its fitted lift (the nose half of the event, wherever the table puts the nose)."""
+    if cam.profile == "harmonic":
+        return 0.0 < angle % REVOLUTION < 180.0
+    low, high = _stroke(cam)
+    lift = derivatives(*lift_series(cam), np.radians([angle]))[0, 0]
+    return bool(lift > 0.5 * (low + high))
+
+
+def _above_mid_stroke_rows(cam: CamSpec, angles: np.ndarray) -> np.ndarray:
+    """:func:`_above_mid_stroke` at every row."""
+    if cam.profile == "harmonic":
+        return (np.mod(angles, REVOLUTION) > 0.0) & (np.mod(angles, REVOLUTION) < 180.0)
+    low, high = _stroke(cam)
+    return derivatives(*lift_series(cam), np.radians(angles))[0] > 0.5 * (low + high)
+
+
+@lru_cache(maxsize=16)
+def _stroke(cam: CamSpec) -> tuple[float, float]:
+    lift = derivatives(*lift_series(cam), np.linspace(0.0, 2.0 * math.pi, 3600, endpoint=False))[0]
+    return float(lift.min()), float(lift.max())
 
 
 def _cam_separation(trace: Trace, name: str) -> tuple[int, float, float]:
@@ -118,7 +142,7 @@ def _cam_separation(trace: Trace, name: str) -> tuple[int, float, float]:
     longest = 0.0
     for episode in trace.episodes(name):
         start = episode.first_angle
-        if episode.kind != SEPARATION or start < REVOLUTION or not _above_mid_stroke(start):
+        if episode.kind != SEPARATION or start < REVOLUTION or not _above_mid_stroke(trace.spec.cam, start):
             continue
         revolution = int(start // REVOLUTION)
         per_revolution[revolution] = per_revolution.get(revolution, 0) + 1
@@ -180,7 +204,7 @@ def run_metrics(trace: Trace) -> dict[str, float]:
     metrics.update(_seat_metrics(trace, seat_index(spec), after))
     for i in range(len(spec.clearances)):
         metrics[f"peak_{force_label(spec, i)}"] = _peak(trace, i, after)
-    nose = after & (np.mod(trace.cam_angle, REVOLUTION) > 0.0) & (np.mod(trace.cam_angle, REVOLUTION) < 180.0)
+    nose = after & _above_mid_stroke_rows(trace.spec.cam, trace.cam_angle)
     in_contact = nose & ((trace.configuration & clearance_bit(spec, cam)) != 0)
     metrics["spring_margin"] = float(trace.contact_force[in_contact, cam].min()) if in_contact.any() else NAN
     metrics["events"] = trace.statistics.events
