@@ -19,7 +19,9 @@ factor 1) and a :class:`vtool.errors.PresetWarning` saying so.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
+import json
 import math
 import re
 import warnings
@@ -102,7 +104,9 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
 
     ``folder`` resolves a ``[cam] lift_table`` file (default: the working folder).
     """
+    train = ""
     if isinstance(doc, dict) and "train" in doc:  # a train type: expanded to the explicit form first
+        train = json.dumps(doc["train"])
         doc = expand(doc, folder)
     top = Table(doc, "")
     top.check_unknown(TOP_KEYS)
@@ -155,6 +159,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         contact=contact,
         follower=follower,
         checks=checks,
+        train=train,
     )
     spec = split_members(spec)
     if seat is not None and seat.lash is not None:
@@ -581,8 +586,9 @@ def check_run(run: RunSpec) -> RunSpec:
 
 
 def dump(spec: MechanismSpec) -> dict[str, Any]:
-    """The preset document for a spec (inverse of :func:`load`)."""
-    spec = unsplit_members(spec)
+    """The preset document for a spec (inverse of :func:`load`); a spec entered by train type dumps as its
+    [train] while its model is what the type gives (:func:`train_document`)."""
+    given, spec = spec, unsplit_members(spec)
     doc: dict[str, Any] = {"kind": "valvetrain", "title": spec.title}
     if spec.notes:
         doc["notes"] = spec.notes
@@ -645,7 +651,25 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         doc["follower"] = dump_follower(spec.follower, _law_doc)
     if spec.checks:
         doc["checks"] = {c.name: c.limit for c in spec.checks}
-    return doc
+    return train_document(given, doc) or doc
+
+
+TRAIN_KEEPS = ("kind", "title", "notes", "units", "gravity", "contact", "damping", "run", "checks")
+
+
+def train_document(spec: MechanismSpec, explicit: dict[str, Any]) -> dict[str, Any] | None:
+    """The train-type document of a spec entered by type, while its model is still what the type gives
+    (else None: the explicit form, e.g. after a member was split or a clearance pinned)."""
+    if not spec.train:
+        return None
+    doc = {key: explicit[key] for key in TRAIN_KEEPS if key in explicit}
+    doc["train"] = json.loads(spec.train)
+    doc["initial"] = {"velocities": spec.initial.velocities}
+    try:
+        again = load(copy.deepcopy(doc))
+    except InputError:  # e.g. a lift_table file the saved copy's folder does not hold
+        return None
+    return doc if again == spec else None
 
 
 RPM_IN_TITLE = re.compile(r"\b\d{1,3}(?:,\d{3})*(?:\.\d+)?\s*RPM\b|\b\d+(?:\.\d+)?\s*RPM\b", re.IGNORECASE)

@@ -44,3 +44,23 @@ def copy_command(name: str, dest: Path, force: bool) -> None:
         raise InputError("dest", str(target), "a path that does not exist yet (or --force)")
     write_atomic(target, source.read_text(encoding="utf-8"), "DEST")
     click.echo(f"copied {source.stem} to {target}")
+
+
+@presets.command("expand")
+@click.argument("name")
+def expand_command(name: str) -> None:
+    """Print a train-type preset ([train] type = ...) as the explicit model it expands to
+    (coordinates, members, clearances, cam, follower); an explicit preset prints unchanged."""
+    import tomli_w
+
+    from vtool.presets import read_document
+    from vtool.presets.trains import expand
+
+    path = find_preset(name)
+    doc = read_document(path)
+    if "train" not in doc:
+        click.echo(path.read_text(encoding="utf-8"), nl=False)
+        return
+    explicit = expand(doc, path.parent)
+    click.echo(f"# {path.stem}: the explicit model of its [train] (vtool presets expand; presets/trains.py)")
+    click.echo(tomli_w.dumps(explicit), nl=False)
