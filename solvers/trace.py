@@ -87,6 +87,43 @@ class RunStatistics:
 
 
 @dataclass(frozen=True)
+class Cycles:
+    """How a cycle-by-cycle run went (:mod:`vtool.solvers.studies.steady`); the trace holds every cycle.
+
+    ``settled`` is None for a fixed number of cycles (``run.cycles``); ``change`` is the largest relative
+    change from the cycle before to the last one, ``changed`` what moved that much; ``changes`` is that
+    change after each cycle (the first has none: NaN). ``peaks`` are the every-step peak contact forces
+    over the evaluated (last) cycle, ``startup_peaks`` over the first.
+    """
+
+    count: int
+    settled: bool | None
+    tolerance: float
+    change: float
+    changed: str
+    changes: tuple[float, ...]
+    peaks: np.ndarray
+    startup_peaks: np.ndarray
+    max_cycles: int = 0
+
+    @property
+    def window(self) -> tuple[float, float]:
+        """The evaluated cycle's cam angles (deg): the last cycle."""
+        return 360.0 * (self.count - 1), 360.0 * self.count
+
+    def text(self) -> str:
+        """One line: which cycle is evaluated and whether the run settled."""
+        where = f"cycle {self.count} of {self.count} (cam angle {360.0 * (self.count - 1):g}-{360.0 * self.count:g} deg)"
+        moved = "" if self.count < 2 else f"; the last cycle changed by {self.change:.3g} ({self.changed})"
+        if self.settled is None:
+            return f"evaluated: {where}, a fixed number of cycles (run.cycles){moved}"
+        if self.settled:
+            return f"evaluated: {where}, settled to {self.tolerance:g}{moved}"
+        return (f"warning: did not settle in {self.count} cycles (run.steady max_cycles = {self.max_cycles}): "
+                f"evaluated {where}{moved}, above the tolerance {self.tolerance:g}")
+
+
+@dataclass(frozen=True)
 class Trace:
     """Response of one run (see module doc). Rows are output instants."""
 
@@ -106,6 +143,7 @@ class Trace:
     message: str = ""
     peak_force_after_first_revolution: np.ndarray | None = None  # per clearance, over every step
     peak_overlap: np.ndarray | None = None  # per clearance, largest overlap of a compliant contact
+    cycles: Cycles | None = None  # a run cycle by cycle (run.cycles, run.steady): how it went
 
     # ----- columns by the engineer's names -----
     def coordinate(self, number: int, rows: slice = slice(None)) -> np.ndarray:

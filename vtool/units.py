@@ -27,6 +27,7 @@ loader state physical bounds once, in SI.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 
@@ -116,3 +117,9 @@ PLATE_UNIT_SYSTEMS: dict[str, UnitSystem] = {
                            pascals_per_pressure=PSI, newtons_per_force=LBF, density_name="lbf*s^2/in^4"),
     "SI": UnitSystem("SI", "m", "N", "s", "kg", 9.80665, "Pa", density_name="kg/m^3"),
 }
+
+
+def cam_speed(rpm: float) -> float:
+    """The cam's angular speed ω in rad/s at ``rpm`` rev/min (ω = 2π rpm / 60): the one place a speed
+    becomes ω (:attr:`vtool.solvers.model.spec.RunSpec.omega` and every study read it)."""
+    return rpm * math.pi / 30.0

@@ -1,11 +1,14 @@
-"""``vtool cam show PRESET [--plot] [--json]``: the cam's lift, its fit, spectrum and derivatives."""
+"""``vtool cam show PRESET [--plot] [--json] [--csv FILE]``: the cam's lift, its fit, spectrum and derivatives,
+and with a follower the cam's shape."""
 
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import click
 
+from vtool.app.cli.options import figure_option, write_figure
 from vtool.errors import InputError
 
 
@@ -20,7 +23,8 @@ def cam() -> None:
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
 @click.option("--csv", "csv_path", type=click.Path(),
               help="With a [follower]: write the ground profile (polar and Cartesian, curvature) for grinding.")
-def show(preset: str, plot: bool, as_json: bool, csv_path: str | None) -> None:
+@figure_option
+def show(preset: str, plot: bool, as_json: bool, csv_path: str | None, figure_path: Path | None) -> None:
     """Fit error, velocity/acceleration/jerk extremes at the preset's speed, the
     acceleration spectrum, and warnings where a lift table's acceleration jumps.
     With a follower ([follower] or a train type): the cam's shape, radius of
@@ -65,53 +69,11 @@ def show(preset: str, plot: bool, as_json: bool, csv_path: str | None) -> None:
         write_atomic(csv_path, profile_csv_text(spec), "--csv")
         if not as_json:
             click.echo(f"wrote the cam profile to {csv_path}")
-    if plot:
-        click.echo(_charts(spec))
-        if spec.follower is not None:
-            click.echo(_shape_charts(spec))
+    if plot or figure_path is not None:
+        from vtool.app.plots import chart_text
+        from vtool.presets.charts import cam_charts, cam_shape_charts
 
-
-def _charts(spec) -> str:  # type: ignore[no-untyped-def]
-    import math
-
-    import numpy as np
-
-    from vtool.app.plots import line_chart
-    from vtool.solvers.model.cam import cam_fit, derivatives
-
-    fit = cam_fit(spec.cam)
-    u = spec.unit_system.length
-    omega = spec.run.rpm * math.pi / 30.0
-    angles = np.linspace(0.0, 360.0, 721)
-    rows = derivatives(fit.c0, fit.a, fit.b, np.radians(angles))
-    names = [f"lift ({u})", f"velocity ({u}/s)", f"acceleration ({u}/s^2)", f"jerk ({u}/s^3)"]
-    charts = []
-    for power, (name, values) in enumerate(zip(names, rows, strict=True)):
-        series = {"Fourier series": values * omega**power}
-        x = angles
-        if power == 0 and spec.cam.angles:
-            charts.append(line_chart(np.array(spec.cam.angles), {"table": np.array(spec.cam.lifts)},
-                                     title=f"lift table ({u})", xlabel="cam angle (deg)", height=14))
-        charts.append(line_chart(x, series, title=f"{name} at {spec.run.rpm:g} rpm",
-                                 xlabel="cam angle (deg)", height=14))
-    return "\n".join(charts)
-
-
-def _shape_charts(spec) -> str:  # type: ignore[no-untyped-def]
-    """The ground profile (x-y) and its radius of curvature and pressure angle against cam angle."""
-    import numpy as np
-
-    from vtool.app.plots import line_chart
-    from vtool.solvers.model.camshape import cam_profile, contact
-
-    u = spec.unit_system.length
-    profile = cam_profile(spec.follower, spec.lift_law, 720)
-    c = contact(spec.follower, spec.lift_law, np.radians(profile.law_angle_deg))
-    rho = np.clip(profile.curvature_radius, -5 * spec.follower.base_radius, 5 * spec.follower.base_radius)
-    return "\n".join([
-        line_chart(np.append(profile.x, profile.x[0]), {"profile": np.append(profile.y, profile.y[0])},
-                   title=f"cam profile ({u}, cam frame)", xlabel=f"x ({u})", height=20),
-        line_chart(profile.law_angle_deg, {"radius of curvature": rho}, title=f"radius of curvature ({u}, clipped)",
-                   xlabel="law angle (deg)", height=14),
-        line_chart(c.cam_angle_deg, {"pressure angle": c.pressure_angle_deg}, title="pressure angle (deg)",
-                   xlabel="cam angle (deg)", height=14)])
+        charts = cam_charts(spec) + (cam_shape_charts(spec) if spec.follower is not None else [])
+        if plot:
+            click.echo("\n".join(chart_text(chart, height=14) for chart in charts))
+        write_figure(charts, figure_path)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from vtool.app.cli.options import impact_laws_option, start_option
+from vtool.app.cli.options import figure_option, impact_laws_option, start_option, write_figure
 
 
 @click.command()
@@ -18,8 +18,10 @@ from vtool.app.cli.options import impact_laws_option, start_option
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), help="Also write the table as CSV.")
 @click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
 @click.option("--markdown", is_flag=True, help="Print the table as Markdown (for reports).")
+@click.option("--plot", is_flag=True, help="Draw each clearance's contact force, one curve per variant.")
+@figure_option
 def compare(preset: str, impacts: tuple[str, ...], starts: tuple[str, ...] | None, degrees: float | None,
-            csv_path: Path | None, as_json: bool, markdown: bool) -> None:
+            csv_path: Path | None, as_json: bool, markdown: bool, plot: bool, figure_path: Path | None) -> None:
     """Run a valve-train preset under several impact laws (and start velocities) with the same back end and
     step, and print side by side: events, episodes per clearance (separations/impacts/bounces/flickers),
     the first throw-off angle in each revolution after the first, peak contact forces after the first
@@ -73,3 +75,11 @@ def compare(preset: str, impacts: tuple[str, ...], starts: tuple[str, ...] | Non
         write_atomic(csv_path, buffer.getvalue())
         if not as_json:
             click.echo(f"wrote {csv_path}")
+    if plot or figure_path is not None:
+        from vtool.app.plots import chart_text
+        from vtool.presets.charts import compare_chart
+
+        chart = compare_chart(variants)
+        if plot and not as_json:
+            click.echo(chart_text(chart))
+        write_figure([chart], figure_path)

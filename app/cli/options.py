@@ -47,3 +47,27 @@ impact_option = click.option(
 start_velocities_option = click.option(
     "--start", default=None, callback=_one("--start", START_VELOCITIES),
     help=f"Start velocities ({', '.join(START_VELOCITIES)}); default: the preset's.")
+
+
+def _figure_path(ctx: click.Context, param: click.Parameter, value: str | None):  # type: ignore[no-untyped-def]
+    if value is None:
+        return None
+    from vtool.app.figures import check_figure_path
+
+    return check_figure_path(value, "--figure")
+
+
+figure_option = click.option(
+    "--figure", "figure_path", type=click.Path(dir_okay=False), callback=_figure_path,
+    help="Also write the charts as a report figure: OUT.png, OUT.svg or OUT.pdf (axes with units, "
+         "events marked, black-and-white readable).")
+
+
+def write_figure(items, path) -> None:  # type: ignore[no-untyped-def]
+    """Draw chart data to ``path`` (checked by the option) and say so on stderr."""
+    if path is None:
+        return
+    from vtool.app.figures import save_figure
+
+    save_figure(items, path)
+    click.echo(f"wrote {path}", err=True)

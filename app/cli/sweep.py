@@ -8,6 +8,8 @@ from pathlib import Path
 
 import click
 
+from vtool.app.cli.options import figure_option, write_figure
+
 DEFAULT_SCAN = "1000:20000:1000"
 
 
@@ -40,9 +42,10 @@ class CountProgress:
                    "clearances[2].restitution) and its values: start:stop:step (stop included) or a,b,c. "
                    "Several --set make a grid.")
 @click.option("--find", "find", type=click.Choice(["jump-speed", "bounce-speed"]),
-              help="Bracket and bisect the cam speed (to 1 rev/min) where the follower first leaves the cam "
-                   f"(jump-speed) or the valve first bounces on its seat (bounce-speed); --set run.rpm gives "
-                   f"the scan (default {DEFAULT_SCAN}), other --set fields a grid of searches.")
+              help="Bracket and bisect (to 1 rev/min) every cam-speed interval where the follower leaves the "
+                   "cam during lift (jump-speed) or the valve bounces on its seat (bounce-speed), each run to "
+                   f"steady state; --set run.rpm gives the scan (default {DEFAULT_SCAN}), other --set fields a "
+                   "grid of searches.")
 @click.option("--workers", type=int, help="Local worker processes (default: all cores; 1 = in this process).")
 @click.option("--scheduler", help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
                                   "processes) or local-threads:N.")
@@ -52,13 +55,14 @@ class CountProgress:
 @click.option("--resume", is_flag=True, help="Continue the sweep in the --csv file, skipping finished points.")
 @click.option("--timing", is_flag=True, help="Also write each point's wall time to the CSV (not reproducible).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON instead of a table.")
-@click.option("--plot", is_flag=True, help="Chart --metric against the first swept field.")
+@click.option("--plot", is_flag=True, help="Chart --metric against the first swept field (--figure: also as a figure file).")
 @click.option("--map", "as_map", is_flag=True, help="Character heat map of --metric over two swept fields.")
 @click.option("--metric", default="spring_margin", show_default=True, help="Metric for --plot and --map.")
 @click.option("--every-step", is_flag=True, help="Metrics from every time step instead of the output rows.")
+@figure_option
 def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | None, scheduler: str | None,
           csv_path: Path | None, resume: bool, timing: bool, as_json: bool, plot: bool, as_map: bool,
-          metric: str, every_step: bool) -> None:
+          metric: str, every_step: bool, figure_path: Path | None) -> None:
     """Run a valve-train preset over a grid of field values and report per-point metrics.
 
     \b
@@ -86,8 +90,9 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     if find is not None:
         if not any(s.partition("=")[0].strip() == "run.rpm" for s in sets):
             sets = (f"run.rpm={DEFAULT_SCAN}",) + sets
-        if resume or plot or as_map:
-            raise InputError("--find", find, "no --resume, --plot or --map (a search prints its bracket history)")
+        if resume or plot or as_map or figure_path:
+            raise InputError("--find", find, "no --resume, --plot, --map or --figure (a search prints its bracket "
+                             "history)")
     elif not sets:
         raise InputError("--set", None, "at least one FIELD=VALUES (or --find jump-speed)")
     plan = plan_sweep(preset, list(sets))
@@ -99,7 +104,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     axes = [f for f in plan.fields if len({dict(p.values)[f[0]] for p in plan.points}) > 1]
     if as_map and len(axes) != 2:
         raise InputError("--map", len(axes), "exactly two swept fields with more than one value")
-    if plot and not axes:
+    if (plot or figure_path) and not axes:
         raise InputError("--plot", plan.fields[0][0] if plan.fields else None, "a swept field with two or more values")
     runner = make_runner(workers, scheduler)  # a Dask scheduler is reached here, before any file is written
     try:
@@ -139,12 +144,21 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
             click.echo(metric_chart(results, axes, metric, names[metric]))
         if as_map:
             click.echo(metric_map(results, axes, metric, names[metric]))
+    if results and figure_path is not None:  # the --plot chart, and the --map as a grey map
+        from vtool.presets.charts import sweep_chart, sweep_map
+
+        items: list = [sweep_chart(results, axes, metric, names[metric], plan.spec.title)]
+        if as_map:
+            items.append(sweep_map(results, axes, metric, names[metric], plan.spec.title))
+        write_figure(items, figure_path)
 
 
 def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # type: ignore[no-untyped-def]
     """One speed search per grid point of the fields other than run.rpm."""
     from vtool.files import write_atomic
     from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.studies.metrics import Criteria
+    from vtool.solvers.studies.steady import steady_text, with_steady
     from vtool.solvers.studies.sweep import find_speed, format_value
 
     scan = sorted({dict(p.values)["run.rpm"] for p in plan.points})
@@ -155,6 +169,10 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
         searches.setdefault(key, point.spec)
     rows = []
     found = []
+    first = with_steady(plan.spec)
+    if not as_json:  # the answers come from steady state, by criteria with stated thresholds
+        click.echo(Criteria.of(first).text(first.unit_system.length))
+        click.echo(steady_text(first))
     for key, spec in searches.items():
         if key and not as_json:
             click.echo(", ".join(f"{k} = {format_value(v)}" for k, v in key))
@@ -164,18 +182,24 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
                 click.echo(f"  {b.stage:<6} {b.rpm:>9g} rev/min  {'holds' if b.holds else 'no':<5}  "
                            f"({format_value(b.value)})")
 
-        result = find_speed(criterion, lambda rpm, spec=spec: with_run_overrides(spec, rpm=rpm), scan, runner,
-                            every_step=every_step, report=report)
+        result = find_speed(criterion, lambda rpm, spec=spec: with_steady(with_run_overrides(spec, rpm=rpm)),
+                            scan, runner, every_step=every_step, report=report)
         if not as_json:
+            for interval in result.intervals:
+                click.echo(f"  interval: {interval.text()}")
             click.echo(f"{criterion}: {result.message}")
         rows.append([format_value(v) for _, v in key] + [format_value(result.speed) if result.speed else "",
                                                          result.message])
         found.append(dict(key) | {criterion.replace("-", "_"): result.speed,
                                   f"{criterion.replace('-', '_')}_unit": "rev/min", "message": result.message,
                                   "history": [{"rpm": b.rpm, "holds": b.holds, "value": b.value, "stage": b.stage}
-                                              for b in result.history]})
+                                              for b in result.history],
+                                  "intervals": [{"low_rpm": i.low, "high_rpm": i.high, "below_rpm": i.below,
+                                                 "above_rpm": i.above} for i in result.intervals]})
     if as_json:
-        click.echo(json.dumps({"preset": plan.spec.title, "criterion": criterion, "searches": found}, indent=2))
+        click.echo(json.dumps({"preset": plan.spec.title, "criterion": criterion,
+                               "criteria": Criteria.of(first).as_dict(first.unit_system.length),
+                               "evaluation": steady_text(first), "searches": found}, indent=2))
     if csv_path is not None:
         header = [f"{f} ({u})" if u else f for f, u in others] + [f"{criterion.replace('-', '_')} (rev/min)",
                                                                   "message"]

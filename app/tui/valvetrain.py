@@ -139,7 +139,6 @@ def quantity_unit(spec: Any, quantity: str) -> str:
 
 class ValveTrainScreen(DomainScreen):
     MODE = "valvetrain"
-    KINDS = ("valvetrain",)
     DEFAULT_PRESET = "gnilka-1a"
     TITLE_TEXT = "VALVE TRAIN"
 
@@ -198,11 +197,6 @@ class ValveTrainScreen(DomainScreen):
         return self.results
 
     # ----- spec -----
-    def loader(self) -> Any:
-        from vtool.presets import valvetrain
-
-        return valvetrain
-
     def fields_for(self, spec: Any, doc: dict[str, Any]) -> list[Field]:
         return valvetrain_fields(spec, doc)
 
@@ -238,9 +232,9 @@ class ValveTrainScreen(DomainScreen):
         worker = get_current_worker()
 
         def announce() -> None:  # the input is checked: say so when a compile is to come, as the CLI does
-            from vtool.solvers.newmark.backend import compile_notice, kernel_laws
+            from vtool.solvers.backends import get
 
-            notice = compile_notice(spec.run.backend, kernel_laws(spec))
+            notice = get(spec.run.backend).compile_notice(spec)
             if notice is not None:
                 self.post_message(CompileAnnounced(run_id, notice))
 
@@ -300,3 +294,7 @@ class ValveTrainScreen(DomainScreen):
     # ----- export -----
     def write_csv(self, path: str) -> None:
         self.results.write_csv(path)
+
+
+#: this module's screen, named by the kinds table (vtool.presets.kinds.KINDS)
+SCREEN = ValveTrainScreen

@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from vtool.solvers.model.units import UNIT_SYSTEMS, UnitSystem
+from vtool.units import cam_speed
 
 BAR = "bar"
 BEAM = "beam"
@@ -116,10 +117,14 @@ class ClearanceSpec:
     A linear contact acts while the parts overlap (Kelvin–Voigt): near the
     end of a contact its dashpot may pull (F < 0), a known property of the
     model; the overlap, not the force, decides when the contact ends.
-    ``hertz``: F = k δⁿ (1 + 3(1 - e)/2 · δ̇/v⁻), n = ``contact_exponent``,
-    with the Hunt–Crossley damping of the clearance's restitution e at the
-    approach velocity v⁻ of the contact's closing; it never pulls. Nonlinear:
-    the Newmark back end iterates, scipy integrates it, exact refuses it.
+    ``hertz``: F = k δⁿ (1 + a δ̇/v⁻), n = ``contact_exponent``, with
+    Hunt–Crossley damping at the approach velocity v⁻ of the contact's
+    closing; it never pulls. ``restitution`` is the rebound of a lone mass:
+    a is the root of a (1 + e) = ln((1 + a)/(1 - a e)), exact for any n
+    (:mod:`vtool.solvers.model.hertz`; Hunt and Crossley's 3(1 - e)/2 is its
+    expansion near e = 1), and a Hertz contact takes 0.01 <= e <= 1 (e = 0
+    would need infinite damping). Nonlinear: the Newmark back end iterates,
+    scipy integrates it, exact refuses it.
     """
 
     name: str
@@ -239,6 +244,11 @@ class DampingSpec:
         return LayerDampingSpec(tuple(sorted(closed)), self.default_ratio)
 
 
+#: The back end a run uses when its settings name none (the registry's default,
+#: :data:`vtool.solvers.backends.DEFAULT`; the one place outside the registry a back end is named).
+DEFAULT_BACKEND = "newmark"
+
+
 @dataclass(frozen=True)
 class RunSpec:
     """Run settings: cam speed, length of run, time step, back end, output."""
@@ -246,11 +256,29 @@ class RunSpec:
     rpm: float
     degrees: float
     time_step: float
-    backend: str = "newmark"
+    backend: str = DEFAULT_BACKEND
     output_interval: float = 1.0  # degrees of cam rotation between output rows
     beta: float = 1.0 / 6.0
     gamma: float = 0.5
     quantities: tuple[str, ...] = ()  # extra CSV/plot columns: "q7", "q1-q9", "F2"
+    # cycle by cycle (vtool.solvers.studies.steady): a fixed number of cam cycles (0: run ``degrees``), or
+    # until the cycle's start state and metrics change by less than steady_tolerance (0: off), at most
+    # steady_max_cycles; ``degrees`` is then unused
+    cycles: int = 0
+    steady_tolerance: float = 0.0
+    steady_max_cycles: int = 0
+    # speed criteria (vtool.solvers.studies.metrics): the follower leaves the cam when the cam contact is
+    # open during the lift event for more than jump_angle (deg) with a gap above jump_gap (length); the
+    # valve bounces when it re-opens after seating by more than bounce_lift (length); None: the default
+    # share of the cam's lift (metrics.GAP_FRACTION)
+    jump_angle: float = 1.0
+    jump_gap: float | None = None
+    bounce_lift: float | None = None
+
+    @property
+    def omega(self) -> float:
+        """Cam speed in rad/s (:func:`vtool.units.cam_speed`)."""
+        return cam_speed(self.rpm)
 
 
 #: Follower kinds and arrangements (see :mod:`vtool.solvers.model.camshape`).
