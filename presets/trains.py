@@ -125,10 +125,12 @@ def polydyne_table(t: Table, units: UnitSystem) -> tuple[list[float], list[float
     scale = _angle_scale(t)
     lift = _length(t, "lift", units)
     ramp = t.number("ramp_height", unit=units.length, min_value=0.0, max_exclusive=lift)
-    ramp_deg = scale * t.number("ramp_deg", unit="deg", min_exclusive=0.0, max_value=180.0)
-    flank_deg = scale * t.number("flank_deg", unit="deg", min_exclusive=0.0, max_value=180.0)
+    unit = "cam deg" if scale == 1.0 else "crank deg"
+    ramp_deg = scale * t.number("ramp_deg", unit=unit, min_exclusive=0.0, max_value=180.0 / scale)
+    flank_deg = scale * t.number("flank_deg", unit=unit, min_exclusive=0.0, max_value=180.0 / scale)
     if ramp_deg + flank_deg >= 180.0:
-        raise InputError(t.field("flank_deg"), flank_deg / scale, "ramp_deg + flank_deg < 180 cam degrees", "deg")
+        raise InputError(t.field("flank_deg"), flank_deg / scale,
+                         f"ramp_deg + flank_deg < {180.0 / scale:g} (half a cam turn)", unit)
     nose = t.number("nose_deg", unit="deg", default=0.0, min_value=-360.0, max_value=360.0)
     step = t.number("step_deg", unit="deg", default=MODEL_STEP_DEG, min_value=0.05, max_value=5.0)
     angles = np.arange(0.0, 360.0, step)
