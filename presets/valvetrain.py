@@ -141,6 +141,12 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     follower_table = top.table("follower", required=False)
     follower = None if follower_table is None else load_follower(
         follower_table, units, lambda t: _law(t, cam.coordinate, units, folder))
+    if follower is not None:
+        from vtool.solvers.model.camshape import undercut_warning
+
+        undercut = undercut_warning(follower, follower.lift or cam)
+        if undercut is not None:
+            warnings.warn(PresetWarning(undercut), stacklevel=2)
     checks_table = top.table("checks", required=False)
     checks = () if checks_table is None else load_checks(checks_table, units)
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)  # type: ignore[arg-type]

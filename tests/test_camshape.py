@@ -164,3 +164,34 @@ def test_dowson_higginson_film_closed_form_and_scaling() -> None:
     h2 = film_thickness(np.array([w * 10.0]), 10.0, np.array([R]), E, np.array([2 * u]), eta, alpha)[0]
     assert h2 / h == pytest.approx(2**0.7, rel=1e-12)
     assert film_thickness(np.array([0.0]), 10.0, np.array([R]), E, np.array([u]), eta, alpha)[0] == 0.0
+
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@settings(max_examples=30, deadline=None)
+@given(base=st.floats(5.0, 40.0), harmonics=st.lists(st.floats(-1.0, 1.0), min_size=2, max_size=8))
+def test_flat_radius_identity_and_envelope_for_any_law(base: float, harmonics: list[float]) -> None:
+    """Any smooth periodic law: the profile's curvature radius is r_b + L + L'' wherever the profile is regular."""
+    angles = np.arange(0.0, 360.0, 2.0)
+    theta = np.radians(angles)
+    lift = sum(c * (1 - np.cos((k + 1) * theta)) for k, c in enumerate(harmonics))
+    lift = lift - lift.min()
+    law = table_law(angles, lift, harmonics=len(harmonics))
+    profile = cam_profile(FollowerSpec("flat", "translating", base, 10.0), law, points=720)
+    L, _, ddL, _ = law_derivatives(law, np.radians(profile.law_angle_deg))
+    rho = base + L + ddL
+    regular = np.abs(rho) > 1e-6
+    np.testing.assert_allclose(profile.curvature_radius[regular], rho[regular], rtol=1e-9, atol=1e-9)
+    assert (len(profile.undercut) > 0) == bool((rho < 0).any())
+
+
+@settings(max_examples=30, deadline=None)
+@given(force=st.floats(1.0, 1e5), radius=st.floats(0.5, 100.0), width=st.floats(1.0, 50.0))
+def test_hertz_line_contact_invariants(force: float, radius: float, width: float) -> None:
+    E = 1.1e5
+    p0, b = hertz_line(np.array([force]), width, np.array([radius]), E)
+    assert p0[0] * b[0] * math.pi * width / 2 == pytest.approx(force, rel=1e-12)  # the load the pressure carries
+    p4, _ = hertz_line(np.array([4 * force]), width, np.array([radius]), E)
+    assert p4[0] == pytest.approx(2 * p0[0], rel=1e-12)

@@ -191,3 +191,12 @@ def test_presets_expand_and_cam_show_csv(tmp_path) -> None:  # type: ignore[no-u
     assert lines[0].startswith("law_angle (deg),lift (mm),x (mm),y (mm),polar_radius (mm)") and len(lines) == 721
     result = runner.invoke(cli, ["cam", "show", "gnilka-1a", "--csv", str(tmp_path / "x.csv")])
     assert result.exit_code == 2 and "[follower]" in result.output
+
+
+def test_an_undercut_cam_warns_on_loading() -> None:
+    from vtool.errors import PresetWarning
+
+    doc = _doc("direct-acting-bucket")
+    doc["train"]["follower"]["base_radius"] = 10.0
+    with pytest.warns(PresetWarning, match="undercuts at law angles"):
+        load_document(doc)

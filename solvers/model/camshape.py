@@ -406,3 +406,14 @@ def profile_csv_text(spec, step_deg: float = 0.5) -> str:  # type: ignore[no-unt
     rows = np.column_stack([profile.law_angle_deg, profile.lift, profile.x, profile.y, profile.radius,
                             profile.polar_angle_deg, profile.curvature_radius])
     return header + "\n" + "\n".join(",".join(f"{v:.10g}" for v in row) for row in rows) + "\n"
+
+
+def undercut_warning(follower: FollowerSpec, law: CamSpec) -> str | None:
+    """One line when the cam undercuts (the follower cannot follow the law there), else None."""
+    spans = cam_profile(follower, law).undercut
+    if not spans:
+        return None
+    named = ", ".join(f"{a:.1f}..{b:.1f}" for a, b in spans[:4]) + (" ..." if len(spans) > 4 else "")
+    return (f"follower: the cam undercuts at law angles {named} deg ({follower.kind} follower, base radius "
+            f"{follower.base_radius:g}): the follower cannot follow the lift law there, and the contact stress "
+            f"there is not computed (a larger base circle, a smaller roller or a gentler nose)")
