@@ -109,6 +109,13 @@ def _section(t: Table, units: UnitSystem, element: str, extra: tuple[str, ...] =
     return member
 
 
+def _part(train: Table, key: str) -> Table:
+    """A required part's table (``train.KEY``)."""
+    table = train.table(key)
+    assert table is not None  # required=True raises when absent
+    return table
+
+
 def _length(t: Table, key: str, units: UnitSystem, default: float | None = None) -> float:
     return t.number(key, unit=units.length, default=default, min_exclusive=0.0, max_value=1e4)
 
@@ -187,8 +194,7 @@ def _follower(train: Table, units: UnitSystem, kind: str | None, required: bool)
 
 
 def _seat(train: Table, units: UnitSystem, coordinate: int) -> dict[str, Any]:
-    t = train.table("seat")
-    assert t is not None
+    t = _part(train, "seat")
     doc: dict[str, Any] = {"coordinate": coordinate, "name": "seat"}
     if t.has("lash") == t.has("position"):
         raise InputError(t.field("lash"), t.raw("lash"), "either lash or position, not both", units.length)
@@ -223,7 +229,7 @@ def _initial(doc: dict[str, Any], closed: list[str], preload: float, ratio: floa
 
 def ohv_pushrod(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """Gnilka's layout (gnilka-1a's coordinates and members) from its parts."""
-    pushrod_t, rocker_t, valve_t = (train.table(k) for k in ("pushrod", "rocker", "valve"))
+    pushrod_t, rocker_t, valve_t = (_part(train, k) for k in ("pushrod", "rocker", "valve"))
     pushrod_length = _length(pushrod_t, "length", units)
     pushrod = _section(pushrod_t, units, "bar")
     cam_arm, valve_arm = _length(rocker_t, "cam_arm", units), _length(rocker_t, "valve_arm", units)
@@ -233,7 +239,7 @@ def ohv_pushrod(train: Table, units: UnitSystem, folder: Path | None) -> dict[st
     for t in (pushrod_t, rocker_t, valve_t):
         t.finish()
     tip = cam_arm + valve_arm
-    spring = spring_model(train.table("spring"), units, 4, 9, (tip + 0.2 * cam_arm, 0.0))
+    spring = spring_model(_part(train, "spring"), units, 4, 9, (tip + 0.2 * cam_arm, 0.0))
     coordinates = _coordinates(
         ("follower (pushrod lower end)", "translation"), ("left rocker tip", "translation"),
         ("left rocker tip rotation", "rotation"), ("right rocker tip / valve stem top / spring end", "translation"),
@@ -255,7 +261,7 @@ def ohv_pushrod(train: Table, units: UnitSystem, folder: Path | None) -> dict[st
 
 def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """Bucket on the valve: cam -> bucket (q1) -> stem top / retainer (q2) -> valve head (q3)."""
-    bucket_t, valve_t = train.table("bucket"), train.table("valve")
+    bucket_t, valve_t = _part(train, "bucket"), _part(train, "valve")
     bucket = {"mass": bucket_t.number("mass", unit=units.mass, min_exclusive=0.0, max_value=1e9),
               "stiffness": bucket_t.number("stiffness", unit=units.stiffness, min_exclusive=0.0, max_value=1e16)}
     bucket_length = _length(bucket_t, "length", units, default=1.0)
@@ -263,7 +269,7 @@ def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[
     valve = _section(valve_t, units, "bar")
     bucket_t.finish()
     valve_t.finish()
-    spring = spring_model(train.table("spring"), units, 2, 4, (0.0, -bucket_length))
+    spring = spring_model(_part(train, "spring"), units, 2, 4, (0.0, -bucket_length))
     coordinates = _coordinates(("bucket (cam contact)", "translation"),
                                ("valve stem top / retainer / spring end", "translation"),
                                ("valve head", "translation")) + spring.coordinates
@@ -278,7 +284,7 @@ def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[
 
 def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """End-pivot roller finger: pivot support, two beams (pivot-roller, roller-pad), valve (module doc)."""
-    finger_t, pivot_t, valve_t = train.table("finger"), train.table("pivot"), train.table("valve")
+    finger_t, pivot_t, valve_t = _part(train, "finger"), _part(train, "pivot"), _part(train, "valve")
     a = _length(finger_t, "roller_arm", units)
     b = finger_t.number("valve_arm", unit=units.length, min_exclusive=a, max_value=1e4)
     geometry = {"roller_arm": a, "valve_arm": b}
@@ -293,7 +299,7 @@ def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dic
     valve = _section(valve_t, units, "bar")
     for t in (finger_t, pivot_t, valve_t):
         t.finish()
-    spring = spring_model(train.table("spring"), units, 7, 9, (b, 0.0))
+    spring = spring_model(_part(train, "spring"), units, 7, 9, (b, 0.0))
     coordinates = _coordinates(
         ("finger pivot (lash adjuster)", "translation"), ("finger pivot rotation", "rotation"),
         ("finger at the roller (cam contact)", "translation"), ("finger rotation at the roller", "rotation"),
@@ -328,8 +334,7 @@ def expand(doc: dict[str, Any], folder: Path | None = None) -> dict[str, Any]:
     assert train is not None
     kind = train.string("type", choices=TYPES)
     built = BUILDERS[kind](train, units, folder)
-    cam_t = train.table("cam")
-    assert cam_t is not None
+    cam_t = _part(train, "cam")
     law = _law(cam_t, units, folder)
     follower = _follower(train, units, built["follower_kind"], required=kind != OHV_PUSHROD)
     seat = _seat(train, units, built["seat"])
@@ -383,7 +388,7 @@ def law_spec_of(law: dict[str, Any], units: UnitSystem) -> Any:
 
 def train_parameters(doc: dict[str, Any]) -> list[tuple[tuple[str, ...], str]]:
     """(path, unit kind) of every number a train's form may edit: ``("train", "finger", "roller_arm")``."""
-    result = []
+    result: list[tuple[tuple[str, ...], str]] = []
     train = doc.get("train", {})
     for part, table in train.items():
         if not isinstance(table, dict):
