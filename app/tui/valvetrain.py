@@ -45,7 +45,7 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
     u = spec.unit_system
     unit = {"length": u.length, "area": f"{u.length}^2", "inertia": f"{u.length}^4",
             "pressure": u.pressure, "specific_weight": u.specific_weight, "density": u.density,
-            "stiffness": u.stiffness, "mass": u.mass}
+            "stiffness": u.stiffness, "mass": u.mass, "force": u.force}
     installed = tuple(backends.available())
     backend_choices = installed if doc["run"]["backend"] in installed else (doc["run"]["backend"], *installed)
     fields = [
@@ -56,6 +56,10 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
         Field(("run", "beta"), "Newmark beta", group="Run"),
         Field(("run", "gamma"), "Newmark gamma", group="Run"),
         Field(("run", "output_interval"), "output every", "deg", group="Run"),
+    ]
+    if "train" in doc:  # entered by train type: its parameters (presets/trains.py), not the expanded members
+        return fields + train_fields(doc, unit) + damping_fields(doc)
+    fields += [
         *([Field(("cam", "amplitude"), "cam amplitude", u.length, group="Cam and spring")]
           if "amplitude" in doc["cam"] else
           [Field(("cam", key), f"cam {key}", u.length if key == "tolerance" else "", group="Cam and spring")
@@ -84,8 +88,14 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
         for key, label, kind in MEMBER_KEYS:
             if key in member and key != "stiffness":
                 fields.append(Field(("members", name, key), label, unit[kind], group=group))
-    fields.append(Field(("damping", "factor"), "global factor", group="Damping (modal ratios)"))
-    fields.append(Field(("damping", "default_ratio"), "default ratio", group="Damping (modal ratios)"))
+    fields += damping_fields(doc)
+    fields.append(Field(("gravity",), "gravity", u.acceleration, group="Mechanism"))
+    return fields
+
+
+def damping_fields(doc: dict[str, Any]) -> list[Field]:
+    fields = [Field(("damping", "factor"), "global factor", group="Damping (modal ratios)"),
+              Field(("damping", "default_ratio"), "default ratio", group="Damping (modal ratios)")]
     for i, layer in enumerate(doc["damping"].get("layers", [])):
         closed = "+".join(layer["closed"]) or "none closed"
         fields.append(Field(("damping", "layers", i, "default_ratio"), f"{closed}: ratio",
@@ -93,7 +103,19 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
         for mode in layer.get("mode_ratios", {}):
             fields.append(Field(("damping", "layers", i, "mode_ratios", mode), f"{closed}: mode {mode}",
                                 group="Damping (modal ratios)"))
-    fields.append(Field(("gravity",), "gravity", u.acceleration, group="Mechanism"))
+    return fields
+
+
+def train_fields(doc: dict[str, Any], unit: dict[str, str]) -> list[Field]:
+    """A train type's numbers, one group per part ("Train: spring"), and its limits ([checks])."""
+    from vtool.presets.trains import train_parameters
+
+    kinds = unit | {"deg": "deg", "": ""}
+    fields = []
+    for path, kind in train_parameters(doc):
+        part, key = path[1], path[2]
+        fields.append(Field(path, key.replace("_", " ")[:15], kinds.get(kind, kind),
+                            group=f"Train ({doc['train'].get('type', '')}): {part}"))
     return fields
 
 
