@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import json
 import re
 import warnings
 from dataclasses import replace
@@ -108,7 +109,9 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
 
     ``folder`` resolves a ``[cam] lift_table`` file (default: the working folder).
     """
+    train = ""
     if isinstance(doc, dict) and "train" in doc:  # a train type: expanded to the explicit form first
+        train = json.dumps(doc["train"])
         doc = expand(doc, folder)
     top = Table(doc, "")
     top.check_unknown(TOP_KEYS)
@@ -141,6 +144,12 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     follower_table = top.table("follower", required=False)
     follower = None if follower_table is None else load_follower(
         follower_table, units, lambda t: _law(t, cam.coordinate, units, folder))
+    if follower is not None:
+        from vtool.solvers.model.camshape import undercut_warning
+
+        undercut = undercut_warning(follower, follower.lift or cam)
+        if undercut is not None:
+            warnings.warn(PresetWarning(undercut), stacklevel=2)
     checks_table = top.table("checks", required=False)
     checks = () if checks_table is None else load_checks(checks_table, units)
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)  # type: ignore[arg-type]
@@ -161,6 +170,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         contact=contact,
         follower=follower,
         checks=checks,
+        train=train,
     )
     spec = split_members(spec)
     if seat is not None and seat.lash is not None:
@@ -515,13 +525,13 @@ def _quantity_names(coordinates, cam, seat, clearances) -> tuple[set[int], set[i
 QUANTITY = re.compile(r"q(\d+)(?:-q(\d+))?|F(\d+)")
 
 
-def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...]:
-    value = t.raw("quantities", [])
+def _quantities(t: Table, numbers: set[int], forces: set[int], key: str = "quantities") -> tuple[str, ...]:
+    value = t.raw(key, [])
     expected = (f"a list of 'q<i>', 'q<i>-q<j>' (i, j in {sorted(numbers)}) or 'F<i>' "
                 f"(i in {sorted(forces)})")
     if not isinstance(value, list):
-        raise InputError(t.field("quantities"), value, expected)
-    _count(t.field("quantities"), value, MAX_QUANTITIES, "quantities")
+        raise InputError(t.field(key), value, expected)
+    _count(t.field(key), value, MAX_QUANTITIES, "quantities")
     for item in value:
         match = QUANTITY.fullmatch(item) if isinstance(item, str) else None
         ok = match is not None and (
@@ -529,18 +539,19 @@ def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...
             or (match[1] is not None and int(match[1]) in numbers and (match[2] is None or int(match[2]) in numbers))
         )
         if not ok:
-            raise InputError(t.field("quantities"), item, expected)
+            raise InputError(t.field(key), item, expected)
     return tuple(value)
 
 
 RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta", "gamma", "quantities",
-            "cycles", "steady", "jump_angle", "jump_gap", "bounce_lift")
+            "cycles", "steady", "jump_angle", "jump_gap", "bounce_lift", "orders", "highest_order")
 #: [run] cycle-by-cycle and criteria ranges: key -> (min, max, unit)
 CYCLE_LIMITS: dict[str, tuple[float, float, str]] = {
     "cycles": (1, 10_000, "cam cycles"),
     "max_cycles": (2, 10_000, "cam cycles"),
     "tolerance": (1e-12, 1.0, "(relative change per cycle)"),
     "jump_angle": (0.0, 360.0, "deg"),
+    "highest_order": (1, 1000, "cam orders"),
 }
 
 
@@ -589,13 +600,17 @@ def _run(t: Table, names: tuple[set[int], set[int]], units: Any) -> RunSpec:
     gamma = t.number("gamma", default=0.5, min_value=GAMMA_RANGE[0], max_value=GAMMA_RANGE[1])
     quantities = _quantities(t, *names)
     cycles = _cycles(t, units)
+    cycles["orders"] = _quantities(t, *names, key="orders")
+    low, high, _ = CYCLE_LIMITS["highest_order"]
+    cycles["highest_order"] = t.integer("highest_order", default=24, min_value=int(low), max_value=int(high))
     t.finish()
     return RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities, **cycles)
 
 
 def dump(spec: MechanismSpec) -> dict[str, Any]:
-    """The preset document for a spec (inverse of :func:`load`)."""
-    spec = unsplit_members(spec)
+    """The preset document for a spec (inverse of :func:`load`); a spec entered by train type dumps as its
+    [train] while its model is what the type gives (:func:`train_document`)."""
+    given, spec = spec, unsplit_members(spec)
     doc: dict[str, Any] = {"kind": "valvetrain", "title": spec.title}
     if spec.notes:
         doc["notes"] = spec.notes
@@ -653,7 +668,25 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         doc["follower"] = dump_follower(spec.follower, _law_doc)
     if spec.checks:
         doc["checks"] = {c.name: c.limit for c in spec.checks}
-    return doc
+    return train_document(given, doc) or doc
+
+
+TRAIN_KEEPS = ("kind", "title", "notes", "units", "gravity", "contact", "damping", "run", "checks")
+
+
+def train_document(spec: MechanismSpec, explicit: dict[str, Any]) -> dict[str, Any] | None:
+    """The train-type document of a spec entered by type, while its model is still what the type gives
+    (else None: the explicit form, e.g. after a member was split or a clearance pinned)."""
+    if not spec.train:
+        return None
+    doc = {key: explicit[key] for key in TRAIN_KEEPS if key in explicit}
+    doc["train"] = json.loads(spec.train)
+    doc["initial"] = {"velocities": spec.initial.velocities}
+    try:
+        again = load(copy.deepcopy(doc))
+    except InputError:  # e.g. a lift_table file the saved copy's folder does not hold
+        return None
+    return doc if again == spec else None
 
 
 def _dump_run(r: RunSpec) -> dict[str, Any]:
@@ -670,6 +703,10 @@ def _dump_run(r: RunSpec) -> dict[str, Any]:
     for key in ("jump_gap", "bounce_lift"):
         if getattr(r, key) is not None:
             run[key] = getattr(r, key)
+    if r.orders:
+        run["orders"] = list(r.orders)
+    if r.highest_order != 24:
+        run["highest_order"] = r.highest_order
     return run
 
 

@@ -21,7 +21,7 @@ import click
 from vtool.app.cli.options import figure_option, write_figure
 from vtool.errors import InputError
 from vtool.solvers.backends import available
-from vtool.solvers.cost import MAX_STEPS
+from vtool.solvers.cost import MAX_SCIPY_STEPS, MAX_STEPS
 from vtool.solvers.model.spec import IMPACT_LAWS, START_VELOCITIES
 
 
@@ -39,7 +39,7 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @click.option("--degrees", type=float,
               help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's run.degrees.")
 @click.option("--max-steps", type=float, callback=_max_steps,
-              help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}).")
+              help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}; scipy {MAX_SCIPY_STEPS:.0e}).")
 @click.option("--csv", "csv_path", type=click.Path(),  # a str: '' stays '' in the error
               help="Write the response as CSV (per output interval, or per step with --every-step).")
 @click.option("--every-step", is_flag=True, help="CSV rows at every time step (and event) instead of per degree.")
@@ -49,9 +49,13 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @click.option("--events", "show_events", is_flag=True, help="Also print the event list.")
 @click.option("--impact", help=f"Impact law for every clearance ({', '.join(IMPACT_LAWS)}); default: the preset's.")
 @click.option("--start", help=f"Start velocities ({', '.join(START_VELOCITIES)}); default: the preset's.")
+@click.option("--orders", "orders", metavar="QUANTITY",
+              help="Also print the cam-order spectrum of QUANTITY (q7, q1-q9, F7) over the evaluated cycles: "
+                   "a table, and with --plot a chart with the natural frequencies marked.")
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
           max_steps: float | None, csv_path: str | None, every_step: bool, plot: bool, as_json: bool,
-          show_events: bool, impact: str | None, start: str | None, figure_path: Path | None) -> None:
+          show_events: bool, orders: str | None, impact: str | None, start: str | None,
+          figure_path: Path | None) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
@@ -70,7 +74,7 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
     kind = KINDS[kind_of(doc)]
     given = {"--backend": backend, "--dt": dt, "--rpm": rpm, "--degrees": degrees,
              "--max-steps": max_steps, "--every-step": every_step or None,
-             "--events": show_events or None, "--impact": impact, "--start": start}
+             "--events": show_events or None, "--impact": impact, "--start": start, "--orders": orders}
     for flag, value in given.items():
         if value is not None and flag not in kind.run_options:
             raise InputError(flag, value, f"no {flag} for {preset}: it is a {kind.name} preset "
@@ -87,7 +91,7 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
 #: ``vtool solve``'s run flags and the keyword that carries each to a kind's solve function
 FLAG_ARGUMENTS = {"--backend": "backend", "--dt": "dt", "--rpm": "rpm", "--degrees": "degrees",
                   "--max-steps": "max_steps", "--every-step": "every_step", "--events": "show_events",
-                  "--impact": "impact", "--start": "start"}
+                  "--impact": "impact", "--start": "start", "--orders": "orders"}
 
 
 def applies_to(flag: str) -> list[str]:
@@ -98,7 +102,8 @@ def applies_to(flag: str) -> list[str]:
 
 
 def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *, every_step: bool = False,
-                   show_events: bool = False, max_steps: float | None = None, figure: Path | None = None) -> None:
+                   show_events: bool = False, max_steps: float | None = None, figure: Path | None = None,
+                   orders: str | None = None) -> None:
     """``vtool solve`` for a valvetrain preset (its flags that are preset fields already in ``spec``): the
     run and its summary."""
     from vtool.app.cli.progress import DelayedProgress
@@ -124,10 +129,26 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
                                  stream=stream, before_run=before_run)
     finally:
         progress.close()
+    from vtool.solvers.studies.metrics import evaluation_summary
+
+    evaluation = evaluation_summary(trace)
+    spectrum = None
+    if orders is not None:
+        from vtool.solvers.studies.orders import spectrum as order_spectrum
+
+        spectrum = order_spectrum(trace, orders)
     if as_json:
-        click.echo(json_text(trace.summary()))
+        summary = trace.summary() | {"evaluation": evaluation}
+        if spectrum is not None:
+            summary["orders"] = spectrum.as_dict()
+        click.echo(json_text(summary))
     else:
         click.echo(trace.summary_text())
+        click.echo("")
+        click.echo("\n".join(evaluation["lines"]))
+        if spectrum is not None:
+            click.echo("")
+            click.echo(spectrum.table())
         if show_events:
             click.echo("")
             click.echo(trace.event_table())
@@ -137,6 +158,11 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
         from vtool.app.valvetrain_charts import all_charts
 
         click.echo(all_charts(trace))
+        if spectrum is not None:
+            from vtool.app.order_charts import order_chart
+            from vtool.solvers.studies.orders import natural_frequencies
+
+            click.echo(order_chart(spectrum, natural_frequencies(trace)))
     if figure is not None:
         from vtool.presets.charts import trace_charts
 
