@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vtool.chart import Chart
+
 _LOCK = threading.Lock()
 
 
@@ -132,6 +134,19 @@ def stacked_chart(
     panels = [Panel(_curves(xs, series, False), title if i == 0 else "", ylabel)
               for i, (ylabel, series) in enumerate(groups)]
     return _render(panels, xlabel=xlabel, width=width, height=height, color=color)
+
+
+def chart_text(chart: Chart, *, width: int = 100, height: int = 22, color: bool = True) -> str:
+    """A :class:`vtool.chart.Chart` as text: its panels stacked, the title on the top one.
+
+    Event marks are left to the figures (a braille chart has no room for them);
+    the terminal lists events with ``--events``.
+    """
+    panels = [Panel([(c.label, *(_curves(c.x, {"": c.y}, c.step)[0][1:])) for c in panel.curves],
+                    chart.title if i == 0 else "", panel.ylabel, panel.ylim, panel.yticks)
+              for i, panel in enumerate(chart.panels)]
+    return _render(panels, xlabel=chart.xlabel, width=width, height=height, color=color, xlim=chart.xlim,
+                   xlog=chart.xlog)
 
 
 def shape_chart(

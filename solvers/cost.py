@@ -3,9 +3,9 @@
 A run covers ``t_end = degrees / (6 rpm)`` seconds (cam speed ω = 2π rpm / 60).
 The work is
 
-* ``newmark``: ``t_end / Δt`` steps (plus the short refined stretches after
-  events, not counted);
-* ``exact`` and ``scipy``: about 16 samples per period of the highest
+* a back end flagged ``fixed_step`` (``newmark``): ``t_end / Δt`` steps
+  (plus the short refined stretches after events, not counted);
+* any other (``exact``, ``scipy``): about 16 samples per period of the highest
   natural frequency, ``16 t_end ω_max / 2π`` (the exact back end scans at
   1/16 of the shortest period; solve_ivp's steps are of the same order);
 
@@ -18,11 +18,18 @@ the CSV table and its text: measured 3.7 GB peak for 900,000 rows of 47
 values, which this counts as 2.9 GB), plus the ``2^n_c`` configuration tables
 of ``6 n²`` floats.
 
-:func:`check` refuses a run above :data:`MAX_STEPS` steps or
-:data:`MAX_BYTES` bytes with one line giving the estimate and how to proceed
-(``--max-steps``, fewer degrees, a coarser step or output interval). At about
-1 million Newmark steps per second on the development machine, the default
-limit bounds a run at roughly a minute.
+:func:`check` refuses a run above its back end's step limit
+(:func:`max_steps_for`) or :data:`MAX_BYTES` bytes with one line giving the
+estimate and how to proceed (``--max-steps``, fewer degrees, a coarser step
+or output interval). At about 1 million Newmark steps per second on the
+development machine, :data:`MAX_STEPS` bounds a run at roughly a minute. A
+scipy sample costs far more (solve_ivp calls Python for every stage of
+every step, and restarts at every event): 0.16 ms per estimated sample on
+gnilka-1a with every contact linear at k = 1e10 lbf/in (14.6 s for 9.2e4),
+so scipy's limit is :data:`MAX_SCIPY_STEPS`, about the same minute; its
+estimate grows with the stiffest linear contact through omega_max (k = 1e13
+gives 2.3e7 samples for 720 deg of 1A: refused, where it used to run for
+more than 300 s).
 """
 
 from __future__ import annotations
@@ -31,11 +38,15 @@ import math
 from dataclasses import dataclass
 
 from vtool.errors import InputError
+from vtool.solvers import backends
+from vtool.units import cam_speed
 
 #: Default largest number of steps (or samples) of one run.
 MAX_STEPS = 5e7
 #: Largest --max-steps a user may ask for.
 LARGEST_MAX_STEPS = 1e12
+#: ... of a scipy run (module doc: a sample costs about 160 Newmark steps).
+MAX_SCIPY_STEPS = 5e5
 #: Default largest memory of one run's output (bytes).
 MAX_BYTES = 2e9
 #: Samples per period of the highest natural frequency (exact, scipy).
@@ -64,9 +75,9 @@ def estimate(*, backend: str, rpm: float, degrees: float, time_step: float, outp
              every_step: bool, omega_max: float, n_coordinates: int, n_sources: int,
              n_clearances: int, n_quantities: int = 0) -> Estimate:
     """The cost of one run (see module doc); all inputs in the preset's units."""
-    omega = rpm * 2.0 * math.pi / 60.0
+    omega = cam_speed(rpm)
     t_end = math.radians(degrees) / omega if omega > 0 else math.inf
-    if backend == "newmark":
+    if backends.get(backend).fixed_step:
         steps = t_end / time_step if time_step > 0 else math.inf
     else:
         steps = t_end * omega_max / (2.0 * math.pi) * SAMPLES_PER_PERIOD
@@ -97,16 +108,22 @@ class CostError(InputError):
             allow = (f", or --max-steps {math.ceil(c.steps):d}" if c.steps <= LARGEST_MAX_STEPS
                      else f" (more than the largest --max-steps, {LARGEST_MAX_STEPS:.0e})")
             limit = (f"more than the limit of {self.max_steps:.3g} steps; to proceed: fewer --degrees, "
-                     f"a higher --rpm, a larger --dt (newmark){allow}")
+                     f"a higher --rpm, a larger --dt (fixed-step back ends){allow}")
         else:
             limit = (f"more than the limit of {self.max_bytes / 1e9:g} GB of output; to proceed: fewer "
                      "--degrees, a larger run.output_interval, or no --every-step")
         return f"run too large: {c.describe()} ({c.backend}, {c.t_end:.3g} s of motion), {limit}"
 
 
+def max_steps_for(backend: str) -> float:
+    """The default step limit of a back end (module doc)."""
+    limit = backends.get(backend).max_steps  # a back end may set its own (the scipy back end's steps cost more)
+    return MAX_STEPS if limit is None else limit
+
+
 def check(cost: Estimate, max_steps: float | None = None, max_bytes: float | None = None) -> Estimate:
     """Refuse (:class:`CostError`, exit 2) a run above the limits; returns ``cost``."""
-    max_steps = MAX_STEPS if max_steps is None else max_steps
+    max_steps = max_steps_for(cost.backend) if max_steps is None else max_steps
     max_bytes = MAX_BYTES if max_bytes is None else max_bytes
     if not cost.steps >= 1.0:
         raise CostError(cost, max_steps, max_bytes, "short")

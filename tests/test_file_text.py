@@ -10,21 +10,10 @@ import tomllib
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
-from vtool.app.cli.main import cli
+from tests.test_outputs import one_line, run
 from vtool.errors import InputError
 from vtool.presets import PRESET_DIR, load_document, parse_text
-
-
-def run(*args: str):  # type: ignore[no-untyped-def]
-    return CliRunner().invoke(cli, list(args))
-
-
-def one_line(result) -> str:  # type: ignore[no-untyped-def]
-    lines = [line for line in result.stderr.splitlines() if not line.startswith("warning: ")]
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr[-2000:]
-    return lines[0]
 
 
 def rows_of(path: Path) -> list[list[str]]:

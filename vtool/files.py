@@ -32,7 +32,7 @@ import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
-from typing import TextIO
+from typing import BinaryIO, TextIO
 
 from vtool.errors import InputError, RunError
 
@@ -229,3 +229,21 @@ def json_text(data: object, indent: int | None = 2) -> str:
     if places and isinstance(cleaned, dict):
         cleaned["non_finite"] = places
     return json.dumps(cleaned, indent=indent, allow_nan=False)
+
+
+@contextlib.contextmanager
+def open_atomic_binary(path: str | os.PathLike[str], field: str = "output") -> Iterator[BinaryIO]:
+    """A binary file handle with :func:`open_atomic`'s checks and guarantees (figures, PDF, Parquet).
+
+    The bytes go to the same temporary file, renamed over ``path`` only when the
+    block ends without error.
+    """
+    with open_atomic(path, field) as handle:
+        handle.flush()
+        yield handle.buffer  # the text handle's own binary layer: nothing was written through the text one
+
+
+def write_atomic_bytes(path: str | os.PathLike[str], data: bytes, field: str = "output") -> None:
+    """Write bytes to ``path`` atomically (see the module doc)."""
+    with open_atomic_binary(path, field) as handle:
+        handle.write(data)

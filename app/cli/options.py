@@ -32,23 +32,28 @@ start_option = click.option(
     help=f"Start velocities to compare (comma-separated from {', '.join(START_VELOCITIES)}); default: the preset's.")
 
 
-def _one(field: str, allowed: tuple[str, ...]):  # type: ignore[no-untyped-def]
-    def convert(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
-        if value is not None and value not in allowed:
-            from vtool.errors import InputError
+def _figure_path(ctx: click.Context, param: click.Parameter, value: str | None):  # type: ignore[no-untyped-def]
+    if value is None:
+        return None
+    from vtool.app.figures import check_figure_path
 
-            raise InputError(field, value, f"one of: {', '.join(allowed)}")
-        return value
-
-    return convert
+    return check_figure_path(value, "--figure")
 
 
-impact_option = click.option(
-    "--impact", default=None, callback=_one("--impact", IMPACT_LAWS),
-    help=f"Impact law for every clearance ({', '.join(IMPACT_LAWS)}); default: the preset's.")
-start_velocities_option = click.option(
-    "--start", default=None, callback=_one("--start", START_VELOCITIES),
-    help=f"Start velocities ({', '.join(START_VELOCITIES)}); default: the preset's.")
+figure_option = click.option(
+    "--figure", "figure_path", type=click.Path(dir_okay=False), callback=_figure_path,
+    help="Also write the charts as a report figure: OUT.png, OUT.svg or OUT.pdf (axes with units, "
+         "events marked, black-and-white readable).")
+
+
+def write_figure(items, path) -> None:  # type: ignore[no-untyped-def]
+    """Draw chart data to ``path`` (checked by the option) and say so on stderr."""
+    if path is None:
+        return
+    from vtool.app.figures import save_figure
+
+    save_figure(items, path)
+    click.echo(f"wrote {path}", err=True)
 
 
 class OutputPath(click.ParamType):
@@ -69,7 +74,6 @@ class OutputPath(click.ParamType):
 
 #: The one type of every output-file option (``--csv`` of every command).
 OUTPUT = OutputPath()
-
 
 
 def json_alone(as_json: bool, **others: bool) -> None:

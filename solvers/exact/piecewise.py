@@ -31,12 +31,12 @@ from typing import Any
 import numpy as np
 
 from vtool.errors import InputError, RunError
-from vtool.solvers.backends import Backend, Cancel, Progress
+from vtool.solvers.backends import Backend, Cancel, Progress, RunStats
 from vtool.solvers.exact.statespace import StateSpace, from_layer
 from vtool.solvers.model.contact import ContactProblem, OrderedLayer
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.sources import SourceSeries
-from vtool.solvers.model.spec import HERTZ
+from vtool.solvers.model.spec import HERTZ, MechanismSpec
 from vtool.solvers.newmark import build as kernel_build
 from vtool.solvers.newmark import layout
 from vtool.solvers.trace import OPENED, TraceBuilder
@@ -370,10 +370,10 @@ class PiecewiseRun(ABC):
         new_c = self.settle(new_c, t, x, v, a)
         return new_c, x, v, a
 
-    def statistics(self, settings: dict[str, Any]) -> dict[str, Any]:
+    def statistics(self, settings: dict[str, Any]) -> RunStats:
         self.flush_rows()
-        return {"steps": self.steps, "peak": self.peak, "peak_late": self.peak_late, "peak_overlap": self.peak_overlap,
-                "configurations": tuple(sorted(self.spaces)), "settings": settings}
+        return RunStats(self.steps, self.peak, self.peak_late, self.peak_overlap, tuple(sorted(self.spaces)),
+                        settings)
 
 
 def refuse_hertz(mechanism: Mechanism, backend: str) -> None:
@@ -389,8 +389,15 @@ class PiecewiseBackend(Backend):
 
     run_class: type[PiecewiseRun]
 
+    @classmethod
+    def compile_notice(cls, spec: MechanismSpec, impacts: tuple[str, ...] = ()) -> str | None:
+        """The event rules' compile (``impact``, ``settle``, ``fill_sources``), called from Python."""
+        from vtool.solvers.newmark.backend import compile_notice, kernel_laws
+
+        return compile_notice(cls.name, kernel_laws(spec, impacts))
+
     def integrate(self, problem: ContactProblem, options: Any, builder: TraceBuilder,
-                  progress: Progress | None, cancel: Cancel | None) -> dict[str, Any]:
+                  progress: Progress | None, cancel: Cancel | None) -> RunStats:
         run = self.run_class(problem, options, builder)  # type: ignore[call-arg]
         run.execute(progress, cancel)
         return run.statistics(self.settings(options))

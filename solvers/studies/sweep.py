@@ -22,8 +22,9 @@ assignments). This module evaluates them and keeps the results:
   flushed), so a killed sweep keeps what it finished and a resumed one skips
   it; when the sweep ends (or is stopped) the file is rewritten in point
   order, atomically, so every execution path gives the same bytes.
-* :func:`find_speed` brackets and bisects the cam speed at which a criterion
-  (follower leaves the cam; valve bounces on its seat) first holds.
+* :func:`find_speed` brackets and bisects every cam-speed interval in which a
+  criterion (follower leaves the cam during lift; valve bounces on its seat,
+  :mod:`vtool.solvers.studies.metrics`) holds.
 """
 
 from __future__ import annotations
@@ -54,6 +55,7 @@ from vtool.solvers.studies.metrics import (
     metric_columns,
     run_metrics,
 )
+from vtool.solvers.studies.steady import is_cyclic, simulate_cycles
 
 OK = "ok"
 
@@ -128,9 +130,12 @@ def evaluate_point(spec: MechanismSpec, *, every_step: bool = False, previous: M
     try:
         mechanism = _mechanism(spec, previous)
         backend = _backend_class(spec.run.backend)()
-        options = backend.options_from_run(spec.run, every_step)
-        trace = backend.simulate(mechanism, options, progress=None,
-                                 cancel=cancel if backend.supports_cancel else None)
+        if is_cyclic(spec):  # run.cycles or run.steady: cycle by cycle, the metrics of the last
+            trace = simulate_cycles(backend, mechanism, every_step=every_step, cancel=cancel)
+        else:
+            options = backend.options_from_run(spec.run, every_step)
+            trace = backend.simulate(mechanism, options, progress=None,
+                                     cancel=cancel if backend.supports_cancel else None)
     except (RunError, InputError) as exc:
         return failed_metrics(spec), str(exc).replace("\n", " "), mechanism
     return run_metrics(trace), OK, mechanism
@@ -160,10 +165,15 @@ def chunks(points: Sequence[Point], workers: int, per_worker: int = 4, largest: 
 
 # ----- execution -----
 
-def _ignore_interrupt(ready: Any = None) -> None:
-    """Worker initializer: Ctrl+C is handled by the parent, which stops the pool cleanly; ``ready``
-    (a semaphore) is released once the worker runs (see :meth:`ProcessRunner.start`)."""
+def _ignore_interrupt(ready: Any = None, stderr: str | None = None) -> None:
+    """Worker initializer: Ctrl+C is handled by the parent, which stops the pool cleanly; with
+    ``stderr`` (a file path), the worker's standard error (descriptor 2) is that file; ``ready`` (a
+    semaphore) is released once the worker runs (see :meth:`ProcessRunner.start`)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if stderr is not None:
+        target = os.open(stderr, os.O_WRONLY | os.O_APPEND)
+        os.dup2(target, 2)
+        os.close(target)
     if ready is not None:
         ready.release()
 
@@ -301,19 +311,23 @@ def _pool_start() -> Iterator[None]:
 class ProcessRunner:
     """A forkserver process pool of ``workers`` processes that ignore Ctrl+C (the parent stops them);
     its helper processes import the installed ``vtool`` whatever the current folder holds
-    (:func:`_pool_start`)."""
+    (:func:`_pool_start`).
 
-    def __init__(self, workers: int) -> None:
+    ``stderr``: a file the workers write their standard error to instead of the parent's (the TUI
+    passes os.devnull: its terminal is Textual's screen).
+    """
+
+    def __init__(self, workers: int, stderr: str | None = None) -> None:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
         context = multiprocessing.get_context("forkserver")
-        context.set_forkserver_preload(["vtool.solvers.studies.sweep", "vtool.solvers.newmark.backend"])
+        context.set_forkserver_preload(["vtool.solvers.studies.sweep", backends.module_of(backends.DEFAULT)])
         self.workers = workers
         self.ready = context.Semaphore(0)
         self.started = False
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt,
-                                        initargs=(self.ready,))
+                                        initargs=(self.ready, stderr))
 
     def start(self, timeout: float = 300.0) -> None:
         """Start every worker and wait until each runs (inside :func:`_pool_start`).
@@ -389,12 +403,15 @@ def check_workers(workers: int) -> int:
     return workers
 
 
-def make_runner(workers: int | None = None, scheduler: str | None = None) -> Any:
-    """The runner for these settings; a Dask scheduler is connected here (InputError if unreachable)."""
+def make_runner(workers: int | None = None, scheduler: str | None = None, *, stderr: str | None = None) -> Any:
+    """The runner for these settings; a Dask scheduler is connected here (InputError if unreachable).
+
+    ``stderr``: where local worker processes write their standard error (see :class:`ProcessRunner`).
+    """
     if scheduler is not None:
         return DaskRunner(scheduler)
     count = check_workers(workers) if workers is not None else os.cpu_count() or 1
-    return SerialRunner() if count == 1 else ProcessRunner(count)
+    return SerialRunner() if count == 1 else ProcessRunner(count, stderr)
 
 
 @dataclass
@@ -621,9 +638,9 @@ class SweepFile:
 
 # ----- derived speeds -----
 
-#: criterion name -> (metric, test, words)
+#: criterion name -> (metric, test, words); the criteria themselves: vtool.solvers.studies.metrics
 CRITERIA: dict[str, tuple[str, Callable[[float], bool], str]] = {
-    "jump-speed": ("cam_separations", lambda v: v >= 1, "the follower leaves the cam above mid-stroke"),
+    "jump-speed": ("cam_separations", lambda v: v >= 1, "the follower leaves the cam during lift"),
     "bounce-speed": ("seat_bounces", lambda v: v >= 1, "the valve bounces on its seat"),
 }
 
@@ -640,24 +657,46 @@ class Bracket:
 
 
 @dataclass(frozen=True)
+class Interval:
+    """A speed interval where the criterion holds: its bisected edges (rev/min) and the speeds just outside.
+
+    ``low`` is the lowest speed found where it holds and ``below`` the highest where it does not (None:
+    it holds at the lowest scanned speed); ``high`` and ``above`` likewise at the top (None: it holds at
+    the highest scanned speed)."""
+
+    low: float
+    high: float
+    below: float | None
+    above: float | None
+
+    def text(self) -> str:
+        low = f"{self.low:g}" if self.below is not None else f"{self.low:g} (the lowest scanned speed, or below)"
+        high = f"{self.high:g}" if self.above is not None else f"{self.high:g} (the highest scanned speed, or above)"
+        outside = [f"not at {v:g}" for v in (self.below, self.above) if v is not None]
+        return f"{low} to {high} rev/min" + (f" ({', '.join(outside)})" if outside else "")
+
+
+@dataclass(frozen=True)
 class SpeedResult:
     criterion: str
     speed: float | None  # rev/min: lowest speed found where the criterion holds; None if not bracketed
     history: tuple[Bracket, ...]
     message: str
+    intervals: tuple[Interval, ...] = ()  # every speed interval where it holds, bisected at both ends
 
 
 def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan: Sequence[float],
                runner: Any, *, tolerance: float = 1.0, every_step: bool = False,
                report: Callable[[Bracket], None] | None = None,
                cancel: Callable[[], bool] | None = None) -> SpeedResult:
-    """The lowest cam speed (to ``tolerance`` rev/min) at which ``criterion`` holds.
+    """Every cam-speed interval where ``criterion`` holds, each edge bisected to ``tolerance`` rev/min.
 
-    The speeds ``scan`` (ascending) are run together on ``runner``; the first
-    one where the criterion holds and the one before it bracket the answer,
-    which is then bisected (integer speeds for tolerance 1). The answer is the
-    first crossing on the scan: a criterion that holds, stops and holds again
-    with speed is reported at its lowest bracketed crossing.
+    The speeds ``scan`` (ascending) are run together on ``runner``; every change between neighbouring
+    scanned speeds (holds / does not) brackets an edge, which is then bisected (integer speeds for
+    tolerance 1). A window of contact loss below a window of contact is its own interval; an interval
+    narrower than the scan's step can fall between two scanned speeds unseen (scan finer). ``speed``
+    is the lowest edge (the jump speed), None when the criterion holds at no scanned speed or already
+    at the lowest.
     """
     if criterion not in CRITERIA:
         raise InputError("--find", criterion, f"one of: {', '.join(CRITERIA)}")
@@ -683,25 +722,62 @@ def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan
     if not any(holds):
         return SpeedResult(criterion, None, tuple(history), f"{words} at none of the scanned speeds "
                                                             f"(up to {scan[-1]:g} rev/min)")
-    first = holds.index(True)
-    if first == 0:
-        return SpeedResult(criterion, None, tuple(history),
-                           f"{words} already at the lowest scanned speed ({scan[0]:g} rev/min): scan lower")
-    low, high = scan[first - 1], scan[first]
     serial = SerialRunner()
-    while high - low > tolerance:
-        if cancel is not None and cancel():
-            raise RunError(f"{criterion}: stopped while bisecting between {low:g} and {high:g} rev/min")
-        mid = math.floor((low + high) / 2) if tolerance >= 1 else (low + high) / 2
-        if mid <= low:
-            mid = (low + high) / 2
-        result = run_points([Point(0, (("run.rpm", mid),), make_spec(mid))], serial, every_step=every_step)
-        if note(mid, result.results[0], "bisect"):
-            high = mid
-        else:
-            low = mid
-    return SpeedResult(criterion, high, tuple(history),
-                       f"{words} from {high:g} rev/min (not at {low:g})")
+
+    def bisect(low: float, high: float, rising: bool) -> tuple[float, float]:
+        """(the last speed on the low side, the first on the high side) of one edge."""
+        while high - low > tolerance:
+            if cancel is not None and cancel():
+                raise RunError(f"{criterion}: stopped while bisecting between {low:g} and {high:g} rev/min")
+            mid = math.floor((low + high) / 2) if tolerance >= 1 else (low + high) / 2
+            if mid <= low:
+                mid = (low + high) / 2
+            result = run_points([Point(0, (("run.rpm", mid),), make_spec(mid))], serial, every_step=every_step)
+            if note(mid, result.results[0], "bisect") == rising:
+                high = mid
+            else:
+                low = mid
+        return low, high
+
+    intervals = []
+    start: tuple[float, float | None] | None = (scan[0], None) if holds[0] else None
+    for i in range(1, len(scan)):
+        if holds[i] and not holds[i - 1]:
+            below, low = bisect(scan[i - 1], scan[i], rising=True)
+            start = (low, below)
+        elif holds[i - 1] and not holds[i]:
+            assert start is not None
+            high, above = bisect(scan[i - 1], scan[i], rising=False)
+            intervals.append(Interval(start[0], high, start[1], above))
+            start = None
+    if start is not None:
+        intervals.append(Interval(start[0], scan[-1], start[1], None))
+    first = intervals[0]
+    if first.below is None:
+        message = f"{words} already at the lowest scanned speed ({scan[0]:g} rev/min): scan lower"
+        speed = None
+    else:
+        message = f"{words} from {first.low:g} rev/min (not at {first.below:g})"
+        speed = first.low
+    return SpeedResult(criterion, speed, tuple(history), message, tuple(intervals))
+
+
+def scan_intervals(results: Sequence[PointResult], field: str, criterion: str) -> list[tuple[float, float]]:
+    """(first, last) swept value of every run of neighbouring points (in ``field``'s order) where ``criterion``
+    (a :data:`CRITERIA` name) holds: the intervals a scan shows, edges not bisected (``find_speed`` does)."""
+    metric, test, _ = CRITERIA[criterion]
+    points = sorted(((dict(r.values)[field], r) for r in results if r.ok), key=lambda vr: vr[0])
+    intervals: list[tuple[float, float]] = []
+    start = None
+    for k, (value, result) in enumerate(points):
+        if test(result.metrics[metric]):
+            start = value if start is None else start
+        elif start is not None:
+            intervals.append((start, points[k - 1][0]))
+            start = None
+    if start is not None:
+        intervals.append((start, points[-1][0]))
+    return intervals
 
 
 # ----- reports -----
