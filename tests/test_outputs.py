@@ -323,3 +323,24 @@ def test_a_tiny_top_speed_is_one_line() -> None:
 def test_a_run_too_long_for_any_step_limit_is_one_line() -> None:
     result = run("solve", "gnilka-1a", "--rpm", "0.001", "--degrees", "3.6e6")
     assert result.exit_code == 2 and "more than the largest --max-steps" in one_line(result)
+
+
+# ----- the every-step CSV's size -----------------------------------------------------------------
+
+def test_an_every_step_csv_is_estimated_from_the_steps_and_refused_above_the_file_limit(tmp_path: Path) -> None:
+    from vtool.presets import load_preset
+    from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.run import _assemble, run_cost
+
+    out = tmp_path / "steps.csv"
+    result = run("solve", "gnilka-1a", "--rpm", "1000", "--degrees", "360", "--every-step", "--csv", str(out))
+    assert result.exit_code == 0, result.output
+    spec = with_run_overrides(load_preset("gnilka-1a"), rpm=1000.0, degrees=360.0)
+    estimate = run_cost(_assemble(spec), csv=True, csv_every_step=True)
+    assert 0.8 < estimate.file_bytes / out.stat().st_size < 1.4  # measured 1.06
+    assert estimate.bytes < 0.1 * estimate.file_bytes  # the memory holds only the interval rows
+    refused = run("solve", "gnilka-1a", "--rpm", "100", "--degrees", "3600", "--every-step", "--csv",
+                  str(tmp_path / "big.csv"))
+    line = one_line(refused)
+    assert refused.exit_code == 2 and "MB of CSV (6e+06 rows)" in line and "limit of 2 GB of CSV" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["steps.csv"]
