@@ -44,7 +44,8 @@ def check_edges(criterion: str, make_spec, result, step: float, reach: float,  #
                 upper: bool = True) -> None:
     """Around every bisected edge a fine scan (``step`` rev/min, ``reach`` either side) has its own edge (the
     lowest speed that holds for a lower edge, the highest for an upper one) within two steps of it: an edge
-    can be ragged on a scale below the step (1A's bounce ends at 12,165 rev/min but holds again at 12,185)."""
+    can be ragged on a scale below the step (where 1A's bounces end, near 12,000 rev/min, they stop and
+    start again within tens of rev/min)."""
     for interval in result.intervals:
         for edge, lower in ((interval.low, True), (interval.high, False)):
             if (interval.below if lower else interval.above) is None or not (lower or upper):
@@ -91,5 +92,5 @@ def test_the_bounce_speed_of_gnilka_1a_is_found_and_where_a_fine_scan_puts_it() 
     make = preset_at("gnilka-1a")
     result = find_speed("bounce-speed", make, list(range(1000, 20001, 1000)), SerialRunner())
     assert result.speed is not None and 1000 < result.speed < 5000
-    # the bounce speed (the lower edge); the upper end, near 12,200 rev/min, is ragged over 100 rev/min
+    # the bounce speed (the lower edge); the upper end, near 12,000 rev/min, is ragged over hundreds of rev/min
     check_edges("bounce-speed", make, result, step=20.0, reach=60.0, upper=False)
