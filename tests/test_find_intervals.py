@@ -72,9 +72,10 @@ def test_two_windows_of_contact_loss_are_two_intervals_each_where_a_fine_scan_pu
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["gnilka-1a", "ramped-cam", "ohv-pushrod-1a"])
+@pytest.mark.parametrize("name", ["gnilka-1a", "ramped-cam", "ohv-pushrod-1a", "direct-acting-bucket",
+                                  "ohc-finger-follower"])
 def test_jump_speed_is_the_lowest_speed_a_brute_force_scan_shows_the_follower_off_the_cam(name: str) -> None:
-    """The thesis mechanism, the ramped cam and the train-type preset (ohv-pushrod-1a)."""
+    """The thesis mechanism, the ramped cam and the train-type presets."""
     make = preset_at(name)
     result = find_speed("jump-speed", make, list(range(1000, 20001, 1000)), SerialRunner())
     assert result.speed is not None
