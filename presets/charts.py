@@ -178,7 +178,7 @@ def cam_charts(spec: Any, points: int = 721) -> list[Chart]:
 
     fit = cam_fit(spec.cam)
     u = spec.unit_system.length
-    omega = spec.run.rpm * math.pi / 30.0
+    omega = spec.run.omega
     angles = np.linspace(0.0, 360.0, points)
     rows = derivatives(fit.c0, fit.a, fit.b, np.radians(angles))
     names = [("lift", u), ("velocity", f"{u}/s"), ("acceleration", f"{u}/s^2"), ("jerk", f"{u}/s^3")]

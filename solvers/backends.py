@@ -159,6 +159,10 @@ class Backend(ABC):
     fixed_step: ClassVar[bool] = False
     reference: ClassVar[bool] = False
     library_dependent: ClassVar[bool] = False
+    #: the cost guard's default step limit for this back end (None: vtool.solvers.cost.MAX_STEPS)
+    max_steps: ClassVar[float | None] = None
+    #: what to try when a run's result is not to be trusted (the trace's warnings say it)
+    remedy: ClassVar[str] = "another back end to compare"
 
     @classmethod
     def stable_step(cls, mechanism: Mechanism) -> float:
@@ -221,6 +225,7 @@ class Backend(ABC):
             settings["contact"] = {c.name: c.contact for c in spec.clearances if not c.rigid}
         built = problem.tables.layers if stats.configurations is None else stats.configurations
         statistics = RunStatistics(self.name, stats.steps, len(builder.events), wall, tuple(sorted(built)), settings,
-                                   compile_time=compile_time, plain_steps=stats.plain_steps, kernel=stats.kernel)
+                                   compile_time=compile_time, plain_steps=stats.plain_steps, kernel=stats.kernel,
+                                   remedy=self.remedy)
         return builder.build(stats.peak, statistics, stats.peak_late, sort=stats.sort,
                              peak_overlap=stats.peak_overlap)

@@ -113,7 +113,8 @@ class CostError(InputError):
 
 def max_steps_for(backend: str) -> float:
     """The default step limit of a back end (module doc)."""
-    return MAX_SCIPY_STEPS if backend == "scipy" else MAX_STEPS
+    limit = backends.get(backend).max_steps  # a back end may set its own (the scipy back end's steps cost more)
+    return MAX_STEPS if limit is None else limit
 
 
 def check(cost: Estimate, max_steps: float | None = None, max_bytes: float | None = None) -> Estimate:

@@ -86,6 +86,7 @@ class RunStatistics:
     compile_time: float = 0.0  # s spent compiling (or loading) the kernel, not in wall_time
     plain_steps: int = 0  # of ``steps``, those run as plain Python (before the compiled kernel was ready)
     kernel: str = ""  # newmark: what ran its last steps, "native", "numba" or "plain" (newmark.kernel_kind)
+    remedy: str = ""  # the back end's advice when a result is not to be trusted (Backend.remedy)
 
 
 @dataclass(frozen=True)
@@ -195,8 +196,7 @@ class Trace:
             named.append(f"{self.force_label(int(k))} ({self.spec.clearances[k].name}) {tensile[k]:.4g} {unit} "
                          f"at {self.cam_angle[row]:.1f} deg")
         backend = self.statistics.backend
-        remedy = {"scipy": "a tighter rtol, or the exact back end", "newmark": "a smaller time step, or the exact "
-                  "back end"}.get(backend, "another back end to compare")
+        remedy = self.statistics.remedy or "another back end to compare"
         return (f"contact forces of the wrong sign: {', '.join(named)}: a closed contact pulled, a release "
                 f"the {backend} back end missed; the events and peaks after it are not to be trusted ({remedy})")
 

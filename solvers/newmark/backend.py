@@ -236,6 +236,7 @@ class NewmarkBackend(Backend):
 
     name = "newmark"
     fixed_step = True
+    remedy = "a smaller time step, or the exact back end"
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> NewmarkOptions:
