@@ -167,6 +167,7 @@ def test_cli_orders_and_campbell() -> None:
     assert "evaluated: after the first revolution (cam angle 360-850 deg)" in solved.output
     assert "start-up shock (first revolution): startup_peak_force" in solved.output
     assert "F7 in cam orders over 1 cycle (cam angle 360-720 deg" in solved.output
+    assert "dominant orders near each natural frequency (within 15 %):" in solved.output
     swept = CliRunner().invoke(cli, ["sweep", "gnilka-1a", "--set", "run.rpm=9000:10000:500", "--campbell", "F7",
                                      "--steady", "--workers", "1"])
     assert swept.exit_code == 0, swept.output
