@@ -178,7 +178,7 @@ def cam_charts(spec: Any, points: int = 721) -> list[Chart]:
 
     fit = cam_fit(spec.cam)
     u = spec.unit_system.length
-    omega = spec.run.rpm * math.pi / 30.0
+    omega = spec.run.omega
     angles = np.linspace(0.0, 360.0, points)
     rows = derivatives(fit.c0, fit.a, fit.b, np.radians(angles))
     names = [("lift", u), ("velocity", f"{u}/s"), ("acceleration", f"{u}/s^2"), ("jerk", f"{u}/s^3")]
@@ -255,7 +255,7 @@ PLATE_QUANTITIES = ("displacement", "velocity", "acceleration")
 def plate_response_chart(resp: Any, exact: Any, quantity: str, subject: str = "") -> Chart:
     """One centre history of a transient run against the exact modal solution (dimensionless)."""
     curves = [curve(f"{resp.case} {resp.scheme}", resp.tau, getattr(resp, quantity))]
-    if exact is not None and not (quantity == "acceleration" and not exact.acceleration_converged):
+    if exact is not None and not (quantity == "acceleration" and not exact.acceleration_defined):
         curves.append(curve("exact", resp.tau, np.interp(resp.tau, exact.tau, getattr(exact, quantity))))
     return Chart(f"centre {quantity}, {resp.load} step load", "t / T (exact fundamental period) (-)",
                  (Panel(tuple(curves), PLATE_LABELS[quantity]),), subject)

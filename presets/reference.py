@@ -27,6 +27,8 @@ from vtool.presets.paths import set_fields
 
 #: Shipped presets with fields changed (None: removed) so that the loader reads the keys of its other branches.
 VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
+    ("gnilka-1a", {"run.cycles": 2, "run.jump_gap": 0.001, "run.bounce_lift": 0.001}),
+    ("gnilka-1a", {"run.steady": {"tolerance": 1e-3, "max_cycles": 5}}),
     # the other unit system of each kind (the same numbers: each key's unit and SI-derived bounds in it)
     ("gnilka-1a", {"units": "SI"}), ("boom-brick-wall", {"units": "m-N-s"}),
     ("boom-tall-building", {"units": "m-N-s", "floors[0].moment_of_inertia": 4e-4, "floors[0].storey_height": 3.7,
@@ -38,6 +40,9 @@ VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
                    "clearances[0].contact_damping": 1.0}),
     ("gnilka-1a", {"clearances[2].contact": "hertz", "clearances[2].contact_stiffness": 1e7,
                    "clearances[2].contact_exponent": 1.5, "clearances[2].restitution": 0.5}),
+    ("gnilka-1a", {"run.steady": {"tolerance": 1e-3, "max_cycles": 20}, "run.jump_gap": 0.002,
+                   "run.bounce_lift": 0.002, "run.orders": ["F7"]}),
+    ("gnilka-1a", {"run.cycles": 3}),
     *((name, changes) for name in ("boom-brick-wall", "boom-tall-building") for changes in (
         {"boom.pulse": "N", "boom.envelope": None},
         {"boom.pulse": "csv", "boom.csv": "pulse.csv", "boom.envelope": None},
@@ -275,8 +280,16 @@ MEANINGS: dict[str, dict[str, str]] = {
         "run.beta": "Newmark's beta (thesis: 1/6).",
         "run.gamma": "Newmark's gamma (thesis: 1/2).",
         "run.quantities": "Extra CSV and chart columns: coordinates (\"q7\", \"q1-q9\") and forces (\"F2\").",
-        "run.steady": "Run cycle by cycle until the response settles ({ tolerance, max_cycles }; {} takes the defaults).",
-        "run.jump_angle": "Cam rotation the follower must stay off the cam in the lift event to count as a jump.",
+        "run.cycles": "Run this many cam cycles, cycle by cycle; the metrics cover the last (instead of `degrees`).",
+        "run.steady": "Run cycle by cycle until the cycle's start state and metrics settle; the last is evaluated.",
+        "run.steady.tolerance": "Largest relative change from one cycle to the next that counts as settled.",
+        "run.steady.max_cycles": "Cycles after which a run that has not settled stops and says so.",
+        "run.jump_angle": "The follower leaves the cam when its contact is open longer than this during lift.",
+        "run.jump_gap": "... and its gap exceeds this (default: 0.1 % of the cam's lift).",
+        "run.bounce_lift": "The valve bounces when it re-opens after seating by more than this (default: 0.1 % of "
+                           "the cam's lift).",
+        "run.orders": "Quantities whose cam-order amplitudes are metrics (`QUANTITY_order_K`).",
+        "run.highest_order": "The highest cam order of those metrics.",
     },
     "boom_wall": COMMON | BOOM | {
         "walls": "The walls to assess, one table each.",

@@ -141,6 +141,8 @@ class ValveTrainScreen(DomainScreen):
     MODE = "valvetrain"
     DEFAULT_PRESET = "gnilka-1a"
     TITLE_TEXT = "VALVE TRAIN"
+    # a table cam's file is written inline (docs/cams.md): a saved copy must not depend on its folder
+    FILE_REFERENCES = ((("cam",), "lift_table", ("angles", "lifts")),)
 
     def result_panes(self) -> list[TabPane]:
         """The result tabs, in order: a new tab is one more pane in this list."""
@@ -157,6 +159,8 @@ class ValveTrainScreen(DomainScreen):
             TabPane("Events", TextPanel("no run yet", id="events"), id="tab-events"),
             TabPane("Summary", TextPanel("no run yet", id="summary"), id="tab-summary"),
             TabPane("Anim.", MechanismAnimation(id="animation", color=color), id="tab-animation"),
+            TabPane("Orders", ChartView("the cam-order spectrum of the seat force appears here after a run",
+                                        id="order-chart", color=color), id="tab-orders"),
             TabPane("Sweep", SweepPane(self.DEFAULT_PRESET, workers=None, id="sweep", lazy=True), id="tab-sweep"),
         ]
 
@@ -183,6 +187,10 @@ class ValveTrainScreen(DomainScreen):
     @property
     def configuration_chart(self) -> ChartView:
         return self.query_one("#configuration-chart", ChartView)
+
+    @property
+    def order_chart(self) -> ChartView:
+        return self.query_one("#order-chart", ChartView)
 
     @property
     def quantity_list(self) -> SelectionList[str]:
@@ -213,7 +221,7 @@ class ValveTrainScreen(DomainScreen):
 
     def clear_results(self) -> None:
         self.results = None
-        for chart in (self.force_chart, self.displacement_chart, self.configuration_chart):
+        for chart in (self.force_chart, self.displacement_chart, self.configuration_chart, self.order_chart):
             chart.plot(None)
         self.query_one("#events", TextPanel).set_text("no run yet")
         self.query_one("#summary", TextPanel).set_text("no run yet")
@@ -270,12 +278,34 @@ class ValveTrainScreen(DomainScreen):
         self.force_chart.plot(lambda w, h, c: charts.force_chart(trace, w, h, color=c))
         self.plot_displacements()
         self.configuration_chart.plot(lambda w, h, c: charts.configuration_chart(trace, w, h, color=c))
-        summary = trace.summary_text()
+        from vtool.solvers.studies.metrics import evaluation_summary
+
+        summary = trace.summary_text() + "\n\n" + "\n".join(evaluation_summary(trace)["lines"])
         events = trace.event_table() if trace.events else "no events"
+        self.plot_orders(trace)
         self.query_one("#summary", TextPanel).set_text(summary)
         self.query_one("#events", TextPanel).set_text(events)
         self.query_one("#side-panel", TextPanel).set_text(f"{summary}\n\nevents\n{events}")
         self.animation.show_trace(trace)
+
+    def plot_orders(self, trace: Any) -> None:
+        """The spectrum of the default quantity (run.orders' first, else the seat force) over the evaluated
+        cycles: its table and chart with the natural frequencies marked; a run without a whole evaluated
+        cycle says so."""
+        from vtool.errors import InputError
+        from vtool.solvers.studies.orders import default_quantity, natural_frequencies, spectrum
+
+        try:
+            orders = spectrum(trace, default_quantity(trace.spec))
+        except InputError as exc:
+            self.order_chart.placeholder = f"no spectrum: {exc}"
+            self.order_chart.plot(None)
+            return
+        frequencies = natural_frequencies(trace)
+        from vtool.app.order_charts import order_chart
+
+        self.order_chart.plot(lambda w, h, c: orders.table(6) + "\n" + order_chart(
+            orders, frequencies, width=w, height=max(h - 10 - len(frequencies), 8), color=c))
 
     def plot_displacements(self) -> None:
         trace = self.results

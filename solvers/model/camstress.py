@@ -112,7 +112,7 @@ def _periodic(table: StressTable, values: np.ndarray, angles_deg: np.ndarray) ->
 def stress_rows(spec: MechanismSpec, cam_angle_deg: np.ndarray, model_force: np.ndarray) -> dict[str, np.ndarray]:
     """Normal force, p₀, half-width and (with an oil) film thickness at output rows."""
     table = stress_table(spec)
-    omega = spec.run.rpm * math.pi / 30.0
+    omega = spec.run.omega
     angles = np.asarray(cam_angle_deg, dtype=float)
     curvature = _periodic(table, table.curvature, angles)
     with np.errstate(divide="ignore"):
