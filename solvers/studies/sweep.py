@@ -299,7 +299,7 @@ def _pool_start() -> Iterator[None]:
         for sig, handler in handlers.items():
             signal.signal(sig, handler)
     for signum in held[:1]:  # what arrived meanwhile, as it would have arrived
-        handler = handlers[signum]
+        handler = handlers[signal.Signals(signum)]
         if callable(handler):
             handler(signum, None)
         elif handler == signal.SIG_DFL and signum == signal.SIGINT:
