@@ -344,3 +344,36 @@ def test_an_every_step_csv_is_estimated_from_the_steps_and_refused_above_the_fil
     line = one_line(refused)
     assert refused.exit_code == 2 and "MB of CSV (6e+06 rows)" in line and "limit of 2 GB of CSV" in line
     assert sorted(p.name for p in tmp_path.iterdir()) == ["steps.csv"]
+
+
+# ----- the default runner's choice -------------------------------------------------------------
+
+def test_the_pool_is_chosen_only_where_it_wins() -> None:
+    from vtool.solvers.studies.sweep import CHUNK_SECONDS, choose_workers
+
+    cheap = choose_workers(0.009, 98, cores=2, load=0.5, start_seconds=2.0)  # 0.9 s serially: no pool pays
+    assert cheap.workers == 1 and "run in this process" in cheap.reason
+    costly = choose_workers(0.5, 998, cores=2, load=0.5, start_seconds=2.0)  # 500 s serially
+    assert costly.workers == 2 and "2 worker processes" in costly.reason
+    assert costly.chunk * 0.5 >= CHUNK_SECONDS and costly.chunk <= 998 / 4
+    loaded = choose_workers(0.5, 998, cores=2, load=3.0, start_seconds=2.0)  # another job holds the cores
+    assert loaded.workers == 1 and "1.0 of 2 cores free" in loaded.reason
+    small = choose_workers(0.05, 998, cores=8, load=1.0, start_seconds=2.0)
+    assert small.workers == 8 and small.chunk == 5  # 0.25 s of work a chunk
+
+
+def test_the_default_runner_says_what_it_chose_and_gives_the_serial_results() -> None:
+    from vtool.presets.paths import plan_sweep
+    from vtool.solvers.studies.sweep import AutoRunner, SerialRunner, results_csv, run_points
+
+    plan = plan_sweep("gnilka-1a", ["run.rpm=10000:10400:100", "run.degrees=20"])
+    said: list[str] = []
+    runner = AutoRunner(2, announce=said.append)
+    try:
+        auto = run_points(plan.points, runner)
+    finally:
+        runner.close()
+    serial = run_points(plan.points, SerialRunner())
+    assert len(said) == 1 and said[0].startswith("sweep: 3 more points of ") and runner.choice is not None
+    assert (results_csv(auto.results, plan.fields, plan.spec)  # (the machine's wall time left out)
+            == results_csv(serial.results, plan.fields, plan.spec))

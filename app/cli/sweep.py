@@ -135,7 +135,12 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         raise InputError("--map", len(axes), "exactly two swept fields with more than one value")
     if (plot or figure_path) and not axes:
         raise InputError("--plot", plan.fields[0][0] if plan.fields else None, "a swept field with two or more values")
-    runner = make_runner(workers, scheduler)  # a Dask scheduler is reached here, before any file is written
+    import time
+
+    started = time.perf_counter()  # the wall time counts a Dask cluster's or a pool's start-up
+    runner = make_runner(workers, scheduler,  # a Dask scheduler is reached here, before any file is written
+                         announce=lambda text: click.echo(text, err=True))
+    startup = time.perf_counter() - started
     try:
         if find is not None:
             _find(find, plan, runner, csv_path, as_json, every_step)
@@ -174,8 +179,10 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         click.echo(steady_text(plan.spec))  # which cycles the metrics cover, and by which criteria
         click.echo(Criteria.of(plan.spec).text(length))
         n = len(results)
-        click.echo(f"{n} points in {outcome.wall_time:.2f} s ({1000 * outcome.wall_time / max(n, 1):.1f} ms per "
-                   f"point, {runner.workers} worker{'s' if runner.workers > 1 else ''})")
+        wall = startup + outcome.wall_time
+        begun = f", {startup:.2f} s of it starting the cluster" if startup >= 0.005 else ""
+        click.echo(f"{n} points in {wall:.2f} s ({1000 * wall / max(n, 1):.1f} ms per "
+                   f"point, {runner.workers} worker{'s' if runner.workers > 1 else ''}{begun})")
         if csv_path is not None:
             click.echo(f"wrote {outcome.total} rows to {csv_path}")
     if results and (plot or as_map):

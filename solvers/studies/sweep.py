@@ -339,10 +339,19 @@ class ProcessRunner:
         if self.started:
             return
         with _pool_start():
-            for _ in range(self.workers):  # each submission to a pool without an idle worker starts one
-                self.pool.submit(os.getpid)
-            for _ in range(self.workers):
-                if not self.ready.acquire(timeout=timeout):
+            # each submission to a pool without an idle worker starts one
+            futures = [self.pool.submit(os.getpid) for _ in range(self.workers)]
+            deadline = time.perf_counter() + timeout
+            running = 0
+            while running < self.workers:
+                if self.ready.acquire(timeout=0.1):
+                    running += 1
+                    continue
+                failed = next((f.exception() for f in futures if f.done() and f.exception() is not None), None)
+                if failed is not None:
+                    raise RunError(f"the sweep's worker processes did not start ({type(failed).__name__}: "
+                                   f"{str(failed)[:120]})")
+                if time.perf_counter() > deadline:
                     raise RunError(f"the sweep's {self.workers} worker processes did not start within {timeout:g} s")
         self.started = True
 
@@ -394,6 +403,94 @@ class SerialRunner:
         pass
 
 
+#: Seconds a local pool needs before its workers return their first points: the forkserver's imports,
+#: the workers' start and each worker's first kernel load (benchmarks/bench_sweep_choice.py measures it:
+#: 1.1 s for the pool and about 1 s for the first point on the 2-core development machine).
+POOL_START_SECONDS = 2.0
+#: Work per chunk sent to a worker (s): fewer, larger chunks cost less in hand-offs.
+CHUNK_SECONDS = 0.25
+#: Points measured in this process before the choice (the first also loads the kernel: the last one counts).
+MEASURED_POINTS = 2
+
+
+@dataclass(frozen=True)
+class WorkerChoice:
+    """How the rest of a sweep runs: ``workers`` processes (1: in this process), ``chunk`` points a task."""
+
+    workers: int
+    chunk: int
+    reason: str
+
+
+def choose_workers(point_seconds: float, points: int, cores: int, load: float | None = None,
+                   start_seconds: float = POOL_START_SECONDS) -> WorkerChoice:
+    """Workers and chunk size for ``points`` more points of ``point_seconds`` each (measured).
+
+    The cores free for the sweep are ``cores + 1 - load`` (``load``: the one-minute load average, which
+    counts this process), from 1 to ``cores``; with ``w`` workers on ``f`` free cores the pool takes
+    ``start_seconds + points * point_seconds / min(w, f)`` against ``points * point_seconds`` serially,
+    and is chosen only when that saves more than a tenth of the serial time. A chunk holds about
+    :data:`CHUNK_SECONDS` of work, and there are at least two chunks per worker.
+    """
+    serial = points * point_seconds
+    free = float(cores) if load is None else min(float(cores), max(1.0, cores + 1.0 - load))
+    workers = min(cores, points, max(1, int(free + 0.5)))
+    where = f"{points} more point{'s' if points != 1 else ''} of {1000 * point_seconds:.3g} ms"
+    if workers < 2:
+        return WorkerChoice(1, points or 1, f"{where} run in this process ({free:.1f} of {cores} cores free)")
+    pooled = start_seconds + serial / min(workers, free)
+    if pooled > 0.9 * serial:
+        return WorkerChoice(1, points, f"{where} run in this process: {serial:.2g} s, where a pool of {workers} "
+                            f"would take about {pooled:.2g} s with its {start_seconds:g} s start-up")
+    chunk = max(1, min(math.ceil(CHUNK_SECONDS / max(point_seconds, 1e-6)), math.ceil(points / (2 * workers))))
+    return WorkerChoice(workers, chunk, f"{where} run on {workers} worker processes in chunks of {chunk}: about "
+                        f"{pooled:.2g} s against {serial:.2g} s in this process")
+
+
+class AutoRunner:
+    """The default local runner: measures a point in this process, then runs the rest there or on a pool
+    (:func:`choose_workers`); ``announce`` is told the choice (the CLI prints it on stderr)."""
+
+    def __init__(self, cores: int, stderr: str | None = None,
+                 announce: Callable[[str], None] | None = None) -> None:
+        self.cores = cores
+        self.workers = cores  # (for the caller's first grouping; the choice regroups)
+        self.stderr = stderr
+        self.announce = announce
+        self.choice: WorkerChoice | None = None
+        self.pool: ProcessRunner | None = None
+        self.serial = SerialRunner()
+
+    def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
+            cancel: Callable[[], bool]) -> bool:
+        points = [p for batch in batches for p in batch]
+        if self.choice is None:
+            seconds = 0.0
+            for point in points[:MEASURED_POINTS]:
+                started = time.perf_counter()
+                if not self.serial.run([[point]], every_step, on_results, cancel):
+                    return False
+                seconds = time.perf_counter() - started
+            points = points[MEASURED_POINTS:]
+            load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+            self.choice = choose_workers(seconds, len(points), self.cores, load)
+            self.workers = self.choice.workers
+            if self.announce is not None:
+                self.announce(f"sweep: {self.choice.reason}")
+        if not points:
+            return True
+        if self.choice.workers < 2:
+            return self.serial.run([points], every_step, on_results, cancel)
+        if self.pool is None:
+            self.pool = ProcessRunner(self.choice.workers, self.stderr)
+        return self.pool.run(chunks(points, self.choice.workers, per_worker=2, largest=self.choice.chunk),
+                             every_step, on_results, cancel)
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.close()
+
+
 def check_workers(workers: int) -> int:
     """``workers`` if it is from 1 to :func:`max_local_workers`, else an InputError."""
     top = max_local_workers()
@@ -403,14 +500,20 @@ def check_workers(workers: int) -> int:
     return workers
 
 
-def make_runner(workers: int | None = None, scheduler: str | None = None, *, stderr: str | None = None) -> Any:
+def make_runner(workers: int | None = None, scheduler: str | None = None, *, stderr: str | None = None,
+                announce: Callable[[str], None] | None = None) -> Any:
     """The runner for these settings; a Dask scheduler is connected here (InputError if unreachable).
 
-    ``stderr``: where local worker processes write their standard error (see :class:`ProcessRunner`).
+    ``workers=None`` (the default) chooses from the measured cost of a point (:class:`AutoRunner`, which
+    tells ``announce`` what it chose). ``stderr``: where local worker processes write their standard error
+    (see :class:`ProcessRunner`).
     """
     if scheduler is not None:
         return DaskRunner(scheduler)
-    count = check_workers(workers) if workers is not None else os.cpu_count() or 1
+    if workers is None:
+        cores = os.cpu_count() or 1
+        return SerialRunner() if cores == 1 else AutoRunner(cores, stderr, announce)
+    count = check_workers(workers)
     return SerialRunner() if count == 1 else ProcessRunner(count, stderr)
 
 
