@@ -237,9 +237,34 @@ class Trace:
         return self.coordinate_unit(int(re.findall(r"\d+", text)[0]))
 
     # ----- export -----
+    def valve_coordinate(self) -> int | None:
+        """The number of the coordinate that seats (ahead of the seat clearance), or None without a seat."""
+        seat = self.spec.seat
+        if seat is None:
+            return None
+        for c in self.spec.clearances:
+            if c.kind == EXTERNAL and c.behind == seat.coordinate and c.ahead in self.coordinate_numbers:
+                return c.ahead
+        return None
+
+    def valve_lift(self, rows: slice = slice(None)) -> np.ndarray:
+        """Valve lift off its seat: the seat clearance's gap ``q_valve - q_seat`` (length; 0 when seated)."""
+        valve = self.valve_coordinate()
+        if valve is None or self.spec.seat is None:
+            raise KeyError("valve_lift")
+        seat = self.spec.seat.coordinate
+        if seat in self.coordinate_numbers:
+            return self.coordinate(valve, rows) - self.coordinate(seat, rows)
+        return self.coordinate(valve, rows) - self.spec.seat.position
+
     def csv_columns(self, quantities: tuple[str, ...] = ()) -> tuple[list[str], list]:  # type: ignore[type-arg]
         """The CSV header (quantity names with units) and one function per numeric column that gives
-        the column's values on a slice of rows (so a long run is written block by block)."""
+        the column's values on a slice of rows (so a long run is written block by block).
+
+        Every name is unique: a preset quantity that is already a column (``q9``, ``F1``: the thesis
+        presets list seven) or is listed twice is written once. ``valve_lift`` (the seat clearance's
+        gap, :meth:`valve_lift`) follows the contact forces when the preset has a seat.
+        """
         units = self.spec.unit_system
         header = ["time (s)", "cam_angle (deg)"]
         columns: list = [lambda rows: self.time[rows], lambda rows: self.cam_angle[rows]]
@@ -251,8 +276,16 @@ class Trace:
         for i in range(len(self.spec.clearances)):
             header.append(f"{self.force_label(i)} ({units.force})")
             columns.append(lambda rows, i=i: self.contact_force[rows, i])
+        if self.valve_coordinate() is not None:
+            header.append(f"valve_lift ({units.length})")
+            columns.append(self.valve_lift)
+        names = {h.rpartition(" (")[0] for h in header}
         for expression in quantities:
-            header.append(f"{expression} ({self.quantity_unit(expression)})")
+            name = expression.replace(" ", "")
+            if name in names:
+                continue
+            names.add(name)
+            header.append(f"{name} ({self.quantity_unit(expression)})")
             columns.append(lambda rows, expression=expression: self.quantity(expression, rows))
         if self.spec.follower is not None:  # cam contact stress at each row (solvers/model/camstress.py)
             from vtool.solvers.model.camstress import row_unit, stress_rows
@@ -267,8 +300,11 @@ class Trace:
 
     def configuration_csv(self, mask: int) -> str:
         """The last two CSV columns of a configuration: its thesis number (or nothing) and closed clearances."""
+        from vtool.csvrows import csv_text
+
         number = thesis_number(self.spec, mask)
-        return f"{'' if number is None else number},{'+'.join(closed_names(self.spec, mask)) or 'none'}"
+        return csv_text([["" if number is None else number,
+                          "+".join(closed_names(self.spec, mask)) or "none"]]).removesuffix("\n")
 
     def write_csv_to(self, handle, quantities: tuple[str, ...] = (), chunk: int = 20_000,  # type: ignore[no-untyped-def]
                      header: bool = True, compiled: bool | None = None) -> None:
