@@ -121,3 +121,60 @@ def test_cli_find_writes_every_interval_to_csv_and_json(tmp_path) -> None:  # no
     searches = json.loads(shown.stdout)["searches"]
     assert searches[0]["intervals"] == [{"low_rpm": interval.low, "high_rpm": interval.high,
                                          "below_rpm": interval.below, "above_rpm": interval.above}]
+
+
+class PatternRunner:
+    """A runner (the sweep's runner interface) that runs nothing: a point "holds" when its speed lies in one
+    of the given integer intervals, so that find_speed's bracketing and bisection can be checked on any
+    pattern of contact loss."""
+
+    workers = 1
+
+    def __init__(self, intervals: list[tuple[int, int]]) -> None:
+        self.intervals = intervals
+        self.runs = 0
+
+    def holds(self, rpm: float) -> bool:
+        return any(a <= rpm <= b for a, b in self.intervals)
+
+    def run(self, batches, every_step, on_results, cancel) -> bool:  # noqa: ANN001
+        from vtool.solvers.studies.sweep import PointResult
+
+        for batch in batches:
+            self.runs += len(batch)
+            on_results([PointResult(p.index, p.values, {"cam_separations": int(self.holds(dict(p.values)["run.rpm"]))})
+                        for p in batch])
+        return True
+
+
+def test_every_interval_a_scan_touches_is_found_with_exact_edges() -> None:
+    """Property (hypothesis): for any set of disjoint integer speed intervals whose edges fall between
+    different pairs of neighbouring scanned speeds (one change of state per bracket), every interval is
+    reported with its exact edges (tolerance 1 rev/min), and no other."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    spec = load_preset("gnilka-1a")
+    scan = list(range(1000, 20001, 1000))
+    brackets = st.lists(st.integers(0, len(scan) - 2), max_size=8, unique=True).map(sorted)
+
+    @st.composite
+    def patterns(draw) -> list[tuple[int, int]]:  # noqa: ANN001
+        """Changes of state at t = first speed of the new state, one in each chosen (scan[i], scan[i + 1]]."""
+        chosen = draw(brackets)
+        changes = [scan[i] + draw(st.integers(1, scan[i + 1] - scan[i])) for i in chosen]
+        changes = changes[: len(changes) // 2 * 2]
+        return [(changes[i], changes[i + 1] - 1) for i in range(0, len(changes), 2)]
+
+    @settings(max_examples=60, deadline=None)
+    @given(patterns())
+    def check(intervals: list[tuple[int, int]]) -> None:
+        runner = PatternRunner(intervals)
+        result = find_speed("jump-speed", lambda rpm: spec, scan, runner, bisector=runner)
+        assert [(i.low, i.high) for i in result.intervals] == intervals
+        for i in result.intervals:
+            assert i.below == i.low - 1 and i.above == i.high + 1  # bracketed to 1 rev/min either side
+        assert result.speed == (intervals[0][0] if intervals else None)
+        assert runner.runs <= len(scan) + 2 * len(intervals) * 10  # 10 bisections an edge: log2(1000)
+
+    check()

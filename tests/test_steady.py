@@ -195,3 +195,47 @@ def test_the_committed_steady_cycles_table_is_regenerated_unchanged() -> None:
         fresh = table(*module.rows(1e-3, 30))
     assert read_block(root / "docs" / "valvetrain.md", "steady-cycles") == fresh, \
         "run python3 benchmarks/bench_steady.py --write"
+
+
+def _trace_of(values: np.ndarray, angle: np.ndarray):  # noqa: ANN202
+    """A hand-built plain-run trace of 1A whose valve coordinate (q7) is ``values`` at cam angles ``angle``."""
+    from vtool.solvers.trace import RunStatistics, Trace
+
+    spec = load_preset("gnilka-1a")
+    q = np.zeros((len(angle), 10))
+    q[:, 6] = values
+    force = np.zeros((len(angle), 3))
+    statistics = RunStatistics("hand", len(angle), 0, 0.0, ())
+    return Trace(spec, angle / 66000.0, angle, tuple(range(1, 11)), q, q * 0, q * 0, force,
+                 np.full(len(angle), 0b110), (), force.max(axis=0), statistics)
+
+
+@pytest.mark.filterwarnings("ignore")
+def test_spectrum_recovers_any_trigonometric_polynomial_below_the_nyquist_order() -> None:
+    """Property (hypothesis): a mean plus orders 1..60 with any amplitudes and phases, sampled at 1 deg over
+    three revolutions (a plain run: the last two whole cycles evaluated), comes back order by order."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    orders = st.lists(st.tuples(st.integers(1, 60), st.floats(0.0, 10.0), st.floats(-math.pi, math.pi)),
+                      min_size=1, max_size=6, unique_by=lambda t: t[0])
+
+    @settings(max_examples=40, deadline=None)
+    @given(orders, st.floats(-5.0, 5.0))
+    def check(terms: list[tuple[int, float, float]], mean: float) -> None:
+        angle = np.arange(0.0, 1081.0)
+        theta = np.radians(angle)
+        values = mean + sum(a * np.cos(k * theta + phi) for k, a, phi in terms)
+        result = spectrum(_trace_of(values, angle), "q7")
+        assert result.cycles == 2 and result.start == 360.0
+        scale = 1.0 + abs(mean) + sum(a for _, a, _ in terms)
+        assert result.amplitude_of(0) == pytest.approx(abs(mean), abs=1e-9 * scale)
+        expected = {k: a for k, a, _ in terms}
+        for k in range(1, 90):
+            assert result.amplitude_of(k) == pytest.approx(expected.get(k, 0.0), abs=1e-9 * scale)
+            assert result.amplitude_of(k - 0.5) == pytest.approx(0.0, abs=1e-9 * scale)  # nothing between orders
+        for k, a, phi in terms:
+            if a > 1e-6 * scale:
+                assert math.cos(result.phase[2 * k] - phi) == pytest.approx(1.0, abs=1e-6)
+
+    check()
