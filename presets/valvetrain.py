@@ -117,7 +117,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     top.check_unknown(TOP_KEYS)
     top.string("kind", choices=("valvetrain",))
     title = top.string("title", default="")
-    notes = top.string("notes", default="")
+    notes = top.string("notes", default="", multiline=True)
     units_name = top.string("units", choices=tuple(UNIT_SYSTEMS))
     units = UNIT_SYSTEMS[units_name]
     gravity = _magnitude(top, "gravity", units.acceleration, "gravity", default=units.gravity)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from vtool.app.cli.options import figure_option, write_figure
+from vtool.app.cli.options import OUTPUT, figure_option, json_alone, write_figure
 
 DEFAULT_SCAN = "1000:20000:1000"
 
@@ -35,6 +35,20 @@ class CountProgress:
             self.bar = None
 
 
+def _workers(ctx: click.Context, param: click.Parameter, value: int | None) -> int | None:
+    from vtool.solvers.studies.sweep import check_workers
+
+    return None if value is None else check_workers(value)
+
+
+def _scheduler(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    from vtool.solvers.studies.sweep import parse_scheduler
+
+    if value is not None:
+        parse_scheduler(value)  # the one parser: refused here, before the preset is loaded
+    return value
+
+
 @click.command()
 @click.argument("preset")
 @click.option("--set", "sets", multiple=True, metavar="FIELD=VALUES",
@@ -46,10 +60,11 @@ class CountProgress:
                    "cam during lift (jump-speed) or the valve bounces on its seat (bounce-speed), each run to "
                    f"steady state; --set run.rpm gives the scan (default {DEFAULT_SCAN}), other --set fields a "
                    "grid of searches.")
-@click.option("--workers", type=int, help="Local worker processes (default: all cores; 1 = in this process).")
-@click.option("--scheduler", help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
+@click.option("--workers", type=int, callback=_workers,
+              help="Local worker processes (default: chosen from the measured cost of a point; 1 = in this process).")
+@click.option("--scheduler", callback=_scheduler, help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
                                   "processes) or local-threads:N.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("--csv", "csv_path", type=OUTPUT,
               help="Write one row per point (swept fields, status, metrics; units in the header), appended as "
                    "points finish.")
 @click.option("--resume", is_flag=True, help="Continue the sweep in the --csv file, skipping finished points.")
@@ -94,6 +109,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         run_points,
     )
 
+    json_alone(as_json, plot=plot, map=as_map)
     if resume and csv_path is None:
         raise InputError("--resume", True, "a --csv file to resume")
     if find is not None:
@@ -130,8 +146,12 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
             outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress)
         except KeyboardInterrupt:
             progress.close()
-            where = (f"the finished points are in {csv_path}; run again with --resume to finish"
-                     if csv_path else "nothing was kept (use --csv to keep finished points)")
+            if sink is not None and (sink.written or resume):
+                where = f"the finished points are in {csv_path}; run again with --resume to finish"
+            elif sink is not None:
+                where = f"no point had finished: nothing was written ({csv_path} is as it was)"
+            else:
+                where = "nothing was kept (use --csv to keep finished points)"
             raise RunError(f"interrupted: {where}") from None
         finally:
             progress.close()
@@ -215,8 +235,9 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
             for interval in result.intervals:
                 click.echo(f"  interval: {interval.text()}")
             click.echo(f"{criterion}: {result.message}")
+        intervals = ";".join(f"{format_value(i.low)}-{format_value(i.high)}" for i in result.intervals)
         rows.append([format_value(v) for _, v in key] + [format_value(result.speed) if result.speed else "",
-                                                         result.message])
+                                                         intervals, result.message])
         found.append(dict(key) | {criterion.replace("-", "_"): result.speed,
                                   f"{criterion.replace('-', '_')}_unit": "rev/min", "message": result.message,
                                   "history": [{"rpm": b.rpm, "holds": b.holds, "value": b.value, "stage": b.stage}
@@ -229,7 +250,7 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
                                "evaluation": steady_text(first), "searches": found}, indent=2))
     if csv_path is not None:
         header = [f"{f} ({u})" if u else f for f, u in others] + [f"{criterion.replace('-', '_')} (rev/min)",
-                                                                  "message"]
+                                                                  "intervals (rev/min)", "message"]
         import csv
         import io
 
