@@ -235,3 +235,17 @@ def test_centre_pivot_rocker_follows_its_geometric_valve_lift_on_every_back_end(
     traces = [simulate(with_run_overrides(spec, degrees=120.0, backend=b)) for b in available()]
     assert len({tuple((e.clearance, e.kind) for e in t.events) for t in traces}) == 1
     assert all("cam contact (Hertz" in t.summary_text() for t in traces)
+
+
+def test_compare_and_size_take_a_train_preset() -> None:
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    runner = CliRunner()
+    result = runner.invoke(cli, ["compare", "direct-acting-bucket", "--impact", "local,thesis", "--degrees", "200"])
+    assert result.exit_code == 0, result.output
+    assert "local" in result.output and "thesis" in result.output and "(mm/s)" in result.output
+    result = runner.invoke(cli, ["size", "direct-acting-bucket", "--rpm-max", "3000", "--max-elements", "2"])
+    assert result.exit_code == 0, result.output
+    assert "harmonics" in result.output and "valve_spring" in result.output
