@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vtool.chart import Chart
+
 _LOCK = threading.Lock()
 
 
@@ -51,9 +53,13 @@ def _render(panels: list[Panel], *, xlabel: str, width: int, height: int, color:
             if len(panels) > 1:
                 plt.subplot(number, 1)
             plt.theme("pro" if color else "clear")
+            drawn = 0
             for label, xs, ys in panel.curves:
-                plt.plot(np.asarray(xs, dtype=float).tolist(), np.asarray(ys, dtype=float).tolist(),
-                         label=label, marker="braille")
+                xs, ys = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
+                if not np.isfinite(xs[np.isfinite(ys)]).any():  # nothing to draw (plotext fails on it)
+                    continue
+                plt.plot(xs.tolist(), ys.tolist(), label=label, marker="braille")
+                drawn += 1
             if xlim is not None:
                 plt.xlim(*xlim)
             if panel.ylim is not None:
@@ -62,7 +68,7 @@ def _render(panels: list[Panel], *, xlabel: str, width: int, height: int, color:
                 plt.yticks(list(panel.yticks[0]), list(panel.yticks[1]))
             if xlog:
                 plt.xscale("log")
-            plt.title(panel.title)
+            plt.title(panel.title if drawn else f"{panel.title}: no finite value to draw".lstrip(": "))
             plt.ylabel(panel.ylabel)
             if number == len(panels):
                 plt.xlabel(xlabel)
@@ -128,6 +134,19 @@ def stacked_chart(
     panels = [Panel(_curves(xs, series, False), title if i == 0 else "", ylabel)
               for i, (ylabel, series) in enumerate(groups)]
     return _render(panels, xlabel=xlabel, width=width, height=height, color=color)
+
+
+def chart_text(chart: Chart, *, width: int = 100, height: int = 22, color: bool = True) -> str:
+    """A :class:`vtool.chart.Chart` as text: its panels stacked, the title on the top one.
+
+    Event marks are left to the figures (a braille chart has no room for them);
+    the terminal lists events with ``--events``.
+    """
+    panels = [Panel([(c.label, *(_curves(c.x, {"": c.y}, c.step)[0][1:])) for c in panel.curves],
+                    chart.title if i == 0 else "", panel.ylabel, panel.ylim, panel.yticks)
+              for i, panel in enumerate(chart.panels)]
+    return _render(panels, xlabel=chart.xlabel, width=width, height=height, color=color, xlim=chart.xlim,
+                   xlog=chart.xlog)
 
 
 def shape_chart(

@@ -1,22 +1,36 @@
 """The one table of preset kinds: what each ``kind`` loads into and who runs and shows it.
 
-Every place that dispatches on a preset's kind reads :data:`KINDS`: the
-loader (:func:`vtool.presets.load_document`), ``vtool solve`` and the TUI. The
-entries name code by dotted path strings (``module:attribute`` or a module),
-so this table imports nothing: the presets layer never imports ``app/``, and
-the CLI imports only the module of the kind it runs.
+Every place that dispatches on a preset's kind reads :data:`KINDS` and
+nothing else: the loader (:func:`vtool.presets.load_preset`,
+:func:`~vtool.presets.load_document`, :func:`~vtool.presets.save_spec`),
+``vtool solve`` (which flags apply, which function runs and prints), every
+command that takes one kind only (:func:`require_kind`) and the TUI (which
+screen opens a preset, which loader a screen's form uses). The entries name
+code by dotted path strings (``module:attribute`` or a module), so this table
+imports nothing: the presets layer never imports ``app/``, and the CLI
+imports only the module of the kind it runs
+(``tests/test_dispatch.py`` checks that no other module compares a kind).
 
-=============  ==========================================  ================================  ==============================  ========================
-kind           spec type                                   loader (``load``/``dump``)        solve (``vtool solve``)         TUI screen module
-=============  ==========================================  ================================  ==============================  ========================
-valvetrain     vtool.solvers.model.spec:MechanismSpec            vtool.presets.valvetrain          vtool.app.cli.solve:run_valvetrain  vtool.app.tui.valvetrain
-boom_wall      vtool.assessments.sonic_boom.spec:BoomWallSpec   vtool.presets.boom           vtool.app.cli.boom:solve_preset     vtool.app.tui.boom
-boom_floor     vtool.assessments.sonic_boom.spec:BoomFloorSpec  vtool.presets.boom           vtool.app.cli.boom:solve_preset     vtool.app.tui.boom
-plate          vtool.presets.plate:PlateSpec               vtool.presets.plate               vtool.app.cli.plate:solve_preset    vtool.app.tui.plate
-=============  ==========================================  ================================  ==============================  ========================
+==========  ================================================  ========================  ========================================  ========================
+kind        spec type                                         loader (``load/dump``)    solve (``vtool solve``: runs and prints)  TUI screen module
+==========  ================================================  ========================  ========================================  ========================
+valvetrain  vtool.solvers.model.spec:MechanismSpec            vtool.presets.valvetrain  vtool.app.cli.solve:run_valvetrain        vtool.app.tui.valvetrain
+boom_wall   vtool.assessments.sonic_boom.spec:BoomWallSpec    vtool.presets.boom        vtool.app.cli.boom:solve_preset           vtool.app.tui.boom
+boom_floor  vtool.assessments.sonic_boom.spec:BoomFloorSpec   vtool.presets.boom        vtool.app.cli.boom:solve_preset           vtool.app.tui.boom
+plate       vtool.presets.plate:PlateSpec                     vtool.presets.plate       vtool.app.cli.plate:solve_preset          vtool.app.tui.plate
+==========  ================================================  ========================  ========================================  ========================
 
-``solve`` functions of boom and plate take ``(spec, csv_path, plot, as_json)``;
-the valve train's takes more options (see :mod:`vtool.app.cli.solve`).
+A loader module has ``load(doc, folder=None) -> spec`` (``folder``: the
+preset's folder, against which a file it names is found: a cam lift table,
+a boom pulse CSV) and ``dump(spec) -> doc``. A solve function has
+``solve(spec, csv_path, plot, as_json, **flags)``, where ``flags`` are the
+kind's :attr:`Kind.run_options` that are not preset fields, as keyword
+arguments (``--every-step`` is ``every_step``); those that are preset fields
+(:attr:`Kind.overrides`: ``--rpm`` is ``run.rpm``) are set into the document
+and checked by the loader (the loader module then has ``with_overrides(doc,
+{path: value}) -> doc``). ``vtool solve`` refuses any other flag for the kind. A TUI screen module
+has ``SCREEN``, its :class:`~vtool.app.tui.base.DomainScreen` class; one
+screen may show several kinds (the boom screen: walls and floors).
 """
 
 from __future__ import annotations
@@ -40,6 +54,9 @@ class Kind:
     screen: str
     #: the flags of ``vtool solve`` that apply to this kind beyond --csv/--plot/--json
     run_options: tuple[str, ...] = ()
+    #: those of them that are preset fields: flag -> field path, set into the document before the load
+    #: (:class:`vtool.presets.Override`), so the loader checks them once, as the file's own values
+    overrides: tuple[tuple[str, str], ...] = ()
 
 
 KINDS: dict[str, Kind] = {
@@ -47,7 +64,10 @@ KINDS: dict[str, Kind] = {
                        "vtool.solvers.model.spec:MechanismSpec", "vtool.presets.valvetrain",
                        "vtool.app.cli.solve:run_valvetrain", "vtool.app.tui.valvetrain",
                        ("--backend", "--dt", "--rpm", "--degrees", "--every-step", "--events",
-                        "--max-steps")),
+                        "--max-steps", "--impact", "--start", "--orders"),
+                       (("--backend", "run.backend"), ("--dt", "run.time_step"), ("--rpm", "run.rpm"),
+                        ("--degrees", "run.degrees"), ("--impact", "contact.impact"),
+                        ("--start", "initial.velocities"))),
     "boom_wall": Kind("boom_wall", "sonic-boom wall assessment",
                       "vtool.assessments.sonic_boom.spec:BoomWallSpec", "vtool.presets.boom",
                       "vtool.app.cli.boom:solve_preset", "vtool.app.tui.boom"),

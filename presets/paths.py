@@ -26,7 +26,9 @@ from __future__ import annotations
 import copy
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from vtool.errors import InputError
@@ -147,16 +149,48 @@ def parse_values(field: str, text: str, max_points: int = 100_000) -> list[Any]:
     return values
 
 
-def field_unit(doc: dict[str, Any], path: str) -> str:
+def field_unit(doc: dict[str, Any], path: str, folder: Path | None = None) -> str:
     """The unit the loader states for ``path`` (asked by offering it a non-number), or ``""``."""
     from vtool.presets import load_document
 
     try:
-        load_document(set_field(doc, path, "?"))
+        load_document(set_field(doc, path, "?"), folder)
     except InputError as exc:
         if exc.field == path:
             return exc.unit
     return ""
+
+
+class SweepCancelled(Exception):
+    """:func:`plan_sweep` stopped because its ``cancel`` said so (nothing was planned)."""
+
+
+def parse_assignments(sets: list[str] | tuple[str, ...], max_points: int = 100_000) -> list[tuple[str, list[Any]]]:
+    """``FIELD=VALUES`` texts (``--set`` of ``vtool sweep`` and ``vtool solve``) -> (path, values), in order;
+    each field once."""
+    fields: list[tuple[str, list[Any]]] = []
+    for text in sets:
+        path, sep, values = text.partition("=")
+        path = path.strip()
+        if not sep or not path:
+            raise InputError("--set", text, "FIELD=VALUES, e.g. run.rpm=9000:12000:250 or damping.factor=0.5,1,2")
+        if any(path == p for p, _ in fields):
+            raise InputError("--set", path, "each field set once")
+        parse_path(path)
+        fields.append((path, parse_values(path, values, max_points)))
+    return fields
+
+
+def apply_sets(doc: dict[str, Any], sets: list[str] | tuple[str, ...]) -> dict[str, Any]:
+    """``doc`` with ``FIELD=VALUE`` assignments (one value each: ``vtool solve --set``, the same paths and
+    values as a sweep's, a single point); the preset's loader then checks them."""
+    assignments = {}
+    for path, values in parse_assignments(sets, max_points=1_000):
+        if len(values) != 1:
+            raise InputError(f"--set {path}", ",".join(str(v) for v in values),
+                             "one value (a range or list is a sweep: vtool sweep)")
+        assignments[path] = values[0]
+    return set_fields(doc, assignments)
 
 
 @dataclass(frozen=True)
@@ -169,34 +203,34 @@ class SweepPlan:
     points: tuple[Any, ...]  # vtool.solvers.studies.sweep.Point
 
 
-def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> SweepPlan:
+def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000, *,
+               progress: Callable[[int, int], None] | None = None,
+               cancel: Callable[[], bool] | None = None) -> SweepPlan:
     """Parse ``FIELD=VALUES`` assignments and validate every grid point with the preset loader.
 
     Nothing runs: a bad field, range or value raises the loader's own one-line
-    InputError before any work starts.
+    InputError before any work starts. Validating a point costs about 10 ms, so a
+    large grid takes minutes: ``progress(done, total)`` is called as points are
+    checked and ``cancel()`` between them (True raises :class:`SweepCancelled`).
     """
     from vtool.presets import find_preset, load_document, read_document
+    from vtool.presets.kinds import require_kind
     from vtool.solvers.studies.sweep import Point, grid
 
+    folder = find_preset(preset).parent
     doc = read_document(find_preset(preset))
-    spec = load_document(doc)
-    if spec.kind != "valvetrain":
-        raise InputError("preset", preset, f"a valvetrain preset (this one is {spec.kind})")
-    fields: list[tuple[str, list[Any]]] = []
-    for text in sets:
-        path, sep, values = text.partition("=")
-        path = path.strip()
-        if not sep or not path:
-            raise InputError("--set", text, "FIELD=VALUES, e.g. run.rpm=9000:12000:250 or damping.factor=0.5,1,2")
-        if any(path == p for p, _ in fields):
-            raise InputError("--set", path, "each field set once")
-        parse_path(path)
-        fields.append((path, parse_values(path, values, max_points)))
+    spec = load_document(doc, folder)
+    require_kind(spec, "valvetrain", "a sweep")
+    fields = parse_assignments(sets, max_points)
     count = math.prod(len(v) for _, v in fields)
     if count > max_points:
         raise InputError("--set", count, f"a grid of at most {max_points} points")
     points = []
     for index, assignment in enumerate(grid(fields)):
-        points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)))))
-    units = tuple((path, field_unit(doc, path)) for path, _ in fields)
+        if cancel is not None and cancel():
+            raise SweepCancelled
+        points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)), folder)))
+        if progress is not None:
+            progress(index + 1, count)
+    units = tuple((path, field_unit(doc, path, folder)) for path, _ in fields)
     return SweepPlan(doc, spec, units, tuple(points))

@@ -10,6 +10,7 @@ round-trips. See ``presets/plate-table2.toml`` for a commented example.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 from vtool.assessments.plate.assembly import Mesh, Plate
@@ -136,7 +137,7 @@ def _cases(top: Table, plate: Plate, element: str, mesh: tuple[int, int]) -> tup
         grid = Mesh(plate, ELEMENTS[case_element], nx, ny)
         masters = _masters(t, grid, t.path)
         method = t.string("method", default="guyan", choices=METHODS)
-        note = t.string("note", default="")
+        note = t.string("note", default="", multiline=True)
         t.finish()
         cases.append(Case(name, case_element, nx, ny, masters, method, note))
     return tuple(cases)
@@ -176,8 +177,11 @@ def _transient(t: Table | None, cases: tuple[Case, ...], plate: Plate) -> Transi
     return settings
 
 
-def load(doc: dict[str, Any]) -> PlateSpec:
-    """Validate a parsed plate preset and return its frozen spec (echoed values cut short)."""
+def load(doc: dict[str, Any], folder: Path | None = None) -> PlateSpec:
+    """Validate a parsed plate preset and return its frozen spec (echoed values cut short).
+
+    ``folder`` (the preset's folder) is accepted like every loader's; a plate preset names no file.
+    """
     try:
         return _load(doc)
     except InputError as exc:
@@ -188,7 +192,7 @@ def _load(doc: dict[str, Any]) -> PlateSpec:
     top = Table(doc, "")
     top.string("kind", choices=("plate",))
     title = top.string("title", default="")
-    notes = top.string("notes", default="")
+    notes = top.string("notes", default="", multiline=True)
     units_name = top.string("units", choices=tuple(UNIT_SYSTEMS))
     units = UNIT_SYSTEMS[units_name]
     plate = _plate(top.table("plate"), units)  # type: ignore[arg-type]

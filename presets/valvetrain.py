@@ -9,9 +9,11 @@ Every number is finite and within a stated physical range (:data:`BOUNDS`,
 :data:`RUN_LIMITS`, the counts below), checked before any numerics, so no
 preset can reach the solver with values its floating-point arithmetic cannot
 carry. The ranges are wide (the same numbers in either unit system) and are
-listed in ``docs/limits.md``. The [run] settings are checked by
-:func:`check_run`, which also checks ``--rpm``, ``--dt``, ``--degrees`` and
-``--backend`` overrides (:func:`with_run_overrides`).
+listed in ``docs/limits.md``. The [run] settings are read by one function,
+:func:`_run`, whatever gave them: the preset, ``vtool solve``'s ``--rpm``,
+``--dt``, ``--degrees`` and ``--backend`` (set into the document by
+:func:`with_overrides` before the load), a TUI field, or a study's
+:func:`with_run_overrides`.
 
 A missing [damping] section loads with the default (ratio 0.1 on every mode,
 factor 1) and a :class:`vtool.errors.PresetWarning` saying so.
@@ -19,8 +21,9 @@ factor 1) and a :class:`vtool.errors.PresetWarning` saying so.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
-import math
+import json
 import re
 import warnings
 from dataclasses import replace
@@ -28,16 +31,20 @@ from pathlib import Path
 from typing import Any
 
 from vtool.errors import InputError, PresetWarning
-from vtool.presets.fields import Table, as_float
+from vtool.presets.fields import Table
 from vtool.presets.lift_table import read_lift_table
+from vtool.solvers.backends import DEFAULT, available
 from vtool.solvers.model.assembly import split_members, unsplit_members
+from vtool.solvers.model.hertz import MIN_RESTITUTION, check_restitution
 from vtool.solvers.model.spec import (
     BAR,
     BEAM,
+    BETA_RANGE,
     CONTACT_LAWS,
     ELEMENT_SIZE,
     ENABLED,
     EXTERNAL,
+    GAMMA_RANGE,
     HERTZ,
     IMPACT_LAWS,
     INTERNAL,
@@ -100,11 +107,17 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
 
     ``folder`` resolves a ``[cam] lift_table`` file (default: the working folder).
     """
+    train = ""
+    if isinstance(doc, dict) and "train" in doc:  # a train type: expanded to the explicit form first
+        from vtool.presets.trains import expand
+
+        train = json.dumps(doc["train"])
+        doc = expand(doc, folder)
     top = Table(doc, "")
     top.check_unknown(TOP_KEYS)
     top.string("kind", choices=("valvetrain",))
     title = top.string("title", default="")
-    notes = top.string("notes", default="")
+    notes = top.string("notes", default="", multiline=True)
     units_name = top.string("units", choices=tuple(UNIT_SYSTEMS))
     units = UNIT_SYSTEMS[units_name]
     gravity = _magnitude(top, "gravity", units.acceleration, "gravity", default=units.gravity)
@@ -128,7 +141,24 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
             stacklevel=2)
     damping = _damping(damping_table, names)
     contact = _contact(top.table("contact", required=False))
-    run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances))  # type: ignore[arg-type]
+    follower_table = top.table("follower", required=False)
+    follower = None
+    if follower_table is not None:  # (modules imported only by presets that use them: a sweep loads often)
+        from vtool.presets.follower import load_follower
+        from vtool.solvers.model.camshape import undercut_warning
+
+        follower = load_follower(follower_table, units, lambda t: _law(t, cam.coordinate, units, folder))
+
+        undercut = undercut_warning(follower, follower.lift or cam)
+        if undercut is not None:
+            warnings.warn(PresetWarning(undercut), stacklevel=2)
+    checks_table = top.table("checks", required=False)
+    checks: tuple = ()
+    if checks_table is not None:
+        from vtool.presets.follower import load_checks
+
+        checks = load_checks(checks_table, units)
+    run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)  # type: ignore[arg-type]
     top.finish()
     spec = MechanismSpec(
         title=title,
@@ -144,6 +174,9 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         run=run,
         notes=notes,
         contact=contact,
+        follower=follower,
+        checks=checks,
+        train=train,
     )
     spec = split_members(spec)
     if seat is not None and seat.lash is not None:
@@ -211,7 +244,7 @@ def _contact(t: Table | None) -> ContactSpec:
 
 
 TOP_KEYS = ("kind", "title", "notes", "units", "gravity", "coordinates", "members", "cam", "seat",
-            "clearances", "initial", "contact", "damping", "run")
+            "clearances", "initial", "contact", "damping", "run", "follower", "checks")
 
 
 def _magnitude(t: Table, key: str, unit: str, what: str, *, default: float | None = None,
@@ -273,6 +306,24 @@ def _cam(t: Table, n: int, units: UnitSystem, folder: Path | None = None) -> Cam
     return CamSpec(coordinate, amplitude, offset, name, profile, **table)
 
 
+def _law(t: Table, coordinate: int, units: UnitSystem, folder: Path | None) -> CamSpec:
+    """A lift law given as a [cam]-like table without its coordinate ([follower.lift])."""
+    profile = t.string("profile", default="harmonic", choices=("harmonic", "table"))
+    table = _cam_table(t, units, folder) if profile == "table" else {}
+    amplitude = 0.5 * max(table["lifts"]) if table else _magnitude(t, "amplitude", units.length, "length")
+    t.finish()
+    return CamSpec(coordinate, amplitude, None, "lift law", profile, **table)
+
+
+def _law_doc(cam: CamSpec) -> dict[str, Any]:
+    """The lift-law keys of a cam (inverse of :func:`_law`; [cam] adds its coordinate, name and offset)."""
+    if cam.profile == "harmonic":
+        return {"profile": cam.profile, "amplitude": cam.amplitude}
+    # inline, so a saved copy does not depend on the table file's folder
+    return {"profile": cam.profile, "angles": list(cam.angles), "lifts": list(cam.lifts)} | (
+        {"harmonics": cam.harmonics} if cam.harmonics else {"tolerance": cam.tolerance})
+
+
 def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """A lift table (file or inline arrays) and its fit setting; see solvers/model/cam.py."""
     from vtool.solvers.model.cam import fit_table, junction_warning, normalize_table
@@ -305,7 +356,8 @@ def _seat(t: Table, n: int, cam: CamSpec, units: UnitSystem) -> SeatSpec:
     if coordinate == cam.coordinate:
         raise InputError(t.field("coordinate"), coordinate, f"a number other than the cam's ({cam.coordinate})")
     name = t.string("name", default="seat")
-    lash = t.number("lash", unit=units.length, required=False)
+    # a negative lash would be an interference: the valve held off its seat on the base circle
+    lash = t.number("lash", unit=units.length, required=False, min_value=0.0)
     if (lash is not None) == t.has("position"):
         raise InputError(t.field("position"), t.raw("position"), "either position or lash, not both", units.length)
     low, high = BOUNDS["position"]
@@ -399,6 +451,10 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int,
         restitution = t.number("restitution", default=0.0, min_value=0.0, max_value=1.0)
         impact = t.string("impact", choices=IMPACT_LAWS) if t.raw("impact") is not None else None
         contact = _compliance(t, state, units)
+        if contact.get("contact") == HERTZ and not check_restitution(restitution):
+            raise InputError(t.field("restitution"), restitution,
+                             f">= {MIN_RESTITUTION} and <= 1 for a hertz contact (Hunt-Crossley damping gives e = 0 "
+                             f"only at infinite damping; a rigid contact takes 0)")
         t.finish()
         result.append(ClearanceSpec(name, ahead, behind, kind, state, restitution, impact, **contact))
     if sum(c.behind == cam_coordinate for c in result) != 1:
@@ -475,13 +531,13 @@ def _quantity_names(coordinates, cam, seat, clearances) -> tuple[set[int], set[i
 QUANTITY = re.compile(r"q(\d+)(?:-q(\d+))?|F(\d+)")
 
 
-def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...]:
-    value = t.raw("quantities", [])
+def _quantities(t: Table, numbers: set[int], forces: set[int], key: str = "quantities") -> tuple[str, ...]:
+    value = t.raw(key, [])
     expected = (f"a list of 'q<i>', 'q<i>-q<j>' (i, j in {sorted(numbers)}) or 'F<i>' "
                 f"(i in {sorted(forces)})")
     if not isinstance(value, list):
-        raise InputError(t.field("quantities"), value, expected)
-    _count(t.field("quantities"), value, MAX_QUANTITIES, "quantities")
+        raise InputError(t.field(key), value, expected)
+    _count(t.field(key), value, MAX_QUANTITIES, "quantities")
     for item in value:
         match = QUANTITY.fullmatch(item) if isinstance(item, str) else None
         ok = match is not None and (
@@ -489,14 +545,53 @@ def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...
             or (match[1] is not None and int(match[1]) in numbers and (match[2] is None or int(match[2]) in numbers))
         )
         if not ok:
-            raise InputError(t.field("quantities"), item, expected)
+            raise InputError(t.field(key), item, expected)
     return tuple(value)
 
 
-RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta", "gamma", "quantities")
+RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta", "gamma", "quantities",
+            "cycles", "steady", "jump_angle", "jump_gap", "bounce_lift", "orders", "highest_order")
+#: [run] cycle-by-cycle and criteria ranges: key -> (min, max, unit)
+CYCLE_LIMITS: dict[str, tuple[float, float, str]] = {
+    "cycles": (1, 10_000, "cam cycles"),
+    "max_cycles": (2, 10_000, "cam cycles"),
+    "tolerance": (1e-12, 1.0, "(relative change per cycle)"),
+    "jump_angle": (0.0, 360.0, "deg"),
+    "highest_order": (1, 1000, "cam orders"),
+}
 
 
-def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
+def _cycles(t: Table, units: Any) -> dict[str, Any]:
+    """run.cycles, run.steady = { tolerance, max_cycles } and the speed criteria (vtool.solvers.studies.steady,
+    vtool.solvers.studies.metrics); run.steady = {} takes the defaults."""
+    from vtool.solvers.studies.steady import DEFAULT_MAX_CYCLES, DEFAULT_TOLERANCE
+
+    def integer(table: Table, key: str, default: int) -> int:
+        low, high, _ = CYCLE_LIMITS[key]
+        return table.integer(key, default=default, min_value=int(low), max_value=int(high)) if table.has(key) \
+            else default
+
+    values: dict[str, Any] = {"cycles": integer(t, "cycles", 0)}
+    steady = t.table("steady", required=False)
+    if steady is not None:
+        if values["cycles"]:
+            raise InputError("run.steady", "with run.cycles", "one of run.cycles (a fixed count) or run.steady")
+        low, high, unit = CYCLE_LIMITS["tolerance"]
+        values["steady_tolerance"] = steady.number("tolerance", default=DEFAULT_TOLERANCE, min_value=low,
+                                                   max_value=high)
+        values["steady_max_cycles"] = integer(steady, "max_cycles", DEFAULT_MAX_CYCLES)
+        steady.finish()
+    low, high, unit = CYCLE_LIMITS["jump_angle"]
+    values["jump_angle"] = t.number("jump_angle", unit=unit, default=1.0, min_value=low, max_value=high)
+    for key in ("jump_gap", "bounce_lift"):
+        if t.has(key):
+            values[key] = t.number(key, unit=units.length, min_value=0.0, max_value=1e4)
+    return values
+
+
+def _run(t: Table, names: tuple[set[int], set[int]], units: Any) -> RunSpec:
+    """The [run] table: every value checked here, once (ranges :data:`RUN_LIMITS`, Newmark's
+    ``BETA_RANGE``/``GAMMA_RANGE``, the installed back ends); below the loader a RunSpec is trusted."""
     t.check_unknown(RUN_KEYS)
     def limited(key: str, default: float | None = None) -> float:
         low, high, unit = RUN_LIMITS[key]
@@ -505,55 +600,23 @@ def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
     rpm = limited("rpm")
     degrees = limited("degrees")
     time_step = limited("time_step")
-    backend = t.string("backend", default="newmark")
+    backend = t.string("backend", default=DEFAULT, choices=tuple(available()))
     output_interval = limited("output_interval", 1.0)
-    beta = t.number("beta", default=1.0 / 6.0)
-    gamma = t.number("gamma", default=0.5)
+    beta = t.number("beta", default=1.0 / 6.0, min_exclusive=BETA_RANGE[0], max_value=BETA_RANGE[1])
+    gamma = t.number("gamma", default=0.5, min_value=GAMMA_RANGE[0], max_value=GAMMA_RANGE[1])
     quantities = _quantities(t, *names)
+    cycles = _cycles(t, units)
+    cycles["orders"] = _quantities(t, *names, key="orders")
+    low, high, _ = CYCLE_LIMITS["highest_order"]
+    cycles["highest_order"] = t.integer("highest_order", default=24, min_value=int(low), max_value=int(high))
     t.finish()
-    return check_run(RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities))
-
-
-def check_run_value(key: str, value: Any, field: str | None = None) -> Any:
-    """One [run] setting checked against :data:`RUN_LIMITS` (and beta, gamma, backend); returns it.
-
-    ``field`` names it in the error (default ``run.KEY``; the CLI passes ``--rpm``).
-    """
-    field = field or f"run.{key}"
-    if key == "backend":
-        from vtool.solvers.backends import available
-
-        if value not in available():
-            raise InputError(field, value, f"one of the installed back ends: {', '.join(available())}")
-        return value
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise InputError(field, value, "a number")
-    number = as_float(value)
-    if key == "beta":
-        low, high, unit, text = 0.0, 0.5, "", "> 0 and <= 0.5"
-        ok = math.isfinite(number) and low < number <= high
-    elif key == "gamma":
-        low, high, unit, text = 0.5, 1.0, "", ">= 0.5 and <= 1"
-        ok = math.isfinite(number) and low <= number <= high
-    else:
-        low, high, unit = RUN_LIMITS[key]
-        text = f">= {low:g} and <= {high:g}"
-        ok = math.isfinite(number) and low <= number <= high
-    if not ok:
-        raise InputError(field, value, text, unit)
-    return number
-
-
-def check_run(run: RunSpec) -> RunSpec:
-    """The [run] settings checked by :func:`check_run_value`, field by field; returns ``run``."""
-    for key in ("rpm", "degrees", "time_step", "output_interval", "beta", "gamma", "backend"):
-        check_run_value(key, getattr(run, key))
-    return run
+    return RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities, **cycles)
 
 
 def dump(spec: MechanismSpec) -> dict[str, Any]:
-    """The preset document for a spec (inverse of :func:`load`)."""
-    spec = unsplit_members(spec)
+    """The preset document for a spec (inverse of :func:`load`); a spec entered by train type dumps as its
+    [train] while its model is what the type gives (:func:`train_document`)."""
+    given, spec = spec, unsplit_members(spec)
     doc: dict[str, Any] = {"kind": "valvetrain", "title": spec.title}
     if spec.notes:
         doc["notes"] = spec.notes
@@ -577,13 +640,7 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
     doc["members"] = members
     cam = spec.cam
     doc["cam"] = {"coordinate": cam.coordinate, "name": cam.name, "profile": cam.profile,
-                  "offset": STATIC_START if cam.offset is None else cam.offset}
-    if cam.profile == "harmonic":
-        doc["cam"]["amplitude"] = cam.amplitude
-    else:
-        # inline, so a saved copy does not depend on the table file's folder
-        doc["cam"].update({"angles": list(cam.angles), "lifts": list(cam.lifts)})
-        doc["cam"].update({"harmonics": cam.harmonics} if cam.harmonics else {"tolerance": cam.tolerance})
+                  "offset": STATIC_START if cam.offset is None else cam.offset} | _law_doc(cam)
     if spec.seat is not None:
         seat = spec.seat
         doc["seat"] = {"coordinate": seat.coordinate, "name": seat.name}
@@ -612,13 +669,53 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         damping["layers"] = layers
     doc["damping"] = damping
     r = spec.run
-    doc["run"] = {
-        "rpm": r.rpm, "degrees": r.degrees, "time_step": r.time_step, "backend": r.backend,
-        "output_interval": r.output_interval, "beta": r.beta, "gamma": r.gamma,
-    }
+    doc["run"] = _dump_run(r)
+    if spec.follower is not None:
+        from vtool.presets.follower import dump_follower
+
+        doc["follower"] = dump_follower(spec.follower, _law_doc)
+    if spec.checks:
+        doc["checks"] = {c.name: c.limit for c in spec.checks}
+    return train_document(given, doc) or doc
+
+
+TRAIN_KEEPS = ("kind", "title", "notes", "units", "gravity", "contact", "damping", "run", "checks")
+
+
+def train_document(spec: MechanismSpec, explicit: dict[str, Any]) -> dict[str, Any] | None:
+    """The train-type document of a spec entered by type, while its model is still what the type gives
+    (else None: the explicit form, e.g. after a member was split or a clearance pinned)."""
+    if not spec.train:
+        return None
+    doc = {key: explicit[key] for key in TRAIN_KEEPS if key in explicit}
+    doc["train"] = json.loads(spec.train)
+    doc["initial"] = {"velocities": spec.initial.velocities}
+    try:
+        again = load(copy.deepcopy(doc))
+    except InputError:  # e.g. a lift_table file the saved copy's folder does not hold
+        return None
+    return doc if again == spec else None
+
+
+def _dump_run(r: RunSpec) -> dict[str, Any]:
+    run: dict[str, Any] = {"rpm": r.rpm, "degrees": r.degrees, "time_step": r.time_step, "backend": r.backend,
+                           "output_interval": r.output_interval, "beta": r.beta, "gamma": r.gamma}
     if r.quantities:
-        doc["run"]["quantities"] = list(r.quantities)
-    return doc
+        run["quantities"] = list(r.quantities)
+    if r.cycles:
+        run["cycles"] = r.cycles
+    if r.steady_tolerance:
+        run["steady"] = {"tolerance": r.steady_tolerance, "max_cycles": r.steady_max_cycles}
+    if r.jump_angle != 1.0:
+        run["jump_angle"] = r.jump_angle
+    for key in ("jump_gap", "bounce_lift"):
+        if getattr(r, key) is not None:
+            run[key] = getattr(r, key)
+    if r.orders:
+        run["orders"] = list(r.orders)
+    if r.highest_order != 24:
+        run["highest_order"] = r.highest_order
+    return run
 
 
 RPM_IN_TITLE = re.compile(r"\b\d{1,3}(?:,\d{3})*(?:\.\d+)?\s*RPM\b|\b\d+(?:\.\d+)?\s*RPM\b", re.IGNORECASE)
@@ -634,7 +731,7 @@ def rpm_title(title: str, rpm: float) -> str:
 
 
 def with_run_overrides(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
-    """The spec with some [run] settings changed, checked by :func:`check_run` as the loader does.
+    """The spec with some [run] settings changed, read by the loader's own [run] reader (:func:`_run`).
 
     ``changes`` uses the preset's [run] keys (rpm, degrees, time_step, backend,
     output_interval, beta, gamma); ``None`` values are ignored. A changed speed
@@ -644,8 +741,30 @@ def with_run_overrides(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
     unknown = sorted(set(given) - set(RUN_KEYS))
     if unknown:
         raise InputError(f"run.{unknown[0]}", given[unknown[0]], f"one of: {', '.join(RUN_KEYS)}")
-    run = check_run(dataclasses.replace(spec.run, **given))
+    names = _quantity_names(spec.coordinates, spec.cam, spec.seat, spec.clearances)
+    run = _run(Table(_dump_run(spec.run) | given, "run"), names, spec.unit_system)
     title = spec.title
     if "rpm" in given and run.rpm != spec.run.rpm:
         title = rpm_title(title, run.rpm)
     return dataclasses.replace(spec, run=run, title=title)
+
+
+def with_overrides(doc: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
+    """The preset document with values given outside it (``vtool solve``'s flags, by field path:
+    ``run.rpm``, ``contact.impact``, ...) set, for the loader to check once like any other field. An impact
+    law for the mechanism (``contact.impact``) applies to every clearance, dropping their own; a changed
+    speed is written into the title as :func:`with_run_overrides` does."""
+    result = copy.deepcopy(doc)
+    for path, value in overrides.items():
+        table, _, key = path.rpartition(".")
+        if not isinstance(result.get(table), dict):
+            result[table] = {}
+        result[table][key] = value
+    if "contact.impact" in overrides:
+        for clearance in result.get("clearances", []):
+            if isinstance(clearance, dict):
+                clearance.pop("impact", None)
+    rpm = overrides.get("run.rpm")
+    if rpm is not None and isinstance(result.get("title", ""), str) and rpm != doc.get("run", {}).get("rpm"):
+        result["title"] = rpm_title(result.get("title", ""), float(rpm))
+    return result

@@ -19,7 +19,7 @@ import numpy as np
 
 from vtool.files import open_atomic
 from vtool.solvers.model.configurations import closed_names, configuration_label, thesis_number
-from vtool.solvers.model.spec import EXTERNAL, MechanismSpec
+from vtool.solvers.model.spec import ENABLED, EXTERNAL, MechanismSpec
 from vtool.solvers.newmark import layout
 
 OPENED = "opened"
@@ -33,6 +33,8 @@ EVENT_KINDS: dict[int, str] = {int(layout.EV_OPENED): OPENED, int(layout.EV_CLOS
 EPISODE_WINDOW_DEG = 0.1
 #: A seat re-opening that closes again within this (degrees) is a bounce, not the cam lifting the valve.
 BOUNCE_WINDOW_DEG = 90.0
+#: a closed rigid contact force below -this share of the run's largest peak force is flagged (Trace.tensile_forces)
+TENSILE_FRACTION = 1e-6
 
 #: Episode kinds by the clearance's state before and after the burst of events.
 SEPARATION, IMPACT, BOUNCE, FLICKER = "separation", "impact", "bounce", "flicker"
@@ -82,6 +84,60 @@ class RunStatistics:
     settings: dict = field(default_factory=dict)
     error_estimate: float | None = None
     compile_time: float = 0.0  # s spent compiling (or loading) the kernel, not in wall_time
+    remedy: str = ""  # the back end's advice when a result is not to be trusted (Backend.remedy)
+
+
+@dataclass(frozen=True)
+class Cycles:
+    """How a cycle-by-cycle run went (:mod:`vtool.solvers.studies.steady`); the trace holds every cycle.
+
+    ``settled`` is None for a fixed number of cycles (``run.cycles``). ``period`` is the number of cycles
+    after which the motion repeats (1; 2 or more for a subharmonic orbit, whose last ``period`` cycles are
+    evaluated). ``change`` is the largest relative change of the continuous measures from the cycle a
+    period before to the last one, ``changed`` what moved that much, ``events_changed`` how the events per
+    clearance differ ("" when they repeat); ``changes`` is the cycle-to-cycle change after each cycle
+    (the first has none: NaN; inf where the events differ). ``peaks`` are the every-step peak contact
+    forces over the evaluated cycles, ``startup_peaks`` over the first (NaN after a periodic start).
+    """
+
+    count: int
+    settled: bool | None
+    tolerance: float
+    change: float
+    changed: str
+    changes: tuple[float, ...]
+    peaks: np.ndarray
+    startup_peaks: np.ndarray
+    max_cycles: int = 0
+    period: int = 1
+    events_changed: str = ""
+
+    @property
+    def window(self) -> tuple[float, float]:
+        """The evaluated cycles' cam angles (deg): the last ``period`` cycles."""
+        return 360.0 * (self.count - self.period), 360.0 * self.count
+
+    def text(self) -> str:
+        """One line: which cycles are evaluated and whether the run settled."""
+        start, end = self.window
+        which = (f"cycle {self.count} of {self.count}" if self.period == 1 else
+                 f"cycles {self.count - self.period + 1}-{self.count} of {self.count}")
+        where = f"{which} (cam angle {start:g}-{end:g} deg)"
+        before = "the cycle before" if self.period == 1 else f"the cycle {self.period} before"
+        moved = "" if self.count < 2 else f"; the last cycle changed by {self.change:.3g} from {before} ({self.changed})"
+        events = f"; events per cycle still change ({self.events_changed})" if self.events_changed else ""
+        if self.settled is None:
+            return f"evaluated: {where}, a fixed number of cycles (run.cycles){moved}{events}"
+        if self.settled:
+            period = "" if self.period == 1 else f" repeating every {self.period} cycles (a subharmonic orbit),"
+            return f"evaluated: {where},{period} settled to {self.tolerance:g}{moved}"
+        return (f"warning: did not settle in {self.count} cycles (run.steady max_cycles = {self.max_cycles}), "
+                f"nor repeat every 2 to {MAX_PERIOD} cycles: evaluated {where}{moved}{events}, above the "
+                f"tolerance {self.tolerance:g}")
+
+
+#: the longest period (in cam cycles) a steady run looks for
+MAX_PERIOD = 4
 
 
 @dataclass(frozen=True)
@@ -104,6 +160,43 @@ class Trace:
     message: str = ""
     peak_force_after_first_revolution: np.ndarray | None = None  # per clearance, over every step
     peak_overlap: np.ndarray | None = None  # per clearance, largest overlap of a compliant contact
+    cycles: Cycles | None = None  # a run cycle by cycle (run.cycles, run.steady): how it went
+
+    # ----- results that should not be trusted -----
+    def tensile_forces(self) -> np.ndarray:
+        """Per clearance, the most tensile (negative) force an enabled rigid contact carried while closed,
+        over the output rows (0.0: never; compliant and pinned clearances 0.0: they may pull).
+
+        A closed rigid contact only pushes: every back end releases it when its force reaches zero. A
+        force below -:data:`TENSILE_FRACTION` of the run's largest peak force is a release the back end
+        missed (solve_ivp looks for sign changes only between its own steps: a loose ``rtol`` lets a
+        force cross zero and back within one step), and what follows it is not to be trusted.
+        """
+        result = np.zeros(len(self.spec.clearances))
+        if not self.contact_force.size:
+            return result
+        scale = TENSILE_FRACTION * max(float(np.max(self.peak_force, initial=0.0)), 1e-300)
+        for k, c in enumerate(self.spec.clearances):
+            if c.rigid and c.state == ENABLED:
+                least = float(np.min(self.contact_force[:, k]))
+                result[k] = least if least < -scale else 0.0
+        return result
+
+    def force_sign_warning(self) -> str | None:
+        """One line naming the contacts that pulled while closed (:meth:`tensile_forces`), or None."""
+        tensile = self.tensile_forces()
+        if not tensile.any():
+            return None
+        unit = self.spec.unit_system.force
+        named = []
+        for k in np.flatnonzero(tensile):
+            row = int(np.argmin(self.contact_force[:, k]))
+            named.append(f"{self.force_label(int(k))} ({self.spec.clearances[k].name}) {tensile[k]:.4g} {unit} "
+                         f"at {self.cam_angle[row]:.1f} deg")
+        backend = self.statistics.backend
+        remedy = self.statistics.remedy or "another back end to compare"
+        return (f"contact forces of the wrong sign: {', '.join(named)}: a closed contact pulled, a release "
+                f"the {backend} back end missed; the events and peaks after it are not to be trusted ({remedy})")
 
     # ----- columns by the engineer's names -----
     def coordinate(self, number: int, rows: slice = slice(None)) -> np.ndarray:
@@ -142,9 +235,34 @@ class Trace:
         return self.coordinate_unit(int(re.findall(r"\d+", text)[0]))
 
     # ----- export -----
+    def valve_coordinate(self) -> int | None:
+        """The number of the coordinate that seats (ahead of the seat clearance), or None without a seat."""
+        seat = self.spec.seat
+        if seat is None:
+            return None
+        for c in self.spec.clearances:
+            if c.kind == EXTERNAL and c.behind == seat.coordinate and c.ahead in self.coordinate_numbers:
+                return c.ahead
+        return None
+
+    def valve_lift(self, rows: slice = slice(None)) -> np.ndarray:
+        """Valve lift off its seat: the seat clearance's gap ``q_valve - q_seat`` (length; 0 when seated)."""
+        valve = self.valve_coordinate()
+        if valve is None or self.spec.seat is None:
+            raise KeyError("valve_lift")
+        seat = self.spec.seat.coordinate
+        if seat in self.coordinate_numbers:
+            return self.coordinate(valve, rows) - self.coordinate(seat, rows)
+        return self.coordinate(valve, rows) - self.spec.seat.position
+
     def csv_columns(self, quantities: tuple[str, ...] = ()) -> tuple[list[str], list]:  # type: ignore[type-arg]
         """The CSV header (quantity names with units) and one function per numeric column that gives
-        the column's values on a slice of rows (so a long run is written block by block)."""
+        the column's values on a slice of rows (so a long run is written block by block).
+
+        Every name is unique: a preset quantity that is already a column (``q9``, ``F1``: the thesis
+        presets list seven) or is listed twice is written once. ``valve_lift`` (the seat clearance's
+        gap, :meth:`valve_lift`) follows the contact forces when the preset has a seat.
+        """
         units = self.spec.unit_system
         header = ["time (s)", "cam_angle (deg)"]
         columns: list = [lambda rows: self.time[rows], lambda rows: self.cam_angle[rows]]
@@ -156,15 +274,35 @@ class Trace:
         for i in range(len(self.spec.clearances)):
             header.append(f"{self.force_label(i)} ({units.force})")
             columns.append(lambda rows, i=i: self.contact_force[rows, i])
+        if self.valve_coordinate() is not None:
+            header.append(f"valve_lift ({units.length})")
+            columns.append(self.valve_lift)
+        names = {h.rpartition(" (")[0] for h in header}
         for expression in quantities:
-            header.append(f"{expression} ({self.quantity_unit(expression)})")
+            name = expression.replace(" ", "")
+            if name in names:
+                continue
+            names.add(name)
+            header.append(f"{name} ({self.quantity_unit(expression)})")
             columns.append(lambda rows, expression=expression: self.quantity(expression, rows))
+        if self.spec.follower is not None:  # cam contact stress at each row (solvers/model/camstress.py)
+            from vtool.solvers.model.camstress import row_unit, stress_rows
+
+            cam = next(i for i, c in enumerate(self.spec.clearances) if c.behind == self.spec.cam.coordinate)
+            names = list(stress_rows(self.spec, self.cam_angle[:1], self.contact_force[:1, cam]))
+            for name in names:
+                header.append(f"cam_{name} ({row_unit(self.spec, name)})")
+                columns.append(lambda rows, name=name: stress_rows(
+                    self.spec, self.cam_angle[rows], self.contact_force[rows, cam])[name])
         return header + ["configuration", "closed"], columns
 
     def configuration_csv(self, mask: int) -> str:
         """The last two CSV columns of a configuration: its thesis number (or nothing) and closed clearances."""
+        from vtool.csvrows import csv_text
+
         number = thesis_number(self.spec, mask)
-        return f"{'' if number is None else number},{'+'.join(closed_names(self.spec, mask)) or 'none'}"
+        return csv_text([["" if number is None else number,
+                          "+".join(closed_names(self.spec, mask)) or "none"]]).removesuffix("\n")
 
     def write_csv_to(self, handle, quantities: tuple[str, ...] = (), chunk: int = 20_000,  # type: ignore[no-untyped-def]
                      header: bool = True, compiled: bool | None = None) -> None:
@@ -258,21 +396,12 @@ class Trace:
             opened_at = e.cam_angle
         return result
 
-    def per_revolution(self, angles: list[float]) -> list[int]:
-        """Counts of the given angles in each whole cam revolution after the first."""
-        revolutions = int(self.cam_angle[-1] // 360.0) if len(self.cam_angle) else 0
-        counts = [0] * max(revolutions - 1, 0)
-        for angle in angles:
-            index = int(angle // 360.0) - 1
-            if 0 <= index < len(counts):
-                counts[index] += 1
-        return counts
-
     def summary(self) -> dict:
         """Counts, peaks and seating velocities per clearance, and the run statistics."""
         units = self.spec.unit_system
         clearances = []
         late = self.peak_force_after_first_revolution
+        tensile = self.tensile_forces()
         for i, c in enumerate(self.spec.clearances):
             impacts = self.events_at(c.name, (CLOSED,))
             episodes = self.episodes(c.name)
@@ -289,6 +418,7 @@ class Trace:
                 "peak_force": float(self.peak_force[i]),
                 "peak_force_after_first_revolution": None if late is None else float(late[i]),
                 "peak_force_unit": units.force,
+                "tensile_force": float(tensile[i]),  # the most tensile force while closed: 0 unless it pulled
                 "contact": c.contact,
             }
             if not c.rigid and self.peak_overlap is not None:
@@ -328,7 +458,22 @@ class Trace:
                 for e in self.events
             ],
             "clearances": clearances,
-        }
+            "warnings": [w for w in (self.force_sign_warning(),) if w is not None],
+        } | self.follower_summary()
+
+    def follower_summary(self) -> dict:
+        """The cam contact's stress extremes (with a [follower]) and the [checks] judged (with limits)."""
+        result: dict = {}
+        if self.spec.follower is not None:
+            from vtool.solvers.model.camstress import stress_summary
+
+            cam = next(c.name for c in self.spec.clearances if c.behind == self.spec.cam.coordinate)
+            result["contact_stress"] = stress_summary(self.spec, self.cam_angle, self.force(cam))
+        if self.spec.checks:
+            from vtool.solvers.studies.checks import evaluate
+
+            result["checks"] = [c.as_dict() for c in evaluate(self.spec, self)]
+        return result
 
     def summary_text(self) -> str:
         s = self.summary()
@@ -369,6 +514,14 @@ class Trace:
                 if any(heights):
                     lines.append(f"{c['clearance']} largest bounce height per revolution ({c['bounce_height_unit']}, "
                                  f"at the output interval): " + ", ".join(f"{h:.4g}" for h in heights))
+        if "contact_stress" in s:
+            from vtool.solvers.model.camstress import stress_text
+
+            lines += stress_text(s["contact_stress"])
+        if "checks" in s:
+            from vtool.solvers.studies.checks import checks_text
+
+            lines += checks_text(s["checks"])
         if not s["success"]:
             lines.append(f"run stopped: {s['message']}")
         return "\n".join(lines)

@@ -1,4 +1,4 @@
-"""Layering: nothing below app/ imports textual, plotext or click (STYLE.md)."""
+"""Layering: nothing below app/ imports textual, plotext, matplotlib or click (STYLE.md)."""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ HEADLESS = [
     "vtool.files",
     "vtool.units",
     "vtool.numba_cache",
+    "vtool.chart",
 ]
 
 
@@ -25,7 +26,7 @@ def test_headless_module_imports_no_ui(module: str) -> None:
         f"pkg = importlib.import_module({module!r})\n"
         "for info in pkgutil.walk_packages(getattr(pkg, '__path__', []), pkg.__name__ + '.'):\n"
         "    importlib.import_module(info.name)\n"
-        "bad = [m for m in ('textual', 'plotext', 'click') if m in sys.modules]\n"
+        "bad = [m for m in ('textual', 'plotext', 'click', 'matplotlib') if m in sys.modules]\n"
         "print(','.join(bad))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -66,7 +67,7 @@ def test_solve_imports_no_ui_and_no_study_tools() -> None:
         "from vtool.app.cli.main import cli\n"
         "r = CliRunner().invoke(cli, ['solve', 'gnilka-1a'])\n"
         "assert r.exit_code == 0, r.output\n"
-        "print(','.join(m for m in ('textual', 'plotext', 'dask', 'distributed', 'tomlkit', 'tomli_w',"
+        "print(','.join(m for m in ('textual', 'plotext', 'matplotlib', 'dask', 'distributed', 'tomlkit', 'tomli_w',"
         " 'hypothesis', 'pytest', 'scipy.optimize', 'scipy.integrate') if m in sys.modules))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -90,3 +91,21 @@ def test_the_kinds_table_names_importable_code() -> None:
         assert isinstance(resolve(kind.spec_type), type)
         assert hasattr(resolve(kind.loader), "load") and callable(resolve(kind.solve))
         assert resolve(kind.screen).__name__ == kind.screen
+
+
+def test_every_module_sits_in_an_import_contract() -> None:
+    """Each top-level module of vtool/ and each layer package is named by an import-linter contract
+    (the layers, or the core's forbidden contract): a new core module must be placed."""
+    import tomllib
+
+    from tests import typing_tree
+
+    config = tomllib.loads((typing_tree.ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    named: set[str] = set()
+    for contract in config["tool"]["importlinter"]["contracts"]:
+        for layer in contract.get("layers", []):
+            named |= {part.strip() for part in layer.replace("|", ":").split(":")}
+        named |= set(contract.get("source_modules", []))
+    modules = {f"vtool.{path.stem}" for path in (typing_tree.ROOT / "vtool").glob("*.py") if path.stem != "__init__"}
+    modules |= {f"vtool.{folder}" for folder in typing_tree.FOLDERS}
+    assert modules - named == set(), f"modules in no import contract: {sorted(modules - named)}"

@@ -423,7 +423,7 @@ def test_twenty_clearances_allocate_only_the_configurations_a_run_visits() -> No
     mechanism = assemble(spec)
     backend = NewmarkBackend()
     trace = backend.simulate(mechanism, backend.options_from_run(spec.run))
-    tables = mechanism.configuration_tables()
+    tables = ContactProblem.for_run(mechanism).tables  # (the mechanism's shared tables)
     built = len(trace.statistics.configurations_built)
     assert len(spec.clearances) == 21 and trace.events and built >= 3
     assert set(tables.slots) == set(tables.layers) == set(trace.statistics.configurations_built)

@@ -31,9 +31,11 @@ its kernel is worth it (:func:`choose`).
 
 from __future__ import annotations
 
+import csv
+import io
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Sequence
 from types import ModuleType
 from typing import Any
 
@@ -193,3 +195,11 @@ def compile_notice() -> str | None:
     from vtool import jit
 
     return jit.compile_notice("the CSV writer", "put_rows")
+
+
+def csv_text(rows: Iterable[Sequence[object]]) -> str:
+    """Rows of cells as CSV text (``\\n`` line ends), quoted by the csv module wherever a cell holds a
+    comma, a quote or a line break: the one way vtool writes a CSV row that holds text."""
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="\n").writerows(rows)
+    return buffer.getvalue()

@@ -6,19 +6,20 @@ from pathlib import Path
 
 import click
 
+from vtool.app.cli.options import OUTPUT
+
 
 @click.command()
 @click.argument("preset")
 @click.option("--degrees", type=float, help="Degrees of cam rotation; default: the preset's.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), help="Also write the table as CSV.")
+@click.option("--csv", "csv_path", type=OUTPUT, help="Also write the table as CSV.")
 @click.option("--markdown", is_flag=True, help="Print the table as Markdown (for reports).")
 def accuracy(preset: str, degrees: float | None, csv_path: Path | None, markdown: bool) -> None:
     """The speed/accuracy trade of a valve-train preset: Newmark (dt 1e-4 to 1e-7 s, beta 1/6 and 1/4)
     and scipy (rtol 1e-4 to 1e-11) against the exact back end: wall time, steps, events, and errors in
     event angles, peak contact forces, valve seating velocity and valve lift."""
-    from vtool.presets import load_preset
+    from vtool.presets import Override, load_preset
     from vtool.presets.kinds import require_kind
-    from vtool.presets.valvetrain import with_run_overrides
     from vtool.solvers.studies.accuracy import (
         accuracy_study,
         table_markdown,
@@ -26,9 +27,9 @@ def accuracy(preset: str, degrees: float | None, csv_path: Path | None, markdown
         write_table_csv,
     )
 
-    spec = load_preset(preset)
+    # --degrees is the preset's run.degrees: the loader checks it, as the file's own value
+    spec = load_preset(preset, () if degrees is None else (Override("run.degrees", degrees, "--degrees"),))
     require_kind(spec, "valvetrain", "`vtool accuracy`")
-    spec = with_run_overrides(spec, degrees=degrees)
     _, rows = accuracy_study(spec)
     unit = spec.unit_system.length
     click.echo(f"{spec.title}: {spec.run.degrees:g} degrees at {spec.run.rpm:g} rev/min, errors against the exact back end")

@@ -14,6 +14,7 @@ from typing import Any
 
 import click
 
+from vtool.app.cli.options import OUTPUT, figure_option, json_alone, write_figure
 from vtool.errors import InputError
 
 PULSE_CHOICES = ("N", "P", "Q", "R", "T")
@@ -68,19 +69,21 @@ def _summary_lines(res: Any, quantity: str) -> list[str]:
 @click.option("--damping", type=float, default=0.0, show_default=True, help="Damping ratio zeta, [0, 1).")
 @click.option("--range", "grid", default="0:2.5:0.01", show_default=True, callback=_parse_range,
               help="tau/T values start:stop:step (inclusive).")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+@click.option("--csv", "csv_path", type=OUTPUT, default=None,
               help="Write the DAF curves to this CSV file.")
 @click.option("--json", "as_json", is_flag=True, help="Print the DAF curves as JSON (units named).")
 @click.option("--plot", is_flag=True, help="Draw the DAF curves in the terminal.")
+@figure_option
 def daf_command(kind: str, s: float, r1: float, r2: float | None, alpha: float | None,
                 beta: float | None, pulse_csv: Path | None, envelope: bool, family: str,
                 damping: float, grid: tuple[float, float, float], csv_path: Path | None,
-                as_json: bool, plot: bool) -> None:
+                as_json: bool, plot: bool, figure_path: Path | None) -> None:
     """DAF against tau/T (forced, free and overall) for one pulse, or an envelope."""
     import numpy as np
 
     from vtool.assessments.sonic_boom import fourier, pulses, report, response, spectra
 
+    json_alone(as_json, plot=plot)
     response.check_damping(damping)
     ratio = spectra.ratio_grid(*grid)
     lines: list[str] = []
@@ -128,10 +131,14 @@ def daf_command(kind: str, s: float, r1: float, r2: float | None, alpha: float |
         click.echo(json.dumps(document, indent=2))
     else:
         click.echo("\n".join(lines))
-    if plot:
-        from vtool.app.plots import line_chart
+    if plot or figure_path is not None:
+        from vtool.app.plots import chart_text
+        from vtool.presets.charts import daf_chart
 
-        click.echo(line_chart(ratio, series, title=title, xlabel="tau/T", ylabel="DAF"))
+        chart = daf_chart(ratio, series, title)
+        if plot:
+            click.echo(chart_text(chart))
+        write_figure([chart], figure_path)
 
 
 def _write(path: Path, text: str) -> None:
@@ -147,27 +154,23 @@ def _write(path: Path, text: str) -> None:
 
 
 def _preset_command(expected: str, name: str, preset: str, csv_path: Path | None, plot: bool,
-                    as_json: bool) -> None:
-    from vtool.presets import boom as boom_presets
-    from vtool.presets import find_preset, kind_of, load_document, read_document
+                    as_json: bool, figure_path: Path | None) -> None:
+    json_alone(as_json, plot=plot)
+    from vtool.presets import load_preset
+    from vtool.presets.kinds import require_kind
 
-    path = find_preset(preset)
-    doc = read_document(path)
-    if kind_of(doc) in boom_presets.KINDS:
-        spec = boom_presets.load(doc, base=path.parent)  # pulse CSVs beside the preset
-    else:
-        spec = load_document(doc)
-    if spec.kind != expected:
-        raise InputError("preset", preset, f"a {expected} preset for `vtool boom {name}` (got {spec.kind})")
-    solve_preset(spec, csv_path, plot, as_json)
+    spec = load_preset(preset)  # a pulse CSV is found beside the preset
+    require_kind(spec, expected, f"`vtool boom {name}`")
+    solve_preset(spec, csv_path, plot, as_json, figure=figure_path)
 
 
 _preset_options = [
     click.argument("preset"),
-    click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+    click.option("--csv", "csv_path", type=OUTPUT, default=None,
                  help="Write the allowable-pressure table to this CSV file."),
     click.option("--plot", is_flag=True, help="Draw the DAF and design curves in the terminal."),
     click.option("--json", "as_json", is_flag=True, help="Print the results as JSON."),
+    figure_option,
 ]
 
 
@@ -179,19 +182,22 @@ def _with_preset_options(func: Any) -> Any:
 
 @boom.command("wall")
 @_with_preset_options
-def wall_command(preset: str, csv_path: Path | None, plot: bool, as_json: bool) -> None:
+def wall_command(preset: str, csv_path: Path | None, plot: bool, as_json: bool,
+                 figure_path: Path | None) -> None:
     """Damage / safe-limit boom pressures for the walls of a boom_wall PRESET."""
-    _preset_command("boom_wall", "wall", preset, csv_path, plot, as_json)
+    _preset_command("boom_wall", "wall", preset, csv_path, plot, as_json, figure_path)
 
 
 @boom.command("floor")
 @_with_preset_options
-def floor_command(preset: str, csv_path: Path | None, plot: bool, as_json: bool) -> None:
+def floor_command(preset: str, csv_path: Path | None, plot: bool, as_json: bool,
+                 figure_path: Path | None) -> None:
     """Annoyance boom pressures (tentative) for the floors of a boom_floor PRESET."""
-    _preset_command("boom_floor", "floor", preset, csv_path, plot, as_json)
+    _preset_command("boom_floor", "floor", preset, csv_path, plot, as_json, figure_path)
 
 
-def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool) -> None:
+def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *,
+                 figure: Path | None = None) -> None:
     """Run a boom_wall / boom_floor preset: table (or JSON), optional CSV and charts.
 
     Shared by ``vtool boom wall|floor`` and ``vtool solve``.
@@ -208,9 +214,12 @@ def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool) ->
         click.echo(report.limits_text(a))
         if csv_path is not None:
             click.echo(f"wrote {csv_path}")
-    if plot:
-        from vtool.app.plots import line_chart
+    if plot or figure is not None:
+        from vtool.app.plots import chart_text
+        from vtool.presets.charts import boom_design_charts
 
-        for name, frequency, series in report.design_series(a):
-            click.echo(line_chart(frequency, series, title=f"{name}: allowable p+ against frequency",
-                                  xlabel="f [Hz]", ylabel=f"p+ [{a.units.alt_pressure}]"))
+        charts = boom_design_charts(a, getattr(spec, "title", ""))
+        if plot:
+            for chart in charts:
+                click.echo(chart_text(chart))
+        write_figure(charts, figure)

@@ -7,7 +7,13 @@ from pathlib import Path
 
 import click
 
-from vtool.app.cli.options import impact_laws_option, start_option
+from vtool.app.cli.options import (
+    OUTPUT,
+    figure_option,
+    impact_laws_option,
+    start_option,
+    write_figure,
+)
 
 
 @click.command()
@@ -15,33 +21,27 @@ from vtool.app.cli.options import impact_laws_option, start_option
 @impact_laws_option
 @start_option
 @click.option("--degrees", type=float, help="Degrees of cam rotation; default: the preset's.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), help="Also write the table as CSV.")
+@click.option("--csv", "csv_path", type=OUTPUT, help="Also write the table as CSV.")
 @click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
 @click.option("--markdown", is_flag=True, help="Print the table as Markdown (for reports).")
+@click.option("--plot", is_flag=True, help="Draw each clearance's contact force, one curve per variant.")
+@figure_option
 def compare(preset: str, impacts: tuple[str, ...], starts: tuple[str, ...] | None, degrees: float | None,
-            csv_path: Path | None, as_json: bool, markdown: bool) -> None:
+            csv_path: Path | None, as_json: bool, markdown: bool, plot: bool, figure_path: Path | None) -> None:
     """Run a valve-train preset under several impact laws (and start velocities) with the same back end and
     step, and print side by side: events, episodes per clearance (separations/impacts/bounces/flickers),
     the first throw-off angle in each revolution after the first, peak contact forces after the first
     revolution, valve seating velocities and the largest valve lift."""
-    import dataclasses
-
     from vtool.files import write_atomic
     from vtool.markdown import table as markdown_table
-    from vtool.presets import load_preset
+    from vtool.presets import Override, load_preset
+    from vtool.presets.kinds import require_kind
     from vtool.solvers.studies.compare import cell, table
     from vtool.solvers.studies.compare import compare as run_compare
 
-    spec = load_preset(preset)
-    from vtool.presets.kinds import require_kind
-
+    # --degrees is the preset's run.degrees: the loader checks it, as the file's own value
+    spec = load_preset(preset, () if degrees is None else (Override("run.degrees", degrees, "--degrees"),))
     require_kind(spec, "valvetrain", "`vtool compare`")
-    if degrees is not None:
-        from vtool.errors import InputError
-
-        if not 0.0 < degrees <= 36000.0:
-            raise InputError("--degrees", degrees, "> 0 and <= 36000", "deg")
-        spec = dataclasses.replace(spec, run=dataclasses.replace(spec.run, degrees=degrees))
     from vtool.app.cli.solve import announce_compile
 
     variants = run_compare(spec, impacts, starts, before_run=lambda: announce_compile(spec, impacts=impacts))
@@ -73,3 +73,11 @@ def compare(preset: str, impacts: tuple[str, ...], starts: tuple[str, ...] | Non
         write_atomic(csv_path, buffer.getvalue())
         if not as_json:
             click.echo(f"wrote {csv_path}")
+    if plot or figure_path is not None:
+        from vtool.app.plots import chart_text
+        from vtool.presets.charts import compare_chart
+
+        chart = compare_chart(variants)
+        if plot and not as_json:
+            click.echo(chart_text(chart))
+        write_figure([chart], figure_path)

@@ -15,6 +15,7 @@ from typing import Any
 
 import click
 
+from vtool.app.cli.options import OUTPUT, figure_option, json_alone, write_figure
 from vtool.errors import InputError
 
 RK4_LIMIT = 2.8  # thesis eq. 44; kept here so --help needs no numerics
@@ -22,10 +23,10 @@ RK4_LIMIT = 2.8  # thesis eq. 44; kept here so --help needs no numerics
 
 def _load_plate_spec(preset: str) -> Any:
     from vtool.presets import load_preset
+    from vtool.presets.kinds import require_kind
 
     spec = load_preset(preset)
-    if getattr(spec, "kind", "") != "plate":
-        raise InputError("preset", preset, f"a plate preset (this one is kind {spec.kind!r})")
+    require_kind(spec, "plate", "`vtool plate`")
     return spec
 
 
@@ -50,7 +51,7 @@ def _width() -> int:
     return max(60, min(shutil.get_terminal_size((100, 24)).columns, 140))
 
 
-csv_option = click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+csv_option = click.option("--csv", "csv_path", type=OUTPUT,
                           help="Also write the results to this CSV file (header names units).")
 json_option = click.option("--json", "as_json", is_flag=True, help="Print JSON instead of tables.")
 
@@ -70,7 +71,7 @@ def plate() -> None:
 def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path | None, as_json: bool) -> None:
     """Lowest natural frequencies of each case against the exact ones (eq. 40), and omega_max."""
     from vtool.assessments.plate.model import build_model
-    from vtool.assessments.plate.report import modes_csv, modes_text
+    from vtool.assessments.plate.report import cases_modes_csv, modes_text
     from vtool.assessments.plate.vibration import free_vibration
 
     spec = _load_plate_spec(preset)
@@ -86,26 +87,15 @@ def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path 
     else:
         click.echo("\n\n".join(modes_text(f, c) for c, f in results))
     if csv_path is not None:
-        text = "case,KS," + modes_csv(results[0][1]).splitlines()[0] + "\n"
-        for c, f in results:
-            text += "".join(f"{c.name},{f.size},{line}\n" for line in modes_csv(f).splitlines()[1:])
-        _write(csv_path, text)
+        _write(csv_path, cases_modes_csv([(c.name, f) for c, f in results]))
         click.echo(f"wrote {csv_path}", err=True)
 
 
-def _chart(resp: Any, exact: Any, quantity: str, label: str) -> str:
-    import numpy as np
+def _chart(resp: Any, exact: Any, quantity: str) -> str:
+    from vtool.app.plots import chart_text
+    from vtool.presets.charts import plate_response_chart
 
-    from vtool.app.plots import line_chart
-
-    series = {f"{resp.case} {resp.scheme}": getattr(resp, quantity)}
-    if exact is not None and not (quantity == "acceleration" and not exact.acceleration_converged):
-        series["exact"] = np.interp(resp.tau, exact.tau, getattr(exact, quantity))
-    return line_chart(resp.tau, series, title=f"centre {quantity}, {resp.load} step load",
-                      xlabel="t / T (exact fundamental period)", ylabel=label, width=_width(), height=18)
-
-
-LABELS = {"displacement": "w / (p0/(m w11^2))", "velocity": "v / (p0/(m w11))", "acceleration": "a / (p0/m)"}
+    return chart_text(plate_response_chart(resp, exact, quantity), width=_width(), height=18)
 
 
 @plate.command("transient")
@@ -131,7 +121,7 @@ def transient(preset: str, case_name: str | None, load: str, scheme: str, wh: fl
     from vtool.assessments.plate.report import case_run_dict, case_run_text, response_csv
     from vtool.assessments.plate.study import run_case
 
-    spec = _load_plate_spec(preset)
+    spec = _load_plate_spec(preset)  # with --json, the histories are not drawn (--plot is on by default)
     settings = spec.study.transient
     case = _cases(spec, case_name)[0]
     run = run_case(spec.study.plate, case, load, scheme, wh, periods or settings.periods,
@@ -144,7 +134,7 @@ def transient(preset: str, case_name: str | None, load: str, scheme: str, wh: fl
         click.echo(case_run_text(run))
         if plot:
             for q in ("displacement", "velocity", "acceleration"):
-                click.echo(_chart(run.response, run.exact, q, LABELS[q]))
+                click.echo(_chart(run.response, run.exact, q))
     if csv_path is not None:
         click.echo(f"wrote {csv_path}", err=True)
 
@@ -165,16 +155,19 @@ def _write(path: Path, text: str) -> None:
 @click.option("--transient/--no-transient", default=True, show_default=True,
               help="Include the transient runs (Tables 4 and 5).")
 @click.option("--plot", is_flag=True, help="Draw the full model's histories against exact.")
+@figure_option
 @csv_option
 @json_option
-def study(preset: str, transient: bool, plot: bool, csv_path: Path | None, as_json: bool) -> None:
+def study(preset: str, transient: bool, plot: bool, figure_path: Path | None, csv_path: Path | None,
+          as_json: bool) -> None:
     """The thesis' Tables 2-5 regenerated: every case, its KS, errors and cost."""
+    json_alone(as_json, plot=plot)
     spec = _load_plate_spec(preset)
-    solve_preset(spec, csv_path, plot, as_json, transient=transient)
+    solve_preset(spec, csv_path, plot, as_json, transient=transient, figure=figure_path)
 
 
 def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *,
-                 transient: bool = True) -> None:
+                 transient: bool = True, figure: Path | None = None) -> None:
     """Run a plate preset's study: print its tables (or JSON), write CSV, draw charts.
 
     The batch entry point ``vtool solve PRESET`` calls this for plate presets.
@@ -182,6 +175,8 @@ def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *,
     from vtool.assessments.plate.report import study_csv, study_dict, study_text
     from vtool.assessments.plate.study import run_study
 
+    if figure is not None and not transient:
+        raise InputError("--figure", str(figure), "a study with its transient runs (not with --no-transient)")
     result = run_study(spec.study, transient=transient)
     if as_json:
         doc = {"title": spec.title, "units": spec.units, **study_dict(result)}
@@ -192,19 +187,14 @@ def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *,
     if csv_path is not None:
         _write(csv_path, study_csv(result))
         click.echo(f"wrote {csv_path}", err=True)
-    if plot and result.exact:
-        _plot_full_model(spec, result)
+    if (plot or figure is not None) and result.exact:
+        from vtool.app.plots import chart_text
+        from vtool.presets.charts import plate_study_charts
 
-
-def _plot_full_model(spec: Any, result: Any) -> None:
-    from vtool.assessments.plate.model import build_model
-    from vtool.assessments.plate.transient import run_rk4
-
-    settings = spec.study.transient
-    sizes = {r.case: r.size for r in result.transient}
-    full = max(settings.cases, key=lambda name: sizes.get(name, 0))
-    model = build_model(spec.study.plate, spec.study.case(full))
-    for load, exact in result.exact.items():
-        resp = run_rk4(spec.study.plate, model, load, 1.0, settings.periods)
-        for q in ("displacement", "velocity", "acceleration"):
-            click.echo(_chart(resp, exact, q, LABELS[q]))
+        charts = plate_study_charts(spec, result)
+        if plot:
+            for chart in charts:
+                click.echo(chart_text(chart, width=_width(), height=18))
+        write_figure(charts, figure)
+    elif figure is not None:
+        click.echo(f"warning: no transient runs in this study: {figure} not written", err=True)

@@ -7,8 +7,8 @@ from pathlib import Path
 import click
 
 from vtool.errors import InputError
-from vtool.files import exists, is_dir, write_atomic
-from vtool.presets import find_preset, list_presets
+from vtool.files import check_output_path, exists, is_dir, write_atomic
+from vtool.presets import find_preset, list_presets, self_contained_text
 
 
 @click.group()
@@ -38,9 +38,33 @@ def show_command(name: str) -> None:
 @click.option("--force", is_flag=True, help="Overwrite an existing file.")
 def copy_command(name: str, dest: Path, force: bool) -> None:
     """Copy a preset to DEST (a file, or a folder to copy into) to edit it."""
+    if not is_dir(dest):
+        check_output_path(dest, "DEST")  # before any work
     source = find_preset(name)
     target = dest / source.name if is_dir(dest) else dest
+    check_output_path(target, "DEST")
     if exists(target) and not force:
         raise InputError("dest", str(target), "a path that does not exist yet (or --force)")
-    write_atomic(target, source.read_text(encoding="utf-8"), "DEST")
-    click.echo(f"copied {source.stem} to {target}")
+    text, note = self_contained_text(source)  # a lift-table file is written in: the copy loads anywhere
+    write_atomic(target, text, "DEST")
+    click.echo(f"copied {source.stem} to {target}" + (f" ({note})" if note else ""))
+
+
+@presets.command("expand")
+@click.argument("name")
+def expand_command(name: str) -> None:
+    """Print a train-type preset ([train] type = ...) as the explicit model it expands to
+    (coordinates, members, clearances, cam, follower); an explicit preset prints unchanged."""
+    import tomli_w
+
+    from vtool.presets import read_document
+    from vtool.presets.trains import expand
+
+    path = find_preset(name)
+    doc = read_document(path)
+    if "train" not in doc:
+        click.echo(path.read_text(encoding="utf-8"), nl=False)
+        return
+    explicit = expand(doc, path.parent)
+    click.echo(f"# {path.stem}: the explicit model of its [train] (vtool presets expand; presets/trains.py)")
+    click.echo(tomli_w.dumps(explicit), nl=False)

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import click
 
+from vtool.app.cli.options import OUTPUT, figure_option, json_alone, write_figure
+
 DEFAULT_SCAN = "1000:20000:1000"
 
 
@@ -33,6 +35,20 @@ class CountProgress:
             self.bar = None
 
 
+def _workers(ctx: click.Context, param: click.Parameter, value: int | None) -> int | None:
+    from vtool.solvers.studies.sweep import check_workers
+
+    return None if value is None else check_workers(value)
+
+
+def _scheduler(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    from vtool.solvers.studies.sweep import parse_scheduler
+
+    if value is not None:
+        parse_scheduler(value)  # the one parser: refused here, before the preset is loaded
+    return value
+
+
 @click.command()
 @click.argument("preset")
 @click.option("--set", "sets", multiple=True, metavar="FIELD=VALUES",
@@ -40,25 +56,37 @@ class CountProgress:
                    "clearances[2].restitution) and its values: start:stop:step (stop included) or a,b,c. "
                    "Several --set make a grid.")
 @click.option("--find", "find", type=click.Choice(["jump-speed", "bounce-speed"]),
-              help="Bracket and bisect the cam speed (to 1 rev/min) where the follower first leaves the cam "
-                   f"(jump-speed) or the valve first bounces on its seat (bounce-speed); --set run.rpm gives "
-                   f"the scan (default {DEFAULT_SCAN}), other --set fields a grid of searches.")
-@click.option("--workers", type=int, help="Local worker processes (default: all cores; 1 = in this process).")
-@click.option("--scheduler", help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
+              help="Bracket and bisect (to 1 rev/min) every cam-speed interval where the follower leaves the "
+                   "cam during lift (jump-speed) or the valve bounces on its seat (bounce-speed), each run to "
+                   f"steady state; --set run.rpm gives the scan (default {DEFAULT_SCAN}), other --set fields a "
+                   "grid of searches.")
+@click.option("--workers", type=int, callback=_workers,
+              help="Local worker processes (default: chosen from the measured cost of a point; 1 = in this process).")
+@click.option("--scheduler", callback=_scheduler, help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
                                   "processes) or local-threads:N.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("--csv", "csv_path", type=OUTPUT,
               help="Write one row per point (swept fields, status, metrics; units in the header), appended as "
                    "points finish.")
 @click.option("--resume", is_flag=True, help="Continue the sweep in the --csv file, skipping finished points.")
 @click.option("--timing", is_flag=True, help="Also write each point's wall time to the CSV (not reproducible).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON instead of a table.")
-@click.option("--plot", is_flag=True, help="Chart --metric against the first swept field.")
+@click.option("--plot", is_flag=True, help="Chart --metric against the first swept field (--figure: also as a figure file).")
 @click.option("--map", "as_map", is_flag=True, help="Character heat map of --metric over two swept fields.")
 @click.option("--metric", default="spring_margin", show_default=True, help="Metric for --plot and --map.")
 @click.option("--every-step", is_flag=True, help="Metrics from every time step instead of the output rows.")
+@click.option("--steady", is_flag=True, help="Run every point to steady state (run.steady's defaults) unless the "
+                                            "preset sets run.cycles or run.steady; the metrics cover the last cycle.")
+@click.option("--orders", "orders", multiple=True, metavar="QUANTITY",
+              help="Also report QUANTITY's (q7, q1-q9, F7) cam-order amplitudes, orders 1 to run.highest_order "
+                   "(24), as metrics QUANTITY_order_K (for --metric, --plot, --map).")
+@click.option("--campbell", metavar="QUANTITY",
+              help="Campbell (waterfall) map of QUANTITY's order amplitudes against run.rpm, the natural "
+                   "frequencies drawn as the orders they meet.")
+@figure_option
 def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | None, scheduler: str | None,
           csv_path: Path | None, resume: bool, timing: bool, as_json: bool, plot: bool, as_map: bool,
-          metric: str, every_step: bool) -> None:
+          metric: str, every_step: bool, figure_path: Path | None, steady: bool, orders: tuple[str, ...],
+          campbell: str | None) -> None:
     """Run a valve-train preset over a grid of field values and report per-point metrics.
 
     \b
@@ -81,16 +109,22 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         run_points,
     )
 
+    json_alone(as_json, plot=plot, map=as_map)
     if resume and csv_path is None:
         raise InputError("--resume", True, "a --csv file to resume")
     if find is not None:
         if not any(s.partition("=")[0].strip() == "run.rpm" for s in sets):
             sets = (f"run.rpm={DEFAULT_SCAN}",) + sets
-        if resume or plot or as_map:
-            raise InputError("--find", find, "no --resume, --plot or --map (a search prints its bracket history)")
+        if resume or plot or as_map or figure_path:
+            raise InputError("--find", find, "no --resume, --plot, --map or --figure (a search prints its bracket "
+                             "history)")
     elif not sets:
         raise InputError("--set", None, "at least one FIELD=VALUES (or --find jump-speed)")
     plan = plan_sweep(preset, list(sets))
+    if steady or orders or campbell:
+        plan = _with_settings(plan, steady, orders + ((campbell,) if campbell else ()))
+    if campbell and not any(f == "run.rpm" for f, _ in plan.fields):
+        raise InputError("--campbell", campbell, "a sweep over run.rpm")
     if find == "bounce-speed" and seat_index(plan.spec) is None:
         raise InputError("--find", find, "a preset with a valve seat (this one has none)")
     names = {name: unit for name, unit in metric_columns(plan.spec)}
@@ -99,9 +133,14 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     axes = [f for f in plan.fields if len({dict(p.values)[f[0]] for p in plan.points}) > 1]
     if as_map and len(axes) != 2:
         raise InputError("--map", len(axes), "exactly two swept fields with more than one value")
-    if plot and not axes:
+    if (plot or figure_path) and not axes:
         raise InputError("--plot", plan.fields[0][0] if plan.fields else None, "a swept field with two or more values")
-    runner = make_runner(workers, scheduler)  # a Dask scheduler is reached here, before any file is written
+    import time
+
+    started = time.perf_counter()  # the wall time counts a Dask cluster's or a pool's start-up
+    runner = make_runner(workers, scheduler,  # a Dask scheduler is reached here, before any file is written
+                         announce=lambda text: click.echo(text, err=True))
+    startup = time.perf_counter() - started
     try:
         if find is not None:
             _find(find, plan, runner, csv_path, as_json, every_step)
@@ -112,8 +151,12 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
             outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress)
         except KeyboardInterrupt:
             progress.close()
-            where = (f"the finished points are in {csv_path}; run again with --resume to finish"
-                     if csv_path else "nothing was kept (use --csv to keep finished points)")
+            if sink is not None and (sink.written or resume):
+                where = f"the finished points are in {csv_path}; run again with --resume to finish"
+            elif sink is not None:
+                where = f"no point had finished: nothing was written ({csv_path} is as it was)"
+            else:
+                where = "nothing was kept (use --csv to keep finished points)"
             raise RunError(f"interrupted: {where}") from None
         finally:
             progress.close()
@@ -122,14 +165,24 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     results = outcome.results
     if sink is not None and outcome.skipped:
         click.echo(f"resumed: {outcome.skipped} of {outcome.total} points were already in {csv_path}", err=True)
+    from vtool.solvers.studies.metrics import Criteria
+    from vtool.solvers.studies.steady import steady_text
+
+    length = plan.spec.unit_system.length
     if as_json:
-        click.echo(json.dumps(results_json(results, plan.fields, plan.spec, preset), indent=2))
+        click.echo(json.dumps(results_json(results, plan.fields, plan.spec, preset)
+                              | {"evaluation": steady_text(plan.spec),
+                                 "criteria": Criteria.of(plan.spec).as_dict(length)}, indent=2))
     else:
         if results:
             click.echo(results_table(results, plan.fields, plan.spec))
+        click.echo(steady_text(plan.spec))  # which cycles the metrics cover, and by which criteria
+        click.echo(Criteria.of(plan.spec).text(length))
         n = len(results)
-        click.echo(f"{n} points in {outcome.wall_time:.2f} s ({1000 * outcome.wall_time / max(n, 1):.1f} ms per "
-                   f"point, {runner.workers} worker{'s' if runner.workers > 1 else ''})")
+        wall = startup + outcome.wall_time
+        begun = f", {startup:.2f} s of it starting the cluster" if startup >= 0.005 else ""
+        click.echo(f"{n} points in {wall:.2f} s ({1000 * wall / max(n, 1):.1f} ms per "
+                   f"point, {runner.workers} worker{'s' if runner.workers > 1 else ''}{begun})")
         if csv_path is not None:
             click.echo(f"wrote {outcome.total} rows to {csv_path}")
     if results and (plot or as_map):
@@ -139,12 +192,27 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
             click.echo(metric_chart(results, axes, metric, names[metric]))
         if as_map:
             click.echo(metric_map(results, axes, metric, names[metric]))
+    if results and campbell:
+        from vtool.app.sweep_charts import campbell_map
+        from vtool.solvers.studies.orders import campbell as campbell_data
+
+        rows = [(float(dict(r.values)["run.rpm"]), r.metrics) for r in results if r.ok]
+        click.echo(campbell_map(campbell_data(rows, plan.spec, campbell)))
+    if results and figure_path is not None:  # the --plot chart, and the --map as a grey map
+        from vtool.presets.charts import sweep_chart, sweep_map
+
+        items: list = [sweep_chart(results, axes, metric, names[metric], plan.spec.title)]
+        if as_map:
+            items.append(sweep_map(results, axes, metric, names[metric], plan.spec.title))
+        write_figure(items, figure_path)
 
 
 def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # type: ignore[no-untyped-def]
     """One speed search per grid point of the fields other than run.rpm."""
     from vtool.files import write_atomic
     from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.studies.metrics import Criteria
+    from vtool.solvers.studies.steady import steady_text, with_steady
     from vtool.solvers.studies.sweep import find_speed, format_value
 
     scan = sorted({dict(p.values)["run.rpm"] for p in plan.points})
@@ -155,6 +223,10 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
         searches.setdefault(key, point.spec)
     rows = []
     found = []
+    first = with_steady(plan.spec)
+    if not as_json:  # the answers come from steady state, by criteria with stated thresholds
+        click.echo(Criteria.of(first).text(first.unit_system.length))
+        click.echo(steady_text(first))
     for key, spec in searches.items():
         if key and not as_json:
             click.echo(", ".join(f"{k} = {format_value(v)}" for k, v in key))
@@ -164,24 +236,47 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
                 click.echo(f"  {b.stage:<6} {b.rpm:>9g} rev/min  {'holds' if b.holds else 'no':<5}  "
                            f"({format_value(b.value)})")
 
-        result = find_speed(criterion, lambda rpm, spec=spec: with_run_overrides(spec, rpm=rpm), scan, runner,
-                            every_step=every_step, report=report)
+        result = find_speed(criterion, lambda rpm, spec=spec: with_steady(with_run_overrides(spec, rpm=rpm)),
+                            scan, runner, every_step=every_step, report=report)
         if not as_json:
+            for interval in result.intervals:
+                click.echo(f"  interval: {interval.text()}")
             click.echo(f"{criterion}: {result.message}")
+        intervals = ";".join(f"{format_value(i.low)}-{format_value(i.high)}" for i in result.intervals)
         rows.append([format_value(v) for _, v in key] + [format_value(result.speed) if result.speed else "",
-                                                         result.message])
+                                                         intervals, result.message])
         found.append(dict(key) | {criterion.replace("-", "_"): result.speed,
                                   f"{criterion.replace('-', '_')}_unit": "rev/min", "message": result.message,
                                   "history": [{"rpm": b.rpm, "holds": b.holds, "value": b.value, "stage": b.stage}
-                                              for b in result.history]})
+                                              for b in result.history],
+                                  "intervals": [{"low_rpm": i.low, "high_rpm": i.high, "below_rpm": i.below,
+                                                 "above_rpm": i.above} for i in result.intervals]})
     if as_json:
-        click.echo(json.dumps({"preset": plan.spec.title, "criterion": criterion, "searches": found}, indent=2))
+        click.echo(json.dumps({"preset": plan.spec.title, "criterion": criterion,
+                               "criteria": Criteria.of(first).as_dict(first.unit_system.length),
+                               "evaluation": steady_text(first), "searches": found}, indent=2))
     if csv_path is not None:
         header = [f"{f} ({u})" if u else f for f, u in others] + [f"{criterion.replace('-', '_')} (rev/min)",
-                                                                  "message"]
+                                                                  "intervals (rev/min)", "message"]
         import csv
         import io
 
         buffer = io.StringIO()
         csv.writer(buffer, lineterminator="\n").writerows([header] + rows)
         write_atomic(csv_path, buffer.getvalue())
+
+
+def _with_settings(plan, steady: bool, orders: tuple[str, ...]):  # type: ignore[no-untyped-def]
+    """The plan with every point (and its base spec) run to steady state and reporting these order amplitudes."""
+    import dataclasses
+
+    from vtool.solvers.studies.orders import with_orders
+    from vtool.solvers.studies.steady import with_steady
+
+    def change(spec):  # type: ignore[no-untyped-def]
+        spec = with_orders(spec, orders) if orders else spec
+        return with_steady(spec) if steady else spec
+
+    return dataclasses.replace(plan, spec=change(plan.spec),
+                               points=tuple(dataclasses.replace(p, spec=change(p.spec)) for p in plan.points))
+

@@ -34,7 +34,7 @@ from abc import ABCMeta, abstractmethod
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from textual.app import ComposeResult
 from textual.binding import Binding, BindingType
@@ -48,6 +48,10 @@ from vtool.app.tui.form import Field, ParamForm
 from vtool.app.tui.messages import FieldEdited, RunProgressed
 from vtool.app.tui.widgets import KeyFooter
 from vtool.errors import InputError
+from vtool.presets import kind_of, loader_for
+
+if TYPE_CHECKING:
+    from vtool.app.tui.presetfile import FileReference
 
 PROGRESS_INTERVAL = 0.05  # s between progress messages: the bar needs no more
 NARROW = 120  # columns below which a finished run hides the form
@@ -97,11 +101,12 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         Binding("ctrl+t", "next_tab", "Tab", priority=True),
     ]
 
-    #: mode name in the app, preset kinds this screen takes, and its default preset
+    #: mode name in the app and its default preset (the kinds it shows: vtool.presets.kinds.KINDS)
     MODE: ClassVar[str] = ""
-    KINDS: ClassVar[tuple[str, ...]] = ()
     DEFAULT_PRESET: ClassVar[str] = ""
     TITLE_TEXT: ClassVar[str] = ""
+    #: keys of a preset file that name another file, written inline on save (:mod:`.presetfile`)
+    FILE_REFERENCES: ClassVar[tuple[FileReference, ...]] = ()
 
     def __init__(self) -> None:
         super().__init__()
@@ -184,9 +189,9 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         self.progress.set_class(running, "-running")
 
     # ----- what a domain screen provides -----
-    @abstractmethod
     def loader(self) -> Any:
-        """The preset module (``load(doc)``, ``dump(spec)``) of this screen's kind."""
+        """The preset module (``load(doc)``, ``dump(spec)``) of the shown preset's kind (the kinds table's)."""
+        return loader_for(kind_of(self.base_doc))
 
     @abstractmethod
     def fields_for(self, spec: Any, doc: dict[str, Any]) -> list[Field]:
@@ -233,7 +238,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             self.worker.cancel()
         self.source = source
         self.on_source_changed(source)
-        self.base_doc = self.loader().dump(spec)
+        self.base_doc = loader_for(spec.kind).dump(spec)
         self.loaded_doc = self.loader().dump(spec)
         self.spec = spec
         self.problem = None
@@ -412,7 +417,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             source = None
         text, kept = save_text(source, self.loaded_doc, document,
                                lambda doc: loader.dump(loader.load(doc)),
-                               lambda: tomli_w.dumps(loader.dump(loader.load(document))))
+                               lambda: tomli_w.dumps(loader.dump(loader.load(document))), self.FILE_REFERENCES)
         write_atomic(path, text)
         return kept
 

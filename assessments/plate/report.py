@@ -17,6 +17,7 @@ from vtool.assessments.plate.model import Case
 from vtool.assessments.plate.study import CaseRun, StudyResult, TransientRow
 from vtool.assessments.plate.transient import SIGNED_PEAK_FLOOR, SIGNS, ExactHistories, Response
 from vtool.assessments.plate.vibration import FreeVibration
+from vtool.csvrows import csv_text
 
 SIGNED_KEYS = tuple(q + s for q in ("displacement", "velocity", "acceleration") for s in SIGNS)
 ELEMENT_TITLES = {"bfs16": "16-DOF element (bfs16)", "mason24": "24-DOF element (mason24)"}
@@ -34,20 +35,31 @@ def case_description(case: Case) -> str:
     return f"{case.nx}x{case.ny} {text}{method}"
 
 
-def frequency_table(free: list[FreeVibration], cases: dict[str, Case], title: str) -> str:
-    """Thesis Table 2/3 layout: one row per case, errors of the lowest modes in %."""
+def frequency_table(free: list[FreeVibration], cases: dict[str, Case], title: str, *,
+                    masters_last: bool = False) -> str:
+    """Thesis Table 2/3 layout: one row per case, errors of the lowest modes in %.
+
+    ``masters_last``: the master-set description after the numbers (the TUI beside its
+    form: the errors stay in view, the description is what a narrow panel cuts).
+    """
     if not free:
         return ""
     modes: list[NavierMode] = max((f.exact for f in free), key=len)
-    head = f"{'case':<5} {'KS':>4}  {'masters':<52}" + "".join(f"{f'({m.m},{m.n})':>8}" for m in modes)
-    head += f"{'wmax/w11':>10}"
-    exact = f"{'':<5} {'':>4}  {'exact omega, rad/s':<52}" + "".join(f"{m.omega:>8.1f}" for m in modes)
-    lines = [title, head, exact, "-" * len(head)]
+    numbers = "".join(f"{f'({m.m},{m.n})':>8}" for m in modes) + f"{'wmax/w11':>10}"
+    table = [(f"{'case':<5} {'KS':>4}  ", "masters", numbers),
+             (f"{'':<5} {'':>4}  ", "exact omega, rad/s", "".join(f"{m.omega:>8.1f}" for m in modes))]
     for f in free:
-        desc = case_description(cases[f.case])[:52]
         errs = "".join(_pct(e) for e in f.errors_pct) + " " * 8 * (len(modes) - len(f.errors_pct))
-        lines.append(f"{f.case:<5} {f.size:>4}  {desc:<52}{errs}{f.omega_max_ratio:>10.1f}")
-    lines.append("errors: (approximate - exact)/exact x 100 % (eq. 40), k-th lowest against k-th lowest")
+        table.append((f"{f.case:<5} {f.size:>4}  ", case_description(cases[f.case])[:52],
+                      f"{errs}{f.omega_max_ratio:>10.1f}"))
+    if masters_last:
+        lines = [start + f"{numbers:<{len(table[0][2])}}  " + text for start, text, numbers in table]
+        rule = "-" * len(table[0][0] + table[0][2])
+    else:
+        lines = [start + f"{text:<52}" + numbers for start, text, numbers in table]
+        rule = "-" * len(lines[0])
+    lines = [title, lines[0], lines[1], rule, *lines[2:],
+             "errors: (approximate - exact)/exact x 100 % (eq. 40), k-th lowest against k-th lowest"]
     return "\n".join(lines)
 
 
@@ -87,11 +99,12 @@ def cost_table(result: StudyResult) -> str:
 
 
 def truncation_pct(exact: ExactHistories, fine: ExactHistories) -> dict[str, float]:
-    """Change of each exact peak magnitude from N to 4N modes, % of the 4N peak."""
+    """Change of each exact peak magnitude from N to 4N modes, % of the 4N peak (peaks refined between
+    the samples: :meth:`ExactHistories.extreme`)."""
     out = {}
     for q in ("displacement", "velocity", "acceleration"):
-        a = float(np.max(np.abs(getattr(exact, q))))
-        b = float(np.max(np.abs(getattr(fine, q))))
+        a = max(exact.extreme(q, "+"), -exact.extreme(q, "-"))
+        b = max(fine.extreme(q, "+"), -fine.extreme(q, "-"))
         out[q] = (a - b) / b * 100.0 if b else 0.0
     return out
 
@@ -106,9 +119,13 @@ def exact_note(exact: ExactHistories, fine: ExactHistories | None = None) -> str
         text += (f"\n  truncation: {exact.n_modes}-mode peak against {fine.n_modes} modes: "
                  f"displacement {t['displacement']:+.3f} %, velocity {t['velocity']:+.2f} %, "
                  f"acceleration {t['acceleration']:+.1f} %")
-    if not exact.acceleration_converged:
+    if not exact.acceleration_defined:
         text += ("\n  point-load acceleration does not converge with the number of modes "
                  "(its series terms do not decay): no exact value, its errors are not reported")
+    elif not exact.acceleration_converged:
+        text += (f"\n  uniform-load acceleration not converged at {exact.n_modes} modes (its peak moves "
+                 f"{c['acceleration']:.1f} % when they are halved): its errors are against the "
+                 f"{exact.n_modes}-mode series, as the thesis', not an exact value")
     return text
 
 
@@ -251,15 +268,16 @@ def study_dict(result: StudyResult) -> dict[str, Any]:
 
 
 def study_csv(result: StudyResult) -> str:
-    """One row per case and quantity (long format), header with units."""
-    lines = ["table,case,KS,load,omega_max_h,quantity,mode,value,unit"]
+    """One row per case and quantity (long format), header with units; text cells quoted as needed."""
+    rows: list[list[object]] = [["table", "case", "KS", "load", "omega_max_h", "quantity", "mode", "value", "unit"]]
     for f in result.free:
         for m, e in zip(f.exact, f.errors_pct, strict=True):
-            lines.append(f"frequency,{f.case},{f.size},,,frequency_error,{m.m}-{m.n},{e:.6g},%")
-        lines.append(f"frequency,{f.case},{f.size},,,omega_max_over_omega11,,{f.omega_max_ratio:.6g},1")
-        lines.append(f"cost,{f.case},{f.size},,,eigen_time,,{f.solve_seconds:.6g},s")
+            rows.append(["frequency", f.case, f.size, "", "", "frequency_error", f"{m.m}-{m.n}", f"{e:.6g}", "%"])
+        rows.append(["frequency", f.case, f.size, "", "", "omega_max_over_omega11", "", f"{f.omega_max_ratio:.6g}", "1"])
+        rows.append(["cost", f.case, f.size, "", "", "eigen_time", "", f"{f.solve_seconds:.6g}", "s"])
     for r in result.convergence:
-        lines.append(f"convergence,{r.element}-{r.n}x{r.n},{r.size},,,fundamental_error,1-1,{r.fundamental_error_pct:.6g},%")
+        rows.append(["convergence", f"{r.element}-{r.n}x{r.n}", r.size, "", "", "fundamental_error", "1-1",
+                     f"{r.fundamental_error_pct:.6g}", "%"])
     for r in result.transient:
         wh = "modal" if math.isnan(r.omega_max_h) else f"{r.omega_max_h:g}"
         for suffix, errors in (("_peak_error", r.errors_pct), ("_peak_error_4n_modes", r.errors_4n_pct),
@@ -267,10 +285,10 @@ def study_csv(result: StudyResult) -> str:
             for q, v in errors.items():
                 value = "" if math.isnan(v) else f"{v:.6g}"
                 name = q.replace("+", "_positive").replace("-", "_negative")
-                lines.append(f"transient,{r.case},{r.size},{r.load},{wh},{name}{suffix},,{value},%")
-        lines.append(f"cost,{r.case},{r.size},{r.load},{wh},time_loop,,{r.seconds:.6g},s")
-        lines.append(f"cost,{r.case},{r.size},{r.load},{wh},steps,,{r.steps},1")
-    return "\n".join(lines) + "\n"
+                rows.append(["transient", r.case, r.size, r.load, wh, f"{name}{suffix}", "", value, "%"])
+        rows.append(["cost", r.case, r.size, r.load, wh, "time_loop", "", f"{r.seconds:.6g}", "s"])
+        rows.append(["cost", r.case, r.size, r.load, wh, "steps", "", r.steps, "1"])
+    return csv_text(rows)
 
 
 def modes_text(free: FreeVibration, case: Case) -> str:
@@ -283,11 +301,23 @@ def modes_text(free: FreeVibration, case: Case) -> str:
     return "\n".join(lines)
 
 
+MODES_HEADER = ["mode", "m", "n", "exact_omega_rad_per_s", "model_omega_rad_per_s", "error_pct"]
+
+
+def modes_rows(free: FreeVibration) -> list[list[object]]:
+    """The rows of :func:`modes_csv` (no header)."""
+    return [[k, m.m, m.n, f"{m.omega:.9g}", f"{free.omega[k - 1]:.9g}", f"{e:.6g}"]
+            for k, (m, e) in enumerate(zip(free.exact, free.errors_pct, strict=True), start=1)]
+
+
 def modes_csv(free: FreeVibration) -> str:
-    lines = ["mode,m,n,exact_omega_rad_per_s,model_omega_rad_per_s,error_pct"]
-    for k, (m, e) in enumerate(zip(free.exact, free.errors_pct, strict=True), start=1):
-        lines.append(f"{k},{m.m},{m.n},{m.omega:.9g},{free.omega[k - 1]:.9g},{e:.6g}")
-    return "\n".join(lines) + "\n"
+    return csv_text([MODES_HEADER, *modes_rows(free)])
+
+
+def cases_modes_csv(results: list[tuple[str, FreeVibration]]) -> str:
+    """Several cases' modes in one CSV: ``case`` (quoted as needed) and ``KS`` columns first."""
+    return csv_text([["case", "KS", *MODES_HEADER]]
+                    + [[name, f.size, *row] for name, f in results for row in modes_rows(f)])
 
 
 def response_csv(resp: Response, exact: ExactHistories | None) -> str:

@@ -69,10 +69,11 @@ class ExactOptions:
         return cls(run.output_interval, every_step)
 
 
-class ExactBackend(PiecewiseBackend):
+class ExactBackend(PiecewiseBackend[ExactOptions]):
     """Piecewise-exact back end (see module doc). Registered as ``exact``."""
 
     name = "exact"
+    reference = True
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> ExactOptions:

@@ -32,12 +32,12 @@ from typing import Any
 import numpy as np
 
 from vtool.errors import InputError, RunError
-from vtool.solvers.backends import Backend, Cancel, Progress
+from vtool.solvers.backends import Backend, Cancel, OptionsT, Progress, RunStats
 from vtool.solvers.exact.statespace import StateSpace, from_layer
 from vtool.solvers.model.contact import ContactProblem, OrderedLayer, event_buffers
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.sources import SourceSeries
-from vtool.solvers.model.spec import HERTZ
+from vtool.solvers.model.spec import HERTZ, MechanismSpec
 from vtool.solvers.newmark import layout
 from vtool.solvers.newmark.records import Motion, Output, State
 from vtool.solvers.trace import OPENED, TraceBuilder
@@ -382,10 +382,10 @@ class PiecewiseRun(ABC):
         new_c = self.settle(new_c, t, x, v, a)
         return new_c, x, v, a
 
-    def statistics(self, settings: dict[str, Any]) -> dict[str, Any]:
+    def statistics(self, settings: dict[str, Any]) -> RunStats:
         self.flush_rows()
-        return {"steps": self.steps, "peak": self.peak, "peak_late": self.peak_late, "peak_overlap": self.peak_overlap,
-                "configurations": tuple(sorted(self.spaces)), "settings": settings}
+        return RunStats(self.steps, self.peak, self.peak_late, self.peak_overlap, tuple(sorted(self.spaces)),
+                        settings)
 
 
 def refuse_hertz(mechanism: Mechanism, backend: str) -> None:
@@ -396,16 +396,23 @@ def refuse_hertz(mechanism: Mechanism, backend: str) -> None:
                              f"({c.name}: nonlinear between events, so the exact solution does not apply)")
 
 
-class PiecewiseBackend(Backend):
+class PiecewiseBackend(Backend[OptionsT]):
     """A back end whose run is a :class:`PiecewiseRun` subclass (``run_class``)."""
 
     run_class: type[PiecewiseRun]
 
-    def integrate(self, problem: ContactProblem, options: Any, builder: TraceBuilder,
-                  progress: Progress | None, cancel: Cancel | None) -> dict[str, Any]:
+    @classmethod
+    def compile_notice(cls, spec: MechanismSpec, impacts: tuple[str, ...] = ()) -> str | None:
+        """The event rules' compile (``apply_impacts``, ``release_pulling``, ``sources``, ...), called from Python."""
+        from vtool.solvers.newmark.backend import compile_notice, kernel_laws
+
+        return compile_notice(cls.name, kernel_laws(spec, impacts))
+
+    def integrate(self, problem: ContactProblem, options: OptionsT, builder: TraceBuilder,
+                  progress: Progress | None, cancel: Cancel | None) -> RunStats:
         run = self.run_class(problem, options, builder)  # type: ignore[call-arg]
         run.execute(progress, cancel)
         return run.statistics(self.settings(options))
 
-    def settings(self, options: Any) -> dict[str, Any]:
+    def settings(self, options: OptionsT) -> dict[str, Any]:
         return {}

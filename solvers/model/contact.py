@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vtool.errors import RunError
 from vtool.solvers.model.configurations import (
     clearance_bit,
     compliant_terms,
@@ -43,6 +44,7 @@ from vtool.solvers.model.configurations import (
     partition,
     sources,
 )
+from vtool.solvers.model.hertz import kernel_restitution
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.sources import SourceSeries
 from vtool.solvers.model.spec import (
@@ -57,8 +59,8 @@ from vtool.solvers.model.spec import (
     THESIS,
 )
 from vtool.solvers.newmark import layout
-from vtool.solvers.newmark.records import Problem, State, Tables, mask_hash
-from vtool.solvers.trace import EVENT_KINDS
+from vtool.solvers.newmark.records import Motion, Output, Problem, State, Tables, mask_hash
+from vtool.solvers.trace import EVENT_KINDS, OPENED, TraceBuilder
 
 LAW_CODES = {MOMENTUM: layout.LAW_MOMENTUM, LOCAL: layout.LAW_LOCAL, THESIS: layout.LAW_THESIS}
 SOFT_CODES = {RIGID: 0, LINEAR: layout.SOFT_LINEAR, HERTZ: layout.SOFT_HERTZ}
@@ -378,6 +380,28 @@ class EventRules:
     zeno_stop: int = 400
 
 
+@dataclass(frozen=True)
+class LayerOperator:
+    """z̈_F = on_z z + on_zd ż + on_aP z̈_P + on_src s: a configuration's equations solved for the free
+    accelerations (M_FF⁻¹ times the layer's rows), with the index maps between the full coordinates and
+    the layer's (free ``kept``, prescribed ``source``, ``group``)."""
+
+    free: np.ndarray  # full coordinate of each free z index
+    prescribed: np.ndarray  # 3 x the source of each prescribed z index (its x in the sources' vector)
+    group: np.ndarray  # z index of each full coordinate
+    on_z: np.ndarray
+    on_zd: np.ndarray
+    on_aP: np.ndarray
+    on_src: np.ndarray
+
+    @classmethod
+    def of(cls, layer: OrderedLayer, n: int) -> LayerOperator:
+        nf = layer.nf
+        solve = np.linalg.inv(layer.M[:nf, :nf])
+        return cls(layer.kept[:nf].astype(np.int64), 3 * layer.source.astype(np.int64), layer.group,
+                   -solve @ layer.K[:nf], -solve @ layer.C[:nf], -solve @ layer.M[:nf, nf:], -solve @ layer.S[:nf])
+
+
 class ContactProblem:
     """The clearances, sources, configurations and impact laws of one mechanism at one cam speed."""
 
@@ -388,7 +412,7 @@ class ContactProblem:
         self.spec = spec
         self.rules = rules
         self.n, self.ncl = spec.n_coordinates, len(spec.clearances)
-        self.tables = mechanism.configuration_tables()
+        self.tables = mechanism.shared(ConfigurationTables, lambda: ConfigurationTables(mechanism))
         self.series = source_series(mechanism)
         self.ns, self.nh = self.series.n_sources, self.series.n_harmonics
         self.source_numbers = self.series.numbers
@@ -399,7 +423,9 @@ class ContactProblem:
                      self.series.index(c.behind) if c.behind > self.n else -1,
                      int(c.state == ENABLED), int(c.state == PINNED), clearance_bit(spec, k),
                      LAW_CODES[spec.impact_law(c)], SOFT_CODES[c.contact])
-            clf[k, :layout.CLF_HV] = (c.restitution, spec.contact.rocker_scale, c.contact_stiffness,
+            # a Hertz contact's slot holds the e' whose a = 3(1 - e')/2 rebounds at c.restitution (hertz.py)
+            restitution = kernel_restitution(c.restitution) if c.contact == HERTZ else c.restitution
+            clf[k, :layout.CLF_HV] = (restitution, spec.contact.rocker_scale, c.contact_stiffness,
                                       c.contact_exponent)
         self.cl, self.clf = cl, clf
         self.hertz, self.momentum = layout.laws(cl)  # the kernel's law switches
@@ -424,6 +450,8 @@ class ContactProblem:
         kept = mechanism.kept(("contact problem", mechanism.omega, rules), lambda: cls(mechanism, rules))
         problem = copy.copy(kept)
         problem.mechanism, problem.spec, problem.clf = mechanism, mechanism.spec, kept.clf.copy()
+        if mechanism.start_mask is not None:  # a carried start (Mechanism.with_start)
+            problem.start_mask = mechanism.start_mask
         return problem
 
     def velocity_scale(self) -> float:
@@ -492,6 +520,80 @@ class ContactProblem:
         return new, [(int(ev_i[r, 0]), EVENT_KINDS[int(ev_i[r, 1])], float(ev_f[r, 1]), int(ev_i[r, 2]),
                       int(ev_i[r, 3])) for r in range(int(state.ist[layout.I_NEV]))]
 
+    # ----- the Python-level contract a back end integrates against (vtool.solvers.backends, point 4) -----
+    # Rigid and linear contacts: a Hertz contact's force is the kernel's hertz_law (the Newmark and
+    # piecewise back ends), so a back end written against these methods alone refuses one.
+
+    def operator(self, mask: int) -> LayerOperator:
+        """Configuration ``mask``'s equations as :meth:`accelerations` uses them (made once per mask)."""
+        operators = self.__dict__.setdefault("_operators", {})
+        if mask not in operators:
+            operators[mask] = LayerOperator.of(self.build(mask), self.n)
+        return operators[mask]  # type: ignore[no-any-return]  # the dict holds LayerOperators only
+
+    def layer_vectors(self, mask: int, t: float, x: np.ndarray, v: np.ndarray,
+                      a: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+        """The configuration's layer vectors (z, ż[, z̈]) in its order (free coordinates, then the prescribed
+        ones from the sources at t), and the sources' (x, v, a) vector."""
+        op, src = self.operator(mask), self.sources_at(t)
+        parts = (x, v) if a is None else (x, v, a)
+        return (*(np.concatenate((w[op.free], src[op.prescribed + i])) for i, w in enumerate(parts)), src)
+
+    def accelerations(self, mask: int, t: float, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """ẍ of every coordinate in configuration ``mask`` at t, from (x, v) of every coordinate:
+        M_FF z̈_F = -(K_FF z_F + C_FF ż_F) - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F s(t)
+        (F free, P prescribed; S the sources' pull through closed linear contacts)."""
+        op, src = self.operator(mask), self.sources_at(t)
+        z = np.concatenate((x[op.free], src[op.prescribed]))
+        zd = np.concatenate((v[op.free], src[op.prescribed + 1]))
+        aP = src[op.prescribed + 2]
+        zdd = np.concatenate((op.on_z @ z + op.on_zd @ zd + op.on_aP @ aP + op.on_src @ src, aP))
+        return zdd[op.group]
+
+    def project(self, mask: int, t: float, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(x, v) made to satisfy configuration ``mask``'s ties: tied coordinates take their free
+        coordinate's values, those on a source the source's."""
+        layer = self.build(mask)
+        z, zd, _ = self.layer_vectors(mask, t, x, v)
+        return z[layer.group], zd[layer.group]
+
+    def monitors(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """Each clearance's monitor at t: its gap while open, its contact force while closed (a linear
+        contact: its overlap), NaN where not monitored. An event is a monitored clearance's value going
+        below zero (:attr:`monitored`)."""
+        z, zd, zdd, src = self.layer_vectors(mask, t, x, v, a)
+        values = np.full(self.ncl, np.nan)
+        forces = self.contact_forces(mask, t, x, v, a)
+        for k, (kind, ahead, behind) in enumerate(self.tables.of(mask)[3][:, :layout.MK_M]):
+            if kind in (layout.MK_GAP, layout.MK_OVERLAP):
+                other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
+                values[k] = (1.0 if kind == layout.MK_GAP else -1.0) * (z[ahead] - other) + self.gap_noise
+            elif kind == layout.MK_FORCE:
+                values[k] = forces[k]
+        return values
+
+    def contact_forces(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """Each clearance's contact force at t (compression positive; 0 while open)."""
+        z, zd, zdd, src = self.layer_vectors(mask, t, x, v, a)
+        n, ns, m = self.n, self.ns, len(z)
+        forces = np.zeros(self.ncl)
+        _, _, _, mk, mon = self.tables.of(mask)
+        for k, kind in enumerate(mk[:, layout.MK_KIND]):
+            if kind in (layout.MK_FORCE, layout.MK_OVERLAP):
+                row = mon[k]
+                forces[k] = (row[:m] @ z + row[n:n + m] @ zd + row[2 * n:2 * n + m] @ zdd
+                             + row[3 * n:3 * n + 3 * ns] @ src + row[3 * n + 3 * ns])
+        return forces
+
+    @property
+    def monitored(self) -> np.ndarray:
+        """Which clearances are watched for events (enabled ones)."""
+        return self.cl[:, layout.CL_MON].astype(bool)
+
+    def transitions(self, builder: TraceBuilder) -> Transitions:
+        """The event rules for one run into ``builder`` (see :class:`Transitions`)."""
+        return Transitions(self, builder)
+
     def label(self, mask: int) -> str:
         return configuration_label(self.spec, mask)
 
@@ -502,3 +604,90 @@ class ContactProblem:
 
     def angle_to_time(self, degrees: float) -> float:
         return degrees * math.pi / 180.0 / self.omega
+
+
+class Transitions:
+    """The shared event and impact rules of one run, as a back end calls them (plain Python; the
+    Newmark kernel runs the same rules compiled):
+
+    * :meth:`start`: the static start, its pulling contacts released (settled);
+    * :meth:`apply`: at an event, open the closed clearances whose force reached zero, apply the impact
+      laws of those whose gap closed (after ``zeno_stick`` rapid events, closing contacts stick), settle,
+      record every event in the builder; ``zeno_stop`` rapid events stop the run (RunError).
+    """
+
+    def __init__(self, problem: ContactProblem, builder: TraceBuilder) -> None:
+        from vtool.solvers.newmark import (
+            kernel,  # the compiled rules (numba: imported by those who call them)
+        )
+
+        self.problem, self.builder = problem, builder
+        self.rules = kernel
+        self.record = problem.record()
+        self.events = Output(*event_buffers(4 * problem.ncl + 4))
+        self.ev_f, self.ev_i = self.events.ev_f, self.events.ev_i
+        self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
+        self.fst = np.zeros(layout.F_SIZE)
+        self.rapid, self.last_event = 0, -math.inf
+
+    def start(self) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+        """(configuration, x, v, a) at t = 0: the mechanism's static start, settled (fresh arrays)."""
+        start = self.problem.mechanism.start
+        x, v, a = start.q.copy(), start.qd.copy(), start.qdd.copy()
+        mask = self.settle(self.problem.start_mask, 0.0, x, v, a)
+        return mask, x, v, self.problem.accelerations(mask, 0.0, x, v)
+
+    def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
+        """Release the contacts that pull in configuration ``mask`` at t (events recorded); the new mask."""
+        problem, tables, m = self.problem, self.problem.tables, self.problem.n
+        while True:
+            self.ist[layout.I_NEV] = 0
+            result = int(self.rules.release_pulling(
+                self.record, tables.record(), mask, t, State(x, v, a, self.ist, self.fst), problem.sources_at(t),
+                self.events, Motion(np.zeros(m), np.zeros(m), np.zeros(m)), np.zeros(m), problem.hertz))
+            self.take_events()
+            if result >= 0:
+                return result
+            mask = -1 - result
+            problem.build(mask)
+
+    def take_events(self) -> None:
+        count = int(self.ist[layout.I_NEV])
+        self.builder.add_events(self.ev_f[:count], self.ev_i[:count])
+        self.ist[layout.I_NEV] = 0
+
+    def apply(self, mask: int, t: float, x: np.ndarray, v: np.ndarray,
+              crossed: list[int]) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+        """The configuration and (x, v, a) after the events of the clearances ``crossed`` at t."""
+        problem = self.problem
+        x, v = x.copy(), v.copy()
+        bits = problem.cl[:, layout.CL_BIT]
+        new = mask
+        closing = np.zeros(problem.ncl, dtype=np.int64)
+        for k in crossed:
+            if mask & bits[k]:
+                new &= ~int(bits[k])
+            else:
+                closing[k] = 1
+        self.rapid = self.rapid + 1 if t - self.last_event <= problem.zeno_window else 0
+        self.last_event = t
+        if self.rapid >= problem.rules.zeno_stop:
+            raise RunError(f"chattering contact at t = {t:.6g} s in configuration {problem.label(mask)}")
+        src = problem.sources_at(t)
+        for k in range(problem.ncl):
+            if (mask & bits[k]) and not (new & bits[k]):
+                u = 0.0
+                if problem.cl[k, layout.CL_SOFT]:  # a linear contact's parts leave with their relative velocity
+                    self.rules.shut_gap(problem.cl, k, x, src)
+                    u = float(self.rules.gap_velocity(problem.cl, k, v, src))
+                self.builder.add_event(t, k, OPENED, u, mask, new)
+        if closing.any():
+            self.ist[layout.I_NEV] = 0
+            state = State(x, v, np.zeros_like(x), self.ist, self.fst)
+            new = int(self.rules.apply_impacts(self.record, new, closing, src, state,
+                                               self.rapid >= problem.rules.zeno_stick, self.events, t,
+                                               problem.momentum))
+            self.take_events()
+        a = problem.accelerations(new, t, x, v)
+        new = self.settle(new, t, x, v, a)
+        return new, x, v, problem.accelerations(new, t, x, v)

@@ -56,6 +56,7 @@ Method (see the kernel's docstring for the equations):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time as wallclock
 from dataclasses import dataclass
@@ -64,10 +65,25 @@ from typing import Any
 import numpy as np
 
 from vtool.errors import InputError, RunError
-from vtool.solvers.backends import Backend, Cancel, Progress
-from vtool.solvers.model.contact import ContactProblem
+from vtool.solvers.backends import (
+    AccuracyKnobs,
+    AccuracySetting,
+    Backend,
+    Cancel,
+    Progress,
+    RunStats,
+)
+from vtool.solvers.model.contact import ContactProblem, EventRules
 from vtool.solvers.model.mechanism import Mechanism
-from vtool.solvers.model.spec import HERTZ, MOMENTUM, RIGID, RunSpec
+from vtool.solvers.model.spec import (
+    BETA_RANGE,
+    GAMMA_RANGE,
+    HERTZ,
+    MOMENTUM,
+    RIGID,
+    MechanismSpec,
+    RunSpec,
+)
 from vtool.solvers.newmark import layout
 from vtool.solvers.newmark.records import Output, State, scratch
 from vtool.solvers.trace import TraceBuilder
@@ -82,6 +98,10 @@ def row_buffer(t_end: float, out_dt: float, every_step: bool) -> int:
     if every_step or not out_dt > 0.0:
         return ROW_BUFFER
     return int(min(ROW_BUFFER, t_end / out_dt + 3.0))
+
+
+#: The accuracy study's row of the thesis' own scheme (see NewmarkBackend.accuracy_settings).
+PLAIN_SETTING = "dt=1e-06 beta=1/6, no refinement (the thesis' scheme)"
 
 
 @dataclass(frozen=True)
@@ -175,10 +195,11 @@ def check_settings(mechanism: Mechanism, options: NewmarkOptions) -> None:
     dt = options.time_step
     if not dt > 0.0:
         raise InputError("run.time_step", dt, "> 0", "s")
-    if not 0.0 < options.beta <= 0.5:
-        raise InputError("run.beta", options.beta, "> 0 and <= 0.5")
-    if not 0.5 <= options.gamma <= 1.0:
-        raise InputError("run.gamma", options.gamma, ">= 0.5 and <= 1")
+    (beta_low, beta_high), (gamma_low, gamma_high) = BETA_RANGE, GAMMA_RANGE  # the loader's bounds
+    if not beta_low < options.beta <= beta_high:
+        raise InputError("run.beta", options.beta, f"> {beta_low:g} and <= {beta_high:g}")
+    if not gamma_low <= options.gamma <= gamma_high:
+        raise InputError("run.gamma", options.gamma, f">= {gamma_low:g} and <= {gamma_high:g}")
     if not options.refine >= 1:
         raise InputError("refine", options.refine, ">= 1")
     limit = stability_limit(options.beta, options.gamma, highest_frequency(mechanism))
@@ -190,28 +211,51 @@ def check_settings(mechanism: Mechanism, options: NewmarkOptions) -> None:
         )
 
 
-class NewmarkBackend(Backend):
+class NewmarkBackend(Backend[NewmarkOptions]):
     """Newmark back end (see module doc). Registered as ``newmark``."""
 
     name = "newmark"
+    fixed_step = True
+    remedy = "a smaller time step, or the exact back end"
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> NewmarkOptions:
         return NewmarkOptions.from_run(run, every_step)
 
+    @classmethod
+    def stable_step(cls, mechanism: Mechanism) -> float:
+        run = mechanism.spec.run
+        return stability_limit(run.beta, run.gamma, highest_frequency(mechanism))
+
+    @classmethod
+    def compile_notice(cls, spec: MechanismSpec, impacts: tuple[str, ...] = ()) -> str | None:
+        return compile_notice(cls.name, kernel_laws(spec, impacts))
+
+    @classmethod
+    def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:
+        """Every step at every beta (with the default refinement after events), then the thesis' plain
+        scheme at 1 µs."""
+        settings = [AccuracySetting(f"dt={dt:.0e} beta={'1/6' if abs(beta - 1 / 6) < 1e-12 else '1/4'}",
+                                    dataclasses.replace(run, time_step=dt, beta=beta))
+                    for beta in knobs.betas for dt in knobs.time_steps]
+        return [*settings, AccuracySetting(PLAIN_SETTING, run, NewmarkOptions(1e-6, refine=1))]
+
     def check(self, mechanism: Mechanism, options: NewmarkOptions) -> None:
         check_settings(mechanism, options)
 
+    def event_rules(self, options: NewmarkOptions) -> EventRules:
+        return EventRules(options.rest_velocity, options.zeno_stick, options.zeno_stop)
+
     def integrate(self, problem: ContactProblem, options: NewmarkOptions, builder: TraceBuilder,
-                  progress: Progress | None, cancel: Cancel | None) -> dict[str, Any]:
+                  progress: Progress | None, cancel: Cancel | None) -> RunStats:
         run = KernelRun(problem, options, builder)
         run.execute(progress, cancel)
         o = options
-        return {"steps": int(run.ist[layout.I_STEPS]), "peak": run.peak[layout.PEAK_ALL].copy(),
-                "peak_late": run.peak[layout.PEAK_LATE].copy(), "peak_overlap": run.peak[layout.PEAK_OVERLAP].copy(),
-                "compile_time": run.compile_time,
-                "settings": {"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
-                             "refine_after_events": o.refine}}
+        return RunStats(int(run.ist[layout.I_STEPS]), run.peak[layout.PEAK_ALL].copy(),
+                        run.peak[layout.PEAK_LATE].copy(), run.peak[layout.PEAK_OVERLAP].copy(),
+                        compile_time=run.compile_time,
+                        settings={"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
+                                  "refine_after_events": o.refine})
 
 
 class KernelRun:

@@ -27,6 +27,8 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
 from vtool.errors import InputError, RunError
+from vtool.solvers.backends import AccuracyKnobs, AccuracySetting
+from vtool.solvers.cost import MAX_SCIPY_STEPS
 from vtool.solvers.exact.backend import peak_brackets
 from vtool.solvers.exact.piecewise import PiecewiseBackend, PiecewiseRun
 from vtool.solvers.exact.statespace import StateSpace
@@ -52,14 +54,22 @@ class ScipyOptions:
         return cls(output_interval=run.output_interval, every_step=every_step)
 
 
-class ScipyBackend(PiecewiseBackend):
+class ScipyBackend(PiecewiseBackend[ScipyOptions]):
     """solve_ivp back end (see module doc). Registered as ``scipy``."""
 
     name = "scipy"
+    library_dependent = True
+    max_steps = MAX_SCIPY_STEPS
+    remedy = "a tighter rtol, or the exact back end"
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> ScipyOptions:
         return ScipyOptions.from_run(run, every_step)
+
+    @classmethod
+    def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:
+        """DOP853 at every relative tolerance."""
+        return [AccuracySetting(f"DOP853 rtol={rtol:.0e}", run, ScipyOptions(rtol=rtol)) for rtol in knobs.rtols]
 
     def check(self, mechanism: Mechanism, options: ScipyOptions) -> None:
         if not 1e-14 <= options.rtol <= 1e-2:

@@ -10,7 +10,11 @@ For a preset and the top of its speed range (``rpm_max``) the study
    elements, one run each at ``rpm_max``, until doubling n changes every
    measured result by less than ``tolerance`` (relative): the peak force at
    every clearance and the largest seating velocity. The recommended n is the
-   last one before that converged doubling. Peak forces are taken over the
+   last one before that converged doubling. The results are those of the
+   evaluated window (:func:`vtool.solvers.studies.metrics.evaluation_window`:
+   after the first revolution, or the last cycle of a run to steady state),
+   as ``vtool solve`` and ``vtool sweep`` report them, not the start-up
+   shock. Peak forces are taken over the
    output rows (every ``output_interval`` degrees), not over every step: with
    rigid contacts the one-step force spike of an impact grows without bound
    as the element at the contact shrinks (gnilka-1a at 12,000 rpm, left
@@ -35,6 +39,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from vtool.solvers import backends
 from vtool.solvers.model.assembly import split_members, unsplit_members
 from vtool.solvers.model.cam import (
     HARMONIC,
@@ -45,6 +50,8 @@ from vtool.solvers.model.cam import (
 )
 from vtool.solvers.model.mechanism import assemble
 from vtool.solvers.model.spec import EXTERNAL, MechanismSpec
+from vtool.solvers.studies.metrics import evaluation_window, run_metrics
+from vtool.units import cam_speed
 
 
 @dataclass(frozen=True)
@@ -88,15 +95,17 @@ def measure(spec: MechanismSpec) -> tuple[dict[str, float], int, float]:
     from vtool.solvers.run import simulate
 
     trace = simulate(spec)
-    summary = trace.summary()
+    metrics = run_metrics(trace)  # the evaluated window, as solve and sweep report it: not the start-up shock
+    start, end = evaluation_window(trace)
+    rows = (trace.cam_angle >= start) & (trace.cam_angle <= end)
+    sampled = trace.contact_force[rows].max(axis=0) if rows.any() else np.zeros(len(spec.clearances))
     results = {}
-    sampled = trace.contact_force.max(axis=0) if len(trace.time) else np.zeros(len(spec.clearances))
     for c, peak in zip(spec.clearances, sampled, strict=True):
         results[f"peak {c.name} force"] = float(peak)
     if "max seating velocity" in result_names(spec):
-        seating = [v for e in summary["clearances"] for v in e.get("seating_velocities", [])]
-        results["max seating velocity"] = max(seating, default=0.0)
-    return results, summary["steps"], summary["wall_time_s"]
+        seating = metrics["seating_velocity_max"]
+        results["max seating velocity"] = 0.0 if math.isnan(seating) else float(seating)
+    return results, trace.statistics.steps, trace.statistics.wall_time
 
 
 def relative_change(new: dict[str, float], old: dict[str, float]) -> float:
@@ -110,13 +119,12 @@ def relative_change(new: dict[str, float], old: dict[str, float]) -> float:
 
 
 def stable_time_step(spec: MechanismSpec) -> float:
-    """The preset's step, cut to 0.9 of Newmark's stability limit for the model's highest mode."""
-    if spec.run.backend != "newmark":
+    """The preset's step, cut to 0.9 of its back end's stability limit for the model's highest mode
+    (:meth:`~vtool.solvers.backends.Backend.stable_step`; a back end that takes no fixed step keeps it)."""
+    backend = backends.get(spec.run.backend)
+    if not backend.fixed_step:
         return spec.run.time_step
-    from vtool.solvers.newmark.backend import highest_frequency, stability_limit
-
-    limit = stability_limit(spec.run.beta, spec.run.gamma, highest_frequency(assemble(spec)))
-    return min(spec.run.time_step, 0.9 * limit)
+    return min(spec.run.time_step, 0.9 * backend.stable_step(assemble(spec)))
 
 
 def with_elements(spec: MechanismSpec, member: str, n: int) -> MechanismSpec:
@@ -130,7 +138,7 @@ def cam_reach(spec: MechanismSpec, rpm_max: float) -> tuple[int, float, list[tup
     from vtool.solvers.model.assembly import surge_labels
 
     k_max = harmonic_that_matters(spec.cam)
-    omega = rpm_max * math.pi / 30.0
+    omega = cam_speed(rpm_max)
     layer = assemble(spec).start_layer
     labels = surge_labels(spec, layer.T @ layer.modes.shapes)
     reach = [(float(w), label or "mechanism") for w, label in zip(layer.modes.omega, labels, strict=True)
@@ -212,7 +220,8 @@ def study_text(study: SizeStudy, title: str) -> str:
 
     header, rows = study_rows(study)
     lines = [title,
-             f"at {study.rpm_max:g} rpm, tolerance {100 * study.tolerance:g} % on peak forces and seating velocity",
+             f"at {study.rpm_max:g} rpm, tolerance {100 * study.tolerance:g} % on peak forces and seating velocity "
+             "in the evaluated window (after the first revolution, or the last cycle of run.steady)",
              f"highest cam harmonic that matters (acceleration >= {MATTERS:.0%} of the largest): "
              f"{study.cam_harmonic} ({study.cam_frequency_hz:.4g} Hz)",
              "starting-layer modes it can reach (<= 2x that frequency): "
