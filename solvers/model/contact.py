@@ -16,7 +16,7 @@ reads:
   standard and refined steps.
 
 The event rules (located sign changes, earliest first; impact laws;
-:func:`~vtool.solvers.newmark.kernel.settle` after every transition; sticking
+:func:`~vtool.solvers.newmark.kernel.release_pulling` after every transition; sticking
 and stopping of chattering contacts) are the kernel's functions, called by
 every back end: a back end only integrates between events.
 

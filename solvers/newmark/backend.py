@@ -22,10 +22,10 @@ Method (see the kernel's docstring for the equations):
   starts at zero (a contact just released) has a round-off sign, so a gap
   closes when it falls below -1e-13 of the mechanism's size.
 * Impacts: the clearance's impact law (``local``, ``thesis``, ``momentum``;
-  see :func:`vtool.solvers.newmark.kernel.impact`) with Newton's restitution
+  see :func:`vtool.solvers.newmark.kernel.apply_impacts`) with Newton's restitution
   coefficient. After every transition the contact forces of the new
   configuration are evaluated and any contact that would pull is released
-  at once (:func:`vtool.solvers.newmark.kernel.settle`). Separations and
+  at once (:func:`vtool.solvers.newmark.kernel.release_pulling`). Separations and
   bounces slower than ``rest_velocity`` (default 1e-5 of the cam amplitude
   times the larger of the cam speed and the lowest natural frequency) are
   resting contacts that stay closed until their contact force says
