@@ -348,6 +348,11 @@ BY_NAME: dict[str, list[str]] = {
 }
 PRESET_NAMES = ["gnilka-1a", "gnilka-2", "ramped-cam", "boom-brick-wall", "boom-tall-building", "plate-irs",
                 "no-such-preset", ".", ""]
+#: presets of the kind each command takes (drawn three times in four, so that most draws get past the kind)
+KIND_PRESETS = {"boom wall": ["boom-brick-wall"], "boom floor": ["boom-tall-building"],
+                "plate modes": ["plate-irs"], "plate study": ["plate-irs"], "plate transient": ["plate-irs"],
+                "presets show": PRESET_NAMES[:6], "presets copy": PRESET_NAMES[:6], "presets expand": PRESET_NAMES[:6]}
+VALVETRAIN_PRESETS = ["gnilka-1a", "gnilka-2", "ramped-cam"]
 OUTPUTS = ["ok", "missing-dir", "empty", "folder", "device", "fifo", "symlink"]
 #: flags every draw of a command gets first (bounds on cost; a drawn value of the same flag comes after)
 BASE: dict[str, list[str]] = {
@@ -408,12 +413,14 @@ def any_command(draw: st.DrawFn) -> tuple[str, list[str], dict[str, str]]:
     for param in command.params:
         if isinstance(param, click.Argument):
             if param.name in ("preset", "name"):
-                args.append(draw(st.sampled_from(PRESET_NAMES)))
+                fitting = KIND_PRESETS.get(name, VALVETRAIN_PRESETS if name != "solve" else PRESET_NAMES[:6])
+                args.append(draw(st.sampled_from(fitting)) if draw(st.integers(0, 3)) else
+                            draw(st.sampled_from(PRESET_NAMES)))
             else:  # presets copy DEST
                 paths["DEST"] = draw(st.sampled_from(OUTPUTS + ["ok-folder"]))
                 args.append("{path:DEST}")
     options = [p for p in command.params if isinstance(p, click.Option) and p.opts[0] not in ("--help",)]
-    for param in draw(st.lists(st.sampled_from(options), max_size=4, unique_by=lambda p: p.opts[0])) if options else []:
+    for param in draw(st.lists(st.sampled_from(options), max_size=3, unique_by=lambda p: p.opts[0])) if options else []:
         flag = param.opts[0]
         if param.is_flag:
             args.append(draw(st.sampled_from(param.opts + list(param.secondary_opts))))
