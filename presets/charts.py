@@ -217,7 +217,7 @@ def cam_shape_charts(spec: Any, points: int = 720) -> list[Chart]:
         Chart("pressure angle (deg)", CAM_ANGLE,
               (Panel((curve("pressure angle", c.cam_angle_deg, c.pressure_angle_deg),), "pressure angle (deg)"),),
               spec.title)]
-    if follower.arrangement == "finger":
+    if follower.arrangement in ("finger", "rocker"):
         charts.append(Chart("finger ratio dV/du (-)", CAM_ANGLE,
                             (Panel((curve("ratio", c.cam_angle_deg, c.ratio),), "ratio (-)"),), spec.title))
     return charts

@@ -47,8 +47,8 @@ def read_lift_table(field: str, name: str, folder: Path | None, unit: str) -> tu
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        line = data[: exc.start].count(b"\n") + 1
-        raise InputError(field, str(path), f"UTF-8 text (line {line} is not)") from None
+        bad = data[: exc.start].count(b"\n") + 1
+        raise InputError(field, str(path), f"UTF-8 text (line {bad} is not)") from None
     angles: list[float] = []
     lifts: list[float] = []
     first = True

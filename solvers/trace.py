@@ -93,10 +93,13 @@ class RunStatistics:
 class Cycles:
     """How a cycle-by-cycle run went (:mod:`vtool.solvers.studies.steady`); the trace holds every cycle.
 
-    ``settled`` is None for a fixed number of cycles (``run.cycles``); ``change`` is the largest relative
-    change from the cycle before to the last one, ``changed`` what moved that much; ``changes`` is that
-    change after each cycle (the first has none: NaN). ``peaks`` are the every-step peak contact forces
-    over the evaluated (last) cycle, ``startup_peaks`` over the first.
+    ``settled`` is None for a fixed number of cycles (``run.cycles``). ``period`` is the number of cycles
+    after which the motion repeats (1; 2 or more for a subharmonic orbit, whose last ``period`` cycles are
+    evaluated). ``change`` is the largest relative change of the continuous measures from the cycle a
+    period before to the last one, ``changed`` what moved that much, ``events_changed`` how the events per
+    clearance differ ("" when they repeat); ``changes`` is the cycle-to-cycle change after each cycle
+    (the first has none: NaN; inf where the events differ). ``peaks`` are the every-step peak contact
+    forces over the evaluated cycles, ``startup_peaks`` over the first (NaN after a periodic start).
     """
 
     count: int
@@ -108,22 +111,35 @@ class Cycles:
     peaks: np.ndarray
     startup_peaks: np.ndarray
     max_cycles: int = 0
+    period: int = 1
+    events_changed: str = ""
 
     @property
     def window(self) -> tuple[float, float]:
-        """The evaluated cycle's cam angles (deg): the last cycle."""
-        return 360.0 * (self.count - 1), 360.0 * self.count
+        """The evaluated cycles' cam angles (deg): the last ``period`` cycles."""
+        return 360.0 * (self.count - self.period), 360.0 * self.count
 
     def text(self) -> str:
-        """One line: which cycle is evaluated and whether the run settled."""
-        where = f"cycle {self.count} of {self.count} (cam angle {360.0 * (self.count - 1):g}-{360.0 * self.count:g} deg)"
-        moved = "" if self.count < 2 else f"; the last cycle changed by {self.change:.3g} ({self.changed})"
+        """One line: which cycles are evaluated and whether the run settled."""
+        start, end = self.window
+        which = (f"cycle {self.count} of {self.count}" if self.period == 1 else
+                 f"cycles {self.count - self.period + 1}-{self.count} of {self.count}")
+        where = f"{which} (cam angle {start:g}-{end:g} deg)"
+        before = "the cycle before" if self.period == 1 else f"the cycle {self.period} before"
+        moved = "" if self.count < 2 else f"; the last cycle changed by {self.change:.3g} from {before} ({self.changed})"
+        events = f"; events per cycle still change ({self.events_changed})" if self.events_changed else ""
         if self.settled is None:
-            return f"evaluated: {where}, a fixed number of cycles (run.cycles){moved}"
+            return f"evaluated: {where}, a fixed number of cycles (run.cycles){moved}{events}"
         if self.settled:
-            return f"evaluated: {where}, settled to {self.tolerance:g}{moved}"
-        return (f"warning: did not settle in {self.count} cycles (run.steady max_cycles = {self.max_cycles}): "
-                f"evaluated {where}{moved}, above the tolerance {self.tolerance:g}")
+            period = "" if self.period == 1 else f" repeating every {self.period} cycles (a subharmonic orbit),"
+            return f"evaluated: {where},{period} settled to {self.tolerance:g}{moved}"
+        return (f"warning: did not settle in {self.count} cycles (run.steady max_cycles = {self.max_cycles}), "
+                f"nor repeat every 2 to {MAX_PERIOD} cycles: evaluated {where}{moved}{events}, above the "
+                f"tolerance {self.tolerance:g}")
+
+
+#: the longest period (in cam cycles) a steady run looks for
+MAX_PERIOD = 4
 
 
 @dataclass(frozen=True)

@@ -152,8 +152,11 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
         click.echo("")
         click.echo("\n".join(evaluation["lines"]))
         if spectrum is not None:
+            from vtool.solvers.studies.orders import dominant_text, natural_frequencies
+
             click.echo("")
             click.echo(spectrum.table())
+            click.echo(dominant_text(spectrum, natural_frequencies(trace)))
         if show_events:
             click.echo("")
             click.echo(trace.event_table())

@@ -242,8 +242,9 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
             for interval in result.intervals:
                 click.echo(f"  interval: {interval.text()}")
             click.echo(f"{criterion}: {result.message}")
+        intervals = ";".join(f"{format_value(i.low)}-{format_value(i.high)}" for i in result.intervals)
         rows.append([format_value(v) for _, v in key] + [format_value(result.speed) if result.speed else "",
-                                                         result.message])
+                                                         intervals, result.message])
         found.append(dict(key) | {criterion.replace("-", "_"): result.speed,
                                   f"{criterion.replace('-', '_')}_unit": "rev/min", "message": result.message,
                                   "history": [{"rpm": b.rpm, "holds": b.holds, "value": b.value, "stage": b.stage}
@@ -256,7 +257,7 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
                                "evaluation": steady_text(first), "searches": found}, indent=2))
     if csv_path is not None:
         header = [f"{f} ({u})" if u else f for f, u in others] + [f"{criterion.replace('-', '_')} (rev/min)",
-                                                                  "message"]
+                                                                  "intervals (rev/min)", "message"]
         import csv
         import io
 

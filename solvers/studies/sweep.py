@@ -299,7 +299,7 @@ def _pool_start() -> Iterator[None]:
         for sig, handler in handlers.items():
             signal.signal(sig, handler)
     for signum in held[:1]:  # what arrived meanwhile, as it would have arrived
-        handler = handlers[signum]
+        handler = handlers[signal.Signals(signum)]
         if callable(handler):
             handler(signum, None)
         elif handler == signal.SIG_DFL and signum == signal.SIGINT:
@@ -791,7 +791,7 @@ class SpeedResult:
 def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan: Sequence[float],
                runner: Any, *, tolerance: float = 1.0, every_step: bool = False,
                report: Callable[[Bracket], None] | None = None,
-               cancel: Callable[[], bool] | None = None) -> SpeedResult:
+               cancel: Callable[[], bool] | None = None, bisector: Any = None) -> SpeedResult:
     """Every cam-speed interval where ``criterion`` holds, each edge bisected to ``tolerance`` rev/min.
 
     The speeds ``scan`` (ascending) are run together on ``runner``; every change between neighbouring
@@ -799,7 +799,7 @@ def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan
     tolerance 1). A window of contact loss below a window of contact is its own interval; an interval
     narrower than the scan's step can fall between two scanned speeds unseen (scan finer). ``speed``
     is the lowest edge (the jump speed), None when the criterion holds at no scanned speed or already
-    at the lowest.
+    at the lowest. The bisections run one point at a time on ``bisector`` (default: in this process).
     """
     if criterion not in CRITERIA:
         raise InputError("--find", criterion, f"one of: {', '.join(CRITERIA)}")
@@ -825,7 +825,7 @@ def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan
     if not any(holds):
         return SpeedResult(criterion, None, tuple(history), f"{words} at none of the scanned speeds "
                                                             f"(up to {scan[-1]:g} rev/min)")
-    serial = SerialRunner()
+    serial = bisector if bisector is not None else SerialRunner()
 
     def bisect(low: float, high: float, rising: bool) -> tuple[float, float]:
         """(the last speed on the low side, the first on the high side) of one edge."""
