@@ -158,6 +158,9 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         from vtool.presets.follower import load_checks
 
         checks = load_checks(checks_table, units)
+    from vtool.presets.springs import load_sheets
+
+    springs = load_sheets(top, units, n)
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)  # type: ignore[arg-type]
     top.finish()
     spec = MechanismSpec(
@@ -176,6 +179,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         contact=contact,
         follower=follower,
         checks=checks,
+        springs=springs,
         train=train,
     )
     spec = split_members(spec)
@@ -244,7 +248,7 @@ def _contact(t: Table | None) -> ContactSpec:
 
 
 TOP_KEYS = ("kind", "title", "notes", "units", "gravity", "coordinates", "members", "cam", "seat",
-            "clearances", "initial", "contact", "damping", "run", "follower", "checks")
+            "clearances", "initial", "contact", "damping", "run", "follower", "checks", "springs")
 
 
 def _magnitude(t: Table, key: str, unit: str, what: str, *, default: float | None = None,
@@ -676,6 +680,10 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         doc["follower"] = dump_follower(spec.follower, _law_doc)
     if spec.checks:
         doc["checks"] = {c.name: c.limit for c in spec.checks}
+    if spec.springs:
+        from vtool.presets.springs import sheet_document
+
+        doc["springs"] = [sheet_document(s) for s in spec.springs]
     return train_document(given, doc) or doc
 
 

@@ -469,6 +469,10 @@ class Trace:
 
             cam = next(c.name for c in self.spec.clearances if c.behind == self.spec.cam.coordinate)
             result["contact_stress"] = stress_summary(self.spec, self.cam_angle, self.force(cam))
+        if self.spec.springs:
+            from vtool.solvers.model.spring import run_report
+
+            result["springs"] = run_report(self.spec.springs, self)
         if self.spec.checks:
             from vtool.solvers.studies.checks import evaluate
 
@@ -518,6 +522,10 @@ class Trace:
             from vtool.solvers.model.camstress import stress_text
 
             lines += stress_text(s["contact_stress"])
+        if "springs" in s:
+            from vtool.solvers.model.spring import report_text
+
+            lines += report_text(s["springs"], units)
         if "checks" in s:
             from vtool.solvers.studies.checks import checks_text
 
