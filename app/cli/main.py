@@ -48,6 +48,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "compare": ("vtool.app.cli.compare", "compare"),
     "cam": ("vtool.app.cli.cam", "cam"),
     "size": ("vtool.app.cli.size", "size"),
+    "report": ("vtool.app.cli.report", "report"),
     "tui": ("vtool.app.cli.tui", "tui"),
 }
 
