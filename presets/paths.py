@@ -175,28 +175,46 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> Sweep
     Nothing runs: a bad field, range or value raises the loader's own one-line
     InputError before any work starts.
     """
-    from vtool.presets import find_preset, load_document, read_document
-    from vtool.solvers.studies.sweep import Point, grid
+    from vtool.presets import find_preset, read_document
 
-    doc = read_document(find_preset(preset))
-    spec = load_document(doc)
-    if spec.kind != "valvetrain":
-        raise InputError("preset", preset, f"a valvetrain preset (this one is {spec.kind})")
+    path = find_preset(preset)
     fields: list[tuple[str, list[Any]]] = []
     for text in sets:
-        path, sep, values = text.partition("=")
-        path = path.strip()
-        if not sep or not path:
+        name, sep, values = text.partition("=")
+        name = name.strip()
+        if not sep or not name:
             raise InputError("--set", text, "FIELD=VALUES, e.g. run.rpm=9000:12000:250 or damping.factor=0.5,1,2")
-        if any(path == p for p, _ in fields):
-            raise InputError("--set", path, "each field set once")
-        parse_path(path)
-        fields.append((path, parse_values(path, values, max_points)))
+        if any(name == p for p, _ in fields):
+            raise InputError("--set", name, "each field set once")
+        parse_path(name)
+        fields.append((name, parse_values(name, values, max_points)))
+    return plan_document(read_document(path), fields, max_points, preset=preset)
+
+
+def plan_document(doc: dict[str, Any], fields: list[tuple[str, list[Any]]], max_points: int = 100_000,
+                  folder: Any = None, preset: str = "preset") -> SweepPlan:
+    """:func:`plan_sweep` for a parsed valvetrain document and (path, values) pairs (the Python API's sweep).
+
+    ``folder`` resolves a cam ``lift_table`` file named relative to the document.
+    """
+    from vtool.presets import load_document
+    from vtool.solvers.studies.sweep import Point, grid
+
+    def load(document: dict[str, Any]) -> Any:
+        if folder is not None and document.get("kind") == "valvetrain":
+            from vtool.presets.valvetrain import load as load_valvetrain
+
+            return load_valvetrain(document, folder=folder)
+        return load_document(document)
+
+    spec = load(doc)
+    if spec.kind != "valvetrain":
+        raise InputError("preset", preset, f"a valvetrain preset (this one is {spec.kind})")
     count = math.prod(len(v) for _, v in fields)
     if count > max_points:
         raise InputError("--set", count, f"a grid of at most {max_points} points")
     points = []
     for index, assignment in enumerate(grid(fields)):
-        points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)))))
+        points.append(Point(index, assignment, load(set_fields(doc, dict(assignment)))))
     units = tuple((path, field_unit(doc, path)) for path, _ in fields)
     return SweepPlan(doc, spec, units, tuple(points))

@@ -116,24 +116,25 @@ def model_section(spec: Any) -> Section:
                       f"{_g(spec.initial.spring_preload)} {u.force}; lever ratio {_g(spec.initial.lever_ratio)}; "
                       f"velocities {spec.initial.velocities}"),
             ("damping", f"factor {_g(spec.damping.factor)}, default ratio {_g(spec.damping.default_ratio)}")]
-    members = []
+    members: list[tuple[str, ...]] = []
     for m in spec.members:
         members.append((m.name, m.element, _g(m.length), _g(m.modulus), _g(m.diameter), _g(m.area),
                         _g(m.inertia), _g(m.density), _g(m.specific_weight), _g(m.stiffness), _g(m.mass),
                         " ".join(str(c) for c in m.coordinates), str(m.elements)))
-    member_header = ("member", "element", f"length ({u.length})", f"modulus ({u.pressure})",
+    member_header: tuple[str, ...] = ("member", "element", f"length ({u.length})", f"modulus ({u.pressure})",
                      f"diameter ({u.length})", f"area ({u.length}^2)", f"inertia ({u.length}^4)",
                      f"density ({u.density})",
                      f"specific weight ({u.force}/{u.length}^3)",
                      f"stiffness ({u.stiffness})", f"mass ({u.mass})", "coordinates", "elements")
     keep = [i for i, _ in enumerate(member_header) if any(row[i] != "-" for row in members)]
-    member_header = tuple(member_header[i] for i in keep)
-    members = [tuple(row[i] for i in keep) for row in members]
+    shown_header = tuple(member_header[i] for i in keep)
+    shown_members = tuple(tuple(row[i] for i in keep) for row in members)
     clearances = [(c.name, c.kind, c.state, f"q{c.ahead} - q{c.behind}", c.contact,
                    spec.impact_law(c) if c.rigid else "-", _g(c.restitution)) for c in spec.clearances]
     return Section("Model", (spec.notes.strip(),) if spec.notes.strip() else (), (
         Table("train data", ("item", "value"), tuple(data)),
-        Table("members (columns no member gives are left out; -: computed from the section and material)", member_header, tuple(members)),
+        Table("members (columns no member gives are left out; -: computed from the section and material)", shown_header,
+              shown_members),
         Table("clearances (gap = q_ahead - q_behind)",
               ("clearance", "kind", "state", "gap", "contact", "impact law", "restitution"), tuple(clearances))))
 
