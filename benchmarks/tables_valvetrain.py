@@ -35,7 +35,7 @@ from vtool.presets import load_preset
 from vtool.solvers.model.spec import MechanismSpec
 from vtool.solvers.run import simulate
 from vtool.solvers.studies.accuracy import (
-    SCIPY_RTOLS,
+    RTOLS,
     AccuracyRow,
     accuracy_study,
     cells,
@@ -67,7 +67,7 @@ class PresetStudy:
 def study(name: str, scipy: bool = True) -> PresetStudy:
     """The accuracy study of one preset (without the scipy rows if ``scipy`` is False)."""
     spec = load_preset(name)
-    reference, rows = accuracy_study(spec, scipy_rtols=SCIPY_RTOLS if scipy else ())
+    reference, rows = accuracy_study(spec, rtols=RTOLS if scipy else ())
     return PresetStudy(name, spec, reference, rows)
 
 

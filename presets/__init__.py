@@ -16,7 +16,9 @@ from __future__ import annotations
 
 import importlib
 import os
+import re
 import tomllib
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -98,12 +100,17 @@ def loader_for(kind: str) -> Any:
     return importlib.import_module(kind_named(kind).loader)
 
 
-def load_document(doc: dict[str, Any]) -> Any:
-    """Validate a parsed preset document and return its frozen spec."""
+def load_document(doc: dict[str, Any], folder: str | os.PathLike[str] | None = None) -> Any:
+    """Validate a parsed preset document and return its frozen spec.
+
+    ``folder`` is the preset file's folder: a file the preset names (a cam
+    lift table, a boom pulse CSV) resolves against it, for every kind and
+    every command (None: the working folder, for a document with no file).
+    """
     if not isinstance(doc, dict):
         raise InputError("<preset>", type(doc).__name__, "a TOML document (a table)")
     try:
-        return loader_for(kind_of(doc)).load(doc)
+        return loader_for(kind_of(doc)).load(doc, None if folder is None else Path(folder))
     except RecursionError:
         raise InputError("<preset>", "values nested too deep", "the fields of a preset") from None
 
@@ -111,10 +118,43 @@ def load_document(doc: dict[str, Any]) -> Any:
 def load_preset(name_or_path: str | os.PathLike[str]) -> Any:
     """Find, parse and validate a preset; returns the spec for its kind."""
     path = find_preset(name_or_path)
-    doc = read_document(path)
-    if kind_of(doc) == "valvetrain":  # resolves a cam lift_table file against the preset's folder
-        return loader_for("valvetrain").load(doc, folder=path.parent)
-    return load_document(doc)
+    return load_document(read_document(path), path.parent)
+
+
+_LIFT_TABLE_LINE = re.compile(r"^[ \t]*lift_table[ \t]*=.*$", re.MULTILINE)
+
+
+def self_contained_text(path: Path) -> tuple[str, str | None]:
+    """The preset's text with the files it names written in, and a note saying what was, or None.
+
+    A copy (``vtool presets copy``) must load from any folder: a cam
+    ``lift_table = "file.csv"`` (relative to the preset's folder) becomes the
+    inline ``angles``/``lifts`` arrays in place of that line, the rest of the
+    text (comments included) unchanged. The new text is checked to load to
+    the same spec.
+    """
+    text = path.read_text(encoding="utf-8")
+    doc = parse_text(text, str(path))
+    cam = doc.get("cam") if kind_of(doc) == "valvetrain" else None
+    name = cam.get("lift_table") if isinstance(cam, dict) else None
+    if not isinstance(name, str) or not name or Path(name).is_absolute():
+        return text, None
+    lines = _LIFT_TABLE_LINE.findall(text)
+    if len(lines) != 1:  # written some other way (an inline table): keep it, the copy says where it points
+        return text, None
+    from vtool.presets.lift_table import read_lift_table
+
+    units = str(doc.get("units", ""))
+    angles, lifts = read_lift_table("cam.lift_table", name, path.parent, units)
+    inline = (f"angles = [{', '.join(repr(a) for a in angles)}] # deg, from {name} (inlined by the copy)\n"
+              f"lifts = [{', '.join(repr(x) for x in lifts)}] # follower lift, preset length unit")
+    copied = text.replace(lines[0], inline, 1)
+    with warnings.catch_warnings():  # loading warned once already, where the preset was read
+        warnings.simplefilter("ignore")
+        same = load_document(parse_text(copied, str(path))) == load_document(doc, path.parent)
+    if not same:
+        raise InputError("cam.lift_table", name, "a table that can be written inline")  # not expected
+    return copied, f"the lift table {name} written inline"
 
 
 def preset_info(path: Path) -> PresetInfo:

@@ -10,13 +10,22 @@ Example::
     t = Table(doc, "")
     length = t.number("length", unit="in", min_exclusive=0.0)
     t.finish()
+
+Every read is also a field definition: inside :func:`recording`, each key a
+loader asks for is noted as a :class:`FieldRead` (its path with ``*`` for a
+named table and ``[]`` for an array entry, type, unit, allowed values and
+default), which :mod:`vtool.presets.reference` turns into docs/presets.md.
 """
 
 from __future__ import annotations
 
 import difflib
 import math
+import re
 from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass, field
 from typing import Any
 
 from vtool.errors import InputError
@@ -25,6 +34,47 @@ from vtool.errors import InputError
 MAX_LIST = 1000
 #: Longest string field (titles, notes, names).
 MAX_STRING = 10_000
+
+
+#: The default of a read that has none (the key is required).
+REQUIRED = "(required)"
+
+
+@dataclass
+class FieldRead:
+    """One key a loader reads, as :func:`recording` notes it; values seen in several reads are merged."""
+
+    path: str  # e.g. "run.rpm", "members.*.length", "clearances[].gap"
+    type: str  # number, integer, string, boolean, numbers, table, tables, array of tables, value
+    units: set[str] = field(default_factory=set)
+    allowed: set[str] = field(default_factory=set)
+    defaults: set[str] = field(default_factory=set)
+
+
+_recording: ContextVar[dict[str, FieldRead] | None] = ContextVar("vtool_field_reads", default=None)
+
+
+@contextmanager
+def recording() -> Iterator[dict[str, FieldRead]]:
+    """Note every key read by a :class:`Table` in this context (path -> :class:`FieldRead`)."""
+    reads: dict[str, FieldRead] = {}
+    token = _recording.set(reads)
+    try:
+        yield reads
+    finally:
+        _recording.reset(token)
+
+
+def _shown_default(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_shown_default(v) for v in value) + "]"
+    return str(value)
 
 
 def as_float(value: Any) -> float:
@@ -58,15 +108,36 @@ def _kind_of(value: Any) -> str:
 class Table:
     """One TOML table with its dotted path; reads keys with validation."""
 
-    def __init__(self, data: Any, path: str) -> None:
+    def __init__(self, data: Any, path: str, pattern: str | None = None) -> None:
         if not isinstance(data, dict):
             raise InputError(path or "<preset>", _kind_of(data), "a table")
         self.data = data
         self.path = path
+        #: the path with ``[]`` for an array entry and ``*`` for a named table (what the reference lists)
+        self.pattern = re.sub(r"\[\d+\]", "[]", path) if pattern is None else pattern
         self._used: set[str] = set()
 
     def field(self, key: str) -> str:
         return f"{self.path}.{key}" if self.path else key
+
+    def _pattern(self, key: str) -> str:
+        key = "<number>" if str(key).isdigit() else key  # keys that are numbers (mode ratios): one entry
+        return f"{self.pattern}.{key}" if self.pattern else key
+
+    def _note(self, key: str, kind: str, unit: str = "", allowed: str = "", default: Any = None,
+              required: bool = False, path: str | None = None) -> None:
+        """Record this read as a field definition when :func:`recording` is on (``path``: the key's
+        pattern when it is not this table's pattern and the key)."""
+        reads = _recording.get()
+        if reads is None:
+            return
+        path = self._pattern(key) if path is None else path
+        read = reads.setdefault(path, FieldRead(path, kind))
+        if unit:
+            read.units.add(unit)
+        if allowed:
+            read.allowed.add(allowed)
+        read.defaults.add(REQUIRED if required else "" if default is None else _shown_default(default))
 
     def has(self, key: str) -> bool:
         return key in self.data
@@ -97,10 +168,11 @@ class Table:
     ) -> float:
         """A finite float within the given bounds (ints are accepted)."""
         required = default is None if required is None else required
+        expected = _range_text(min_value, min_exclusive, max_value, max_exclusive)
+        self._note(key, "number", unit, expected, default, required)
         value = self._get(key, default, required)
         if value is None:
             return None  # type: ignore[return-value]
-        expected = _range_text(min_value, min_exclusive, max_value, max_exclusive)
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise InputError(self.field(key), value, f"a number {expected}".strip(), unit)
         given, value = value, as_float(value)
@@ -123,8 +195,9 @@ class Table:
         min_value: int | None = None,
         max_value: int | None = None,
     ) -> int:
-        value = self._get(key, default, default is None)
         expected = _range_text(min_value, None, max_value, None)
+        self._note(key, "integer", "", expected, default, default is None)
+        value = self._get(key, default, default is None)
         if isinstance(value, bool) or not isinstance(value, int):
             raise InputError(self.field(key), value, f"an integer {expected}".strip())
         if (min_value is not None and value < min_value) or (
@@ -134,6 +207,7 @@ class Table:
         return value
 
     def string(self, key: str, *, default: str | None = None, choices: tuple[str, ...] = ()) -> str:
+        self._note(key, "string", "", f"one of: {', '.join(choices)}" if choices else "", default, default is None)
         value = self._get(key, default, default is None)
         if not isinstance(value, str):
             expected = f"one of: {', '.join(choices)}" if choices else "a string"
@@ -145,34 +219,41 @@ class Table:
         return value
 
     def boolean(self, key: str, *, default: bool | None = None) -> bool:
+        self._note(key, "boolean", "", "true or false", default, default is None)
         value = self._get(key, default, default is None)
         if not isinstance(value, bool):
             raise InputError(self.field(key), value, "true or false")
         return value
 
-    def table(self, key: str, *, required: bool = True) -> Table | None:
+    def table(self, key: str, *, required: bool = True, pattern: str | None = None,
+              kind: str = "table") -> Table | None:
+        pattern = self._pattern(key) if pattern is None else pattern
+        self._note(key, kind, required=required, path=pattern)
         value = self._get(key, None, required)
         if value is None:
             return None
-        return Table(value, self.field(key))
+        return Table(value, self.field(key), pattern)
 
     def tables(self, key: str, *, required: bool = True) -> Iterator[tuple[str, Table]]:
-        """Sub-tables of a table of tables, e.g. ``[members.pushrod]``."""
-        outer = self.table(key, required=required)
+        """Sub-tables of a table of tables, e.g. ``[members.pushrod]`` (``members.*`` in the reference)."""
+        outer = self.table(key, required=required, kind="tables")
         if outer is None:
             return iter(())
-        return ((name, outer.table(name)) for name in list(outer.data))  # type: ignore[misc]
+        inner = f"{outer.pattern}.*"
+        return ((name, outer.table(name, pattern=inner)) for name in list(outer.data))  # type: ignore[misc]
 
     def array_of_tables(self, key: str, *, required: bool = True) -> list[Table]:
         """Entries of an array of tables, e.g. ``[[clearances]]``."""
+        self._note(key, "array of tables", required=required)
         value = self._get(key, [], required)
         if not isinstance(value, list):
             raise InputError(self.field(key), _kind_of(value), "an array of tables")
         if len(value) > MAX_LIST:
             raise InputError(self.field(key), f"{len(value)} entries", f"at most {MAX_LIST} entries")
-        return [Table(item, f"{self.field(key)}[{i}]") for i, item in enumerate(value)]
+        return [Table(item, f"{self.field(key)}[{i}]", f"{self._pattern(key)}[]") for i, item in enumerate(value)]
 
     def numbers(self, key: str, *, unit: str = "", default: list[float] | None = None) -> list[float]:
+        self._note(key, "numbers", unit, "", default, default is None)
         value = self._get(key, default, default is None)
         if not isinstance(value, list) or any(
             isinstance(v, bool) or not isinstance(v, int | float) for v in value
@@ -186,6 +267,7 @@ class Table:
         return numbers
 
     def raw(self, key: str, default: Any = None) -> Any:
+        self._note(key, "value", default=default)
         return self._get(key, default, False)
 
     def finish(self) -> None:

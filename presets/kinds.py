@@ -1,22 +1,33 @@
 """The one table of preset kinds: what each ``kind`` loads into and who runs and shows it.
 
-Every place that dispatches on a preset's kind reads :data:`KINDS`: the
-loader (:func:`vtool.presets.load_document`), ``vtool solve`` and the TUI. The
-entries name code by dotted path strings (``module:attribute`` or a module),
-so this table imports nothing: the presets layer never imports ``app/``, and
-the CLI imports only the module of the kind it runs.
+Every place that dispatches on a preset's kind reads :data:`KINDS` and
+nothing else: the loader (:func:`vtool.presets.load_preset`,
+:func:`~vtool.presets.load_document`, :func:`~vtool.presets.save_spec`),
+``vtool solve`` (which flags apply, which function runs and prints), every
+command that takes one kind only (:func:`require_kind`) and the TUI (which
+screen opens a preset, which loader a screen's form uses). The entries name
+code by dotted path strings (``module:attribute`` or a module), so this table
+imports nothing: the presets layer never imports ``app/``, and the CLI
+imports only the module of the kind it runs
+(``tests/test_dispatch.py`` checks that no other module compares a kind).
 
-=============  ==========================================  ================================  ==============================  ========================
-kind           spec type                                   loader (``load``/``dump``)        solve (``vtool solve``)         TUI screen module
-=============  ==========================================  ================================  ==============================  ========================
-valvetrain     vtool.solvers.model.spec:MechanismSpec            vtool.presets.valvetrain          vtool.app.cli.solve:run_valvetrain  vtool.app.tui.valvetrain
-boom_wall      vtool.assessments.sonic_boom.spec:BoomWallSpec   vtool.presets.boom           vtool.app.cli.boom:solve_preset     vtool.app.tui.boom
-boom_floor     vtool.assessments.sonic_boom.spec:BoomFloorSpec  vtool.presets.boom           vtool.app.cli.boom:solve_preset     vtool.app.tui.boom
-plate          vtool.presets.plate:PlateSpec               vtool.presets.plate               vtool.app.cli.plate:solve_preset    vtool.app.tui.plate
-=============  ==========================================  ================================  ==============================  ========================
+==========  ================================================  ========================  ========================================  ========================
+kind        spec type                                         loader (``load/dump``)    solve (``vtool solve``: runs and prints)  TUI screen module
+==========  ================================================  ========================  ========================================  ========================
+valvetrain  vtool.solvers.model.spec:MechanismSpec            vtool.presets.valvetrain  vtool.app.cli.solve:run_valvetrain        vtool.app.tui.valvetrain
+boom_wall   vtool.assessments.sonic_boom.spec:BoomWallSpec    vtool.presets.boom        vtool.app.cli.boom:solve_preset           vtool.app.tui.boom
+boom_floor  vtool.assessments.sonic_boom.spec:BoomFloorSpec   vtool.presets.boom        vtool.app.cli.boom:solve_preset           vtool.app.tui.boom
+plate       vtool.presets.plate:PlateSpec                     vtool.presets.plate       vtool.app.cli.plate:solve_preset          vtool.app.tui.plate
+==========  ================================================  ========================  ========================================  ========================
 
-``solve`` functions of boom and plate take ``(spec, csv_path, plot, as_json)``;
-the valve train's takes more options (see :mod:`vtool.app.cli.solve`).
+A loader module has ``load(doc, folder=None) -> spec`` (``folder``: the
+preset's folder, against which a file it names is found: a cam lift table,
+a boom pulse CSV) and ``dump(spec) -> doc``. A solve function has
+``solve(spec, csv_path, plot, as_json, **flags)``, where ``flags`` are the
+kind's :attr:`Kind.run_options` as keyword arguments (``--dt`` is ``dt``);
+``vtool solve`` refuses any other flag for the kind. A TUI screen module
+has ``SCREEN``, its :class:`~vtool.app.tui.base.DomainScreen` class; one
+screen may show several kinds (the boom screen: walls and floors).
 """
 
 from __future__ import annotations
@@ -47,7 +58,7 @@ KINDS: dict[str, Kind] = {
                        "vtool.solvers.model.spec:MechanismSpec", "vtool.presets.valvetrain",
                        "vtool.app.cli.solve:run_valvetrain", "vtool.app.tui.valvetrain",
                        ("--backend", "--dt", "--rpm", "--degrees", "--every-step", "--events",
-                        "--max-steps")),
+                        "--max-steps", "--impact", "--start")),
     "boom_wall": Kind("boom_wall", "sonic-boom wall assessment",
                       "vtool.assessments.sonic_boom.spec:BoomWallSpec", "vtool.presets.boom",
                       "vtool.app.cli.boom:solve_preset", "vtool.app.tui.boom"),

@@ -26,7 +26,9 @@ from __future__ import annotations
 import copy
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from vtool.errors import InputError
@@ -147,16 +149,20 @@ def parse_values(field: str, text: str, max_points: int = 100_000) -> list[Any]:
     return values
 
 
-def field_unit(doc: dict[str, Any], path: str) -> str:
+def field_unit(doc: dict[str, Any], path: str, folder: Path | None = None) -> str:
     """The unit the loader states for ``path`` (asked by offering it a non-number), or ``""``."""
     from vtool.presets import load_document
 
     try:
-        load_document(set_field(doc, path, "?"))
+        load_document(set_field(doc, path, "?"), folder)
     except InputError as exc:
         if exc.field == path:
             return exc.unit
     return ""
+
+
+class SweepCancelled(Exception):
+    """:func:`plan_sweep` stopped because its ``cancel`` said so (nothing was planned)."""
 
 
 @dataclass(frozen=True)
@@ -169,52 +175,57 @@ class SweepPlan:
     points: tuple[Any, ...]  # vtool.solvers.studies.sweep.Point
 
 
-def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000) -> SweepPlan:
+def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000, *,
+               progress: Callable[[int, int], None] | None = None,
+               cancel: Callable[[], bool] | None = None) -> SweepPlan:
     """Parse ``FIELD=VALUES`` assignments and validate every grid point with the preset loader.
 
     Nothing runs: a bad field, range or value raises the loader's own one-line
-    InputError before any work starts.
+    InputError before any work starts. Validating a point costs about 10 ms, so a
+    large grid takes minutes: ``progress(done, total)`` is called as points are
+    checked and ``cancel()`` between them (True raises :class:`SweepCancelled`).
     """
-    from vtool.presets import find_preset, read_document
+    from vtool.presets import find_preset, load_document, read_document
+    from vtool.presets.kinds import require_kind
 
-    path = find_preset(preset)
+    folder = find_preset(preset).parent
+    doc = read_document(find_preset(preset))
+    require_kind(load_document(doc, folder), "valvetrain", "a sweep")
     fields: list[tuple[str, list[Any]]] = []
     for text in sets:
-        name, sep, values = text.partition("=")
-        name = name.strip()
-        if not sep or not name:
+        path, sep, values = text.partition("=")
+        path = path.strip()
+        if not sep or not path:
             raise InputError("--set", text, "FIELD=VALUES, e.g. run.rpm=9000:12000:250 or damping.factor=0.5,1,2")
-        if any(name == p for p, _ in fields):
-            raise InputError("--set", name, "each field set once")
-        parse_path(name)
-        fields.append((name, parse_values(name, values, max_points)))
-    return plan_document(read_document(path), fields, max_points, preset=preset)
+        if any(path == p for p, _ in fields):
+            raise InputError("--set", path, "each field set once")
+        parse_path(path)
+        fields.append((path, parse_values(path, values, max_points)))
+    return plan_document(doc, fields, max_points, folder, progress=progress, cancel=cancel)
 
 
 def plan_document(doc: dict[str, Any], fields: list[tuple[str, list[Any]]], max_points: int = 100_000,
-                  folder: Any = None, preset: str = "preset") -> SweepPlan:
+                  folder: Path | None = None, *, progress: Callable[[int, int], None] | None = None,
+                  cancel: Callable[[], bool] | None = None) -> SweepPlan:
     """:func:`plan_sweep` for a parsed valvetrain document and (path, values) pairs (the Python API's sweep).
 
-    ``folder`` resolves a cam ``lift_table`` file named relative to the document.
+    ``folder`` resolves a file the document names (a cam lift table) as :func:`vtool.presets.load_document`.
     """
     from vtool.presets import load_document
+    from vtool.presets.kinds import require_kind
     from vtool.solvers.studies.sweep import Point, grid
 
-    def load(document: dict[str, Any]) -> Any:
-        if folder is not None and document.get("kind") == "valvetrain":
-            from vtool.presets.valvetrain import load as load_valvetrain
-
-            return load_valvetrain(document, folder=folder)
-        return load_document(document)
-
-    spec = load(doc)
-    if spec.kind != "valvetrain":
-        raise InputError("preset", preset, f"a valvetrain preset (this one is {spec.kind})")
+    spec = load_document(doc, folder)
+    require_kind(spec, "valvetrain", "a sweep")
     count = math.prod(len(v) for _, v in fields)
     if count > max_points:
         raise InputError("--set", count, f"a grid of at most {max_points} points")
     points = []
     for index, assignment in enumerate(grid(fields)):
-        points.append(Point(index, assignment, load(set_fields(doc, dict(assignment)))))
-    units = tuple((path, field_unit(doc, path)) for path, _ in fields)
+        if cancel is not None and cancel():
+            raise SweepCancelled
+        points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)), folder)))
+        if progress is not None:
+            progress(index + 1, count)
+    units = tuple((path, field_unit(doc, path, folder)) for path, _ in fields)
     return SweepPlan(doc, spec, units, tuple(points))

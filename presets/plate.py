@@ -10,6 +10,7 @@ round-trips. See ``presets/plate-table2.toml`` for a commented example.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 from vtool.assessments.plate.assembly import Mesh, Plate
@@ -176,8 +177,11 @@ def _transient(t: Table | None, cases: tuple[Case, ...], plate: Plate) -> Transi
     return settings
 
 
-def load(doc: dict[str, Any]) -> PlateSpec:
-    """Validate a parsed plate preset and return its frozen spec (echoed values cut short)."""
+def load(doc: dict[str, Any], folder: Path | None = None) -> PlateSpec:
+    """Validate a parsed plate preset and return its frozen spec (echoed values cut short).
+
+    ``folder`` (the preset's folder) is accepted like every loader's; a plate preset names no file.
+    """
     try:
         return _load(doc)
     except InputError as exc:

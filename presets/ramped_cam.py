@@ -50,11 +50,16 @@ def flank_coefficients(h: float, h_r: float, v_r: float, beta_f: float) -> np.nd
     return np.linalg.solve(np.array(rows), np.array(rhs))
 
 
-def ramped_lift(angles_deg: np.ndarray) -> np.ndarray:
-    """Lift (in) at cam angles (deg from the nose)."""
-    beta_r, beta_f = math.radians(RAMP_DEG), math.radians(FLANK_DEG)
-    v_r = 2.0 * RAMP_HEIGHT / beta_r
-    p = flank_coefficients(LIFT, RAMP_HEIGHT, v_r, beta_f)
+def ramped_lift(angles_deg: np.ndarray, lift: float = LIFT, ramp_height: float = RAMP_HEIGHT,
+                ramp_deg: float = RAMP_DEG, flank_deg: float = FLANK_DEG) -> np.ndarray:
+    """Lift at cam angles (deg from the nose); by default the shipped table's (in).
+
+    The train types' ``law = "polydyne"`` (:mod:`vtool.presets.trains`) passes
+    its own lift and ramp height (length units) and ramp and flank angles (cam deg).
+    """
+    beta_r, beta_f = math.radians(ramp_deg), math.radians(flank_deg)
+    v_r = 2.0 * ramp_height / beta_r
+    p = flank_coefficients(lift, ramp_height, v_r, beta_f)
     distance = np.radians(np.abs((np.asarray(angles_deg, dtype=float) + 180.0) % 360.0 - 180.0))
     phi = beta_r + beta_f - distance  # from the start of the opening ramp
     x = np.clip(phi / beta_r, 0.0, 1.0)

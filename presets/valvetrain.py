@@ -29,8 +29,12 @@ from typing import Any
 
 from vtool.errors import InputError, PresetWarning
 from vtool.presets.fields import Table, as_float
+from vtool.presets.follower import dump_follower, load_checks, load_follower
 from vtool.presets.lift_table import read_lift_table
+from vtool.presets.trains import expand
+from vtool.solvers.backends import DEFAULT
 from vtool.solvers.model.assembly import split_members, unsplit_members
+from vtool.solvers.model.hertz import MIN_RESTITUTION, check_restitution
 from vtool.solvers.model.spec import (
     BAR,
     BEAM,
@@ -100,6 +104,8 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
 
     ``folder`` resolves a ``[cam] lift_table`` file (default: the working folder).
     """
+    if isinstance(doc, dict) and "train" in doc:  # a train type: expanded to the explicit form first
+        doc = expand(doc, folder)
     top = Table(doc, "")
     top.check_unknown(TOP_KEYS)
     top.string("kind", choices=("valvetrain",))
@@ -128,7 +134,12 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
             stacklevel=2)
     damping = _damping(damping_table, names)
     contact = _contact(top.table("contact", required=False))
-    run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances))  # type: ignore[arg-type]
+    follower_table = top.table("follower", required=False)
+    follower = None if follower_table is None else load_follower(
+        follower_table, units, lambda t: _law(t, cam.coordinate, units, folder))
+    checks_table = top.table("checks", required=False)
+    checks = () if checks_table is None else load_checks(checks_table, units)
+    run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)  # type: ignore[arg-type]
     top.finish()
     spec = MechanismSpec(
         title=title,
@@ -144,6 +155,8 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         run=run,
         notes=notes,
         contact=contact,
+        follower=follower,
+        checks=checks,
     )
     spec = split_members(spec)
     if seat is not None and seat.lash is not None:
@@ -211,7 +224,7 @@ def _contact(t: Table | None) -> ContactSpec:
 
 
 TOP_KEYS = ("kind", "title", "notes", "units", "gravity", "coordinates", "members", "cam", "seat",
-            "clearances", "initial", "contact", "damping", "run")
+            "clearances", "initial", "contact", "damping", "run", "follower", "checks")
 
 
 def _magnitude(t: Table, key: str, unit: str, what: str, *, default: float | None = None,
@@ -273,6 +286,24 @@ def _cam(t: Table, n: int, units: UnitSystem, folder: Path | None = None) -> Cam
     return CamSpec(coordinate, amplitude, offset, name, profile, **table)
 
 
+def _law(t: Table, coordinate: int, units: UnitSystem, folder: Path | None) -> CamSpec:
+    """A lift law given as a [cam]-like table without its coordinate ([follower.lift])."""
+    profile = t.string("profile", default="harmonic", choices=("harmonic", "table"))
+    table = _cam_table(t, units, folder) if profile == "table" else {}
+    amplitude = 0.5 * max(table["lifts"]) if table else _magnitude(t, "amplitude", units.length, "length")
+    t.finish()
+    return CamSpec(coordinate, amplitude, None, "lift law", profile, **table)
+
+
+def _law_doc(cam: CamSpec) -> dict[str, Any]:
+    """The lift-law keys of a cam (inverse of :func:`_law`; [cam] adds its coordinate, name and offset)."""
+    if cam.profile == "harmonic":
+        return {"profile": cam.profile, "amplitude": cam.amplitude}
+    # inline, so a saved copy does not depend on the table file's folder
+    return {"profile": cam.profile, "angles": list(cam.angles), "lifts": list(cam.lifts)} | (
+        {"harmonics": cam.harmonics} if cam.harmonics else {"tolerance": cam.tolerance})
+
+
 def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """A lift table (file or inline arrays) and its fit setting; see solvers/model/cam.py."""
     from vtool.solvers.model.cam import fit_table, junction_warning, normalize_table
@@ -305,7 +336,8 @@ def _seat(t: Table, n: int, cam: CamSpec, units: UnitSystem) -> SeatSpec:
     if coordinate == cam.coordinate:
         raise InputError(t.field("coordinate"), coordinate, f"a number other than the cam's ({cam.coordinate})")
     name = t.string("name", default="seat")
-    lash = t.number("lash", unit=units.length, required=False)
+    # a negative lash would be an interference: the valve held off its seat on the base circle
+    lash = t.number("lash", unit=units.length, required=False, min_value=0.0)
     if (lash is not None) == t.has("position"):
         raise InputError(t.field("position"), t.raw("position"), "either position or lash, not both", units.length)
     low, high = BOUNDS["position"]
@@ -399,6 +431,10 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int,
         restitution = t.number("restitution", default=0.0, min_value=0.0, max_value=1.0)
         impact = t.string("impact", choices=IMPACT_LAWS) if t.raw("impact") is not None else None
         contact = _compliance(t, state, units)
+        if contact.get("contact") == HERTZ and not check_restitution(restitution):
+            raise InputError(t.field("restitution"), restitution,
+                             f">= {MIN_RESTITUTION} and <= 1 for a hertz contact (Hunt-Crossley damping gives e = 0 "
+                             f"only at infinite damping; a rigid contact takes 0)")
         t.finish()
         result.append(ClearanceSpec(name, ahead, behind, kind, state, restitution, impact, **contact))
     if sum(c.behind == cam_coordinate for c in result) != 1:
@@ -493,10 +529,46 @@ def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...
     return tuple(value)
 
 
-RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta", "gamma", "quantities")
+RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta", "gamma", "quantities",
+            "cycles", "steady", "jump_angle", "jump_gap", "bounce_lift")
+#: [run] cycle-by-cycle and criteria ranges: key -> (min, max, unit)
+CYCLE_LIMITS: dict[str, tuple[float, float, str]] = {
+    "cycles": (1, 10_000, "cam cycles"),
+    "max_cycles": (2, 10_000, "cam cycles"),
+    "tolerance": (1e-12, 1.0, "(relative change per cycle)"),
+    "jump_angle": (0.0, 360.0, "deg"),
+}
 
 
-def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
+def _cycles(t: Table, units: Any) -> dict[str, Any]:
+    """run.cycles, run.steady = { tolerance, max_cycles } and the speed criteria (vtool.solvers.studies.steady,
+    vtool.solvers.studies.metrics); run.steady = {} takes the defaults."""
+    from vtool.solvers.studies.steady import DEFAULT_MAX_CYCLES, DEFAULT_TOLERANCE
+
+    def integer(table: Table, key: str, default: int) -> int:
+        low, high, _ = CYCLE_LIMITS[key]
+        return table.integer(key, default=default, min_value=int(low), max_value=int(high)) if table.has(key) \
+            else default
+
+    values: dict[str, Any] = {"cycles": integer(t, "cycles", 0)}
+    steady = t.table("steady", required=False)
+    if steady is not None:
+        if values["cycles"]:
+            raise InputError("run.steady", "with run.cycles", "one of run.cycles (a fixed count) or run.steady")
+        low, high, unit = CYCLE_LIMITS["tolerance"]
+        values["steady_tolerance"] = steady.number("tolerance", default=DEFAULT_TOLERANCE, min_value=low,
+                                                   max_value=high)
+        values["steady_max_cycles"] = integer(steady, "max_cycles", DEFAULT_MAX_CYCLES)
+        steady.finish()
+    low, high, unit = CYCLE_LIMITS["jump_angle"]
+    values["jump_angle"] = t.number("jump_angle", unit=unit, default=1.0, min_value=low, max_value=high)
+    for key in ("jump_gap", "bounce_lift"):
+        if t.has(key):
+            values[key] = t.number(key, unit=units.length, min_value=0.0, max_value=1e4)
+    return values
+
+
+def _run(t: Table, names: tuple[set[int], set[int]], units: Any) -> RunSpec:
     t.check_unknown(RUN_KEYS)
     def limited(key: str, default: float | None = None) -> float:
         low, high, unit = RUN_LIMITS[key]
@@ -505,13 +577,14 @@ def _run(t: Table, names: tuple[set[int], set[int]]) -> RunSpec:
     rpm = limited("rpm")
     degrees = limited("degrees")
     time_step = limited("time_step")
-    backend = t.string("backend", default="newmark")
+    backend = t.string("backend", default=DEFAULT)
     output_interval = limited("output_interval", 1.0)
     beta = t.number("beta", default=1.0 / 6.0)
     gamma = t.number("gamma", default=0.5)
     quantities = _quantities(t, *names)
+    cycles = _cycles(t, units)
     t.finish()
-    return check_run(RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities))
+    return check_run(RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities, **cycles))
 
 
 def check_run_value(key: str, value: Any, field: str | None = None) -> Any:
@@ -577,13 +650,7 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
     doc["members"] = members
     cam = spec.cam
     doc["cam"] = {"coordinate": cam.coordinate, "name": cam.name, "profile": cam.profile,
-                  "offset": STATIC_START if cam.offset is None else cam.offset}
-    if cam.profile == "harmonic":
-        doc["cam"]["amplitude"] = cam.amplitude
-    else:
-        # inline, so a saved copy does not depend on the table file's folder
-        doc["cam"].update({"angles": list(cam.angles), "lifts": list(cam.lifts)})
-        doc["cam"].update({"harmonics": cam.harmonics} if cam.harmonics else {"tolerance": cam.tolerance})
+                  "offset": STATIC_START if cam.offset is None else cam.offset} | _law_doc(cam)
     if spec.seat is not None:
         seat = spec.seat
         doc["seat"] = {"coordinate": seat.coordinate, "name": seat.name}
@@ -618,6 +685,19 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
     }
     if r.quantities:
         doc["run"]["quantities"] = list(r.quantities)
+    if r.cycles:
+        doc["run"]["cycles"] = r.cycles
+    if r.steady_tolerance:
+        doc["run"]["steady"] = {"tolerance": r.steady_tolerance, "max_cycles": r.steady_max_cycles}
+    if r.jump_angle != 1.0:
+        doc["run"]["jump_angle"] = r.jump_angle
+    for key in ("jump_gap", "bounce_lift"):
+        if getattr(r, key) is not None:
+            doc["run"][key] = getattr(r, key)
+    if spec.follower is not None:
+        doc["follower"] = dump_follower(spec.follower, _law_doc)
+    if spec.checks:
+        doc["checks"] = {c.name: c.limit for c in spec.checks}
     return doc
 
 

@@ -5,8 +5,15 @@ pyproject.toml). Listing them imports none; :func:`get` loads one.
 
 The contract every back end follows (subclass :class:`Backend`)
 ---------------------------------------------------------------
-1. A lowercase ``name`` and the ability flags ``supports_cancel`` and
-   ``supports_progress`` (class attributes).
+1. A lowercase ``name`` and the ability flags (class attributes):
+   ``supports_cancel``, ``supports_progress``; ``fixed_step`` (it steps by
+   the run's ``time_step``: ``--dt`` applies, a run costs ``t_end / dt``
+   steps, its step may be bounded by :meth:`Backend.stable_step`);
+   ``reference`` (its events are located on the exact solution: the
+   reference of accuracy studies); ``library_dependent`` (its last bits
+   follow the numerical libraries' versions and BLAS kernels).
+   Other modules ask the registry (:func:`available`, :func:`get`,
+   :func:`with_flag`) and these flags, and never name a back end.
 2. ``options_from_run(run: RunSpec, every_step: bool) -> Options``: the back
    end's own frozen options dataclass, built from the preset's run settings.
 3. ``check(mechanism, options)``: raise :class:`vtool.errors.InputError` for
@@ -35,25 +42,49 @@ they are added, so a back end hands them to the builder in time order).
 
 from __future__ import annotations
 
+import math
 import time as wallclock
 from abc import ABC, abstractmethod
 from collections.abc import Callable
+from dataclasses import dataclass
 from functools import cache, lru_cache
 from importlib.metadata import EntryPoint, entry_points
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from vtool.errors import InputError
+from vtool.solvers.model.spec import DEFAULT_BACKEND
 
 if TYPE_CHECKING:
     from vtool.solvers.model.contact import ContactProblem
     from vtool.solvers.model.mechanism import Mechanism
-    from vtool.solvers.model.spec import RunSpec
+    from vtool.solvers.model.spec import MechanismSpec, RunSpec
     from vtool.solvers.trace import CsvStream, Trace, TraceBuilder
 
 ENTRY_POINT_GROUP = "vtool.backends"
 
 Progress = Callable[[float], None]
 Cancel = Callable[[], bool]
+
+
+@dataclass(frozen=True)
+class AccuracyKnobs:
+    """What an accuracy study sweeps: steps and Newmark-type beta values for fixed-step back ends,
+    relative tolerances for adaptive ones (each back end takes the knobs that apply to it)."""
+
+    time_steps: tuple[float, ...] = ()  # s
+    betas: tuple[float, ...] = ()
+    rtols: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class AccuracySetting:
+    """One setting of a back end in an accuracy study: its label, the run settings (the back end's
+    options from them, unless ``options`` are given), and a note for its row."""
+
+    label: str
+    run: RunSpec
+    options: Any = None
+    note: str = ""
 
 
 @lru_cache(maxsize=1)
@@ -64,6 +95,24 @@ def _entry_points() -> dict[str, EntryPoint]:
 def available() -> list[str]:
     """Names of the installed back ends (nothing is imported)."""
     return sorted(_entry_points())
+
+
+#: The back end a preset runs when its [run] table names none.
+DEFAULT = DEFAULT_BACKEND
+
+
+def with_flag(flag: str) -> list[str]:
+    """Names of the installed back ends whose class sets ``flag`` (e.g. ``"reference"``), sorted; this
+    imports them all."""
+    return [name for name in available() if getattr(get(name), flag)]
+
+
+def module_of(name: str) -> str:
+    """The module that holds back end ``name`` (nothing is imported)."""
+    ep = _entry_points().get(name)
+    if ep is None:
+        raise InputError("run.backend", name, f"one of the installed back ends: {', '.join(available())}")
+    return ep.module
 
 
 @cache
@@ -81,6 +130,26 @@ class Backend(ABC):
     name: ClassVar[str]
     supports_cancel: ClassVar[bool] = True
     supports_progress: ClassVar[bool] = True
+    fixed_step: ClassVar[bool] = False
+    reference: ClassVar[bool] = False
+    library_dependent: ClassVar[bool] = False
+
+    @classmethod
+    def stable_step(cls, mechanism: Mechanism) -> float:
+        """The largest stable step of this back end for the mechanism's run settings (s; inf: no bound)."""
+        return math.inf
+
+    @classmethod
+    def compile_notice(cls, spec: MechanismSpec, impacts: tuple[str, ...] = ()) -> str | None:
+        """The line to show before a run of ``spec`` (and of it under the impact laws ``impacts``) that
+        must first compile code, or None (default: nothing to compile)."""
+        return None
+
+    @classmethod
+    def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:
+        """The settings an accuracy study runs this back end at (default: none; see
+        :mod:`vtool.solvers.studies.accuracy`)."""
+        return []
 
     @staticmethod
     @abstractmethod

@@ -3,9 +3,9 @@
 A run covers ``t_end = degrees / (6 rpm)`` seconds (cam speed ω = 2π rpm / 60).
 The work is
 
-* ``newmark``: ``t_end / Δt`` steps (plus the short refined stretches after
-  events, not counted);
-* ``exact`` and ``scipy``: about 16 samples per period of the highest
+* a back end flagged ``fixed_step`` (``newmark``): ``t_end / Δt`` steps
+  (plus the short refined stretches after events, not counted);
+* any other (``exact``, ``scipy``): about 16 samples per period of the highest
   natural frequency, ``16 t_end ω_max / 2π`` (the exact back end scans at
   1/16 of the shortest period; solve_ivp's steps are of the same order);
 
@@ -31,6 +31,8 @@ import math
 from dataclasses import dataclass
 
 from vtool.errors import InputError
+from vtool.solvers import backends
+from vtool.units import cam_speed
 
 #: Default largest number of steps (or samples) of one run.
 MAX_STEPS = 5e7
@@ -62,9 +64,9 @@ def estimate(*, backend: str, rpm: float, degrees: float, time_step: float, outp
              every_step: bool, omega_max: float, n_coordinates: int, n_sources: int,
              n_clearances: int, n_quantities: int = 0) -> Estimate:
     """The cost of one run (see module doc); all inputs in the preset's units."""
-    omega = rpm * 2.0 * math.pi / 60.0
+    omega = cam_speed(rpm)
     t_end = math.radians(degrees) / omega if omega > 0 else math.inf
-    if backend == "newmark":
+    if backends.get(backend).fixed_step:
         steps = t_end / time_step if time_step > 0 else math.inf
     else:
         steps = t_end * omega_max / (2.0 * math.pi) * SAMPLES_PER_PERIOD
@@ -93,7 +95,7 @@ class CostError(InputError):
                     "to proceed: more --degrees or a smaller --dt")
         if self.what == "steps":
             limit = (f"more than the limit of {self.max_steps:.3g} steps; to proceed: fewer --degrees, "
-                     f"a higher --rpm, a larger --dt (newmark), or --max-steps {math.ceil(c.steps):d}")
+                     f"a higher --rpm, a larger --dt (fixed-step back ends), or --max-steps {math.ceil(c.steps):d}")
         else:
             limit = (f"more than the limit of {self.max_bytes / 1e9:g} GB of output; to proceed: fewer "
                      "--degrees, a larger run.output_interval, or no --every-step")

@@ -22,8 +22,9 @@ import numpy as np
 from vtool.errors import PresetWarning, RunError
 from vtool.solvers import backends, cost
 from vtool.solvers.model.mechanism import Mechanism, assemble
-from vtool.solvers.model.preflight import seat_reach_warning
+from vtool.solvers.model.preflight import run_warnings
 from vtool.solvers.model.spec import MechanismSpec, RunSpec
+from vtool.solvers.studies.steady import is_cyclic, run_degrees, simulate_cycles
 from vtool.solvers.trace import CsvStream, Trace
 from vtool.threads import limited
 
@@ -39,7 +40,7 @@ def run_cost(mechanism: Mechanism, every_step: bool = False) -> cost.Estimate:
     r = spec.run
     omega_max = mechanism.highest_frequency
     n_sources = 1 + (spec.seat is not None)
-    return cost.estimate(backend=r.backend, rpm=r.rpm, degrees=r.degrees, time_step=r.time_step,
+    return cost.estimate(backend=r.backend, rpm=r.rpm, degrees=run_degrees(spec), time_step=r.time_step,
                          output_interval=r.output_interval, every_step=every_step, omega_max=omega_max,
                          n_coordinates=spec.n_coordinates, n_sources=n_sources,
                          n_clearances=len(spec.clearances), n_quantities=len(r.quantities))
@@ -127,6 +128,8 @@ def simulate(
 
     ``max_steps`` and ``max_bytes`` override the cost limits
     (:data:`vtool.solvers.cost.MAX_STEPS`, :data:`vtool.solvers.cost.MAX_BYTES`).
+    A spec with ``run.cycles`` or ``run.steady`` runs cycle by cycle
+    (:mod:`vtool.solvers.studies.steady`; ``options`` are then the run's own).
     With a ``stream`` the rows are written to its CSV as the run goes; a
     thinning stream keeps the memory of an every-step run to that of a run at
     the output interval (the memory limit counts it so). ``before_run()`` is
@@ -138,9 +141,8 @@ def simulate(
     mechanism = _assemble(spec)
     in_memory_every_step = every_step and not (stream is not None and stream.thin)
     cost.check(run_cost(mechanism, in_memory_every_step), max_steps, max_bytes)
-    reach = seat_reach_warning(mechanism)
-    if reach is not None:
-        warnings.warn(PresetWarning(reach), stacklevel=2)
+    for message in run_warnings(mechanism):
+        warnings.warn(PresetWarning(message), stacklevel=2)
     if options is None:
         options = backend.options_from_run(spec.run, every_step)
     if before_run is not None:
@@ -148,13 +150,19 @@ def simulate(
         before_run()
     try:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            trace = backend.simulate(
-                mechanism,
-                options,
-                progress=progress if backend.supports_progress else None,
-                cancel=cancel if backend.supports_cancel else None,
-                stream=stream,
-            )
+            if is_cyclic(spec):  # cycle by cycle: the rows go to the CSV when the run has ended
+                trace = simulate_cycles(backend, mechanism, every_step=every_step, progress=progress,
+                                        cancel=cancel)
+                if stream is not None:
+                    stream.write(trace)
+            else:
+                trace = backend.simulate(
+                    mechanism,
+                    options,
+                    progress=progress if backend.supports_progress else None,
+                    cancel=cancel if backend.supports_cancel else None,
+                    stream=stream,
+                )
     except NUMERICAL_FAILURES as exc:
         raise RunError(f"{spec.run.backend} run failed ({type(exc).__name__}: {str(exc)[:80]}); likely "
                        "input: the time step, or stiffnesses and masses of very different size") from None

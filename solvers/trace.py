@@ -87,6 +87,43 @@ class RunStatistics:
 
 
 @dataclass(frozen=True)
+class Cycles:
+    """How a cycle-by-cycle run went (:mod:`vtool.solvers.studies.steady`); the trace holds every cycle.
+
+    ``settled`` is None for a fixed number of cycles (``run.cycles``); ``change`` is the largest relative
+    change from the cycle before to the last one, ``changed`` what moved that much; ``changes`` is that
+    change after each cycle (the first has none: NaN). ``peaks`` are the every-step peak contact forces
+    over the evaluated (last) cycle, ``startup_peaks`` over the first.
+    """
+
+    count: int
+    settled: bool | None
+    tolerance: float
+    change: float
+    changed: str
+    changes: tuple[float, ...]
+    peaks: np.ndarray
+    startup_peaks: np.ndarray
+    max_cycles: int = 0
+
+    @property
+    def window(self) -> tuple[float, float]:
+        """The evaluated cycle's cam angles (deg): the last cycle."""
+        return 360.0 * (self.count - 1), 360.0 * self.count
+
+    def text(self) -> str:
+        """One line: which cycle is evaluated and whether the run settled."""
+        where = f"cycle {self.count} of {self.count} (cam angle {360.0 * (self.count - 1):g}-{360.0 * self.count:g} deg)"
+        moved = "" if self.count < 2 else f"; the last cycle changed by {self.change:.3g} ({self.changed})"
+        if self.settled is None:
+            return f"evaluated: {where}, a fixed number of cycles (run.cycles){moved}"
+        if self.settled:
+            return f"evaluated: {where}, settled to {self.tolerance:g}{moved}"
+        return (f"warning: did not settle in {self.count} cycles (run.steady max_cycles = {self.max_cycles}): "
+                f"evaluated {where}{moved}, above the tolerance {self.tolerance:g}")
+
+
+@dataclass(frozen=True)
 class Trace:
     """Response of one run (see module doc). Rows are output instants."""
 
@@ -106,6 +143,7 @@ class Trace:
     message: str = ""
     peak_force_after_first_revolution: np.ndarray | None = None  # per clearance, over every step
     peak_overlap: np.ndarray | None = None  # per clearance, largest overlap of a compliant contact
+    cycles: Cycles | None = None  # a run cycle by cycle (run.cycles, run.steady): how it went
 
     # ----- columns by the engineer's names -----
     def coordinate(self, number: int, rows: slice = slice(None)) -> np.ndarray:
@@ -161,6 +199,15 @@ class Trace:
         for expression in quantities:
             header.append(f"{expression} ({self.quantity_unit(expression)})")
             columns.append(lambda rows, expression=expression: self.quantity(expression, rows))
+        if self.spec.follower is not None:  # cam contact stress at each row (solvers/model/camstress.py)
+            from vtool.solvers.model.camstress import row_unit, stress_rows
+
+            cam = next(i for i, c in enumerate(self.spec.clearances) if c.behind == self.spec.cam.coordinate)
+            names = list(stress_rows(self.spec, self.cam_angle[:1], self.contact_force[:1, cam]))
+            for name in names:
+                header.append(f"cam_{name} ({row_unit(self.spec, name)})")
+                columns.append(lambda rows, name=name: stress_rows(
+                    self.spec, self.cam_angle[rows], self.contact_force[rows, cam])[name])
         return header + ["configuration", "closed"], columns
 
     def configuration_csv(self, mask: int) -> str:
@@ -334,7 +381,21 @@ class Trace:
                 for e in self.events
             ],
             "clearances": clearances,
-        }
+        } | self.follower_summary()
+
+    def follower_summary(self) -> dict:
+        """The cam contact's stress extremes (with a [follower]) and the [checks] judged (with limits)."""
+        result: dict = {}
+        if self.spec.follower is not None:
+            from vtool.solvers.model.camstress import stress_summary
+
+            cam = next(c.name for c in self.spec.clearances if c.behind == self.spec.cam.coordinate)
+            result["contact_stress"] = stress_summary(self.spec, self.cam_angle, self.force(cam))
+        if self.spec.checks:
+            from vtool.solvers.studies.checks import evaluate
+
+            result["checks"] = [c.as_dict() for c in evaluate(self.spec, self)]
+        return result
 
     def summary_text(self) -> str:
         s = self.summary()
@@ -376,6 +437,14 @@ class Trace:
                 if any(heights):
                     lines.append(f"{c['clearance']} largest bounce height per revolution ({c['bounce_height_unit']}, "
                                  f"at the output interval): " + ", ".join(f"{h:.4g}" for h in heights))
+        if "contact_stress" in s:
+            from vtool.solvers.model.camstress import stress_text
+
+            lines += stress_text(s["contact_stress"])
+        if "checks" in s:
+            from vtool.solvers.studies.checks import checks_text
+
+            lines += checks_text(s["checks"])
         if not s["success"]:
             lines.append(f"run stopped: {s['message']}")
         return "\n".join(lines)

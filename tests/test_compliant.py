@@ -247,12 +247,32 @@ def test_hertz_drop_matches_its_closed_form(backend: str) -> None:
     assert opening.relative_velocity == pytest.approx(v0, rel=1e-4)
 
 
-def test_hunt_crossley_damping_lowers_the_rebound() -> None:
-    ratios = []
-    for restitution in (1.0, 0.8, 0.5):
-        _, closing, opening = hertz_contact(restitution, "newmark")
-        ratios.append(opening.relative_velocity / -closing.relative_velocity)
-    assert ratios[0] > ratios[1] > ratios[2] > 0.0
+@pytest.mark.parametrize("backend", ["newmark", "scipy"])
+@pytest.mark.parametrize("restitution", [0.9, 0.5, 0.2, 0.05])
+def test_a_hertz_drop_rebounds_at_the_asked_restitution(backend: str, restitution: float) -> None:
+    """A lone mass on a Hunt-Crossley contact leaves at e v0 (solvers/model/hertz.py: the damping factor
+    comes from the asked e, exactly; the 1 lbf/in spring's share of the force is 1.5e-5)."""
+    _, closing, opening = hertz_contact(restitution, backend)
+    assert opening.relative_velocity / -closing.relative_velocity == pytest.approx(restitution, abs=1e-3)
+
+
+@pytest.mark.parametrize("exponent", [1.0, 1.5, 2.5])
+@pytest.mark.parametrize("restitution", [0.01, 0.1, 0.488, 0.75, 0.999])
+def test_the_damping_factor_rebounds_the_dimensionless_impact_at_e(exponent: float, restitution: float) -> None:
+    """The closed relation a (1 + e) = ln((1 + a)/(1 - a e)) against x'' = -x^n (1 + a x') integrated."""
+    from vtool.solvers.model.hertz import damping_factor, rebound
+
+    assert rebound(damping_factor(restitution), exponent) == pytest.approx(restitution, rel=1e-8)
+    assert damping_factor(0.488) == pytest.approx(1.5, rel=2e-3)  # the old law's "e = 0" rebounded at 0.488
+
+
+@pytest.mark.parametrize("restitution", [0.0, 0.005])
+def test_a_hertz_contact_refuses_a_restitution_it_cannot_give(restitution: float) -> None:
+    doc = hertz_doc(restitution)
+    with pytest.raises(InputError) as info:
+        spec_from(doc)
+    assert str(info.value).startswith(f"clearances[1].restitution: got {restitution}, expected >= 0.01 and <= 1 "
+                                      "for a hertz contact")
 
 
 def test_hertz_seat_on_1a_newmark_and_scipy_agree() -> None:
@@ -265,7 +285,7 @@ def test_hertz_seat_on_1a_newmark_and_scipy_agree() -> None:
     doc["run"]["degrees"] = 400.0
     for c in doc["clearances"]:
         if c["name"] == "seat":
-            c.update(contact="hertz", contact_stiffness=1e8, restitution=0.0)
+            c.update(contact="hertz", contact_stiffness=1e8, restitution=0.1)
     spec = spec_from(doc)
     newmark = simulate(dataclasses.replace(spec, run=dataclasses.replace(spec.run, time_step=2.5e-7)))
     scipy = simulate(dataclasses.replace(spec, run=dataclasses.replace(spec.run, backend="scipy")))
@@ -314,7 +334,7 @@ def test_bad_input_is_one_line_even_when_a_compile_is_due(tmp_path, monkeypatch,
 def test_a_hertz_contact_starts_open() -> None:
     doc = hertz_doc()
     doc["clearances"][0]["state"] = "enabled"
-    doc["clearances"][0].update(contact="hertz", contact_stiffness=1e7)
+    doc["clearances"][0].update(contact="hertz", contact_stiffness=1e7, restitution=0.5)
     doc["initial"]["closed"] = ["cam"]
     with pytest.raises(InputError, match="starts open"):
         spec_from(doc)

@@ -82,6 +82,8 @@ def mutated_text(draw: st.DrawFn) -> bytes:
         clearance["contact_stiffness"] = draw(st.sampled_from([1e3, 1e6, 1e8, 1e12, 1e13]))
         if law == "linear":
             clearance["contact_damping_ratio"] = draw(st.sampled_from([0.0, 0.5, 1.0, 5.0]))
+        else:  # hertz takes 0.01 <= e <= 1 (solvers/model/hertz.py): 0 is refused in one line
+            clearance["restitution"] = draw(st.sampled_from([0.0, 0.05, 0.5, 1.0]))
     for _ in range(draw(st.integers(1, 3))):
         target = at(doc, draw(st.sampled_from(containers(doc))))
         keys = list(target) if isinstance(target, dict) else list(range(len(target)))

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 from textual.app import App, ComposeResult
+from textual.widgets import Input
 
 from vtool.app.sweep_charts import metric_chart
 from vtool.app.tui.sweep import SweepPane
@@ -58,7 +59,7 @@ async def test_bad_range_shows_one_line_and_runs_nothing() -> None:
         pane = app.query_one(SweepPane)
         await _run(pilot, pane)
         assert pane.status_text.startswith("error: --set run.rpm: got '5000:4000:250'")
-        assert pane.worker is None and pane.outcome is None
+        assert pane.plan is None and pane.outcome is None  # checked in the worker: nothing ran
 
 
 async def test_cancel_stops_and_keeps_finished_points() -> None:
@@ -73,3 +74,101 @@ async def test_cancel_stops_and_keeps_finished_points() -> None:
         await pilot.pause()
         assert pane.status_text.startswith("stopped:"), pane.status_text
         assert len(pane.outcome.results) < 1501
+
+
+async def test_several_workers_run_under_textual_and_its_stderr_is_kept() -> None:
+    """Textual's stderr has no file descriptor (fileno() -1); the pool's first start handed it to
+    multiprocessing's helper process: every run with workers failed "bad value(s) in fds_to_keep"."""
+    import sys
+
+    class TwoWorkers(App):
+        def compose(self) -> ComposeResult:
+            yield SweepPane("gnilka-1a", workers=2, values="10000,11000", fixed="run.degrees=460",
+                            metric="peak_F1")
+
+    app = TwoWorkers()
+    async with app.run_test(size=(140, 50)) as pilot:
+        textual_stderr = sys.stderr
+        assert textual_stderr.fileno() == -1  # the condition of the bug
+        pane = app.query_one(SweepPane)
+        await _run(pilot, pane)
+        assert pane.status_text.startswith("finished: 2 of 2 points"), pane.status_text
+        assert [r.status for r in pane.outcome.results] == ["ok", "ok"]
+        assert all(r.metrics["peak_F1"] > 0 for r in pane.outcome.results)
+        assert sys.stderr is textual_stderr  # put back after the pool started
+        await _run(pilot, pane)  # and a second run (the pool's helpers are running now)
+        assert pane.status_text.startswith("finished: 2 of 2 points"), pane.status_text
+
+
+async def test_descriptor_stderr_changes_nothing_when_stderr_has_a_descriptor() -> None:
+    import os
+    import sys
+
+    from vtool.app.tui.sweep import descriptor_stderr
+
+    class NoDescriptor:
+        def fileno(self) -> int:
+            return -1
+
+    before = sys.stderr
+    with descriptor_stderr():
+        assert sys.stderr is before
+    replaced = sys.stderr = NoDescriptor()  # type: ignore[assignment]
+    try:
+        with descriptor_stderr():
+            assert sys.stderr.fileno() >= 0 and sys.stderr.name == os.devnull
+        assert sys.stderr is replaced
+    finally:
+        sys.stderr = before
+
+
+async def test_points_are_checked_off_the_ui_thread_and_cancel_stops_the_check(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Checking a point costs about 10 ms: 100,000 points froze the screen for minutes on the UI
+    thread, and Cancel was not seen. The check runs in the worker, shows its count, and stops."""
+    import threading
+
+    import vtool.presets as presets
+
+    loads_on_ui_thread: list[int] = []
+    load = presets.load_document
+
+    def watched(*args, **kwargs):  # type: ignore[no-untyped-def]
+        if threading.current_thread() is threading.main_thread():
+            loads_on_ui_thread.append(1)
+        return load(*args, **kwargs)
+
+    monkeypatch.setattr(presets, "load_document", watched)
+    app = PaneApp(values="9000:9100:10", fixed="run.degrees=100", metric="peak_F1")
+    async with app.run_test(size=(140, 50)) as pilot:
+        pane = app.query_one(SweepPane)
+        await _run(pilot, pane)
+        assert pane.status_text.startswith("finished: 11 of 11 points"), pane.status_text
+        assert not loads_on_ui_thread
+        pane.query_one("#sweep-values", Input).value = "1000:100999:1"  # 100,000 points
+        pane.run_sweep()
+        for _ in range(200):  # the screen stays live while the worker checks
+            await pilot.pause(0.02)
+            if "checking 100000 points" in pane.status_text:
+                break
+        assert "checking 100000 points" in pane.status_text, pane.status_text
+        assert pane.running
+        await pilot.click("#sweep-cancel")
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert pane.status_text.startswith("stopped while checking the points ("), pane.status_text
+        checked = int(pane.status_text.split("(")[1].split()[0])
+        assert 0 < checked < 100_000
+        assert pane.outcome is not None and len(pane.outcome.results) == 11  # the last results are kept
+        assert not loads_on_ui_thread
+
+
+async def test_a_metric_with_no_value_at_any_point_is_said_not_drawn() -> None:
+    """spring_margin is empty at 100 degrees (the valve never reaches full lift): plotext's chart of
+    all-NaN series raised IndexError and ended the app."""
+    app = PaneApp(values="10000,11000", fixed="run.degrees=100", metric="spring_margin")
+    async with app.run_test(size=(140, 50)) as pilot:
+        pane = app.query_one(SweepPane)
+        await _run(pilot, pane)
+        assert pane.status_text.startswith("finished: 2 of 2 points"), pane.status_text
+        assert pane.chart.function is None and "no point has a value of spring_margin" in str(pane.chart.content)
+    assert app._exception is None

@@ -82,11 +82,7 @@ class Model:
     def _load(self, document: dict[str, Any]) -> Any:
         from vtool.presets import load_document
 
-        if self.folder is not None and document.get("kind") == "valvetrain":
-            from vtool.presets.valvetrain import load as load_valvetrain
-
-            return load_valvetrain(document, folder=self.folder)
-        return load_document(document)
+        return load_document(document, self.folder)
 
     @property
     def title(self) -> str:

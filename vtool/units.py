@@ -11,7 +11,8 @@ valve train says lbf/in^2) and the two theses round g differently, so each
 domain has its own table of the one class:
 
 * :data:`UNIT_SYSTEMS` (valve train): the valve-train thesis' g = 386.0
-  in/s² (Gnilka 1971, subroutine MCK: ``GRAV/386.0D0/``);
+  in/s² (Gnilka 1971, subroutine MCK: ``GRAV/386.0D0/``), SI, and ``mm-N-s``
+  (today's engine data: mm, N, s, MPa, mass in N s²/mm = t, cam degrees);
 * :data:`BOOM_UNIT_SYSTEMS` (sonic boom): thesis 001's g = 386.4 in/s², pressure
   in psi / Pa and also in a second unit engineers quote booms in (lb/ft², kPa);
 * :data:`PLATE_UNIT_SYSTEMS` (plate): the valve train's system names, density
@@ -26,6 +27,7 @@ loader state physical bounds once, in SI.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 
@@ -95,6 +97,11 @@ UNIT_SYSTEMS: dict[str, UnitSystem] = {
     "in-lbf-s": UnitSystem("in-lbf-s", "in", "lbf", "s", "lbf*s^2/in", 386.0, metres_per_length=INCH,
                            pascals_per_pressure=PSI, newtons_per_force=LBF),
     "SI": UnitSystem("SI", "m", "N", "s", "kg", 9.80665),
+    # engine practice: millimetres, newtons, seconds; mass then is N*s^2/mm (= 1 tonne), density
+    # t/mm^3 (steel 7.85e-9), pressure N/mm^2 = MPa; angles stay cam degrees (a lift table in crank
+    # degrees is converted by the train loader, presets/trains.py)
+    "mm-N-s": UnitSystem("mm-N-s", "mm", "N", "s", "N*s^2/mm", 9806.65, "MPa", metres_per_length=1e-3,
+                         pascals_per_pressure=1e6, newtons_per_force=1.0, density_name="t/mm^3"),
 }
 
 BOOM_UNIT_SYSTEMS: dict[str, UnitSystem] = {
@@ -110,3 +117,9 @@ PLATE_UNIT_SYSTEMS: dict[str, UnitSystem] = {
                            pascals_per_pressure=PSI, newtons_per_force=LBF, density_name="lbf*s^2/in^4"),
     "SI": UnitSystem("SI", "m", "N", "s", "kg", 9.80665, "Pa", density_name="kg/m^3"),
 }
+
+
+def cam_speed(rpm: float) -> float:
+    """The cam's angular speed ω in rad/s at ``rpm`` rev/min (ω = 2π rpm / 60): the one place a speed
+    becomes ω (:attr:`vtool.solvers.model.spec.RunSpec.omega` and every study read it)."""
+    return rpm * math.pi / 30.0

@@ -154,17 +154,11 @@ def _write(path: Path, text: str) -> None:
 
 def _preset_command(expected: str, name: str, preset: str, csv_path: Path | None, plot: bool,
                     as_json: bool, figure_path: Path | None) -> None:
-    from vtool.presets import boom as boom_presets
-    from vtool.presets import find_preset, kind_of, load_document, read_document
+    from vtool.presets import load_preset
+    from vtool.presets.kinds import require_kind
 
-    path = find_preset(preset)
-    doc = read_document(path)
-    if kind_of(doc) in boom_presets.KINDS:
-        spec = boom_presets.load(doc, base=path.parent)  # pulse CSVs beside the preset
-    else:
-        spec = load_document(doc)
-    if spec.kind != expected:
-        raise InputError("preset", preset, f"a {expected} preset for `vtool boom {name}` (got {spec.kind})")
+    spec = load_preset(preset)  # a pulse CSV is found beside the preset
+    require_kind(spec, expected, f"`vtool boom {name}`")
     solve_preset(spec, csv_path, plot, as_json, figure=figure_path)
 
 

@@ -23,10 +23,10 @@ RK4_LIMIT = 2.8  # thesis eq. 44; kept here so --help needs no numerics
 
 def _load_plate_spec(preset: str) -> Any:
     from vtool.presets import load_preset
+    from vtool.presets.kinds import require_kind
 
     spec = load_preset(preset)
-    if getattr(spec, "kind", "") != "plate":
-        raise InputError("preset", preset, f"a plate preset (this one is kind {spec.kind!r})")
+    require_kind(spec, "plate", "`vtool plate`")
     return spec
 
 

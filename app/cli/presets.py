@@ -8,7 +8,7 @@ import click
 
 from vtool.errors import InputError
 from vtool.files import exists, is_dir, write_atomic
-from vtool.presets import find_preset, list_presets
+from vtool.presets import find_preset, list_presets, self_contained_text
 
 
 @click.group()
@@ -42,5 +42,6 @@ def copy_command(name: str, dest: Path, force: bool) -> None:
     target = dest / source.name if is_dir(dest) else dest
     if exists(target) and not force:
         raise InputError("dest", str(target), "a path that does not exist yet (or --force)")
-    write_atomic(target, source.read_text(encoding="utf-8"), "DEST")
-    click.echo(f"copied {source.stem} to {target}")
+    text, note = self_contained_text(source)  # a lift-table file is written in: the copy loads anywhere
+    write_atomic(target, text, "DEST")
+    click.echo(f"copied {source.stem} to {target}" + (f" ({note})" if note else ""))

@@ -84,33 +84,45 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
     csv_file = None if csv_path is None else Path(check_output_path(csv_path, "--csv") and csv_path)
     spec = load_preset(preset)
     kind = KINDS[spec.kind]
-    if spec.kind != "valvetrain":
-        given = {"--backend": backend, "--dt": dt, "--rpm": rpm, "--degrees": degrees,
-                 "--max-steps": max_steps, "--every-step": every_step or None,
-                 "--events": show_events or None, "--impact": impact, "--start": start}
-        for flag, value in given.items():
-            if value is not None:
-                raise InputError(flag, value, f"no {flag} for {preset}: it is a {spec.kind} preset "
-                                 f"({flag} applies to valvetrain presets)")
-        resolve(kind.solve)(spec, csv_file, plot, as_json, figure=figure_path)
-        return
-    if impact is not None or start is not None:
-        from vtool.solvers.studies.compare import with_model
-
-        spec = with_model(spec, impact, start)
-    run_valvetrain(spec, backend, dt, rpm, degrees, csv_file, every_step, plot, as_json, show_events,
-                   max_steps=max_steps, figure=figure_path)
+    given = {"--backend": backend, "--dt": dt, "--rpm": rpm, "--degrees": degrees,
+             "--max-steps": max_steps, "--every-step": every_step or None,
+             "--events": show_events or None, "--impact": impact, "--start": start}
+    for flag, value in given.items():
+        if value is not None and flag not in kind.run_options:
+            raise InputError(flag, value, f"no {flag} for {preset}: it is a {spec.kind} preset "
+                             f"({flag} applies to {', '.join(applies_to(flag)) or 'no'} presets)")
+    flags = {FLAG_ARGUMENTS[flag]: value for flag, value in given.items()
+             if flag in kind.run_options and value is not None}
+    resolve(kind.solve)(spec, csv_file, plot, as_json, figure=figure_path, **flags)
 
 
-def run_valvetrain(spec: Any, backend: str | None, dt: float | None, rpm: float | None,
-                   degrees: float | None, csv_path: Path | None, every_step: bool, plot: bool,
-                   as_json: bool, show_events: bool, *, max_steps: float | None = None,
-                   figure: Path | None = None) -> None:
+#: ``vtool solve``'s run flags and the keyword that carries each to a kind's solve function
+FLAG_ARGUMENTS = {"--backend": "backend", "--dt": "dt", "--rpm": "rpm", "--degrees": "degrees",
+                  "--max-steps": "max_steps", "--every-step": "every_step", "--events": "show_events",
+                  "--impact": "impact", "--start": "start"}
+
+
+def applies_to(flag: str) -> list[str]:
+    """The preset kinds whose ``vtool solve`` takes ``flag`` (the kinds table's run options)."""
+    from vtool.presets.kinds import KINDS
+
+    return [name for name, kind in KINDS.items() if flag in kind.run_options]
+
+
+def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *, backend: str | None = None,
+                   dt: float | None = None, rpm: float | None = None, degrees: float | None = None,
+                   every_step: bool = False, show_events: bool = False, max_steps: float | None = None,
+                   impact: str | None = None, start: str | None = None, figure: Path | None = None) -> None:
+    """``vtool solve`` for a valvetrain preset: the run flags as preset overrides, the run, its summary."""
     from vtool.app.cli.progress import DelayedProgress
     from vtool.files import json_text
     from vtool.presets.valvetrain import with_run_overrides
     from vtool.solvers.run import simulate
 
+    if impact is not None or start is not None:
+        from vtool.solvers.studies.compare import with_model
+
+        spec = with_model(spec, impact, start)
     spec = with_run_overrides(spec, backend=backend, time_step=dt, rpm=rpm, degrees=degrees)
     progress = DelayedProgress(f"{spec.run.backend} {spec.run.degrees:g} deg")
 
@@ -154,9 +166,9 @@ def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()
     """One line on stderr before a run that must first compile the solver (a new install's first run, or
     the first with Hertz contacts or momentum-law impacts), and one before the first every-step CSV
     compiles its number formatter (a few seconds, once). ``impacts``: further impact laws to be run."""
-    from vtool.solvers.newmark.backend import compile_notice, kernel_laws
+    from vtool.solvers.backends import get
 
-    notice = compile_notice(spec.run.backend, kernel_laws(spec, impacts))
+    notice = get(spec.run.backend).compile_notice(spec, impacts)
     if notice:
         click.echo(notice, err=True)
     if csv:

@@ -42,9 +42,10 @@ class CountProgress:
                    "clearances[2].restitution) and its values: start:stop:step (stop included) or a,b,c. "
                    "Several --set make a grid.")
 @click.option("--find", "find", type=click.Choice(["jump-speed", "bounce-speed"]),
-              help="Bracket and bisect the cam speed (to 1 rev/min) where the follower first leaves the cam "
-                   f"(jump-speed) or the valve first bounces on its seat (bounce-speed); --set run.rpm gives "
-                   f"the scan (default {DEFAULT_SCAN}), other --set fields a grid of searches.")
+              help="Bracket and bisect (to 1 rev/min) every cam-speed interval where the follower leaves the "
+                   "cam during lift (jump-speed) or the valve bounces on its seat (bounce-speed), each run to "
+                   f"steady state; --set run.rpm gives the scan (default {DEFAULT_SCAN}), other --set fields a "
+                   "grid of searches.")
 @click.option("--workers", type=int, help="Local worker processes (default: all cores; 1 = in this process).")
 @click.option("--scheduler", help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
                                   "processes) or local-threads:N.")
@@ -156,6 +157,8 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
     """One speed search per grid point of the fields other than run.rpm."""
     from vtool.files import write_atomic
     from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.studies.metrics import Criteria
+    from vtool.solvers.studies.steady import steady_text, with_steady
     from vtool.solvers.studies.sweep import find_speed, format_value
 
     scan = sorted({dict(p.values)["run.rpm"] for p in plan.points})
@@ -166,6 +169,10 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
         searches.setdefault(key, point.spec)
     rows = []
     found = []
+    first = with_steady(plan.spec)
+    if not as_json:  # the answers come from steady state, by criteria with stated thresholds
+        click.echo(Criteria.of(first).text(first.unit_system.length))
+        click.echo(steady_text(first))
     for key, spec in searches.items():
         if key and not as_json:
             click.echo(", ".join(f"{k} = {format_value(v)}" for k, v in key))
@@ -175,18 +182,24 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
                 click.echo(f"  {b.stage:<6} {b.rpm:>9g} rev/min  {'holds' if b.holds else 'no':<5}  "
                            f"({format_value(b.value)})")
 
-        result = find_speed(criterion, lambda rpm, spec=spec: with_run_overrides(spec, rpm=rpm), scan, runner,
-                            every_step=every_step, report=report)
+        result = find_speed(criterion, lambda rpm, spec=spec: with_steady(with_run_overrides(spec, rpm=rpm)),
+                            scan, runner, every_step=every_step, report=report)
         if not as_json:
+            for interval in result.intervals:
+                click.echo(f"  interval: {interval.text()}")
             click.echo(f"{criterion}: {result.message}")
         rows.append([format_value(v) for _, v in key] + [format_value(result.speed) if result.speed else "",
                                                          result.message])
         found.append(dict(key) | {criterion.replace("-", "_"): result.speed,
                                   f"{criterion.replace('-', '_')}_unit": "rev/min", "message": result.message,
                                   "history": [{"rpm": b.rpm, "holds": b.holds, "value": b.value, "stage": b.stage}
-                                              for b in result.history]})
+                                              for b in result.history],
+                                  "intervals": [{"low_rpm": i.low, "high_rpm": i.high, "below_rpm": i.below,
+                                                 "above_rpm": i.above} for i in result.intervals]})
     if as_json:
-        click.echo(json.dumps({"preset": plan.spec.title, "criterion": criterion, "searches": found}, indent=2))
+        click.echo(json.dumps({"preset": plan.spec.title, "criterion": criterion,
+                               "criteria": Criteria.of(first).as_dict(first.unit_system.length),
+                               "evaluation": steady_text(first), "searches": found}, indent=2))
     if csv_path is not None:
         header = [f"{f} ({u})" if u else f for f, u in others] + [f"{criterion.replace('-', '_')} (rev/min)",
                                                                   "message"]

@@ -15,22 +15,24 @@ from textual.binding import Binding, BindingType
 from textual.screen import ModalScreen
 
 from vtool.app.tui.base import DomainScreen
-from vtool.app.tui.boom import BoomScreen
 from vtool.app.tui.dialogs import ErrorDialog, HelpScreen, OpenDialog
-from vtool.app.tui.plate import PlateScreen
 from vtool.app.tui.recent import RecentFiles, default_path
-from vtool.app.tui.valvetrain import ValveTrainScreen
 from vtool.errors import InputError, RunError
 from vtool.files import is_file
+from vtool.presets.kinds import KINDS, kind_named, resolve
 
-SCREENS_BY_MODE = {screen.MODE: screen for screen in (ValveTrainScreen, BoomScreen, PlateScreen)}
+
+def screen_for_kind(kind: str) -> type[DomainScreen]:
+    """The screen that shows presets of ``kind`` (the kinds table's screen module)."""
+    return resolve(kind_named(kind).screen).SCREEN  # type: ignore[no-any-return]  # a module's SCREEN class
+
+
+#: the app's modes (one per screen, several kinds may share one), in the kinds table's order
+SCREENS_BY_MODE: dict[str, type[DomainScreen]] = {screen_for_kind(kind).MODE: screen_for_kind(kind) for kind in KINDS}
 
 
 def mode_for_kind(kind: str) -> str:
-    for mode, screen in SCREENS_BY_MODE.items():
-        if kind in screen.KINDS:
-            return mode
-    raise InputError("kind", kind, f"one of: {', '.join(k for s in SCREENS_BY_MODE.values() for k in s.KINDS)}")
+    return screen_for_kind(kind).MODE
 
 
 class VtoolApp(App[None]):

@@ -48,6 +48,7 @@ from vtool.app.tui.form import Field, ParamForm
 from vtool.app.tui.messages import FieldEdited, RunProgressed
 from vtool.app.tui.widgets import KeyFooter
 from vtool.errors import InputError
+from vtool.presets import kind_of, loader_for
 
 PROGRESS_INTERVAL = 0.05  # s between progress messages: the bar needs no more
 NARROW = 120  # columns below which a finished run hides the form
@@ -97,9 +98,8 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         Binding("ctrl+t", "next_tab", "Tab", priority=True),
     ]
 
-    #: mode name in the app, preset kinds this screen takes, and its default preset
+    #: mode name in the app and its default preset (the kinds it shows: vtool.presets.kinds.KINDS)
     MODE: ClassVar[str] = ""
-    KINDS: ClassVar[tuple[str, ...]] = ()
     DEFAULT_PRESET: ClassVar[str] = ""
     TITLE_TEXT: ClassVar[str] = ""
 
@@ -184,9 +184,9 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
         self.progress.set_class(running, "-running")
 
     # ----- what a domain screen provides -----
-    @abstractmethod
     def loader(self) -> Any:
-        """The preset module (``load(doc)``, ``dump(spec)``) of this screen's kind."""
+        """The preset module (``load(doc)``, ``dump(spec)``) of the shown preset's kind (the kinds table's)."""
+        return loader_for(kind_of(self.base_doc))
 
     @abstractmethod
     def fields_for(self, spec: Any, doc: dict[str, Any]) -> list[Field]:
@@ -233,7 +233,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             self.worker.cancel()
         self.source = source
         self.on_source_changed(source)
-        self.base_doc = self.loader().dump(spec)
+        self.base_doc = loader_for(spec.kind).dump(spec)
         self.loaded_doc = self.loader().dump(spec)
         self.spec = spec
         self.problem = None

@@ -148,7 +148,6 @@ def daf_curves(spec: Any, assessment: Any, cancel: Any = None) -> dict[str, Any]
 
 class BoomScreen(DomainScreen):
     MODE = "boom"
-    KINDS = ("boom_wall", "boom_floor")
     DEFAULT_PRESET = "boom-brick-wall"
     TITLE_TEXT = "SONIC BOOM"
 
@@ -173,11 +172,6 @@ class BoomScreen(DomainScreen):
     @property
     def design_charts(self) -> list[ChartView]:
         return list(self.query_one("#design-charts").query(ChartView))
-
-    def loader(self) -> Any:
-        from vtool.presets import boom
-
-        return boom
 
     def fields_for(self, spec: Any, doc: dict[str, Any]) -> list[Field]:
         return boom_fields(spec, doc)
@@ -272,3 +266,7 @@ class BoomScreen(DomainScreen):
         from vtool.files import write_atomic
 
         write_atomic(path, limits_csv(self.results))
+
+
+#: this module's screen, named by the kinds table (vtool.presets.kinds.KINDS)
+SCREEN = BoomScreen

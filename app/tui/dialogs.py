@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from rich.text import Text
+from textual import events
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical, VerticalScroll
@@ -41,7 +42,11 @@ class ErrorDialog(ModalScreen[None]):
 
 
 class OpenDialog(ModalScreen[str | None]):
-    """Pick a shipped or recently used preset, or type a path."""
+    """Pick a shipped or recently used preset, or type a path.
+
+    The list has the focus (arrows and enter pick a preset); typing or pasting goes to the path
+    field whatever has the focus, so enter then opens the typed path, not the highlighted preset.
+    """
 
     BINDINGS = [Binding("escape", "cancel", "Cancel")]
 
@@ -52,7 +57,8 @@ class OpenDialog(ModalScreen[str | None]):
 
     def compose(self) -> ComposeResult:
         with Vertical(id="open-dialog", classes="dialog"):
-            yield Label("Open preset (enter: load, esc: cancel)", classes="dialog-title")
+            yield Label("Open preset: pick one (arrows) or type a path; enter: load, esc: cancel",
+                        classes="dialog-title")
             options: list[Option | None] = []
             if self.recent:
                 options.append(Option(Text("recent", style="bold"), disabled=True))
@@ -62,7 +68,8 @@ class OpenDialog(ModalScreen[str | None]):
                 line = f"{name:<19}{kind:<11}{title}"
                 options.append(Option(line if len(line) <= 68 else line[:67] + "…", id=f"name:{name}"))
             yield OptionList(*options, id="open-list")
-            yield Input(placeholder="or a path to a .toml preset", id="open-path")
+            # not select_on_focus: the key that moves the focus here is its first character
+            yield Input(placeholder="or a path to a .toml preset", id="open-path", select_on_focus=False)
 
     def on_mount(self) -> None:
         option_list = self.query_one(OptionList)
@@ -71,6 +78,24 @@ class OpenDialog(ModalScreen[str | None]):
             if not option_list.get_option_at_index(index).disabled:
                 option_list.highlighted = index
                 break
+
+    @property
+    def path_input(self) -> Input:
+        return self.query_one("#open-path", Input)
+
+    def on_key(self, event: events.Key) -> None:
+        """A printable key outside the path field starts typing a path there."""
+        if event.is_printable and event.character and self.focused is not self.path_input:
+            event.stop()
+            event.prevent_default()
+            self.path_input.focus()
+            self.path_input.insert_text_at_cursor(event.character)
+
+    def on_paste(self, event: events.Paste) -> None:
+        if self.focused is not self.path_input:
+            event.stop()
+            self.path_input.focus()
+            self.path_input.insert_text_at_cursor(event.text)
 
     def on_option_list_option_selected(self, event: OptionList.OptionSelected) -> None:
         event.stop()

@@ -192,8 +192,9 @@ class FieldRow(Widget):
             value = self.initial if self.initial in f.choices else f.choices[0]
             yield ChoiceSelect(options, value=value, allow_blank=False, compact=True, id=f"{f.widget_id}-editor")
         else:
-            yield Input(format_value(self.initial), compact=True, id=f"{f.widget_id}-editor",
-                        select_on_focus=False)
+            # select_on_focus: a field reached by the keyboard has its value selected, so typing replaces
+            # it (as in a spreadsheet); a click or an arrow key places the cursor to edit in place
+            yield Input(format_value(self.initial), compact=True, id=f"{f.widget_id}-editor")
 
     @property
     def label_text(self) -> str:

@@ -194,7 +194,6 @@ def case_text(run: PlateRun) -> str:
 
 class PlateScreen(DomainScreen):
     MODE = "plate"
-    KINDS = ("plate",)
     DEFAULT_PRESET = "plate-table2"
     TITLE_TEXT = "PLATE (condensation)"
 
@@ -219,11 +218,6 @@ class PlateScreen(DomainScreen):
 
     def chart(self, quantity: str) -> ChartView:
         return self.query_one(f"#{quantity}-chart", ChartView)
-
-    def loader(self) -> Any:
-        from vtool.presets import plate
-
-        return plate
 
     async def load_spec(self, spec: Any, source: str) -> None:
         self.options = run_defaults(spec)
@@ -312,7 +306,8 @@ class PlateScreen(DomainScreen):
         for element in dict.fromkeys(cases[f.case].element for f in study.free):
             free = [f for f in study.free if cases[f.case].element == element]
             tables.append(frequency_table(free, cases, f"{ELEMENT_TITLES.get(element, element)}: "
-                                                       "percentage errors of the lowest natural frequencies"))
+                                                       "percentage errors of the lowest natural frequencies",
+                                          masters_last=True))
         self.query_one("#frequencies", TextPanel).set_text("\n\n".join(tables))
         self.query_one("#case-text", TextPanel).set_text(case_text(run))
         self.query_one("#study-text", TextPanel).set_text(study_text(study))
@@ -326,3 +321,7 @@ class PlateScreen(DomainScreen):
         from vtool.files import write_atomic
 
         write_atomic(path, study_csv(self.results.study))
+
+
+#: this module's screen, named by the kinds table (vtool.presets.kinds.KINDS)
+SCREEN = PlateScreen

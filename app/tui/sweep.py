@@ -2,16 +2,31 @@
 
 ``SweepPane(preset)`` is mounted as a tab on the valve-train screen (or in any
 App). The user picks a field (dotted preset path), its values
-(``start:stop:step`` or ``a,b,c``) and a metric, and presses *Run*: the
-points are validated like a preset (an error is shown on the status line and
-nothing runs), then evaluated in a thread worker that posts
-:class:`SweepProgressed` (collapsing) and :class:`SweepFinished`. *Cancel*
-stops between points and keeps what finished; *Export CSV* writes the
-results atomically (same bytes as ``vtool sweep --csv``).
+(``start:stop:step`` or ``a,b,c``) and a metric, and presses *Run*. Everything
+after that happens in a thread worker, so the screen stays live however large
+the grid: the points are first validated like a preset (about 10 ms a point;
+the bar counts them, and an error is shown on the status line and nothing
+runs), then evaluated; the worker posts :class:`SweepProgressed` (collapsing)
+and :class:`SweepFinished`. *Cancel* stops between points, while checking or
+running, and keeps what finished; *Export CSV* writes the results atomically
+(same bytes as ``vtool sweep --csv``).
+
+With several workers the points run on a process pool. Textual replaces
+``sys.stderr`` with a stream that has no file descriptor, and multiprocessing
+hands ``sys.stderr``'s descriptor to the helper process it starts with a
+process's first pool ("bad value(s) in fds_to_keep"): the pool is made with
+an explicit stream (:func:`descriptor_stderr`), and its workers write their
+standard error to os.devnull, not over Textual's screen.
 """
 
 from __future__ import annotations
 
+import math
+import os
+import sys
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -30,25 +45,57 @@ DEFAULT_METRICS = ("spring_margin", "cam_separation_duration", "cam_separations"
                    "events", "wall_time")
 
 
-class SweepProgressed(Message):
-    """``done`` of ``total`` points are finished."""
+_STDERR_LOCK = threading.Lock()
 
-    def __init__(self, done: int, total: int) -> None:
+
+@contextmanager
+def descriptor_stderr() -> Iterator[None]:
+    """``sys.stderr`` a stream with a file descriptor (os.devnull) inside the block, when it has none.
+
+    For making a process pool under Textual (see the module doc). Outside an app
+    (a real ``sys.stderr``) nothing changes. Afterwards the replaced stream is put
+    back unless something else replaced ``sys.stderr`` meanwhile (the app ending).
+    """
+    try:
+        usable = sys.stderr is not None and sys.stderr.fileno() >= 0
+    except (AttributeError, OSError, ValueError):
+        usable = False
+    if usable:
+        yield
+        return
+    with _STDERR_LOCK, open(os.devnull, "w") as devnull:
+        replaced, sys.stderr = sys.stderr, devnull
+        try:
+            yield
+        finally:
+            if sys.stderr is devnull:
+                sys.stderr = replaced
+
+
+class SweepProgressed(Message):
+    """``done`` of ``total`` points are finished (``checking``: validated, before any runs)."""
+
+    def __init__(self, done: int, total: int, checking: bool = False) -> None:
         super().__init__()
         self.done = done
         self.total = total
+        self.checking = checking
 
     def can_replace(self, message: Message) -> bool:
         return isinstance(message, SweepProgressed)
 
 
 class SweepFinished(Message):
-    """The worker ended: ``outcome.complete`` is False when it was cancelled."""
+    """The worker ended: ``outcome.complete`` is False when it was cancelled; ``plan`` and ``outcome``
+    are None when it was cancelled while checking the points, and ``error`` is then the input error
+    that refused them, if any."""
 
-    def __init__(self, plan: Any, outcome: Any) -> None:
+    def __init__(self, plan: Any, outcome: Any, error: str | None = None, checked: int = 0) -> None:
         super().__init__()
         self.plan = plan
         self.outcome = outcome
+        self.error = error
+        self.checked = checked
 
 
 class SweepPane(Widget):
@@ -146,29 +193,42 @@ class SweepPane(Widget):
         return self.worker is not None and self.worker.state in (WorkerState.PENDING, WorkerState.RUNNING)
 
     # ----- actions -----
-    def run_sweep(self) -> None:
-        """Validate the inputs (errors on the status line) and start the worker."""
-        from vtool.errors import InputError
-        from vtool.presets.paths import plan_sweep
-
+    def assignments(self) -> list[str]:
+        """The inputs as ``vtool sweep --set`` assignments: the swept field, then the fixed settings."""
         sets = [f"{self._input('field').value.strip()}={self._input('values').value.strip()}"]
-        sets += [s.strip() for s in self._input("fixed").value.split(";") if s.strip()]
-        try:
-            plan = plan_sweep(self.preset, sets)
-        except InputError as exc:
-            self.status.update(f"error: {exc.one_line()}")
-            return
-        self.plan = plan
-        self.query_one("#sweep-progress", ProgressBar).update(total=len(plan.points), progress=0)
-        self.status.update(f"running {len(plan.points)} points ...")
-        self.worker = self._work(plan)
+        return sets + [s.strip() for s in self._input("fixed").value.split(";") if s.strip()]
+
+    def run_sweep(self) -> None:
+        """Start the worker: it checks every point (errors on the status line), then runs them."""
+        self.plan = None
+        self.query_one("#sweep-progress", ProgressBar).update(total=None, progress=0)
+        self.status.update("checking the points ... (Cancel stops)")
+        self.worker = self._work(self.preset, self.assignments())
 
     @work(thread=True, exclusive=True, exit_on_error=False, group="sweep")
-    def _work(self, plan: Any) -> None:
+    def _work(self, preset: str, sets: list[str]) -> None:
+        from vtool.errors import InputError
+        from vtool.presets.paths import SweepCancelled, plan_sweep
         from vtool.solvers.studies.sweep import make_runner, run_points
 
         worker = get_current_worker()
-        runner = make_runner(self.sweep_workers)
+        checked = [0]
+
+        def check_progress(done: int, total: int) -> None:
+            checked[0] = done
+            self.post_message(SweepProgressed(done, total, checking=True))
+
+        try:
+            plan = plan_sweep(preset, sets, progress=check_progress, cancel=lambda: worker.is_cancelled)
+        except InputError as exc:
+            self.post_message(SweepFinished(None, None, error=exc.one_line()))
+            return
+        except SweepCancelled:
+            self.post_message(SweepFinished(None, None, checked=checked[0]))
+            return
+        self.post_message(SweepProgressed(0, len(plan.points)))
+        with descriptor_stderr():  # the pool's helper processes start here
+            runner = make_runner(self.sweep_workers, stderr=os.devnull)
         try:
             outcome = run_points(plan.points, runner, progress=lambda d, t: self.post_message(SweepProgressed(d, t)),
                                  cancel=lambda: worker.is_cancelled)
@@ -216,8 +276,17 @@ class SweepPane(Widget):
 
     def on_sweep_progressed(self, message: SweepProgressed) -> None:
         self.query_one("#sweep-progress", ProgressBar).update(total=message.total, progress=message.done)
+        if message.checking and message.done == 1:
+            self.status.update(f"checking {message.total} points ... (Cancel stops)")
+        elif not message.checking and message.done == 0:
+            self.status.update(f"running {message.total} points ...")
 
     def on_sweep_finished(self, message: SweepFinished) -> None:
+        if message.outcome is None:  # refused or stopped before any point ran
+            self.status.update(f"error: {message.error}" if message.error else
+                               f"stopped while checking the points ({message.checked} checked): nothing ran")
+            return
+        self.plan = message.plan
         self.outcome = message.outcome
         done = len(message.outcome.results)
         state = "finished" if message.outcome.complete else "stopped"
@@ -241,7 +310,10 @@ class SweepPane(Widget):
             self.chart.plot(None)
             return
         axes = [f for f in plan.fields if len({dict(r.values)[f[0]] for r in results}) > 1]
-        if not axes:
+        values = [r.metrics.get(metric) for r in results]
+        if not axes or not any(isinstance(v, int | float) and math.isfinite(v) for v in values):
+            self.chart.placeholder = (f"no point has a value of {metric}" if axes else
+                                      "a chart needs a swept field with two or more values")
             self.chart.plot(None)
             return
         from vtool.app.sweep_charts import metric_chart

@@ -118,7 +118,6 @@ def quantity_unit(spec: Any, quantity: str) -> str:
 
 class ValveTrainScreen(DomainScreen):
     MODE = "valvetrain"
-    KINDS = ("valvetrain",)
     DEFAULT_PRESET = "gnilka-1a"
     TITLE_TEXT = "VALVE TRAIN"
     # hidden from the footer (its keys are full at 80 columns); listed in the help and docs/tui.md
@@ -179,11 +178,6 @@ class ValveTrainScreen(DomainScreen):
         return self.results
 
     # ----- spec -----
-    def loader(self) -> Any:
-        from vtool.presets import valvetrain
-
-        return valvetrain
-
     def fields_for(self, spec: Any, doc: dict[str, Any]) -> list[Field]:
         return valvetrain_fields(spec, doc)
 
@@ -219,9 +213,9 @@ class ValveTrainScreen(DomainScreen):
         worker = get_current_worker()
 
         def announce() -> None:  # the input is checked: say so when a compile is to come, as the CLI does
-            from vtool.solvers.newmark.backend import compile_notice, kernel_laws
+            from vtool.solvers.backends import get
 
-            notice = compile_notice(spec.run.backend, kernel_laws(spec))
+            notice = get(spec.run.backend).compile_notice(spec)
             if notice is not None:
                 self.post_message(CompileAnnounced(run_id, notice))
 
@@ -308,3 +302,6 @@ class ValveTrainScreen(DomainScreen):
 
         self.app.push_screen(PathDialog("Save report (.pdf or .html) to", f"{Path(self.source).stem}-report.pdf"),
                              save)
+
+#: this module's screen, named by the kinds table (vtool.presets.kinds.KINDS)
+SCREEN = ValveTrainScreen

@@ -34,20 +34,31 @@ def case_description(case: Case) -> str:
     return f"{case.nx}x{case.ny} {text}{method}"
 
 
-def frequency_table(free: list[FreeVibration], cases: dict[str, Case], title: str) -> str:
-    """Thesis Table 2/3 layout: one row per case, errors of the lowest modes in %."""
+def frequency_table(free: list[FreeVibration], cases: dict[str, Case], title: str, *,
+                    masters_last: bool = False) -> str:
+    """Thesis Table 2/3 layout: one row per case, errors of the lowest modes in %.
+
+    ``masters_last``: the master-set description after the numbers (the TUI beside its
+    form: the errors stay in view, the description is what a narrow panel cuts).
+    """
     if not free:
         return ""
     modes: list[NavierMode] = max((f.exact for f in free), key=len)
-    head = f"{'case':<5} {'KS':>4}  {'masters':<52}" + "".join(f"{f'({m.m},{m.n})':>8}" for m in modes)
-    head += f"{'wmax/w11':>10}"
-    exact = f"{'':<5} {'':>4}  {'exact omega, rad/s':<52}" + "".join(f"{m.omega:>8.1f}" for m in modes)
-    lines = [title, head, exact, "-" * len(head)]
+    numbers = "".join(f"{f'({m.m},{m.n})':>8}" for m in modes) + f"{'wmax/w11':>10}"
+    table = [(f"{'case':<5} {'KS':>4}  ", "masters", numbers),
+             (f"{'':<5} {'':>4}  ", "exact omega, rad/s", "".join(f"{m.omega:>8.1f}" for m in modes))]
     for f in free:
-        desc = case_description(cases[f.case])[:52]
         errs = "".join(_pct(e) for e in f.errors_pct) + " " * 8 * (len(modes) - len(f.errors_pct))
-        lines.append(f"{f.case:<5} {f.size:>4}  {desc:<52}{errs}{f.omega_max_ratio:>10.1f}")
-    lines.append("errors: (approximate - exact)/exact x 100 % (eq. 40), k-th lowest against k-th lowest")
+        table.append((f"{f.case:<5} {f.size:>4}  ", case_description(cases[f.case])[:52],
+                      f"{errs}{f.omega_max_ratio:>10.1f}"))
+    if masters_last:
+        lines = [start + f"{numbers:<{len(table[0][2])}}  " + text for start, text, numbers in table]
+        rule = "-" * len(table[0][0] + table[0][2])
+    else:
+        lines = [start + f"{text:<52}" + numbers for start, text, numbers in table]
+        rule = "-" * len(lines[0])
+    lines = [title, lines[0], lines[1], rule, *lines[2:],
+             "errors: (approximate - exact)/exact x 100 % (eq. 40), k-th lowest against k-th lowest"]
     return "\n".join(lines)
 
 

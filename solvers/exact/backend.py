@@ -73,6 +73,7 @@ class ExactBackend(PiecewiseBackend):
     """Piecewise-exact back end (see module doc). Registered as ``exact``."""
 
     name = "exact"
+    reference = True
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> ExactOptions:

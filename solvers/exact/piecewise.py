@@ -36,7 +36,7 @@ from vtool.solvers.exact.statespace import StateSpace, from_layer
 from vtool.solvers.model.contact import ContactProblem, OrderedLayer
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.sources import SourceSeries
-from vtool.solvers.model.spec import HERTZ
+from vtool.solvers.model.spec import HERTZ, MechanismSpec
 from vtool.solvers.newmark import build as kernel_build
 from vtool.solvers.newmark import layout
 from vtool.solvers.trace import OPENED, TraceBuilder
@@ -388,6 +388,13 @@ class PiecewiseBackend(Backend):
     """A back end whose run is a :class:`PiecewiseRun` subclass (``run_class``)."""
 
     run_class: type[PiecewiseRun]
+
+    @classmethod
+    def compile_notice(cls, spec: MechanismSpec, impacts: tuple[str, ...] = ()) -> str | None:
+        """The event rules' compile (``impact``, ``settle``, ``fill_sources``), called from Python."""
+        from vtool.solvers.newmark.backend import compile_notice, kernel_laws
+
+        return compile_notice(cls.name, kernel_laws(spec, impacts))
 
     def integrate(self, problem: ContactProblem, options: Any, builder: TraceBuilder,
                   progress: Progress | None, cancel: Cancel | None) -> dict[str, Any]:

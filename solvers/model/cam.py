@@ -27,8 +27,14 @@ smooth table change by O(h) from sample to sample; a jump J changes them by
 about J within one or two samples, standing out against its neighbours (a
 jump is flagged above 2 % of the table's 90th-percentile |acceleration| and
 3 times the change two samples either side). A kink in the lift (a velocity
-jump) shows as a spike: up then down at one sample. Tables are assumed
-smooth between junctions: lifts rounded to few digits can raise false flags.
+jump) shows as a spike: up then down at one sample. A coarse table (a few
+points per lobe) changes by O(1) from sample to sample even where it is
+smooth, so a flagged change must also survive in the table less its fit of
+(n - 1) // 4 harmonics (half of what n points fix, so at least four samples
+per wavelength): a smooth table, such as a 7-point sine, is such a series and
+leaves nothing, while a jump is wider in frequency than any fit that the
+samples resolve and stays. Tables are assumed smooth between junctions:
+lifts rounded to few digits can raise false flags.
 """
 
 from __future__ import annotations
@@ -271,6 +277,11 @@ def acceleration_jumps(angles_deg: np.ndarray, lifts: np.ndarray) -> list[Juncti
         return []
     neighbours = np.maximum(np.roll(size, 2), np.roll(size, -2))
     flagged = (size > JUMP_FRACTION * scale) & (size > JUMP_ISOLATION * neighbours)
+    if flagged.any():  # a flag must not be explained by a series the samples resolve (module doc)
+        smooth = fit_table(theta, lifts, max(1, max_harmonics(n) // 2))
+        rough = table_acceleration(theta, _residual(np.radians(theta), np.asarray(lifts, dtype=float),
+                                                    smooth.c0, smooth.a, smooth.b))
+        rough_size = np.abs(np.roll(rough, -1) - rough)
     junctions = []
     done: set[int] = set()
     for i in np.nonzero(flagged)[0]:
@@ -283,6 +294,8 @@ def acceleration_jumps(angles_deg: np.ndarray, lifts: np.ndarray) -> list[Juncti
             if np.sign(change[(i + 1) % n]) != np.sign(change[i]):
                 kind = "velocity"  # an isolated spike: the slope itself jumps at the shared sample
         done.update(group)
+        if rough_size[group].max() <= JUMP_FRACTION * scale:
+            continue
         first = group[0]
         before, after = acc[(first - 1) % n], acc[(group[-1] + 2) % n]  # just outside the stencils
         step = theta[(first + 1) % n] - theta[first]
@@ -325,7 +338,7 @@ def cam_report(spec, points: int = 3600, top: int = 8) -> dict:  # type: ignore[
     units = spec.unit_system
     cam = spec.cam
     fit = cam_fit(cam)
-    omega = spec.run.rpm * math.pi / 30.0
+    omega = spec.run.omega
     theta = np.linspace(0.0, 2 * math.pi, points, endpoint=False)
     L, v, acc, jerk = derivatives(fit.c0, fit.a, fit.b, theta)
     lift_amplitude, acc_amplitude = spectrum(fit.a, fit.b)

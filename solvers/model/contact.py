@@ -43,6 +43,7 @@ from vtool.solvers.model.configurations import (
     partition,
     sources,
 )
+from vtool.solvers.model.hertz import kernel_restitution
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.sources import SourceSeries
 from vtool.solvers.model.spec import (
@@ -320,7 +321,7 @@ class ContactProblem:
         self.spec = spec
         self.rules = rules
         self.n, self.ncl = spec.n_coordinates, len(spec.clearances)
-        self.tables = mechanism.configuration_tables()
+        self.tables = mechanism.shared(ConfigurationTables, lambda: ConfigurationTables(mechanism))
         self.series = source_series(mechanism)
         self.ns, self.nh = self.series.n_sources, self.series.n_harmonics
         self.source_numbers = self.series.numbers
@@ -331,7 +332,9 @@ class ContactProblem:
                      self.series.index(c.behind) if c.behind > self.n else -1,
                      int(c.state == ENABLED), int(c.state == PINNED), clearance_bit(spec, k),
                      LAW_CODES[spec.impact_law(c)], SOFT_CODES[c.contact])
-            clf[k, :layout.CLF_HV] = (c.restitution, spec.contact.rocker_scale, c.contact_stiffness,
+            # a Hertz contact's slot holds the e' whose a = 3(1 - e')/2 rebounds at c.restitution (hertz.py)
+            restitution = kernel_restitution(c.restitution) if c.contact == HERTZ else c.restitution
+            clf[k, :layout.CLF_HV] = (restitution, spec.contact.rocker_scale, c.contact_stiffness,
                                       c.contact_exponent)
         self.cl, self.clf = cl, clf
         self.hertz, self.momentum = layout.laws(cl)  # the kernel's law switches
@@ -356,6 +359,8 @@ class ContactProblem:
         kept = mechanism.kept(("contact problem", mechanism.omega, rules), lambda: cls(mechanism, rules))
         problem = copy.copy(kept)
         problem.mechanism, problem.spec, problem.clf = mechanism, mechanism.spec, kept.clf.copy()
+        if mechanism.start_mask is not None:  # a carried start (Mechanism.with_start)
+            problem.start_mask = mechanism.start_mask
         return problem
 
     def velocity_scale(self) -> float:

@@ -80,6 +80,12 @@ def check_open_gaps(spec: MechanismSpec, q: np.ndarray) -> None:
             continue
         ahead = q[c.ahead - 1]
         if spec.seat is not None and c.behind == spec.seat.coordinate:
+            if ahead - spec.seat.position < -1e-12 * max(abs(ahead), 1.0) and spec.seat.lash is not None:
+                raise InputError("seat.lash", spec.seat.lash,
+                                 f"a lash below the cam's lift at angle 0, where the run starts with "
+                                 f"{', '.join(spec.initial.closed)} closed (initial.closed) and the valve off its "
+                                 f"seat (a lift table that starts on the base circle: rotate it so that angle 0 "
+                                 f"is on the lift event)", length)
             if ahead - spec.seat.position < -1e-12 * max(abs(ahead), 1.0):
                 raise InputError("seat.position", spec.seat.position,
                                  f"<= {ahead:.6g} (where the static start puts q{c.ahead}; the run would "

@@ -9,7 +9,6 @@ pinned clearance never produces a layer in which it is open.
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Callable, Hashable
 from functools import cached_property
 from typing import Any, TypeVar
@@ -34,14 +33,15 @@ class Mechanism:
 
     def __init__(self, spec: MechanismSpec, _shared: Mechanism | None = None) -> None:
         self.spec = spec
+        self.start_mask: int | None = None  # a carried start's configuration (with_start); None: the preset's
         if _shared is None:
             self.M, self.K = assemble_full(spec)
             self._layers: dict[frozenset[str], Layer] = {}
-            self._tables: list = []  # the speed-independent configuration tables, made on demand
+            self._lasting: dict[Hashable, Any] = {}  # speed-independent values, made on demand (see shared)
             # what a run derives from the mechanism and its cam speed alone (see kept)
             self._derived: dict[Any, Any] = {}
         else:  # the same mechanism run with other run settings: share what does not depend on them
-            self.M, self.K, self._layers, self._tables = _shared.M, _shared.K, _shared._layers, _shared._tables
+            self.M, self.K, self._layers, self._lasting = _shared.M, _shared.K, _shared._layers, _shared._lasting
             self._derived = _shared._derived
             if "highest_frequency" in _shared.__dict__:
                 self.__dict__["highest_frequency"] = _shared.highest_frequency
@@ -54,13 +54,28 @@ class Mechanism:
         """This mechanism for ``spec``, a spec equal to its own but for the run settings (not checked)."""
         return Mechanism(spec, _shared=self)
 
-    def configuration_tables(self):  # type: ignore[no-untyped-def]
-        """The configuration tables of :mod:`vtool.solvers.model.contact`, shared by every run of this mechanism."""
-        if not self._tables:
-            from vtool.solvers.model.contact import ConfigurationTables
+    def shared(self, key: Hashable, make: Callable[[], T]) -> T:
+        """``make()``, made once for this mechanism and every one :meth:`with_run` gives, and never
+        forgotten: for what depends on the mechanism alone, not on the run settings (the configuration
+        tables of :mod:`vtool.solvers.model.contact`). Unlike :meth:`kept`, it is not bounded: a caller
+        keeps one value per key, not one per cam speed."""
+        if key not in self._lasting:
+            self._lasting[key] = make()
+        return self._lasting[key]  # type: ignore[no-any-return]  # the value make() returned for this key
 
-            self._tables.append(ConfigurationTables(self))
-        return self._tables[0]
+    def with_start(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, mask: int) -> Mechanism:
+        """This mechanism started from a given state (full elastic coordinates, cam angle zero) in
+        configuration ``mask`` instead of its static start: the next cam cycle of a run, whose state at
+        the cycle's end it is (the cam is periodic in 360 deg). The cam's offset and the force scales
+        stay the static start's, so the sources and tolerances are those of the first cycle. Every back
+        end starts from ``start`` and the contact problem's start mask (see ContactProblem.for_run)."""
+        static = self.start
+        other = Mechanism(self.spec, _shared=self)
+        other.__dict__["start"] = StaticStart(static.cam_offset, static.follower_force, static.follower_stiffness,
+                                              np.array(q, dtype=float), np.array(qd, dtype=float),
+                                              np.array(qdd, dtype=float))
+        other.start_mask = int(mask)
+        return other
 
     @cached_property
     def highest_frequency(self) -> float:
@@ -79,7 +94,7 @@ class Mechanism:
     @property
     def omega(self) -> float:
         """Cam speed in rad/s."""
-        return self.spec.run.rpm * math.pi / 30.0
+        return self.spec.run.omega
 
     def layer(self, closed: frozenset[str] | set[str] | tuple[str, ...]) -> Layer:
         """The layer with these internal clearances closed (pinned ones always are)."""

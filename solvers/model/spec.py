@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from vtool.solvers.model.units import UNIT_SYSTEMS, UnitSystem
+from vtool.units import cam_speed
 
 BAR = "bar"
 BEAM = "beam"
@@ -116,10 +117,14 @@ class ClearanceSpec:
     A linear contact acts while the parts overlap (Kelvin–Voigt): near the
     end of a contact its dashpot may pull (F < 0), a known property of the
     model; the overlap, not the force, decides when the contact ends.
-    ``hertz``: F = k δⁿ (1 + 3(1 - e)/2 · δ̇/v⁻), n = ``contact_exponent``,
-    with the Hunt–Crossley damping of the clearance's restitution e at the
-    approach velocity v⁻ of the contact's closing; it never pulls. Nonlinear:
-    the Newmark back end iterates, scipy integrates it, exact refuses it.
+    ``hertz``: F = k δⁿ (1 + a δ̇/v⁻), n = ``contact_exponent``, with
+    Hunt–Crossley damping at the approach velocity v⁻ of the contact's
+    closing; it never pulls. ``restitution`` is the rebound of a lone mass:
+    a is the root of a (1 + e) = ln((1 + a)/(1 - a e)), exact for any n
+    (:mod:`vtool.solvers.model.hertz`; Hunt and Crossley's 3(1 - e)/2 is its
+    expansion near e = 1), and a Hertz contact takes 0.01 <= e <= 1 (e = 0
+    would need infinite damping). Nonlinear: the Newmark back end iterates,
+    scipy integrates it, exact refuses it.
     """
 
     name: str
@@ -239,6 +244,11 @@ class DampingSpec:
         return LayerDampingSpec(tuple(sorted(closed)), self.default_ratio)
 
 
+#: The back end a run uses when its settings name none (the registry's default,
+#: :data:`vtool.solvers.backends.DEFAULT`; the one place outside the registry a back end is named).
+DEFAULT_BACKEND = "newmark"
+
+
 @dataclass(frozen=True)
 class RunSpec:
     """Run settings: cam speed, length of run, time step, back end, output."""
@@ -246,11 +256,105 @@ class RunSpec:
     rpm: float
     degrees: float
     time_step: float
-    backend: str = "newmark"
+    backend: str = DEFAULT_BACKEND
     output_interval: float = 1.0  # degrees of cam rotation between output rows
     beta: float = 1.0 / 6.0
     gamma: float = 0.5
     quantities: tuple[str, ...] = ()  # extra CSV/plot columns: "q7", "q1-q9", "F2"
+    # cycle by cycle (vtool.solvers.studies.steady): a fixed number of cam cycles (0: run ``degrees``), or
+    # until the cycle's start state and metrics change by less than steady_tolerance (0: off), at most
+    # steady_max_cycles; ``degrees`` is then unused
+    cycles: int = 0
+    steady_tolerance: float = 0.0
+    steady_max_cycles: int = 0
+    # speed criteria (vtool.solvers.studies.metrics): the follower leaves the cam when the cam contact is
+    # open during the lift event for more than jump_angle (deg) with a gap above jump_gap (length); the
+    # valve bounces when it re-opens after seating by more than bounce_lift (length); None: the default
+    # share of the cam's lift (metrics.GAP_FRACTION)
+    jump_angle: float = 1.0
+    jump_gap: float | None = None
+    bounce_lift: float | None = None
+
+    @property
+    def omega(self) -> float:
+        """Cam speed in rad/s (:func:`vtool.units.cam_speed`)."""
+        return cam_speed(self.rpm)
+
+
+#: Follower kinds and arrangements (see :mod:`vtool.solvers.model.camshape`).
+FLAT = "flat"
+ROLLER = "roller"
+FOLLOWER_KINDS = (FLAT, ROLLER)
+TRANSLATING = "translating"
+FINGER = "finger"
+ARRANGEMENTS = (TRANSLATING, FINGER)
+
+
+@dataclass(frozen=True)
+class FingerSpec:
+    """An end-pivot (type II) finger follower's geometry, at the base circle.
+
+    In the finger's plane, x along the finger from its pivot (the lash
+    adjuster's ball: :class:`MechanismSpec` keeps it a named coordinate), y
+    downwards (the valve's opening direction). The roller centre is at
+    (``roller_arm``, -``roller_height``), the valve pad's centre at
+    (``valve_arm``, 0); the valve axis is vertical through the pad; the cam
+    centre is above the roller, ``cam_offset`` further along x than the roller
+    centre. The cam turns so that its surface at the roller runs from the
+    valve end towards the pivot (positive sense of this y-down frame).
+    """
+
+    roller_arm: float
+    valve_arm: float
+    roller_height: float = 0.0
+    cam_offset: float = 0.0
+
+
+@dataclass(frozen=True)
+class OilSpec:
+    """The oil at the cam contact: dynamic viscosity (Pa s) and pressure-viscosity coefficient (1/Pa)."""
+
+    viscosity: float
+    pressure_viscosity: float
+
+
+@dataclass(frozen=True)
+class FollowerSpec:
+    """The cam's follower: its geometry gives the cam's shape and the contact stress.
+
+    ``kind``: ``flat`` (a flat face, ``face_diameter`` wide) or ``roller``
+    (``roller_radius``). ``arrangement``: ``translating`` (the follower moves
+    along a line through the cam centre: bucket, tappet, roller lifter) or
+    ``finger`` (:class:`FingerSpec`, roller only). ``base_radius`` is the cam's
+    base-circle radius (profile, not pitch curve), ``width`` the contact
+    length of the line contact. ``lift`` is the lift law at the cam when it
+    is not the model's cam (a finger follower's: the model's cam coordinate
+    then moves as the geometric valve lift over the finger's nominal ratio,
+    see :func:`vtool.solvers.model.camshape.model_lift`). Moduli in the
+    preset's pressure unit.
+    """
+
+    kind: str
+    arrangement: str
+    base_radius: float
+    width: float
+    roller_radius: float = 0.0
+    face_diameter: float | None = None
+    cam_modulus: float = 0.0
+    cam_poisson: float = 0.3
+    follower_modulus: float = 0.0
+    follower_poisson: float = 0.3
+    finger: FingerSpec | None = None
+    lift: CamSpec | None = None
+    oil: OilSpec | None = None
+
+
+@dataclass(frozen=True)
+class CheckLimit:
+    """One limit of a preset's [checks] table (see :mod:`vtool.solvers.studies.checks`)."""
+
+    name: str
+    limit: float
 
 
 @dataclass(frozen=True)
@@ -270,7 +374,16 @@ class MechanismSpec:
     run: RunSpec
     notes: str = ""
     contact: ContactSpec = field(default_factory=ContactSpec)
+    follower: FollowerSpec | None = None  # cam shape and contact stress (presets' [follower] table)
+    checks: tuple[CheckLimit, ...] = ()  # limits signed off (presets' [checks] table)
     kind: str = field(default="valvetrain", init=False)
+
+    @property
+    def lift_law(self) -> CamSpec:
+        """The lift law at the cam: the follower's own when it has one, else the model's cam."""
+        if self.follower is not None and self.follower.lift is not None:
+            return self.follower.lift
+        return self.cam
 
     def impact_law(self, clearance: ClearanceSpec) -> str:
         """The impact law of a clearance: its own, or the mechanism's default."""

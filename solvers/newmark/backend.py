@@ -69,6 +69,7 @@ Method (see the kernel's docstring for the equations):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time as wallclock
 from dataclasses import dataclass
@@ -80,10 +81,10 @@ import numpy as np
 
 from vtool import compile_estimate, numba_cache
 from vtool.errors import InputError, RunError
-from vtool.solvers.backends import Backend, Cancel, Progress
+from vtool.solvers.backends import AccuracyKnobs, AccuracySetting, Backend, Cancel, Progress
 from vtool.solvers.model.contact import ContactProblem
 from vtool.solvers.model.mechanism import Mechanism
-from vtool.solvers.model.spec import HERTZ, MOMENTUM, RIGID, RunSpec
+from vtool.solvers.model.spec import HERTZ, MOMENTUM, RIGID, MechanismSpec, RunSpec
 from vtool.solvers.newmark import build as kernel_build
 from vtool.solvers.newmark import layout
 from vtool.solvers.newmark import native as kernel_native
@@ -108,6 +109,10 @@ def row_buffer(t_end: float, out_dt: float, every_step: bool) -> int:
     if every_step or not out_dt > 0.0:
         return ROW_BUFFER
     return int(min(ROW_BUFFER, t_end / out_dt + 3.0))
+
+
+#: The accuracy study's row of the thesis' own scheme (see NewmarkBackend.accuracy_settings).
+PLAIN_SETTING = "dt=1e-06 beta=1/6, no refinement (the thesis' scheme)"
 
 
 @dataclass(frozen=True)
@@ -214,10 +219,29 @@ class NewmarkBackend(Backend):
     """Newmark back end (see module doc). Registered as ``newmark``."""
 
     name = "newmark"
+    fixed_step = True
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> NewmarkOptions:
         return NewmarkOptions.from_run(run, every_step)
+
+    @classmethod
+    def stable_step(cls, mechanism: Mechanism) -> float:
+        run = mechanism.spec.run
+        return stability_limit(run.beta, run.gamma, highest_frequency(mechanism))
+
+    @classmethod
+    def compile_notice(cls, spec: MechanismSpec, impacts: tuple[str, ...] = ()) -> str | None:
+        return compile_notice(cls.name, kernel_laws(spec, impacts))
+
+    @classmethod
+    def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:
+        """Every step at every beta (with the default refinement after events), then the thesis' plain
+        scheme at 1 µs."""
+        settings = [AccuracySetting(f"dt={dt:.0e} beta={'1/6' if abs(beta - 1 / 6) < 1e-12 else '1/4'}",
+                                    dataclasses.replace(run, time_step=dt, beta=beta))
+                    for beta in knobs.betas for dt in knobs.time_steps]
+        return [*settings, AccuracySetting(PLAIN_SETTING, run, NewmarkOptions(1e-6, refine=1))]
 
     def check(self, mechanism: Mechanism, options: NewmarkOptions) -> None:
         check_settings(mechanism, options)

@@ -27,6 +27,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
 from vtool.errors import InputError, RunError
+from vtool.solvers.backends import AccuracyKnobs, AccuracySetting
 from vtool.solvers.exact.backend import peak_brackets
 from vtool.solvers.exact.piecewise import PiecewiseBackend, PiecewiseRun
 from vtool.solvers.exact.statespace import StateSpace
@@ -56,10 +57,16 @@ class ScipyBackend(PiecewiseBackend):
     """solve_ivp back end (see module doc). Registered as ``scipy``."""
 
     name = "scipy"
+    library_dependent = True
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> ScipyOptions:
         return ScipyOptions.from_run(run, every_step)
+
+    @classmethod
+    def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:
+        """DOP853 at every relative tolerance."""
+        return [AccuracySetting(f"DOP853 rtol={rtol:.0e}", run, ScipyOptions(rtol=rtol)) for rtol in knobs.rtols]
 
     def check(self, mechanism: Mechanism, options: ScipyOptions) -> None:
         if not 1e-14 <= options.rtol <= 1e-2:

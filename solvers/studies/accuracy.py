@@ -1,4 +1,10 @@
-"""The speed/accuracy trade, measured: every back end over its accuracy knob against ``exact``.
+"""The speed/accuracy trade, measured: every back end over its accuracy knob against the reference.
+
+The reference is the installed back end flagged ``reference`` (``exact``);
+every other back end is run at the settings it takes from the knobs
+(:meth:`vtool.solvers.backends.Backend.accuracy_settings`): steps and beta
+values for a fixed-step one, tolerances for an adaptive one. No back end is
+named here.
 
 For each setting the study records wall time, steps and events, and the
 error against the exact back end in
@@ -34,19 +40,17 @@ import numpy as np
 from vtool.errors import InputError, RunError
 from vtool.files import write_atomic
 from vtool.markdown import table as markdown_table
-from vtool.solvers.model.mechanism import assemble
+from vtool.solvers import backends
 from vtool.solvers.model.spec import EXTERNAL, MechanismSpec
-from vtool.solvers.newmark.backend import NewmarkBackend, NewmarkOptions
 from vtool.solvers.run import simulate
-from vtool.solvers.scipy.backend import ScipyBackend, ScipyOptions
 from vtool.solvers.studies.pairing import pair_events
 from vtool.solvers.trace import CLOSED, Trace
 
-NEWMARK_STEPS = (1e-4, 1e-5, 2e-6, 1e-6, 5e-7, 2e-7, 1e-7)
-NEWMARK_BETAS = (1 / 6, 1 / 4)
-SCIPY_RTOLS = (1e-4, 1e-6, 1e-8, 1e-9, 1e-10, 1e-11)
+#: The knobs swept by default: steps and beta values of fixed-step back ends, tolerances of adaptive ones.
+TIME_STEPS = (1e-4, 1e-5, 2e-6, 1e-6, 5e-7, 2e-7, 1e-7)  # s
+BETAS = (1 / 6, 1 / 4)
+RTOLS = (1e-4, 1e-6, 1e-8, 1e-9, 1e-10, 1e-11)
 RESOLUTION_DEG = 0.1  # smallest pairing window: bursts of contacts microseconds apart move as a whole
-PLAIN_SETTING = "dt=1e-06 beta=1/6, no refinement (the thesis' scheme)"
 
 
 @dataclass(frozen=True)
@@ -120,33 +124,33 @@ def compare(trace: Trace, reference: Trace, backend: str, setting: str, note: st
 
 def accuracy_study(
     spec: MechanismSpec,
-    newmark_steps: tuple[float, ...] = NEWMARK_STEPS,
-    newmark_betas: tuple[float, ...] = NEWMARK_BETAS,
-    scipy_rtols: tuple[float, ...] = SCIPY_RTOLS,
+    time_steps: tuple[float, ...] = TIME_STEPS,
+    betas: tuple[float, ...] = BETAS,
+    rtols: tuple[float, ...] = RTOLS,
 ) -> tuple[Trace, list[AccuracyRow]]:
-    """Run the exact reference, then every setting; return (reference, rows)."""
-    reference = simulate(with_run(spec, backend="exact"))
-    rows = [AccuracyRow("exact", "reference", reference.statistics.wall_time, reference.statistics.steps,
+    """Run the reference back end, then every other installed back end at each of its settings
+    (:meth:`~vtool.solvers.backends.Backend.accuracy_settings` from these knobs); return (reference, rows)."""
+    reference_name = backends.with_flag("reference")[0]
+    reference = simulate(with_run(spec, backend=reference_name))
+    rows = [AccuracyRow(reference_name, "reference", reference.statistics.wall_time, reference.statistics.steps,
                         reference.statistics.events, 0, 0.0, 0.0, 0.0, 0.0)]
-    for beta in newmark_betas:
-        for dt in newmark_steps:
-            setting = f"dt={dt:.0e} beta={'1/6' if abs(beta - 1 / 6) < 1e-12 else '1/4'}"
+    knobs = backends.AccuracyKnobs(time_steps, betas, rtols)
+    for name in backends.available():
+        backend = backends.get(name)
+        if backend.reference:
+            continue
+        for setting in backend.accuracy_settings(spec.run, knobs):
+            note = library_versions() if backend.library_dependent else setting.note
+            run = dataclasses.replace(setting.run, backend=name)
             try:
-                trace = simulate(with_run(spec, backend="newmark", time_step=dt, beta=beta))
+                trace = simulate(dataclasses.replace(spec, run=run), options=setting.options)
             except InputError as error:
-                rows.append(AccuracyRow("newmark", setting, note=f"refused: {error.expected}"))
+                rows.append(AccuracyRow(name, setting.label, note=f"refused: {error.expected}"))
                 continue
             except RunError as error:
-                rows.append(AccuracyRow("newmark", setting, note=f"failed: {error}"))
+                rows.append(AccuracyRow(name, setting.label, note=f"failed: {error}"))
                 continue
-            rows.append(compare(trace, reference, "newmark", setting))
-    mechanism = assemble(spec)
-    plain = NewmarkBackend().simulate(mechanism, NewmarkOptions(1e-6, refine=1))
-    rows.append(compare(plain, reference, "newmark", PLAIN_SETTING))
-    versions = library_versions()
-    for rtol in scipy_rtols:
-        trace = ScipyBackend().simulate(mechanism, ScipyOptions(rtol=rtol))
-        rows.append(compare(trace, reference, "scipy", f"DOP853 rtol={rtol:.0e}", versions))
+            rows.append(compare(trace, reference, name, setting.label, note))
     return reference, rows
 
 

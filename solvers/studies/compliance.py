@@ -68,8 +68,9 @@ def with_contacts(spec: MechanismSpec, stiffness: float | None, ratio: float = 1
     return dataclasses.replace(spec, clearances=clearances, contact=contact, run=run)
 
 
-def figures(spec: MechanismSpec, backend: str = "exact", time_step: float | None = None) -> Figures:
-    """Run the spec with a back end and read its first figures."""
+def figures(spec: MechanismSpec, backend: str | None = None, time_step: float | None = None) -> Figures:
+    """Run the spec with a back end (default: the registry's reference back end) and read its first figures."""
+    backend = backend or backends.with_flag("reference")[0]
     if time_step is not None:
         spec = dataclasses.replace(spec, run=dataclasses.replace(spec.run, time_step=time_step))
     mechanism = assemble(spec)
@@ -103,7 +104,7 @@ def step_needed(spec: MechanismSpec, reference: Figures) -> tuple[float | None, 
     """The largest step of :data:`STEPS` at which Newmark meets the tolerances against ``reference``."""
     for dt in STEPS:
         try:
-            found = figures(spec, "newmark", dt)
+            found = figures(spec, backends.with_flag("fixed_step")[0], dt)
         except InputError:  # beyond the stability limit
             continue
         if (abs(found.throw_off - reference.throw_off) <= ANGLE_TOLERANCE_DEG

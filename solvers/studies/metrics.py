@@ -1,27 +1,57 @@
 """Per-run metrics of a valve-train trace: the numbers a speed sweep reports.
 
 One function, :func:`run_metrics`, turns a :class:`~vtool.solvers.trace.Trace`
-into a flat, ordered dict of numbers; :func:`metric_columns` gives their names
-and units for a spec. ``vtool sweep`` reports them per point, and a single
-``vtool solve`` run gives the same numbers from the same trace. Definitions
-(also in docs/sweep.md); "after the first revolution" means cam angle
->= 360 deg to the end of the run, revolution k covering [360 k, 360 (k+1)):
+into a flat, ordered dict of numbers over one window of cam angle;
+:func:`metric_columns` gives their names and units for a spec. ``vtool solve``,
+``vtool sweep``, ``vtool compare``, ``vtool size`` and the TUI all evaluate the
+same window (:func:`evaluation_window`):
+
+* a run cycle by cycle (``run.cycles`` or ``run.steady``,
+  :mod:`vtool.solvers.studies.steady`): its last cycle, the settled one;
+* a plain run of ``degrees``: after the first revolution, cam angle 360 deg
+  to the end (the whole run if it is shorter than that), which is not a
+  steady state: :func:`window_text` says so.
+
+The first revolution's start-up shock (the static start catching up with the
+cam) is its own metrics, ``startup_*``.
+
+Speed criteria from the lift event, for any cam (:class:`Criteria`):
+
+* the **lift event** is where the cam's lift L(θ) (its Fourier series,
+  :mod:`vtool.solvers.model.cam`) above its base circle exceeds the lash
+  (the follower clearance on the base circle with the valve seated,
+  :mod:`vtool.solvers.model.lash`; 0 without a seat) by more than
+  ``LIFT_EVENT_FRACTION`` of the total lift: where the cam, not the seat,
+  holds the train (a train with lash is off the cam on the base circle and
+  on the ramps' foot by design). For the thesis' harmonic cam (1A) it is
+  278 to 622 deg, every angle but 82 deg about the base point (270 deg);
+  for the ramped cam, about +-60 deg about the nose at 0.
+* the follower **leaves the cam** when the cam clearance is open during
+  the lift event for more than ``run.jump_angle`` (deg, default 1) with a
+  gap (follower minus cam, on the output rows) above ``run.jump_gap``
+  (default ``GAP_FRACTION`` of the cam's total lift) inside the lift
+  event: a numerical micro-separation (a fraction of a degree, or a gap at round-off) does not
+  count.
+* the valve **bounces** when it re-opens after seating (within
+  ``BOUNCE_WINDOW_DEG``) by more than ``run.bounce_lift`` (default
+  ``GAP_FRACTION`` of the cam's total lift), on the output rows.
+
+Metrics (also in docs/sweep.md):
 
 ``cam_separations``
-    Largest number, over the revolutions after the first, of cam-clearance
-    separation episodes (``Trace.episodes``: a burst of events that leaves
-    the clearance open) that start above mid-stroke: cam angle mod 360 in
-    (0, 180) deg, where the harmonic cam q_cam = A sin(theta) + offset is
-    above its offset and decelerating the follower. One or more means the
-    follower leaves the cam (jump).
+    Largest number, over the revolutions of the window, of intervals where
+    the follower leaves the cam (counted in the revolution where they open,
+    or where the window starts for one already open).
 ``cam_separation_angle`` (deg)
-    The earliest such separation, as an angle within its revolution (NaN if
-    none).
+    The earliest such interval's opening, as an angle within its revolution
+    (NaN if none).
 ``cam_separation_duration`` (deg)
-    The longest such separation: cam angle from the separation to the next
-    cam impact (or to the end of the run); 0 when there is none.
+    The longest such interval, cam angle from opening to closing (or to the
+    window's end); 0 when there is none.
+``cam_separation_gap`` (length)
+    The largest gap of those intervals; 0 when there is none.
 ``lift_loss`` (length)
-    max over output rows after the first revolution of L_kin - L, where
+    max over output rows of the window of L_kin - L, where
     L = max(q_v - s, 0) is the valve's lift off its seat (q_v the seat
     clearance's ``ahead`` coordinate, s the seat position) and
     L_kin = max(r q_cam - s, 0) the kinematic lift of a train that keeps its
@@ -29,24 +59,29 @@ and units for a spec. ``vtool sweep`` reports them per point, and a single
     row (the static start). NaN without a seat.
 ``seating_velocity_max``, ``seating_velocity_mean`` (velocity)
     Approach speed (-d gap/dt before the impact) of the valve's impacts on the
-    seat after the first revolution: largest and mean (NaN without impacts).
+    seat in the window: largest and mean (NaN without impacts).
 ``seat_bounces``
-    Largest number, over the revolutions after the first, of seat bounces
-    (``Trace.seat_bounces``: a re-opening after an impact that closes again
-    within ``BOUNCE_WINDOW_DEG``), counted in the revolution of the landing.
+    Largest number, over the revolutions of the window, of seat bounces
+    higher than ``bounce_lift`` (``Trace.seat_bounces``), counted in the
+    revolution of the landing.
 ``bounce_height`` (length)
-    Largest bounce height of those (the largest seat gap on the output rows
-    between lift-off and landing; 0 without bounces, NaN without a seat).
+    Largest bounce height of those (0 without bounces, NaN without a seat).
 ``peak_F<i>`` (force)
-    Largest contact force at each clearance after the first revolution, over
-    every step (``Trace.peak_force_after_first_revolution``; on the output
-    rows for a back end that does not record it; NaN for a removed
-    clearance).
+    Largest contact force at each clearance in the window, over every step
+    where the back end records it (a run cycle by cycle: its last cycle; a
+    plain run: ``Trace.peak_force_after_first_revolution``), else on the
+    output rows; NaN for a removed clearance.
 ``spring_margin`` (force)
-    Smallest cam contact force on the output rows after the first revolution
-    over the nose (cam angle mod 360 in (0, 180) deg) while the cam clearance
-    is closed: how much spring force is left before the follower leaves the
-    cam (NaN when it is never in contact there).
+    Smallest cam contact force on the output rows of the window during the
+    lift event while the cam clearance is closed: how much spring force is
+    left before the follower leaves the cam (NaN when never in contact there).
+``startup_peak_force`` (force), ``startup_seating_velocity`` (velocity)
+    The start-up shock: the largest contact force at any clearance and the
+    largest seating velocity in the first revolution (every step where the
+    back end records it).
+``cycles``, ``cycle_change``
+    Cycles run (0 for a plain run) and the relative change of the last cycle
+    (NaN for a plain run); see :class:`~vtool.solvers.trace.Cycles`.
 ``events``
     Events (configuration changes) in the whole run.
 ``wall_time`` (s)
@@ -57,15 +92,23 @@ and units for a spec. ``vtool sweep`` reports them per point, and a single
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from vtool.solvers.model.configurations import clearance_bit
-from vtool.solvers.model.spec import EXTERNAL, REMOVED, MechanismSpec
-from vtool.solvers.trace import CLOSED, SEPARATION, Trace
+from vtool.solvers.model.spec import EXTERNAL, REMOVED, CamSpec, MechanismSpec
+from vtool.solvers.trace import CLOSED, Trace
 
 REVOLUTION = 360.0
 NAN = float("nan")
+#: the lift event: lift above the base circle by more than this share of the total lift
+LIFT_EVENT_FRACTION = 5e-3
+#: default gap (leaves the cam) and bounce lift: this share of the cam's total lift
+GAP_FRACTION = 1e-3
+#: the lift event's resolution (bins per revolution)
+EVENT_BINS = 3600
 
 #: metrics whose values depend on the machine, not the model
 TIMING_METRICS = ("wall_time",)
@@ -88,6 +131,131 @@ def force_label(spec: MechanismSpec, index: int) -> str:
     return f"F{spec.clearances[index].ahead}"
 
 
+# ----- the lift event and the criteria -----
+
+@lru_cache(maxsize=32)
+def _lift(cam: CamSpec) -> np.ndarray:
+    from vtool.solvers.model.cam import derivatives, lift_series
+
+    c0, a, b = lift_series(cam)
+    theta = np.radians((np.arange(EVENT_BINS) + 0.5) * REVOLUTION / EVENT_BINS)
+    return derivatives(c0, a, b, theta)[0]
+
+
+def total_lift(cam: CamSpec) -> float:
+    """The cam's total lift (length): max - min of its lift law."""
+    lift = _lift(cam)
+    return float(lift.max() - lift.min())
+
+
+def _lash(spec: MechanismSpec) -> float:
+    """The follower clearance on the base circle with the valve seated (:mod:`vtool.solvers.model.lash`;
+    0 without a seat, or when the seat holds the valve off the cam nowhere)."""
+    if seat_index(spec) is None:
+        return 0.0
+    try:
+        return _lash_of(spec)
+    except TypeError:  # an unhashable spec (built by hand with lists)
+        return _lash_of.__wrapped__(spec)
+
+
+@lru_cache(maxsize=32)
+def _lash_of(spec: MechanismSpec) -> float:
+    from vtool.solvers.model.lash import base_and_ratio
+
+    base, ratio = base_and_ratio(spec)
+    return max(ratio * spec.seat.position - base, 0.0) if spec.seat is not None else 0.0
+
+
+def lift_event_bins(spec: MechanismSpec) -> np.ndarray:
+    """Per bin of ``360 / EVENT_BINS`` deg: whether it lies in the lift event (see the module doc)."""
+    return _event_bins(spec.cam, _lash(spec))
+
+
+@lru_cache(maxsize=32)
+def _event_bins(cam: CamSpec, lash: float) -> np.ndarray:
+    lift = _lift(cam) - _lift(cam).min()
+    return lift - lash > LIFT_EVENT_FRACTION * max(float(lift.max()), 1e-300)
+
+
+def lift_event(spec: MechanismSpec) -> tuple[float, float]:
+    """(start, end) of the lift event in deg, start in [0, 360), end > start (it may pass 360)."""
+    inside = lift_event_bins(spec)
+    if inside.all():
+        return 0.0, REVOLUTION
+    step = REVOLUTION / EVENT_BINS
+    starts = np.flatnonzero(inside & ~np.roll(inside, 1))
+    ends = np.flatnonzero(~inside & np.roll(inside, 1))
+    best = (0.0, 0.0)
+    for s in starts:  # the longest run of bins in the event (a cam has one lift event)
+        e = ends[ends > s][0] if np.any(ends > s) else ends[0] + EVENT_BINS
+        if (e - s) * step > best[1] - best[0]:
+            best = (s * step, e * step)
+    return best
+
+
+def in_lift_event(spec: MechanismSpec, start_deg: float, end_deg: float) -> float:
+    """Degrees of [start_deg, end_deg] (absolute cam angles) inside the lift event."""
+    if end_deg <= start_deg:
+        return 0.0
+    inside = lift_event_bins(spec)
+    step = REVOLUTION / EVENT_BINS
+    first, last = math.floor(start_deg / step), math.ceil(end_deg / step)
+    bins = np.arange(first, last)
+    widths = np.minimum((bins + 1) * step, end_deg) - np.maximum(bins * step, start_deg)
+    return float(np.sum(widths[inside[bins % EVENT_BINS]]))
+
+
+@dataclass(frozen=True)
+class Criteria:
+    """The thresholds of the speed criteria (see the module doc), lengths in the spec's unit."""
+
+    jump_angle: float  # deg
+    jump_gap: float
+    bounce_lift: float
+    lift_event: tuple[float, float]  # deg
+
+    @classmethod
+    def of(cls, spec: MechanismSpec) -> Criteria:
+        r = spec.run
+        default = GAP_FRACTION * total_lift(spec.cam)
+        return cls(r.jump_angle, default if r.jump_gap is None else r.jump_gap,
+                   default if r.bounce_lift is None else r.bounce_lift, lift_event(spec))
+
+    def text(self, length: str) -> str:
+        start, end = self.lift_event
+        return (f"criteria: the follower leaves the cam when its contact is open > {self.jump_angle:g} deg with a "
+                f"gap > {self.jump_gap:.3g} {length} during the lift event ({start:g} to {end:g} deg); the "
+                f"valve bounces when it re-opens > {self.bounce_lift:.3g} {length} after seating")
+
+    def as_dict(self, length: str) -> dict[str, float | str]:
+        return {"jump_angle_deg": self.jump_angle, "jump_gap": self.jump_gap, "jump_gap_unit": length,
+                "bounce_lift": self.bounce_lift, "bounce_lift_unit": length,
+                "lift_event_start_deg": self.lift_event[0], "lift_event_end_deg": self.lift_event[1]}
+
+
+# ----- the window -----
+
+def evaluation_window(trace: Trace) -> tuple[float, float]:
+    """The cam angles (deg) the metrics cover: see the module doc."""
+    if trace.cycles is not None:
+        return trace.cycles.window
+    end = float(trace.cam_angle[-1]) if len(trace.cam_angle) else 0.0
+    return (REVOLUTION, end) if end > REVOLUTION else (0.0, end)
+
+
+def window_text(trace: Trace) -> str:
+    """One line: which cycles the metrics cover, and whether they settled."""
+    if trace.cycles is not None:
+        return trace.cycles.text()
+    start, end = evaluation_window(trace)
+    if start == 0.0:
+        return (f"evaluated: the whole run (cam angle 0-{end:g} deg), start-up shock included: not a steady "
+                "state (set run.cycles or run.steady)")
+    return (f"evaluated: after the first revolution (cam angle {start:g}-{end:g} deg), not checked for a "
+            "steady state (set run.cycles or run.steady)")
+
+
 def metric_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
     """(name, unit) of every metric, in report order; ``""`` for counts."""
     u = spec.unit_system
@@ -95,6 +263,7 @@ def metric_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
         ("cam_separations", ""),
         ("cam_separation_angle", "deg"),
         ("cam_separation_duration", "deg"),
+        ("cam_separation_gap", u.length),
         ("lift_loss", u.length),
         ("seating_velocity_max", u.velocity),
         ("seating_velocity_mean", u.velocity),
@@ -102,33 +271,94 @@ def metric_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
         ("bounce_height", u.length),
     ]
     columns += [(f"peak_{force_label(spec, i)}", u.force) for i in range(len(spec.clearances))]
-    columns += [("spring_margin", u.force), ("events", ""), ("wall_time", "s")]
+    columns += [("spring_margin", u.force), ("startup_peak_force", u.force), ("startup_seating_velocity", u.velocity),
+                ("cycles", ""), ("cycle_change", ""), ("events", ""), ("wall_time", "s")]
     return columns
 
 
-def _above_mid_stroke(angle: float) -> bool:
-    return 0.0 < angle % REVOLUTION < 180.0
+# ----- intervals -----
 
-
-def _cam_separation(trace: Trace, name: str) -> tuple[int, float, float]:
-    end = float(trace.cam_angle[-1]) if len(trace.cam_angle) else 0.0
-    impacts = [e.cam_angle for e in trace.events if e.clearance == name and e.kind == CLOSED]
-    per_revolution: dict[int, int] = {}
-    first = NAN
-    longest = 0.0
-    for episode in trace.episodes(name):
-        start = episode.first_angle
-        if episode.kind != SEPARATION or start < REVOLUTION or not _above_mid_stroke(start):
+def open_intervals(trace: Trace, index: int, window: tuple[float, float]) -> list[tuple[float, float]]:
+    """(opening, closing) cam angles (deg) where clearance ``index`` is open within the window, from its
+    events (exact angles) and its state at the window's first row; clipped to the window."""
+    start, end = window
+    bit = clearance_bit(trace.spec, index)
+    name = trace.spec.clearances[index].name
+    rows = np.flatnonzero(trace.cam_angle >= start)
+    if not len(rows):
+        return []
+    first = rows[0]
+    # the state at the window's start: the row's configuration, unless an event at the same angle follows
+    opened_at: float | None = start if not trace.configuration[first] & bit else None
+    intervals = []
+    for e in trace.events:
+        if e.clearance != name or e.cam_angle < start or e.cam_angle > end:
             continue
-        revolution = int(start // REVOLUTION)
-        per_revolution[revolution] = per_revolution.get(revolution, 0) + 1
-        closing = next((a for a in impacts if a > episode.last_angle), end)
-        first = start % REVOLUTION if math.isnan(first) else min(first, start % REVOLUTION)
-        longest = max(longest, closing - start)
-    return max(per_revolution.values(), default=0), first, longest
+        if e.cam_angle == start:  # the row may show either side of an event at the window's edge
+            opened_at = None if e.after & bit else start
+            continue
+        if e.after & bit and opened_at is not None:
+            intervals.append((opened_at, e.cam_angle))
+            opened_at = None
+        elif not e.after & bit and opened_at is None:
+            opened_at = e.cam_angle
+    if opened_at is not None and opened_at < end:
+        intervals.append((opened_at, end))
+    return intervals
 
 
-def _seat_metrics(trace: Trace, index: int | None, after: np.ndarray) -> dict[str, float]:
+def _during_lift(trace: Trace) -> np.ndarray:
+    """Per output row: whether its cam angle lies in the lift event."""
+    bins = np.floor(np.mod(trace.cam_angle, REVOLUTION) / (REVOLUTION / EVENT_BINS)).astype(int) % EVENT_BINS
+    return lift_event_bins(trace.spec)[bins]
+
+
+def _largest(values: np.ndarray, angles: np.ndarray, a: float, b: float) -> float:
+    inside = (angles >= a) & (angles <= b)
+    return float(values[inside].max()) if inside.any() else 0.0
+
+
+def leaves_the_cam(trace: Trace, window: tuple[float, float], criteria: Criteria) -> list[tuple[float, float, float]]:
+    """(opening, closing, largest gap) of every interval in the window where the follower leaves the cam."""
+    spec = trace.spec
+    cam = cam_index(spec)
+    c = spec.clearances[cam]
+    if c.state == REMOVED:
+        return []
+    gap = trace.coordinate(c.ahead) - trace.coordinate(c.behind)
+    during = _during_lift(trace)
+    result = []
+    for a, b in open_intervals(trace, cam, window):
+        if in_lift_event(spec, a, b) <= criteria.jump_angle:
+            continue
+        height = _largest(np.where(during, gap, 0.0), trace.cam_angle, a, b)
+        if height > criteria.jump_gap:
+            result.append((a, b, height))
+    return result
+
+
+def _per_revolution(angles: list[float]) -> int:
+    counts: dict[int, int] = {}
+    for angle in angles:
+        counts[int(angle // REVOLUTION)] = counts.get(int(angle // REVOLUTION), 0) + 1
+    return max(counts.values(), default=0)
+
+
+def _cam_separation(trace: Trace, window: tuple[float, float], criteria: Criteria) -> dict[str, float]:
+    intervals = leaves_the_cam(trace, window, criteria)
+    return {"cam_separations": _per_revolution([a for a, _, _ in intervals]),
+            "cam_separation_angle": min((a % REVOLUTION for a, _, _ in intervals), default=NAN),
+            "cam_separation_duration": max((b - a for a, b, _ in intervals), default=0.0),
+            "cam_separation_gap": max((h for _, _, h in intervals), default=0.0)}
+
+
+def _seatings(trace: Trace, index: int, window: tuple[float, float]) -> list[float]:
+    name = trace.spec.clearances[index].name
+    return [-e.relative_velocity for e in trace.events
+            if e.clearance == name and e.kind == CLOSED and window[0] <= e.cam_angle < window[1]]
+
+
+def _seat_metrics(trace: Trace, index: int | None, window: tuple[float, float], criteria: Criteria) -> dict[str, float]:
     spec = trace.spec
     result = {"lift_loss": NAN, "seating_velocity_max": NAN, "seating_velocity_mean": NAN,
               "seat_bounces": 0, "bounce_height": NAN}
@@ -138,51 +368,75 @@ def _seat_metrics(trace: Trace, index: int | None, after: np.ndarray) -> dict[st
     s = spec.seat.position
     valve = trace.coordinate(clearance.ahead)
     cam = trace.coordinate(spec.cam.coordinate)
-    if len(valve) and after.any():
+    rows = (trace.cam_angle >= window[0]) & (trace.cam_angle <= window[1])
+    if len(valve) and rows.any():
         ratio = valve[0] / cam[0] if cam[0] != 0.0 else spec.initial.lever_ratio
         lift = np.maximum(valve - s, 0.0)
         kinematic = np.maximum(ratio * cam - s, 0.0)
-        result["lift_loss"] = float(np.max((kinematic - lift)[after]))
-    impacts = [e for e in trace.events if e.clearance == clearance.name and e.kind == CLOSED
-               and e.cam_angle >= REVOLUTION]
-    if impacts:
-        speeds = np.array([-e.relative_velocity for e in impacts])
-        result["seating_velocity_max"] = float(speeds.max())
-        result["seating_velocity_mean"] = float(speeds.mean())
-    bounces = [b for b in trace.seat_bounces(clearance.name) if b[1] >= REVOLUTION]
-    per_revolution: dict[int, int] = {}
-    for _, landing, _ in bounces:
-        per_revolution[int(landing // REVOLUTION)] = per_revolution.get(int(landing // REVOLUTION), 0) + 1
-    result["seat_bounces"] = max(per_revolution.values(), default=0)
+        result["lift_loss"] = float(np.max((kinematic - lift)[rows]))
+    speeds = _seatings(trace, index, window)
+    if speeds:
+        result["seating_velocity_max"] = float(max(speeds))
+        result["seating_velocity_mean"] = float(np.mean(speeds))
+    bounces = [b for b in trace.seat_bounces(clearance.name)
+               if window[0] <= b[1] <= window[1] and b[2] > criteria.bounce_lift]
+    result["seat_bounces"] = _per_revolution([landing for _, landing, _ in bounces])
     result["bounce_height"] = max((height for _, _, height in bounces), default=0.0)
     return result
 
 
-def _peak(trace: Trace, index: int, after: np.ndarray) -> float:
-    if trace.spec.clearances[index].state == REMOVED:
-        return NAN
-    if trace.peak_force_after_first_revolution is not None:
-        return float(trace.peak_force_after_first_revolution[index])
-    values = trace.contact_force[after, index]
-    return float(values.max()) if values.size else NAN
+def _peaks(trace: Trace, window: tuple[float, float]) -> np.ndarray:
+    """Every-step peak forces in the window where the trace has them, else the output rows' largest."""
+    if trace.cycles is not None:
+        return trace.cycles.peaks
+    if window[0] == REVOLUTION and trace.peak_force_after_first_revolution is not None:
+        return trace.peak_force_after_first_revolution
+    if window[0] == 0.0:
+        return trace.peak_force
+    rows = (trace.cam_angle >= window[0]) & (trace.cam_angle <= window[1])
+    return trace.contact_force[rows].max(axis=0) if rows.any() else np.full(len(trace.spec.clearances), NAN)
 
 
-def run_metrics(trace: Trace) -> dict[str, float]:
-    """The metrics of one run (see the module doc), keyed as :func:`metric_columns`."""
+def _startup(trace: Trace, seat: int | None) -> dict[str, float]:
+    """The start-up shock (first revolution): largest force at any clearance and seating velocity."""
     spec = trace.spec
-    after = trace.cam_angle >= REVOLUTION
+    used = [i for i, c in enumerate(spec.clearances) if c.state != REMOVED]
+    if trace.cycles is not None:
+        peaks = trace.cycles.startup_peaks
+    else:
+        rows = trace.cam_angle < REVOLUTION
+        peaks = trace.contact_force[rows].max(axis=0) if rows.any() else np.zeros(len(spec.clearances))
+        late = trace.peak_force_after_first_revolution
+        if late is not None:  # a whole-run peak above the later one happened in the first revolution
+            peaks = np.where(trace.peak_force > late, trace.peak_force, peaks)
+        elif not np.any(trace.cam_angle > REVOLUTION):  # the run is its first revolution
+            peaks = trace.peak_force
+    speeds = _seatings(trace, seat, (0.0, REVOLUTION)) if seat is not None else []
+    return {"startup_peak_force": float(np.max(peaks[used])) if used else NAN,
+            "startup_seating_velocity": float(max(speeds)) if speeds else NAN}
+
+
+def run_metrics(trace: Trace, window: tuple[float, float] | None = None) -> dict[str, float]:
+    """The metrics of one run over ``window`` (default :func:`evaluation_window`), keyed as
+    :func:`metric_columns`."""
+    spec = trace.spec
+    window = evaluation_window(trace) if window is None else window
+    criteria = Criteria.of(spec)
     cam = cam_index(spec)
+    seat = seat_index(spec)
     metrics: dict[str, float] = {}
-    count, angle, duration = _cam_separation(trace, spec.clearances[cam].name)
-    metrics["cam_separations"] = count
-    metrics["cam_separation_angle"] = angle
-    metrics["cam_separation_duration"] = duration
-    metrics.update(_seat_metrics(trace, seat_index(spec), after))
-    for i in range(len(spec.clearances)):
-        metrics[f"peak_{force_label(spec, i)}"] = _peak(trace, i, after)
-    nose = after & (np.mod(trace.cam_angle, REVOLUTION) > 0.0) & (np.mod(trace.cam_angle, REVOLUTION) < 180.0)
-    in_contact = nose & ((trace.configuration & clearance_bit(spec, cam)) != 0)
+    metrics.update(_cam_separation(trace, window, criteria))
+    metrics.update(_seat_metrics(trace, seat, window, criteria))
+    peaks = _peaks(trace, window)
+    for i, c in enumerate(spec.clearances):
+        metrics[f"peak_{force_label(spec, i)}"] = NAN if c.state == REMOVED else float(peaks[i])
+    rows = (trace.cam_angle >= window[0]) & (trace.cam_angle <= window[1])
+    during = rows & _during_lift(trace)
+    in_contact = during & ((trace.configuration & clearance_bit(spec, cam)) != 0)
     metrics["spring_margin"] = float(trace.contact_force[in_contact, cam].min()) if in_contact.any() else NAN
+    metrics.update(_startup(trace, seat))
+    metrics["cycles"] = trace.cycles.count if trace.cycles is not None else 0
+    metrics["cycle_change"] = trace.cycles.change if trace.cycles is not None else NAN
     metrics["events"] = trace.statistics.events
     metrics["wall_time"] = trace.statistics.wall_time
     return metrics
@@ -191,3 +445,4 @@ def run_metrics(trace: Trace) -> dict[str, float]:
 def failed_metrics(spec: MechanismSpec) -> dict[str, float]:
     """All metrics NaN (a run that failed), with the same keys."""
     return {name: NAN for name, _ in metric_columns(spec)}
+

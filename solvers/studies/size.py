@@ -35,6 +35,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from vtool.solvers import backends
 from vtool.solvers.model.assembly import split_members, unsplit_members
 from vtool.solvers.model.cam import (
     HARMONIC,
@@ -45,6 +46,7 @@ from vtool.solvers.model.cam import (
 )
 from vtool.solvers.model.mechanism import assemble
 from vtool.solvers.model.spec import EXTERNAL, MechanismSpec
+from vtool.units import cam_speed
 
 
 @dataclass(frozen=True)
@@ -110,13 +112,12 @@ def relative_change(new: dict[str, float], old: dict[str, float]) -> float:
 
 
 def stable_time_step(spec: MechanismSpec) -> float:
-    """The preset's step, cut to 0.9 of Newmark's stability limit for the model's highest mode."""
-    if spec.run.backend != "newmark":
+    """The preset's step, cut to 0.9 of its back end's stability limit for the model's highest mode
+    (:meth:`~vtool.solvers.backends.Backend.stable_step`; a back end that takes no fixed step keeps it)."""
+    backend = backends.get(spec.run.backend)
+    if not backend.fixed_step:
         return spec.run.time_step
-    from vtool.solvers.newmark.backend import highest_frequency, stability_limit
-
-    limit = stability_limit(spec.run.beta, spec.run.gamma, highest_frequency(assemble(spec)))
-    return min(spec.run.time_step, 0.9 * limit)
+    return min(spec.run.time_step, 0.9 * backend.stable_step(assemble(spec)))
 
 
 def with_elements(spec: MechanismSpec, member: str, n: int) -> MechanismSpec:
@@ -130,7 +131,7 @@ def cam_reach(spec: MechanismSpec, rpm_max: float) -> tuple[int, float, list[tup
     from vtool.solvers.model.assembly import surge_labels
 
     k_max = harmonic_that_matters(spec.cam)
-    omega = rpm_max * math.pi / 30.0
+    omega = cam_speed(rpm_max)
     layer = assemble(spec).start_layer
     labels = surge_labels(spec, layer.T @ layer.modes.shapes)
     reach = [(float(w), label or "mechanism") for w, label in zip(layer.modes.omega, labels, strict=True)

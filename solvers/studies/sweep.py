@@ -22,8 +22,9 @@ assignments). This module evaluates them and keeps the results:
   flushed), so a killed sweep keeps what it finished and a resumed one skips
   it; when the sweep ends (or is stopped) the file is rewritten in point
   order, atomically, so every execution path gives the same bytes.
-* :func:`find_speed` brackets and bisects the cam speed at which a criterion
-  (follower leaves the cam; valve bounces on its seat) first holds.
+* :func:`find_speed` brackets and bisects every cam-speed interval in which a
+  criterion (follower leaves the cam during lift; valve bounces on its seat,
+  :mod:`vtool.solvers.studies.metrics`) holds.
 """
 
 from __future__ import annotations
@@ -52,6 +53,7 @@ from vtool.solvers.studies.metrics import (
     metric_columns,
     run_metrics,
 )
+from vtool.solvers.studies.steady import is_cyclic, simulate_cycles
 
 OK = "ok"
 
@@ -126,9 +128,12 @@ def evaluate_point(spec: MechanismSpec, *, every_step: bool = False, previous: M
     try:
         mechanism = _mechanism(spec, previous)
         backend = _backend_class(spec.run.backend)()
-        options = backend.options_from_run(spec.run, every_step)
-        trace = backend.simulate(mechanism, options, progress=None,
-                                 cancel=cancel if backend.supports_cancel else None)
+        if is_cyclic(spec):  # run.cycles or run.steady: cycle by cycle, the metrics of the last
+            trace = simulate_cycles(backend, mechanism, every_step=every_step, cancel=cancel)
+        else:
+            options = backend.options_from_run(spec.run, every_step)
+            trace = backend.simulate(mechanism, options, progress=None,
+                                     cancel=cancel if backend.supports_cancel else None)
     except (RunError, InputError) as exc:
         return failed_metrics(spec), str(exc).replace("\n", " "), mechanism
     return run_metrics(trace), OK, mechanism
@@ -158,9 +163,14 @@ def chunks(points: Sequence[Point], workers: int, per_worker: int = 4, largest: 
 
 # ----- execution -----
 
-def _ignore_interrupt() -> None:
-    """Worker initializer: Ctrl+C is handled by the parent, which stops the pool cleanly."""
+def _ignore_interrupt(stderr: str | None = None) -> None:
+    """Worker initializer: Ctrl+C is handled by the parent, which stops the pool cleanly; with
+    ``stderr`` (a file path), the worker's standard error (descriptor 2) is that file."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if stderr is not None:
+        target = os.open(stderr, os.O_WRONLY | os.O_APPEND)
+        os.dup2(target, 2)
+        os.close(target)
 
 
 def parse_scheduler(text: str) -> tuple[str, int]:
@@ -221,16 +231,21 @@ class DaskRunner:
 
 
 class ProcessRunner:
-    """A forkserver process pool of ``workers`` processes that ignore Ctrl+C (the parent stops them)."""
+    """A forkserver process pool of ``workers`` processes that ignore Ctrl+C (the parent stops them).
 
-    def __init__(self, workers: int) -> None:
+    ``stderr``: a file the workers write their standard error to instead of the parent's (the TUI
+    passes os.devnull: its terminal is Textual's screen).
+    """
+
+    def __init__(self, workers: int, stderr: str | None = None) -> None:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
         context = multiprocessing.get_context("forkserver")
-        context.set_forkserver_preload(["vtool.solvers.studies.sweep", "vtool.solvers.newmark.backend"])
+        context.set_forkserver_preload(["vtool.solvers.studies.sweep", backends.module_of(backends.DEFAULT)])
         self.workers = workers
-        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt)
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt,
+                                        initargs=(stderr,))
 
     def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
             cancel: Callable[[], bool]) -> bool:
@@ -279,14 +294,17 @@ class SerialRunner:
         pass
 
 
-def make_runner(workers: int | None = None, scheduler: str | None = None) -> Any:
-    """The runner for these settings; a Dask scheduler is connected here (InputError if unreachable)."""
+def make_runner(workers: int | None = None, scheduler: str | None = None, *, stderr: str | None = None) -> Any:
+    """The runner for these settings; a Dask scheduler is connected here (InputError if unreachable).
+
+    ``stderr``: where local worker processes write their standard error (see :class:`ProcessRunner`).
+    """
     if scheduler:
         return DaskRunner(scheduler)
     if workers is not None and workers < 1:
         raise InputError("--workers", workers, "an integer >= 1")
     count = workers or os.cpu_count() or 1
-    return SerialRunner() if count == 1 else ProcessRunner(count)
+    return SerialRunner() if count == 1 else ProcessRunner(count, stderr)
 
 
 @dataclass
@@ -479,9 +497,9 @@ class SweepFile:
 
 # ----- derived speeds -----
 
-#: criterion name -> (metric, test, words)
+#: criterion name -> (metric, test, words); the criteria themselves: vtool.solvers.studies.metrics
 CRITERIA: dict[str, tuple[str, Callable[[float], bool], str]] = {
-    "jump-speed": ("cam_separations", lambda v: v >= 1, "the follower leaves the cam above mid-stroke"),
+    "jump-speed": ("cam_separations", lambda v: v >= 1, "the follower leaves the cam during lift"),
     "bounce-speed": ("seat_bounces", lambda v: v >= 1, "the valve bounces on its seat"),
 }
 
@@ -498,24 +516,46 @@ class Bracket:
 
 
 @dataclass(frozen=True)
+class Interval:
+    """A speed interval where the criterion holds: its bisected edges (rev/min) and the speeds just outside.
+
+    ``low`` is the lowest speed found where it holds and ``below`` the highest where it does not (None:
+    it holds at the lowest scanned speed); ``high`` and ``above`` likewise at the top (None: it holds at
+    the highest scanned speed)."""
+
+    low: float
+    high: float
+    below: float | None
+    above: float | None
+
+    def text(self) -> str:
+        low = f"{self.low:g}" if self.below is not None else f"{self.low:g} (the lowest scanned speed, or below)"
+        high = f"{self.high:g}" if self.above is not None else f"{self.high:g} (the highest scanned speed, or above)"
+        outside = [f"not at {v:g}" for v in (self.below, self.above) if v is not None]
+        return f"{low} to {high} rev/min" + (f" ({', '.join(outside)})" if outside else "")
+
+
+@dataclass(frozen=True)
 class SpeedResult:
     criterion: str
     speed: float | None  # rev/min: lowest speed found where the criterion holds; None if not bracketed
     history: tuple[Bracket, ...]
     message: str
+    intervals: tuple[Interval, ...] = ()  # every speed interval where it holds, bisected at both ends
 
 
 def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan: Sequence[float],
                runner: Any, *, tolerance: float = 1.0, every_step: bool = False,
                report: Callable[[Bracket], None] | None = None,
                cancel: Callable[[], bool] | None = None) -> SpeedResult:
-    """The lowest cam speed (to ``tolerance`` rev/min) at which ``criterion`` holds.
+    """Every cam-speed interval where ``criterion`` holds, each edge bisected to ``tolerance`` rev/min.
 
-    The speeds ``scan`` (ascending) are run together on ``runner``; the first
-    one where the criterion holds and the one before it bracket the answer,
-    which is then bisected (integer speeds for tolerance 1). The answer is the
-    first crossing on the scan: a criterion that holds, stops and holds again
-    with speed is reported at its lowest bracketed crossing.
+    The speeds ``scan`` (ascending) are run together on ``runner``; every change between neighbouring
+    scanned speeds (holds / does not) brackets an edge, which is then bisected (integer speeds for
+    tolerance 1). A window of contact loss below a window of contact is its own interval; an interval
+    narrower than the scan's step can fall between two scanned speeds unseen (scan finer). ``speed``
+    is the lowest edge (the jump speed), None when the criterion holds at no scanned speed or already
+    at the lowest.
     """
     if criterion not in CRITERIA:
         raise InputError("--find", criterion, f"one of: {', '.join(CRITERIA)}")
@@ -541,25 +581,44 @@ def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan
     if not any(holds):
         return SpeedResult(criterion, None, tuple(history), f"{words} at none of the scanned speeds "
                                                             f"(up to {scan[-1]:g} rev/min)")
-    first = holds.index(True)
-    if first == 0:
-        return SpeedResult(criterion, None, tuple(history),
-                           f"{words} already at the lowest scanned speed ({scan[0]:g} rev/min): scan lower")
-    low, high = scan[first - 1], scan[first]
     serial = SerialRunner()
-    while high - low > tolerance:
-        if cancel is not None and cancel():
-            raise RunError(f"{criterion}: stopped while bisecting between {low:g} and {high:g} rev/min")
-        mid = math.floor((low + high) / 2) if tolerance >= 1 else (low + high) / 2
-        if mid <= low:
-            mid = (low + high) / 2
-        result = run_points([Point(0, (("run.rpm", mid),), make_spec(mid))], serial, every_step=every_step)
-        if note(mid, result.results[0], "bisect"):
-            high = mid
-        else:
-            low = mid
-    return SpeedResult(criterion, high, tuple(history),
-                       f"{words} from {high:g} rev/min (not at {low:g})")
+
+    def bisect(low: float, high: float, rising: bool) -> tuple[float, float]:
+        """(the last speed on the low side, the first on the high side) of one edge."""
+        while high - low > tolerance:
+            if cancel is not None and cancel():
+                raise RunError(f"{criterion}: stopped while bisecting between {low:g} and {high:g} rev/min")
+            mid = math.floor((low + high) / 2) if tolerance >= 1 else (low + high) / 2
+            if mid <= low:
+                mid = (low + high) / 2
+            result = run_points([Point(0, (("run.rpm", mid),), make_spec(mid))], serial, every_step=every_step)
+            if note(mid, result.results[0], "bisect") == rising:
+                high = mid
+            else:
+                low = mid
+        return low, high
+
+    intervals = []
+    start: tuple[float, float | None] | None = (scan[0], None) if holds[0] else None
+    for i in range(1, len(scan)):
+        if holds[i] and not holds[i - 1]:
+            below, low = bisect(scan[i - 1], scan[i], rising=True)
+            start = (low, below)
+        elif holds[i - 1] and not holds[i]:
+            assert start is not None
+            high, above = bisect(scan[i - 1], scan[i], rising=False)
+            intervals.append(Interval(start[0], high, start[1], above))
+            start = None
+    if start is not None:
+        intervals.append(Interval(start[0], scan[-1], start[1], None))
+    first = intervals[0]
+    if first.below is None:
+        message = f"{words} already at the lowest scanned speed ({scan[0]:g} rev/min): scan lower"
+        speed = None
+    else:
+        message = f"{words} from {first.low:g} rev/min (not at {first.below:g})"
+        speed = first.low
+    return SpeedResult(criterion, speed, tuple(history), message, tuple(intervals))
 
 
 # ----- reports -----

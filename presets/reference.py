@@ -1,0 +1,289 @@
+"""The preset reference (docs/presets.md), made from the loaders' own reads.
+
+Every key's type, unit, allowed values and default come from the read that
+the loader makes (:class:`vtool.presets.fields.Table`, noted inside
+:func:`vtool.presets.fields.recording`) while it loads each shipped preset
+and the :data:`VARIANTS` below (shipped presets with a switch turned, so
+that the keys of other branches are read too: a lift-table cam, a Hertz
+contact, a single boom pulse, user criteria). What a key means is the one
+thing written by hand: :data:`MEANINGS`, per kind, by the key's path
+(``members.*.length``: any member; ``clearances[].gap``: any entry). A key
+the loader reads without a meaning here, or a meaning for a key it never
+reads, fails ``tests/test_presets_reference.py``.
+
+``python benchmarks/presets_reference.py --write`` regenerates
+docs/presets.md; ``--check`` says whether it is current.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from vtool.presets import list_presets, load_document, read_document
+from vtool.presets.fields import REQUIRED, FieldRead, recording
+from vtool.presets.kinds import KINDS
+from vtool.presets.paths import set_fields
+
+#: Shipped presets with fields changed (None: removed) so that the loader reads the keys of its other branches.
+VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
+    # the other unit system of each kind (the same numbers: each key's unit and SI-derived bounds in it)
+    ("gnilka-1a", {"units": "SI"}), ("boom-brick-wall", {"units": "m-N-s"}),
+    ("boom-tall-building", {"units": "m-N-s", "floors[0].moment_of_inertia": 4e-4, "floors[0].storey_height": 3.7,
+                            "floors[0].face_width": 30.0}),
+    ("plate-table2", {"units": "SI", "plate.density": 7800.0, "plate.youngs_modulus": 2e11}),
+    ("gnilka-1a", {"seat.lash": 0.01, "seat.position": None, "clearances[0].contact": "linear", "clearances[0].contact_stiffness": 1e6,
+                   "clearances[0].contact_damping_ratio": 0.05, "clearances[0].impact": "momentum"}),
+    ("gnilka-1a", {"clearances[0].contact": "linear", "clearances[0].contact_stiffness": 1e6,
+                   "clearances[0].contact_damping": 1.0}),
+    ("gnilka-1a", {"clearances[2].contact": "hertz", "clearances[2].contact_stiffness": 1e7,
+                   "clearances[2].contact_exponent": 1.5}),
+    *((name, changes) for name in ("boom-brick-wall", "boom-tall-building") for changes in (
+        {"boom.pulse": "N", "boom.envelope": None},
+        {"boom.pulse": "csv", "boom.csv": "pulse.csv", "boom.envelope": None},
+        {"boom.envelope": {"types": ["N"], "s": [1.6, 2.2, 0.1], "r1": [0.0, 0.5, 0.1], "family": "thesis"}},
+        {"criteria": ["own"], "criterion": [{"name": "own", "source": "a reference", "response": "velocity",
+                                             "value": 1.0, "unit": "in/s", "f_min": 1.0, "f_max": 50.0}]})),
+)
+
+#: Keys every kind has.
+COMMON = {
+    "kind": "Which study the preset describes; picks its loader, runner and TUI screen (presets/kinds.py).",
+    "title": "One line naming the study; shown in summaries, reports and the TUI.",
+    "notes": "Free text kept with the preset (sources, choices made).",
+    "units": "The unit system every number of the preset is in; every output names its units.",
+}
+
+BOOM = {
+    "criteria": "Names of the criteria to assess: built-in ones or those of [[criterion]] tables.",
+    "criterion": "User criteria: a peak response (velocity or displacement) not to exceed.",
+    "criterion[].name": "The criterion's name, as listed in `criteria`.",
+    "criterion[].source": "Where the limit comes from (a standard, a paper), printed with the results.",
+    "criterion[].response": "The response the limit is on.",
+    "criterion[].value": "The limit, in `unit`.",
+    "criterion[].unit": "The unit of `value`.",
+    "criterion[].tentative": "Marks the results of this criterion as tentative.",
+    "criterion[].f_min": "Lowest structure frequency the criterion applies to.",
+    "criterion[].f_max": "Highest structure frequency the criterion applies to.",
+    "boom": "The boom loading: pulse shape, durations and damping.",
+    "boom.positive_durations": "Durations of the pulse's positive phase (tau) to assess.",
+    "boom.pulse": "The pulse: one of the thesis' shapes N, P, Q, R, T, the envelope over a family of "
+                  "shapes, or a tabulated pulse from a CSV file.",
+    "boom.damping": "Damping ratio of the structure's oscillator (0: undamped, as the thesis).",
+    "boom.s": "Shape parameter s of a single pulse (thesis notation).",
+    "boom.r1": "Rise-time ratio r1 of a single pulse.",
+    "boom.r2": "Second ratio r2 of a single pulse (shapes that have one).",
+    "boom.alpha": "Parameter alpha of a single pulse (shapes that have one).",
+    "boom.beta": "Parameter beta of a single pulse (shapes that have one).",
+    "boom.csv": "CSV file of a tabulated pulse (time, pressure), found beside the preset.",
+    "boom.envelope": "The family of pulses whose envelope is assessed (default: the thesis' ranges).",
+    "boom.envelope.types": "Pulse shapes in the envelope.",
+    "boom.envelope.s": "Range of s: first, last, step.",
+    "boom.envelope.r1": "Range of r1: first, last, step.",
+    "boom.envelope.alpha": "Parameter alpha of the envelope's shapes.",
+    "boom.envelope.beta": "Parameter beta of the envelope's shapes.",
+    "boom.envelope.family": "How the family is built: the thesis' or with equal rise times.",
+    "design": "The frequency range of the design curves.",
+    "design.f_min": "Lowest frequency of the design curves.",
+    "design.f_max": "Highest frequency of the design curves.",
+    "design.points": "Points of each design curve.",
+}
+
+MEANINGS: dict[str, dict[str, str]] = {
+    "valvetrain": COMMON | {
+        "gravity": "Standard gravity that turns a specific weight into a density.",
+        "coordinates": "The elastic system's coordinates q1, q2, ... in order (thesis Fig. 2.5).",
+        "coordinates[].name": "What the coordinate is (shown in tables and the TUI).",
+        "coordinates[].motion": "Whether the coordinate is a displacement or a rotation (its unit).",
+        "cam": "The prescribed cam motion.",
+        "cam.coordinate": "The number of the cam's prescribed coordinate (after the elastic ones).",
+        "cam.name": "The cam's name in tables and events.",
+        "cam.profile": "Harmonic (q_cam = amplitude sin(omega t) + offset, the thesis' cam) or a lift table.",
+        "cam.amplitude": "Amplitude of the harmonic cam's motion.",
+        "cam.offset": "Where the cam starts: \"static-start\" (the thesis' XZERO rule) or a length.",
+        "cam.lift_table": "CSV file of lift against cam angle (table profile), found beside the preset.",
+        "cam.harmonics": "Harmonics of the lift table's Fourier fit (0: as many as the table needs).",
+        "cam.tolerance": "Largest lift error the fit may leave.",
+        "seat": "The valve seat: a prescribed, fixed coordinate (absent: no seat).",
+        "seat.coordinate": "The number of the seat's prescribed coordinate.",
+        "seat.name": "The seat's name in tables and events.",
+        "seat.position": "The seat's position on its coordinate.",
+        "seat.lash": "Lash at the static start; sets the seat position instead of `position`.",
+        "members": "The elastic members, one table each ([members.pushrod], ...).",
+        "members.*": "One member: its element, section, material and coordinates.",
+        "members.*.element": "Axial bar (2 coordinates) or Euler-Bernoulli beam (4).",
+        "members.*.length": "The member's length.",
+        "members.*.coordinates": "The thesis' beta matrix row: the signed system coordinate of each element "
+                                 "coordinate, 0 for a grounded end.",
+        "members.*.diameter": "Diameter of a round section (gives area and inertia).",
+        "members.*.area": "Cross-section area (instead of a diameter).",
+        "members.*.inertia": "Second moment of area (a beam; instead of a diameter).",
+        "members.*.modulus": "Young's modulus.",
+        "members.*.specific_weight": "Weight per volume (with gravity, the density).",
+        "members.*.density": "Mass per volume (instead of a specific weight).",
+        "members.*.stiffness": "Axial stiffness of a spring member (instead of a modulus).",
+        "members.*.mass": "The member's mass (instead of a density).",
+        "members.*.position": "Where the member starts in the drawing (drawing only).",
+        "members.*.direction": "The member's angle in the drawing (drawing only).",
+        "members.*.elements": "Finite elements the member is split into.",
+        "clearances": "The clearances, in the thesis' order (clearance 1 is the configuration's leading bit).",
+        "clearances[].name": "The clearance's name in tables and events.",
+        "clearances[].kind": "External (against a prescribed coordinate) or internal (between two elastic ones).",
+        "clearances[].ahead": "The coordinate ahead: gap = q[ahead] - q[behind], contact when gap <= 0.",
+        "clearances[].behind": "The coordinate behind.",
+        "clearances[].state": "Enabled, pinned (always closed) or removed (never monitored).",
+        "clearances[].restitution": "Coefficient of restitution of its impacts.",
+        "clearances[].impact": "Its own impact law (default: contact.impact).",
+        "clearances[].contact": "Rigid, linear spring-dashpot or Hertz/Hunt-Crossley contact.",
+        "clearances[].contact_stiffness": "Contact stiffness (linear: force per length; Hertz: per length^n).",
+        "clearances[].contact_damping": "Contact damping coefficient (linear contact).",
+        "clearances[].contact_damping_ratio": "Contact damping as a ratio of critical (linear contact).",
+        "clearances[].contact_exponent": "Exponent n of a Hertz contact's force law.",
+        "initial": "The static start.",
+        "initial.closed": "Clearances closed at the start (the starting configuration).",
+        "initial.spring_preload": "The valve spring's preload.",
+        "initial.lever_ratio": "Follower force per unit spring force at the start.",
+        "initial.velocities": "Start velocities: the thesis' or quasi-static.",
+        "damping": "Modal damping, per contact layer.",
+        "damping.factor": "Factor on every damping ratio.",
+        "damping.default_ratio": "Damping ratio of every mode not named otherwise.",
+        "damping.layers": "Ratios of one contact layer (the layer with these internal clearances closed).",
+        "damping.layers[].closed": "The internal clearances closed in this layer.",
+        "damping.layers[].default_ratio": "Damping ratio of this layer's modes not named.",
+        "damping.layers[].mode_ratios": "Ratios of single modes of this layer, by mode number.",
+        "damping.layers[].mode_ratios.<number>": "The damping ratio of the mode of this number (ascending frequency).",
+        "contact": "Impact rules of the rigid clearances.",
+        "contact.impact": "Impact law: local (thesis eq. 3.53), thesis (eq. 3.54) or momentum (one LCP).",
+        "contact.rocker_scale": "The thesis' SCALE at the rocker (eq. 3.54).",
+        "run": "The run: cam speed, length, step, back end, output.",
+        "run.rpm": "Cam speed (`vtool solve --rpm`).",
+        "run.degrees": "Cam rotation to run (`--degrees`).",
+        "run.time_step": "Time step of a fixed-step back end (`--dt`).",
+        "run.backend": "The back end that integrates (`--backend`; the installed ones).",
+        "run.output_interval": "Cam rotation between output rows.",
+        "run.beta": "Newmark's beta (thesis: 1/6).",
+        "run.gamma": "Newmark's gamma (thesis: 1/2).",
+        "run.quantities": "Extra CSV and chart columns: coordinates (\"q7\", \"q1-q9\") and forces (\"F2\").",
+    },
+    "boom_wall": COMMON | BOOM | {
+        "walls": "The walls to assess, one table each.",
+        "walls[].name": "The wall's name in the results.",
+        "walls[].base_width": "Width of the wall's base.",
+        "walls[].thickness": "The wall's thickness.",
+        "walls[].youngs_modulus": "Young's modulus of the wall.",
+        "walls[].poisson_ratio": "Poisson's ratio of the wall.",
+        "walls[].surface_weight": "Weight per area of the wall.",
+        "walls[].net_area": "Net area (openings removed), for the pseudo-height rule.",
+        "walls[].height": "The wall's height (instead of the pseudo height).",
+        "walls[].measured_frequency": "A measured natural frequency, used instead of the plate formula.",
+        "walls[].pseudo_height_rule": "The pseudo height net_area / base_width as is, or rounded to "
+                                      "whole units as the thesis does.",
+    },
+    "boom_floor": COMMON | BOOM | {
+        "floors": "The floors to assess, one table each.",
+        "floors[].name": "The floor's name in the results.",
+        "floors[].columns": "Columns n carrying the floor (stiffness 12 n E I / l^3).",
+        "floors[].youngs_modulus": "Young's modulus of the columns.",
+        "floors[].moment_of_inertia": "Second moment of area of one column.",
+        "floors[].storey_height": "The storey height l.",
+        "floors[].face_width": "Width of the face the boom loads.",
+        "floors[].floor_weight": "Weight of the floor.",
+        "floors[].measured_frequency": "A measured natural frequency, used instead of the formula.",
+    },
+    "plate": COMMON | {
+        "plate": "The simply supported plate.",
+        "plate.a": "Side a (along x).",
+        "plate.b": "Side b (along y).",
+        "plate.thickness": "The plate's thickness.",
+        "plate.youngs_modulus": "Young's modulus.",
+        "plate.density": "Mass per volume.",
+        "plate.poisson": "Poisson's ratio.",
+        "study": "Defaults of every case.",
+        "study.element": "Element: 16-DOF (bfs16) or 24-DOF (mason24).",
+        "study.mesh": "Mesh NX, NY over the plate.",
+        "study.frequencies": "Lowest modes compared with the exact (Navier) frequencies.",
+        "study.convergence_meshes": "Meshes of the convergence table.",
+        "cases": "The condensed models compared, one table each.",
+        "cases[].name": "The case's name in the results.",
+        "cases[].element": "The case's element (default: study.element).",
+        "cases[].mesh": "The case's mesh (default: study.mesh).",
+        "cases[].masters": "The master set: a named set, \"auto\" or node labels.",
+        "cases[].method": "Reduction: Irons/Guyan or IRS.",
+        "cases[].note": "Free text shown with the case.",
+        "cases[].auto": "Masters chosen automatically (with masters = \"auto\").",
+        "transient": "Transient step loads (RK4 and exact modal superposition).",
+        "transient.cases": "Cases run transient (default: all).",
+        "transient.loads": "Step loads: uniform and/or central point.",
+        "transient.omega_max_h": "RK4 steps as omega_max * h.",
+        "transient.periods": "Length of run in periods of the lowest mode.",
+        "transient.exact_modes": "Modes of the exact superposition.",
+        "transient.tolerance": "Error above which a transient result is flagged.",
+        "transient.truncation_check": "Check the exact superposition's truncation by doubling its modes.",
+    },
+}
+
+
+def _merge(into: dict[str, FieldRead], reads: dict[str, FieldRead]) -> None:
+    for path, read in reads.items():
+        kept = into.setdefault(path, FieldRead(path, read.type))
+        kept.units |= read.units
+        kept.allowed |= read.allowed
+        kept.defaults |= read.defaults
+
+
+def field_reads() -> dict[str, dict[str, FieldRead]]:
+    """kind -> path -> what the loader read, over the shipped presets and :data:`VARIANTS`."""
+    documents: list[tuple[dict[str, Any], Path]] = []
+    for info in list_presets():
+        documents.append((read_document(info.path), info.path.parent))
+    shipped = {info.name: info.path for info in list_presets()}
+    for name, changes in VARIANTS:
+        doc = set_fields(read_document(shipped[name]), {k: v for k, v in changes.items() if v is not None})
+        for path in (k for k, v in changes.items() if v is None):
+            table, _, key = path.rpartition(".")
+            doc[table].pop(key, None)  # (a key of a top-level table)
+        documents.append((doc, shipped[name].parent))
+    result: dict[str, dict[str, FieldRead]] = {kind: {} for kind in KINDS}
+    for doc, folder in documents:
+        with recording() as reads:
+            load_document(doc, folder)
+        _merge(result[doc["kind"]], reads)
+    return result
+
+
+def _cell(values: set[str], joiner: str = "; ") -> str:
+    return joiner.join(sorted(v for v in values if v)).replace("|", "\\|")
+
+
+def markdown(reads: dict[str, dict[str, FieldRead]] | None = None) -> str:
+    """docs/presets.md: one table per kind."""
+    reads = field_reads() if reads is None else reads
+    lines = ["# Preset reference", "",
+             "Every key the loaders read, per preset kind: its type, unit (of each unit system a preset may "
+             "declare), allowed values, default and meaning. Generated from the loaders' own reads "
+             "(presets/fields.py, presets/reference.py) by `python benchmarks/presets_reference.py --write`; "
+             "do not edit by hand. `*` stands for any name (`members.*`: every member), `[]` for any entry "
+             "of an array of tables, `<number>` for a key that is a number.", ""]
+    for name, kind in KINDS.items():
+        lines += [f"## `{name}`: {kind.description}", "",
+                  "| key | type | unit | allowed | default | meaning |", "|---|---|---|---|---|---|"]
+        meanings = MEANINGS.get(name, {})
+        for path, read in reads[name].items():
+            default = "required" if REQUIRED in read.defaults else _cell(read.defaults, " or ")
+            meaning = _cell({meanings.get(path, "")})
+            lines.append(f"| `{path}` | {read.type} | {_cell(read.units, ', ')} | {_cell(read.allowed)} | "
+                         f"{default} | {meaning} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def missing_meanings(reads: dict[str, dict[str, FieldRead]]) -> list[str]:
+    """``kind: path`` of every key read without a meaning."""
+    return [f"{kind}: {path}" for kind, paths in reads.items() for path in paths
+            if path not in MEANINGS.get(kind, {})]
+
+
+def stale_meanings(reads: dict[str, dict[str, FieldRead]]) -> list[str]:
+    """``kind: path`` of every meaning whose key the loader never read."""
+    return [f"{kind}: {path}" for kind, meanings in MEANINGS.items() for path in meanings
+            if path not in reads.get(kind, {})]

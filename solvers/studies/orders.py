@@ -1,0 +1,158 @@
+"""Cam-order spectra: any output of a run over its evaluated cycles, in multiples of the cam speed.
+
+Over a window of N whole cam cycles (:func:`vtool.solvers.studies.metrics.evaluation_window`
+rounded to whole cycles: a steady run's last cycle, a plain run's whole
+revolutions after the first), a quantity y (``q7``, ``q1-q9``, ``F2``: see
+:meth:`Trace.quantity <vtool.solvers.trace.Trace.quantity>`) sampled at P
+equal cam-angle steps per cycle (the output interval; rows between are
+interpolated linearly, events add no rows) has the discrete Fourier series
+
+    y(θ) ≈ c_0 + Σ_k a_k cos(k θ / N) + b_k sin(k θ / N),   θ in deg of cam angle
+
+whose order-j term (j = k / N cam orders: order 1 once per cam revolution)
+has the amplitude |Y_k| 2 / (N P) (c_0 for order 0) and the phase of Y_k,
+Y = rfft(y). This is exact for a response with no orders above P/2 (the
+Nyquist order, 180 at 1 deg rows); higher orders fold back (alias), so a
+chattering contact force wants a finer ``output_interval``. A linear
+train driven by the thesis' harmonic cam responds at orders 0 and 1 alone.
+
+:func:`dominant_near` lists, for each natural frequency of the active
+configurations, the strongest orders within a band about it (ω_n / ω cam
+orders): the orders that excite that mode at this speed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from vtool.errors import InputError
+from vtool.solvers.studies.metrics import REVOLUTION, evaluation_window
+from vtool.solvers.trace import Trace
+
+
+@dataclass(frozen=True)
+class Spectrum:
+    """Order amplitudes of one quantity: ``orders`` (cam orders), ``amplitude`` (the quantity's unit),
+    ``phase`` (rad, of the cosine: y = c_0 + Σ A cos(j θ + φ)), over ``cycles`` whole cycles starting at cam
+    angle ``start`` (deg), ``rpm`` the cam speed."""
+
+    quantity: str
+    unit: str
+    orders: np.ndarray
+    amplitude: np.ndarray
+    phase: np.ndarray
+    start: float
+    cycles: int
+    rpm: float
+
+    @property
+    def nyquist(self) -> float:
+        return float(self.orders[-1])
+
+    def amplitude_of(self, order: float) -> float:
+        """The amplitude at a cam order (0 if it is not a multiple of 1 / cycles)."""
+        k = order * self.cycles
+        if abs(k - round(k)) > 1e-9 or round(k) >= len(self.amplitude):
+            return 0.0
+        return float(self.amplitude[round(k)])
+
+    def top(self, count: int = 10, lowest: float = 0.5) -> list[tuple[float, float]]:
+        """The ``count`` largest (order, amplitude) above order ``lowest`` (the mean left out), largest first."""
+        keep = np.flatnonzero(self.orders >= lowest)
+        best = keep[np.argsort(-self.amplitude[keep], kind="stable")[:count]]
+        return [(float(self.orders[i]), float(self.amplitude[i])) for i in best]
+
+    def table(self, count: int = 12) -> str:
+        """A text table of the mean and the largest orders."""
+        lines = [f"{self.quantity} in cam orders over {self.cycles} cycle{'s' if self.cycles > 1 else ''} "
+                 f"(cam angle {self.start:g}-{self.start + REVOLUTION * self.cycles:g} deg, {self.rpm:g} rev/min; "
+                 f"orders above {self.nyquist:g} fold back)",
+                 f"{'order':>8} {'frequency (Hz)':>15} {'amplitude (' + self.unit + ')':>22} {'phase (deg)':>12}",
+                 f"{0:>8g} {0:>15g} {self.amplitude[0]:>22.6g} {'(mean)':>12}"]
+        for order, amplitude in self.top(count):
+            k = int(round(order * self.cycles))
+            lines.append(f"{order:>8g} {order * self.rpm / 60.0:>15.6g} {amplitude:>22.6g} "
+                         f"{math.degrees(self.phase[k]):>12.2f}")
+        return "\n".join(lines)
+
+    def as_dict(self) -> dict:
+        return {"quantity": self.quantity, "amplitude_unit": self.unit, "cycles": self.cycles, "start_deg": self.start,
+                "rpm": self.rpm, "orders": self.orders.tolist(), "amplitude": self.amplitude.tolist(),
+                "phase_rad": self.phase.tolist()}
+
+
+def whole_cycles(trace: Trace) -> tuple[float, int]:
+    """(start in deg, count) of the whole cam cycles in the evaluated window (at least one)."""
+    start, end = evaluation_window(trace)
+    first = math.ceil(start / REVOLUTION - 1e-9) * REVOLUTION
+    count = int(math.floor((end - first) / REVOLUTION + 1e-9))
+    if count < 1:
+        raise InputError("run.degrees", float(trace.cam_angle[-1]) if len(trace.cam_angle) else 0.0,
+                         "a run with a whole cam cycle to analyse (>= 360 deg; >= 720 for a plain run, whose "
+                         "first revolution is the start-up)", "deg")
+    return first, count
+
+
+def spectrum(trace: Trace, quantity: str) -> Spectrum:
+    """The cam-order spectrum of ``quantity`` over the evaluated whole cycles (see the module doc)."""
+    try:
+        values = trace.quantity(quantity)
+        unit = trace.quantity_unit(quantity)
+    except (KeyError, ValueError, IndexError):
+        raise InputError("--orders", quantity, "a quantity of this preset: qN (a coordinate), qN-qM or FN (the "
+                         "contact force at the clearance ahead of qN)") from None
+    start, cycles = whole_cycles(trace)
+    step = trace.spec.run.output_interval
+    per_cycle = max(int(round(REVOLUTION / step)), 4)
+    n = per_cycle * cycles
+    theta = start + np.arange(n) * (REVOLUTION * cycles / n)
+    angle, first = np.unique(trace.cam_angle, return_index=True)  # rows in angle order, one per angle
+    y = np.interp(theta, angle, values[first])
+    Y = np.fft.rfft(y)
+    amplitude = np.abs(Y) * 2.0 / n
+    amplitude[0] = abs(Y[0].real) / n
+    if n % 2 == 0:
+        amplitude[-1] /= 2.0
+    phase = np.angle(Y)
+    phase[0] = 0.0 if Y[0].real >= 0 else math.pi
+    orders = np.arange(len(Y)) / cycles
+    return Spectrum(quantity, unit, orders, amplitude, phase, start, cycles, trace.spec.run.rpm)
+
+
+def natural_frequencies(trace: Trace) -> list[tuple[str, float]]:
+    """(configuration, natural frequency in Hz) of the configurations the run visited, lowest first per
+    configuration (the free coordinates' undamped modes)."""
+    from vtool.solvers.model.contact import ContactProblem
+    from vtool.solvers.model.damping import undamped_modes
+    from vtool.solvers.model.mechanism import assemble
+
+    mechanism = assemble(trace.spec)
+    problem = ContactProblem.for_run(mechanism)
+    result = []
+    for mask in sorted({int(m) for m in np.unique(trace.configuration)}):
+        layer = problem.build(mask)
+        nf = layer.nf
+        if nf == 0:
+            continue
+        modes = undamped_modes(layer.M[:nf, :nf], layer.K[:nf, :nf])
+        for omega in sorted(float(w) for w in modes.omega if w > 0):
+            result.append((problem.label(mask), omega / (2 * math.pi)))
+    return result
+
+
+def dominant_near(spectrum_: Spectrum, frequencies: list[tuple[str, float]], band: float = 0.15,
+                  count: int = 3) -> list[tuple[str, float, float, list[tuple[float, float]]]]:
+    """For each (configuration, natural frequency in Hz): its cam order ω_n / ω and the ``count`` largest
+    orders within ``band`` (a fraction) of it, largest first (empty when none is below the Nyquist order)."""
+    cam_hz = spectrum_.rpm / 60.0
+    result = []
+    for label, hz in frequencies:
+        order = hz / cam_hz
+        near = np.flatnonzero((spectrum_.orders >= order * (1 - band)) & (spectrum_.orders <= order * (1 + band))
+                              & (spectrum_.orders > 0))
+        best = near[np.argsort(-spectrum_.amplitude[near], kind="stable")[:count]]
+        result.append((label, hz, order, [(float(spectrum_.orders[i]), float(spectrum_.amplitude[i])) for i in best]))
+    return result

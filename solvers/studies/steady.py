@@ -1,0 +1,235 @@
+"""Runs to steady state: cam cycle after cam cycle, until the cycle's start state and metrics settle.
+
+With ``run.cycles = N`` a run is N cam cycles (360 deg each); with
+``run.steady = { tolerance, max_cycles }`` it goes on cycle by cycle until
+the change from one cycle to the next (:func:`cycle_change`) is at most the
+tolerance, or stops after ``max_cycles`` and says it did not settle and by
+how much the last cycle still moved. The metrics cover the last cycle
+(:mod:`vtool.solvers.studies.metrics`).
+
+How a run continues: each cycle is one back-end run of 360 deg started from
+the state at the previous cycle's end (:meth:`Mechanism.with_start
+<vtool.solvers.model.mechanism.Mechanism.with_start>`: the cam is periodic in
+360 deg, so the state at its end is a start at cam angle zero). Every back
+end starts from the mechanism's ``start`` and the contact problem's start
+mask, so every back end continues a run unchanged (the Python layer only;
+the compiled kernel is untouched); a cycle continued so equals the same
+cycle of one long run to 1e-11 of the motion (newmark, exact; 1A at 5,000
+rev/min) and 1e-8 (scipy, its own tolerance), and to about 1e-6 where
+events follow (the step grid restarts at each cycle: 1A at 9,000). What a continuation does not carry: a chattering
+contact's stick counters and a Hertz contact's approach velocity (both
+re-derived at the next event).
+
+The change from cycle k-1 to cycle k is the largest of
+
+* the state at the cycle's start: max |Δq| over the elastic coordinates
+  relative to the cycle's largest |q|, and likewise for q̇;
+* the cycle's metrics: every clearance's peak force relative to the
+  cycle's largest peak force; the lift loss relative to the cam's total
+  lift; the largest seating velocity relative to the cam's velocity scale
+  (total lift times the cam speed in rad/s). A metric that appears or
+  disappears (NaN on one side) counts as a change of 1.
+
+and the events per clearance must be the same in both cycles.
+
+A periodic start (:class:`State`): a sweep carries the state at the end of
+a point's last cycle to the next point, velocities scaled by the ratio of
+the cam speeds and accelerations by its square (the state of a train
+moving with its cam); benchmarks/bench_steady.py measures the cycles saved.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from vtool.solvers.model.mechanism import Mechanism
+from vtool.solvers.studies.metrics import run_metrics, total_lift
+from vtool.solvers.trace import Cycles, Event, RunStatistics, Trace
+
+#: run.steady's defaults
+DEFAULT_TOLERANCE = 1e-3
+DEFAULT_MAX_CYCLES = 30
+REVOLUTION = 360.0
+
+
+@dataclass(frozen=True)
+class State:
+    """A run's state at a cam cycle's start (cam angle zero): the elastic coordinates, their velocities and
+    accelerations, the configuration, and the cam speed (rad/s) it was reached at."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    mask: int
+    omega: float
+
+    @classmethod
+    def at_end(cls, trace: Trace, omega: float) -> State:
+        n = trace.spec.n_coordinates
+        return cls(trace.q[-1, :n].copy(), trace.qd[-1, :n].copy(), trace.qdd[-1, :n].copy(),
+                   int(trace.configuration[-1]), omega)
+
+    def start(self, mechanism: Mechanism) -> Mechanism:
+        """``mechanism`` started from this state, scaled to its cam speed."""
+        ratio = mechanism.omega / self.omega if self.omega > 0 else 1.0
+        return mechanism.with_start(self.q, self.qd * ratio, self.qdd * ratio**2, self.mask)
+
+
+def is_cyclic(spec: Any) -> bool:
+    """Whether the spec's run goes cycle by cycle (run.cycles or run.steady)."""
+    return spec.run.cycles > 0 or spec.run.steady_tolerance > 0
+
+
+def with_steady(spec: Any) -> Any:
+    """The spec run to steady state (run.steady's defaults) unless it already runs cycle by cycle."""
+    if is_cyclic(spec):
+        return spec
+    return dataclasses.replace(spec, run=dataclasses.replace(spec.run, steady_tolerance=DEFAULT_TOLERANCE,
+                                                             steady_max_cycles=DEFAULT_MAX_CYCLES))
+
+
+def steady_text(spec: Any) -> str:
+    """How the spec's runs are evaluated: one line."""
+    r = spec.run
+    if r.cycles:
+        return f"each run: {r.cycles} cam cycles, the last evaluated"
+    if r.steady_tolerance:
+        return (f"each run: cycle by cycle to steady state (tolerance {r.steady_tolerance:g}, at most "
+                f"{r.steady_max_cycles} cycles), the last cycle evaluated")
+    return f"each run: {r.degrees:g} deg, evaluated after the first revolution (not checked for a steady state)"
+
+
+def max_cycles(spec: Any) -> int:
+    r = spec.run
+    return r.cycles if r.cycles > 0 else (r.steady_max_cycles or DEFAULT_MAX_CYCLES)
+
+
+def run_degrees(spec: Any) -> float:
+    """Degrees the run may cover (the cost estimate's): its cycles, or ``degrees`` for a plain run."""
+    return REVOLUTION * max_cycles(spec) if is_cyclic(spec) else spec.run.degrees
+
+
+def _relative(a: float, b: float, scale: float) -> float:
+    if math.isnan(a) and math.isnan(b):
+        return 0.0
+    if math.isnan(a) or math.isnan(b):
+        return 1.0
+    return abs(a - b) / max(scale, 1e-300)
+
+
+def _event_counts(trace: Trace) -> dict[str, int]:
+    counts = {c.name: 0 for c in trace.spec.clearances}
+    for e in trace.events:
+        counts[e.clearance] += 1
+    return counts
+
+
+def cycle_change(before: Trace, after: Trace) -> tuple[float, str]:
+    """The largest relative change from one cycle's run to the next (see the module doc) and what it is;
+    (inf, "events ...") when the events per clearance differ."""
+    spec = after.spec
+    n = spec.n_coordinates
+    changes: dict[str, float] = {}
+    for name, data in (("start displacements", "q"), ("start velocities", "qd")):
+        x, y = getattr(before, data)[:, :n], getattr(after, data)[:, :n]
+        scale = max(float(np.abs(x).max()), float(np.abs(y).max()), 1e-300)
+        changes[name] = float(np.abs(y[0] - x[0]).max()) / scale
+    m0, m1 = run_metrics(before, (0.0, REVOLUTION)), run_metrics(after, (0.0, REVOLUTION))
+    peaks = [k for k in m1 if k.startswith("peak_")]
+    force_scale = max([abs(m1[k]) for k in peaks if not math.isnan(m1[k])] + [1e-300])
+    for k in peaks:
+        changes[k] = _relative(m0[k], m1[k], force_scale)
+    lift = total_lift(spec.cam)
+    omega = spec.run.rpm * math.pi / 30.0
+    changes["lift_loss"] = _relative(m0["lift_loss"], m1["lift_loss"], lift)
+    changes["seating_velocity_max"] = _relative(m0["seating_velocity_max"], m1["seating_velocity_max"], lift * omega)
+    what = max(changes, key=lambda k: changes[k])
+    c0, c1 = _event_counts(before), _event_counts(after)
+    if c0 != c1:
+        moved = ", ".join(f"{k} {c0[k]} -> {c1[k]}" for k in c1 if c0[k] != c1[k])
+        return math.inf, f"events per cycle changed: {moved}; {what} by {changes[what]:.3g}"
+    return changes[what], what
+
+
+def _shifted(trace: Trace, k: int, period: float, skip_first: bool) -> tuple[slice, list[Event]]:
+    rows = slice(1 if skip_first else 0, None)
+    events = [dataclasses.replace(e, time=e.time + k * period, cam_angle=e.cam_angle + k * REVOLUTION)
+              for e in trace.events]
+    return rows, events
+
+
+def concatenate(traces: list[Trace], spec: Any, omega: float, cycles: Cycles) -> Trace:
+    """One trace of consecutive cycle runs: times and angles shifted by whole cycles, the first row of every
+    cycle after the first left out (it is the previous cycle's last), events, peaks and statistics joined."""
+    period = 2 * math.pi / omega
+    parts = [_shifted(t, k, period, k > 0) for k, t in enumerate(traces)]
+
+    def join(name: str) -> np.ndarray:
+        return np.concatenate([getattr(t, name)[rows] for t, (rows, _) in zip(traces, parts, strict=True)])
+
+    time = np.concatenate([t.time[rows] + k * period for k, (t, (rows, _)) in enumerate(zip(traces, parts,
+                                                                                             strict=True))])
+    angle = np.concatenate([t.cam_angle[rows] + k * REVOLUTION for k, (t, (rows, _)) in enumerate(zip(traces, parts,
+                                                                                                      strict=True))])
+    events = tuple(e for _, evs in parts for e in evs)
+    first = traces[0].statistics
+    stats = RunStatistics(first.backend, sum(t.statistics.steps for t in traces), len(events),
+                          sum(t.statistics.wall_time for t in traces),
+                          tuple(sorted({c for t in traces for c in t.statistics.configurations_built})),
+                          dict(first.settings, degrees=REVOLUTION * len(traces), cycles=len(traces)),
+                          compile_time=sum(t.statistics.compile_time for t in traces),
+                          plain_steps=sum(t.statistics.plain_steps for t in traces),
+                          kernel=traces[-1].statistics.kernel)
+    peak = np.max([t.peak_force for t in traces], axis=0)
+    late = np.max([t.peak_force for t in traces[1:]], axis=0) if len(traces) > 1 else None
+    overlaps = [t.peak_overlap for t in traces if t.peak_overlap is not None]
+    return Trace(spec, time, angle, traces[0].coordinate_numbers, join("q"), join("qd"), join("qdd"),
+                 join("contact_force"), join("configuration"), events, peak, stats,
+                 peak_force_after_first_revolution=late,
+                 peak_overlap=np.max(overlaps, axis=0) if overlaps else None, cycles=cycles)
+
+
+def simulate_cycles(backend: Any, mechanism: Mechanism, *, every_step: bool = False,
+                    progress: Callable[[float], None] | None = None, cancel: Callable[[], bool] | None = None,
+                    start: State | None = None, on_state: Callable[[State], None] | None = None) -> Trace:
+    """Run ``mechanism`` cycle by cycle (its spec's run.cycles or run.steady) on ``backend``; see the module
+    doc. ``start`` is a periodic start (default: the static start); ``on_state`` receives the state at the
+    last cycle's end (for the next sweep point's start)."""
+    spec = mechanism.spec
+    run = spec.run
+    fixed = run.cycles > 0
+    limit = max_cycles(spec)
+    tolerance = 0.0 if fixed else run.steady_tolerance
+    one = dataclasses.replace(run, degrees=REVOLUTION)
+    base = mechanism.with_run(one)
+    options = backend.options_from_run(one, every_step)
+    current = base if start is None else start.start(base)
+    traces: list[Trace] = []
+    changes = [math.nan]
+    change, changed = math.nan, ""
+    settled: bool | None = None if fixed else False
+    for k in range(limit):
+        part = None if progress is None else (lambda f, k=k: progress((k + f) / limit))
+        trace = backend.simulate(current, options, progress=part if backend.supports_progress else None,
+                                 cancel=cancel if backend.supports_cancel else None)
+        traces.append(trace)
+        if k > 0:
+            change, changed = cycle_change(traces[-2], trace)
+            changes.append(change)
+            if not fixed and change <= tolerance:
+                settled = True
+                break
+        state = State.at_end(trace, base.omega)
+        current = state.start(base)
+    if on_state is not None:
+        on_state(State.at_end(traces[-1], base.omega))
+    cycles = Cycles(len(traces), settled, tolerance, change, changed, tuple(changes), traces[-1].peak_force.copy(),
+                    traces[0].peak_force.copy() if start is None else np.full_like(traces[0].peak_force, math.nan),
+                    max_cycles=limit)
+    return concatenate(traces, spec, base.omega, cycles)

@@ -1,0 +1,109 @@
+"""Runs to steady state (solvers/studies/steady.py) and cam-order spectra (solvers/studies/orders.py), checked
+against the closed-form periodic response of a linear train, and the stop of a run that cannot settle."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tests.test_backends import base_excited_doc
+from tests.valvetrain_cases import spec_from
+from vtool.presets import load_preset
+from vtool.presets.valvetrain import dump, load
+from vtool.solvers.model.contact import ContactProblem
+from vtool.solvers.model.mechanism import assemble
+from vtool.solvers.run import simulate
+from vtool.solvers.studies.metrics import run_metrics, window_text
+from vtool.solvers.studies.orders import spectrum
+
+TOLERANCE = 1e-10
+
+
+def linear_doc(**steady) -> dict:
+    """The base-excited oscillator (the follower pinned to the cam by its preload: one configuration, no
+    clearance changes), damped so that its start-up dies out (gravity only turns weights into masses)."""
+    doc = base_excited_doc(degrees=360.0)
+    doc["damping"] = {"default_ratio": 0.2}
+    doc["run"].update(backend="exact", steady=steady or {"tolerance": TOLERANCE, "max_cycles": 60})
+    return doc
+
+
+def periodic_response(spec) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
+    """Closed form of the periodic response of the free coordinates (full numbers, 0-based) to the cam
+    z = offset + A sin(θ): mean x0 = -K_ff⁻¹ K_fp z0 and order 1 X = -(K_fp + iω C_fp - ω² M_fp) Z / (K_ff + iω C_ff
+    - ω² M_ff), Z = -iA (z = Re(Z e^{iωt})): the harmonic balance of the linear equations of motion, exact for
+    the one harmonic the cam has. Returns (x0, X) per full coordinate of the free ones."""
+    mechanism = assemble(spec)
+    problem = ContactProblem.for_run(mechanism)
+    layer = problem.build(problem.start_mask)
+    nf, w = layer.nf, mechanism.omega
+    M, C, K = layer.M, layer.C, layer.K
+    z0 = mechanism.start.cam_offset
+    A = spec.cam.amplitude
+    ff, fp = np.ix_(range(nf), range(nf)), np.ix_(range(nf), range(nf, layer.m))
+    x0 = -np.linalg.solve(K[ff], K[fp] @ np.full(layer.m - nf, z0))
+    X = -np.linalg.solve(K[ff] + 1j * w * C[ff] - w**2 * M[ff],
+                         (K[fp] + 1j * w * C[fp] - w**2 * M[fp]) @ np.full(layer.m - nf, -1j * A))
+    return layer.kept[:nf], x0, X
+
+
+def test_a_linear_train_settles_to_its_closed_form_periodic_response_and_orders() -> None:
+    spec = spec_from(linear_doc())
+    trace = simulate(spec)
+    assert trace.cycles is not None and trace.cycles.settled and 2 < trace.cycles.count < 60
+    assert not trace.events
+    kept, x0, X = periodic_response(spec)
+    start, end = trace.cycles.window
+    rows = trace.cam_angle >= start
+    theta = np.radians(trace.cam_angle[rows])
+    for j, full in enumerate(kept):
+        exact = x0[j] + (X[j] * np.exp(1j * theta)).real
+        q = trace.q[rows, trace.coordinate_numbers.index(full + 1)]
+        scale = abs(X[j]) + abs(x0[j])
+        assert np.abs(q - exact).max() / scale < 1e-8  # the stated tolerance is 1e-10 per cycle
+        orders = spectrum(trace, f"q{full + 1}")
+        assert orders.cycles == 1 and orders.orders[1] == 1.0
+        assert orders.amplitude_of(0) == pytest.approx(abs(x0[j]), rel=1e-6)
+        assert orders.amplitude_of(1) == pytest.approx(abs(X[j]), rel=1e-6)
+        assert max(a for o, a in orders.top(5) if o != 1.0) < 1e-6 * abs(X[j])  # nothing at other orders
+        assert math.cos(orders.phase[1]) == pytest.approx(math.cos(np.angle(X[j])), abs=1e-6)
+
+
+def test_a_fixed_number_of_cycles_evaluates_the_last() -> None:
+    doc = linear_doc()
+    del doc["run"]["steady"]
+    doc["run"]["cycles"] = 3
+    trace = simulate(spec_from(doc))
+    assert trace.cycles.count == 3 and trace.cycles.settled is None and trace.cycles.window == (720.0, 1080.0)
+    assert trace.cam_angle[-1] == pytest.approx(1080.0) and np.all(np.diff(trace.time) > 0)
+    assert "cycle 3 of 3" in window_text(trace) and "fixed number" in window_text(trace)
+    assert run_metrics(trace)["cycles"] == 3
+
+
+def test_a_cycle_continued_equals_one_long_run() -> None:
+    """Three cycles cycle by cycle against one 1080-degree run (both Newmark): the same motion, to the
+    differences of a step grid that restarts at each cycle (here 4e-7 of the motion, through the events)."""
+    doc = dump(load_preset("gnilka-1a"))
+    doc["run"].update(degrees=1080.0, rpm=9000.0)
+    plain = simulate(load(doc))
+    doc["run"]["cycles"] = 3
+    cycled = simulate(load(doc))
+    n = plain.spec.n_coordinates
+    assert cycled.q.shape == plain.q.shape
+    scale = np.abs(plain.q[:, :n]).max()
+    assert np.abs(cycled.q[:, :n] - plain.q[:, :n]).max() / scale < 1e-5
+    assert [(e.clearance, e.kind) for e in cycled.events] == [(e.clearance, e.kind) for e in plain.events]
+
+
+def test_a_run_that_cannot_settle_stops_at_max_cycles_and_says_so() -> None:
+    """1A at 13,000 rev/min: the follower leaves the cam and lands differently from cycle to cycle (its events
+    per cycle keep changing); the run stops after max_cycles and says it did not settle."""
+    doc = dump(load_preset("gnilka-1a"))
+    doc["run"].update(rpm=13000.0, steady={"tolerance": 1e-6, "max_cycles": 8})
+    trace = simulate(load(doc))
+    assert trace.cycles.count == 8 and trace.cycles.settled is False
+    assert trace.cycles.change > 1e-6
+    text = window_text(trace)
+    assert text.startswith("warning: did not settle in 8 cycles") and "changed by" in text
