@@ -194,6 +194,25 @@ def cam_charts(spec: Any, points: int = 721) -> list[Chart]:
     return charts
 
 
+def scan_charts(scan: Any, unit: str, subject: str = "") -> list[Chart]:
+    """A measured scan raw against smoothed: lift, velocity and acceleration per cam degree.
+
+    Raw derivatives are central differences of the samples (the noise they
+    carry is the point of the chart); smoothed ones are the series' own.
+    """
+    from vtool.presets.cam_scan import per_degree_derivatives, series_derivatives
+
+    raw_v, raw_a = per_degree_derivatives(scan.angles, scan.raw)
+    curves = {"raw scan": (scan.raw, raw_v, raw_a)}
+    if scan.smoothed is not None:
+        curves[f"smoothed ({scan.smoothed.harmonics} harmonics)"] = (scan.lifts,
+                                                                     *series_derivatives(scan.angles, scan.lifts))
+    names = (("lift", unit), ("velocity", f"{unit}/deg"), ("acceleration", f"{unit}/deg^2"))
+    panels = tuple(Panel(tuple(curve(label, scan.angles, values[i]) for label, values in curves.items()),
+                         with_unit(name, u)) for i, (name, u) in enumerate(names))
+    return [Chart("measured scan: raw against smoothed (per cam degree)", CAM_ANGLE, panels, subject)]
+
+
 # ----------------------------------------------------------------------------
 # sonic boom
 

@@ -19,17 +19,22 @@ MAX_BYTES = 4_000_000
 _SPLIT = re.compile(r"[,;\t ]+")
 
 
-def read_lift_table(field: str, name: str, folder: Path | None, unit: str) -> tuple[list[float], list[float]]:
-    """(angles_deg, lifts) from the CSV ``name`` (relative to ``folder``)."""
+def read_table_text(field: str, name: str, folder: Path | None) -> str:
+    """The text of the file ``name`` (relative to ``folder``), with the checks of the module doc."""
     path = Path(name) if Path(name).is_absolute() or folder is None else Path(folder) / name
     if not is_file(path):
         raise InputError(field, str(path), "an existing regular file (relative to the preset's folder)")
     if path.stat().st_size > MAX_BYTES:
         raise InputError(field, str(path), f"a file of at most {MAX_BYTES} bytes")
     try:
-        text = path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(field, str(path), f"a readable UTF-8 text file ({exc})") from None
+
+
+def read_lift_table(field: str, name: str, folder: Path | None, unit: str) -> tuple[list[float], list[float]]:
+    """(angles_deg, lifts) from the CSV ``name`` (relative to ``folder``)."""
+    text = read_table_text(field, name, folder)
     angles: list[float] = []
     lifts: list[float] = []
     first = True

@@ -36,6 +36,9 @@ VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
                    "clearances[0].contact_damping_ratio": 0.05, "clearances[0].impact": "momentum"}),
     ("gnilka-1a", {"clearances[0].contact": "linear", "clearances[0].contact_stiffness": 1e6,
                    "clearances[0].contact_damping": 1.0}),
+    # a measured scan: its units, angle, valve lift and smoothing (presets/cam_scan.py)
+    ("ramped-cam", {"cam.scan": {"lift_unit": "in", "angle": "cam", "lift_of": "valve", "rocker_ratio": 1.0,
+                                 "smoothing": "fourier", "noise": 1e-5, "peak_tolerance": 1e-3}}),
     ("gnilka-1a", {"clearances[2].contact": "hertz", "clearances[2].contact_stiffness": 1e7,
                    "clearances[2].contact_exponent": 1.5}),
     *((name, changes) for name in ("boom-brick-wall", "boom-tall-building") for changes in (
@@ -102,6 +105,16 @@ MEANINGS: dict[str, dict[str, str]] = {
         "cam.amplitude": "Amplitude of the harmonic cam's motion.",
         "cam.offset": "Where the cam starts: \"static-start\" (the thesis' XZERO rule) or a length.",
         "cam.lift_table": "CSV file of lift against cam angle (table profile), found beside the preset.",
+        "cam.polyline": "A measured scan as a polyline script of angle,lift points (instead of lift_table), "
+                        "found beside the preset (presets/cam_scan.py).",
+        "cam.scan": "What a measured lift table's numbers are, and its smoothing (presets/cam_scan.py).",
+        "cam.scan.lift_unit": "The unit of the scan's lifts (mm, in, thou, m); converted to the preset's.",
+        "cam.scan.angle": "Cam degrees, or crank degrees (halved to cam degrees: four-stroke).",
+        "cam.scan.lift_of": "Tappet (cam follower) lift, or valve lift (divided by rocker_ratio).",
+        "cam.scan.rocker_ratio": "Valve lift per tappet lift, for a valve-lift scan.",
+        "cam.scan.smoothing": "none, or fourier: a truncated Fourier series cut off at the scan's noise.",
+        "cam.scan.noise": "The scan's noise rms (default: estimated from its spectrum).",
+        "cam.scan.peak_tolerance": "How far smoothing may move the peak lift (default: 4 x the noise rms).",
         "cam.harmonics": "Harmonics of the lift table's Fourier fit (0: as many as the table needs).",
         "cam.tolerance": "Largest lift error the fit may leave.",
         "seat": "The valve seat: a prescribed, fixed coordinate (absent: no seat).",

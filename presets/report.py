@@ -25,7 +25,9 @@ The checks are the run's own criteria (the metrics of
 the run completes; the follower stays on the cam (``cam_separations = 0``);
 the valve does not bounce on its seat (``seat_bounces = 0``); spring force
 is left over the nose (``spring_margin > 0``). A run of one revolution or
-less cannot be judged: its checks say ``n/a``.
+less cannot be judged: its checks say ``n/a``. The limits of the preset's
+``[checks]`` table (:mod:`vtool.solvers.studies.checks`) follow, each with
+its limit, value and margin.
 """
 
 from __future__ import annotations
@@ -182,6 +184,16 @@ def run_checks(trace: Any) -> tuple[Check, ...]:
     else:
         checks.append(Check("spring force left over the nose", f"spring_margin > 0 {force}", "-", NOT_APPLICABLE,
                             "no cam contact over the nose after the first revolution"))
+    if getattr(trace.spec, "checks", None):  # the limits of the preset's [checks] table
+        from vtool.solvers.studies.checks import MAX
+        from vtool.solvers.studies.checks import evaluate as evaluate_limits
+
+        for c in evaluate_limits(trace.spec, trace):
+            sign = "<=" if c.sense == MAX else ">="
+            outcome = NOT_APPLICABLE if c.passed is None else PASS if c.passed else FAIL
+            checks.append(Check(c.description, f"{sign} {_g(c.limit)} {c.unit} ([checks] {c.name})",
+                                "-" if c.value is None else f"{_g(c.value)} {c.unit}", outcome,
+                                "" if c.margin is None else f"{_g(c.margin)} {c.unit}"))
     return tuple(checks)
 
 

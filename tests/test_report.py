@@ -132,3 +132,18 @@ async def test_tui_saves_the_same_report(tmp_path: Path) -> None:
     tui, cli_text = content("tui.html"), content("cli.html")
     assert html_sections(tui) == html_sections(cli_text) and tui.count("<figure>") == cli_text.count("<figure>")
     assert tui == cli_text
+
+
+def test_the_presets_checks_table_is_in_the_report() -> None:
+    """A preset's [checks] limits (solvers/studies/checks.py) follow the run's own checks, with their margin."""
+    import vtool
+    from vtool.presets.report import run_checks
+
+    document = vtool.load("gnilka-1a").document
+    document["checks"] = {"seating_velocity_max": 1.0}  # in/s: 1A seats far faster, so it fails
+    result = vtool.load(document).solve()
+    checks = {c.name: c for c in run_checks(result.trace)}
+    seating = checks["valve seating velocity (largest)"]
+    largest = max(max(c.get("seating_velocities") or [0.0]) for c in result.summary()["clearances"])
+    assert seating.outcome == FAIL and seating.criterion.startswith("<= 1 in/s")
+    assert float(seating.margin.split()[0]) == pytest.approx(1.0 - largest, rel=1e-5)
