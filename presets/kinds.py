@@ -58,7 +58,7 @@ KINDS: dict[str, Kind] = {
                        "vtool.solvers.model.spec:MechanismSpec", "vtool.presets.valvetrain",
                        "vtool.app.cli.solve:run_valvetrain", "vtool.app.tui.valvetrain",
                        ("--backend", "--dt", "--rpm", "--degrees", "--every-step", "--events",
-                        "--max-steps", "--impact", "--start")),
+                        "--max-steps", "--impact", "--start", "--format")),
     "boom_wall": Kind("boom_wall", "sonic-boom wall assessment",
                       "vtool.assessments.sonic_boom.spec:BoomWallSpec", "vtool.presets.boom",
                       "vtool.app.cli.boom:solve_preset", "vtool.app.tui.boom"),

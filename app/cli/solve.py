@@ -57,8 +57,11 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
               help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's.")
 @click.option("--max-steps", type=float, callback=_max_steps,
               help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}).")
-@click.option("--csv", "csv_path", type=click.Path(),  # a str: '' stays '' in the error
+@click.option("--csv", "--out", "csv_path", type=click.Path(),  # a str: '' stays '' in the error
               help="Write the response as CSV (per output interval, or per step with --every-step).")
+@click.option("--format", "file_format", type=click.Choice(["csv", "parquet"]),
+              help="Format of the --csv/--out file (default: parquet for a .parquet file, else csv); Parquet "
+                   "needs pyarrow (pip install 'vtool[parquet]'), written in row groups as the run goes.")
 @click.option("--every-step", is_flag=True, help="CSV rows at every time step (and event) instead of per degree.")
 @click.option("--plot", is_flag=True, help="Draw force, displacement and configuration charts (not with --json).")
 @figure_option
@@ -68,7 +71,8 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @start_velocities_option
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
           max_steps: float | None, csv_path: str | None, every_step: bool, plot: bool, as_json: bool,
-          show_events: bool, impact: str | None, start: str | None, figure_path: Path | None) -> None:
+          show_events: bool, impact: str | None, start: str | None, figure_path: Path | None,
+          file_format: str | None) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
@@ -82,11 +86,16 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
     if as_json and plot:
         raise InputError("--plot", "with --json", "one of --json (machine-readable stdout) or --plot")
     csv_file = None if csv_path is None else Path(check_output_path(csv_path, "--csv") and csv_path)
+    if file_format is not None and csv_file is None:
+        raise InputError("--format", file_format, "an output file to write (--out PATH)")
+    if csv_file is not None and file_format is None and str(csv_file).lower().endswith((".parquet", ".pq")):
+        file_format = "parquet"
     spec = load_preset(preset)
     kind = KINDS[spec.kind]
     given = {"--backend": backend, "--dt": dt, "--rpm": rpm, "--degrees": degrees,
              "--max-steps": max_steps, "--every-step": every_step or None,
-             "--events": show_events or None, "--impact": impact, "--start": start}
+             "--events": show_events or None, "--impact": impact, "--start": start,
+             "--format": None if file_format == "csv" else file_format}
     for flag, value in given.items():
         if value is not None and flag not in kind.run_options:
             raise InputError(flag, value, f"no {flag} for {preset}: it is a {spec.kind} preset "
@@ -99,7 +108,7 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
 #: ``vtool solve``'s run flags and the keyword that carries each to a kind's solve function
 FLAG_ARGUMENTS = {"--backend": "backend", "--dt": "dt", "--rpm": "rpm", "--degrees": "degrees",
                   "--max-steps": "max_steps", "--every-step": "every_step", "--events": "show_events",
-                  "--impact": "impact", "--start": "start"}
+                  "--impact": "impact", "--start": "start", "--format": "file_format"}
 
 
 def applies_to(flag: str) -> list[str]:
@@ -112,7 +121,8 @@ def applies_to(flag: str) -> list[str]:
 def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *, backend: str | None = None,
                    dt: float | None = None, rpm: float | None = None, degrees: float | None = None,
                    every_step: bool = False, show_events: bool = False, max_steps: float | None = None,
-                   impact: str | None = None, start: str | None = None, figure: Path | None = None) -> None:
+                   impact: str | None = None, start: str | None = None, figure: Path | None = None,
+                   file_format: str | None = None) -> None:
     """``vtool solve`` for a valvetrain preset: the run flags as preset overrides, the run, its summary."""
     from vtool.app.cli.progress import DelayedProgress
     from vtool.files import json_text
@@ -124,6 +134,11 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
 
         spec = with_model(spec, impact, start)
     spec = with_run_overrides(spec, backend=backend, time_step=dt, rpm=rpm, degrees=degrees)
+    parquet = False
+    if csv_path is not None:
+        from vtool.solvers.parquet import output_format
+
+        parquet = output_format(csv_path, file_format) == "parquet"  # pyarrow checked before the run
     progress = DelayedProgress(f"{spec.run.backend} {spec.run.degrees:g} deg")
 
     def before_run() -> None:  # the input is checked: announce a compile, if one is to come
@@ -133,6 +148,17 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
         if csv_path is None:
             trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps,
                              before_run=before_run)
+        elif parquet:  # row groups to the temporary file as the run makes them; renamed at the end
+            from vtool.files import open_atomic_binary
+            from vtool.solvers.parquet import ParquetStream
+
+            with open_atomic_binary(csv_path, "--out") as binary:
+                stream = ParquetStream(binary, spec.run.quantities, thin=every_step, title=spec.title)
+                try:
+                    trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps,
+                                     stream=stream, before_run=before_run)
+                finally:  # the writer's footer goes to the temporary file before it is renamed (or removed)
+                    stream.close()
         else:  # rows go to the temporary file as the run makes them; renamed over the target at the end
             from vtool.files import open_atomic
             from vtool.solvers.trace import CsvStream

@@ -49,9 +49,14 @@ class CountProgress:
 @click.option("--workers", type=int, help="Local worker processes (default: all cores; 1 = in this process).")
 @click.option("--scheduler", help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
                                   "processes) or local-threads:N.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("--csv", "--out", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Write one row per point (swept fields, status, metrics; units in the header), appended as "
                    "points finish.")
+@click.option("--format", "file_format", type=click.Choice(["csv", "parquet"]),
+              help="Format of the --csv/--out file (default: parquet for a .parquet file, else csv). Parquet "
+                   "(needs pyarrow: pip install 'vtool[parquet]') is written in row groups, memory bounded; "
+                   "the table is then not printed unless --json, --plot, --map or --figure needs it, and an "
+                   "interrupted sweep keeps nothing (no --resume).")
 @click.option("--resume", is_flag=True, help="Continue the sweep in the --csv file, skipping finished points.")
 @click.option("--timing", is_flag=True, help="Also write each point's wall time to the CSV (not reproducible).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON instead of a table.")
@@ -62,7 +67,7 @@ class CountProgress:
 @figure_option
 def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | None, scheduler: str | None,
           csv_path: Path | None, resume: bool, timing: bool, as_json: bool, plot: bool, as_map: bool,
-          metric: str, every_step: bool, figure_path: Path | None) -> None:
+          metric: str, every_step: bool, figure_path: Path | None, file_format: str | None) -> None:
     """Run a valve-train preset over a grid of field values and report per-point metrics.
 
     \b
@@ -87,6 +92,19 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
 
     if resume and csv_path is None:
         raise InputError("--resume", True, "a --csv file to resume")
+    if file_format is not None and csv_path is None:
+        raise InputError("--format", file_format, "an output file to write (--out PATH)")
+    parquet = False
+    if csv_path is not None:
+        from vtool.files import check_output_path
+        from vtool.solvers.parquet import output_format
+
+        parquet = output_format(csv_path, file_format) == "parquet"
+        if parquet and (resume or find is not None):
+            raise InputError("--format", "parquet", "csv for --resume and --find (a Parquet sweep is written "
+                             "whole at the end)")
+        if parquet:
+            check_output_path(csv_path, "--out")
     if find is not None:
         if not any(s.partition("=")[0].strip() == "run.rpm" for s in sets):
             sets = (f"run.rpm={DEFAULT_SCAN}",) + sets
@@ -111,14 +129,19 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         if find is not None:
             _find(find, plan, runner, csv_path, as_json, every_step)
             return
-        sink = SweepFile(csv_path, plan.fields, plan.spec, resume=resume, timing=timing) if csv_path else None
+        sink = SweepFile(csv_path, plan.fields, plan.spec, resume=resume, timing=timing) if (
+            csv_path and not parquet) else None
         progress = CountProgress(f"{len(plan.points)} points")
+        keep = not parquet or as_json or plot or as_map or figure_path is not None
         try:
-            outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress)
+            if parquet:
+                outcome = _run_to_parquet(plan, runner, csv_path, every_step, timing, keep, progress)
+            else:
+                outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress)
         except KeyboardInterrupt:
             progress.close()
             where = (f"the finished points are in {csv_path}; run again with --resume to finish"
-                     if csv_path else "nothing was kept (use --csv to keep finished points)")
+                     if csv_path and not parquet else "nothing was kept (use --csv to keep finished points)")
             raise RunError(f"interrupted: {where}") from None
         finally:
             progress.close()
@@ -130,9 +153,9 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     if as_json:
         click.echo(json.dumps(results_json(results, plan.fields, plan.spec, preset), indent=2))
     else:
-        if results:
+        if results and not parquet:
             click.echo(results_table(results, plan.fields, plan.spec))
-        n = len(results)
+        n = outcome.total - outcome.skipped
         click.echo(f"{n} points in {outcome.wall_time:.2f} s ({1000 * outcome.wall_time / max(n, 1):.1f} ms per "
                    f"point, {runner.workers} worker{'s' if runner.workers > 1 else ''})")
         if csv_path is not None:
@@ -151,6 +174,18 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         if as_map:
             items.append(sweep_map(results, axes, metric, names[metric], plan.spec.title))
         write_figure(items, figure_path)
+
+
+def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):  # type: ignore[no-untyped-def]
+    """The sweep with its points written to a Parquet file as they finish (renamed into place at the end)."""
+    from vtool.files import open_atomic_binary
+    from vtool.solvers.parquet import SweepParquet
+    from vtool.solvers.studies.sweep import run_points
+
+    with open_atomic_binary(path, "--out") as handle:
+        sink = SweepParquet(handle, plan.fields, plan.spec, timing=timing)
+        return run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress, keep=keep)
+        # (run_points finishes the sink, footer included, also when interrupted: the file is then removed)
 
 
 def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # type: ignore[no-untyped-def]
