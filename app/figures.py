@@ -143,27 +143,27 @@ def build_figure(items: Sequence[Drawable], caption: str = "") -> Any:
     return figure
 
 
-def _save_options(fmt: str) -> dict[str, Any]:
+def _save_options(fmt: str, dpi: float) -> dict[str, Any]:
     metadata = {"png": {"Software": None}, "svg": {"Date": None}, "pdf": {"CreationDate": None}}[fmt]
-    return {"format": fmt, "dpi": DPI, "metadata": metadata}
+    return {"format": fmt, "dpi": dpi, "metadata": metadata}
 
 
-def figure_bytes(figure: Any, fmt: str) -> bytes:
-    """The figure rendered as PNG, SVG (text kept as text) or PDF."""
+def figure_bytes(figure: Any, fmt: str, dpi: float = DPI) -> bytes:
+    """The figure rendered as PNG (at ``dpi``), SVG (text kept as text) or PDF."""
     import matplotlib
 
     buffer = io.BytesIO()
     with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "vtool"}):
-        figure.savefig(buffer, **_save_options(fmt))
+        figure.savefig(buffer, **_save_options(fmt, dpi))
     return buffer.getvalue()
 
 
-def save_figure(items: Sequence[Drawable], path: str | Path, field: str = "--figure") -> Path:
+def save_figure(items: Sequence[Drawable], path: str | Path, field: str = "--figure", dpi: float = DPI) -> Path:
     """Draw ``items`` and write them to ``path`` (format by suffix), atomically."""
     from vtool.files import write_atomic_bytes
 
     fmt = output_format(path, field)
-    write_atomic_bytes(path, figure_bytes(build_figure(items), fmt), field)
+    write_atomic_bytes(path, figure_bytes(build_figure(items), fmt, dpi), field)
     return Path(path)
 
 

@@ -133,3 +133,18 @@ def test_a_heat_map_names_its_three_axes() -> None:
     assert (ax.get_xlabel(), ax.get_ylabel(), bar.get_ylabel()) == ("speed (rev/min)", "stiffness (N/mm)",
                                                                      "peak (N)")
     assert "blank: no value" in ax.get_title()
+
+
+def test_docs_figures_are_embedded_and_regenerate() -> None:
+    """benchmarks/docs_figures.py --check: every PNG docs/figures.md embeds exists; one redrawn is a small PNG."""
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    sys.path.insert(0, str(root / "benchmarks"))
+    try:
+        import docs_figures
+    finally:
+        sys.path.pop(0)
+    assert set(docs_figures.FIGURES) == {p.stem for p in (root / "docs" / "figures").glob("*.png")}
+    assert docs_figures.main(["--check", "--only", "boom-daf"]) == 0
