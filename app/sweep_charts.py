@@ -10,11 +10,15 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+import numpy as np
+
 from vtool.app.plots import chart_text
 from vtool.presets.charts import sweep_chart, sweep_map
+from vtool.solvers.studies.orders import Campbell
 from vtool.solvers.studies.sweep import PointResult, format_value
 
 SHADES = " .:-=+*#%@"
+DECADES = 3  # the Campbell map's shades span this many decades of amplitude
 
 
 def metric_chart(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], metric: str, unit: str,
@@ -47,3 +51,37 @@ def metric_map(results: Sequence[PointResult], fields: Sequence[tuple[str, str]]
     lines.append(f"{'':>{label_width}}  {format_value(heat.x[0])} ... {format_value(heat.x[-1])}")
     lines.append(f"scale: '{SHADES[0]}' = {low:.4g} ... '{SHADES[-1]}' = {high:.4g} {unit}; '?' = none / failed")
     return "\n".join(lines)
+
+
+def campbell_map(data: Campbell, *, highest: int | None = None) -> str:
+    """A Campbell (waterfall) map as characters: cam order up (1 at the bottom), cam speed across, each cell
+    shaded by the order's amplitude on a log scale (decades below the largest), and 'o' where a natural
+    frequency meets that order at that speed (order = f_n 60 / rpm)."""
+    amplitude = data.amplitude[: highest or len(data.amplitude)]
+    finite = amplitude[np.isfinite(amplitude) & (amplitude > 0)]
+    top = float(finite.max()) if finite.size else 1.0
+    levels = len(SHADES) - 1  # the shades span DECADES decades below the largest
+    lines = [f"{data.quantity}: amplitude per cam order and speed (log shades over {DECADES} decades: "
+             f"'{SHADES[-1]}' = {top:.4g} {data.unit}, '{SHADES[1]}' = {top / 10**DECADES:.3g} and below; "
+             "'o' a natural frequency)", "cam order up, run.rpm across"]
+    marks = np.zeros(amplitude.shape, dtype=bool)
+    for _, hz in data.frequencies:
+        order = np.rint(data.line(hz)).astype(int)
+        for j, k in enumerate(order):
+            if 1 <= k <= len(amplitude):
+                marks[k - 1, j] = True
+    for k in reversed(range(len(amplitude))):
+        cells = []
+        for j, v in enumerate(amplitude[k]):
+            if marks[k, j]:
+                cells.append("o")
+            elif not math.isfinite(v):
+                cells.append("?")
+            else:
+                level = levels * (1 + math.log10(v / top) / DECADES) if v > 0 else 1.0
+                cells.append(SHADES[max(1, min(levels, int(math.floor(level))))])
+        lines.append(f"{k + 1:>5} |{''.join(c * 2 for c in cells)}|")
+    lines.append(f"{'':>5}  {data.rpm[0]:g} ... {data.rpm[-1]:g} rev/min")
+    lines.append("natural frequencies: " + ", ".join(f"{hz:.0f} Hz ({label})" for label, hz in data.frequencies))
+    return "\n".join(lines)
+

@@ -30,7 +30,7 @@ from pathlib import Path
 
 from vtool import compile_estimate
 
-CACHED = ("import sys; from vtool.solvers import newmark_kernel as k; "
+CACHED = ("import sys; from vtool.solvers.newmark import kernel as k; "
           "sys.exit(0 if k.is_cached(('run_chunk',), None, None) else 1)")
 
 

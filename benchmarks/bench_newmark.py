@@ -200,11 +200,11 @@ def first_compile() -> tuple[float, float, float]:
     return compile_s, cpu, wall
 
 
-CACHED = ("import sys; from vtool.solvers import newmark_kernel as k; "
+CACHED = ("import sys; from vtool.solvers.newmark import kernel as k; "
           "sys.exit(0 if k.is_cached(('run_chunk',), None, None) else 1)")
 
 
-NATIVE = ("import sys; from vtool.solvers import kernel_native as k; "
+NATIVE = ("import sys; from vtool.solvers.newmark import native as k; "
           "sys.exit(0 if k.exists((None, None)) else 1)")
 
 

@@ -18,6 +18,7 @@ from vtool.presets import load_preset
 from vtool.presets.paths import plan_sweep
 from vtool.presets.valvetrain import with_run_overrides
 from vtool.solvers.studies.metrics import metric_columns, seat_index
+from vtool.solvers.studies.steady import with_steady
 from vtool.solvers.studies.sweep import CRITERIA, SerialRunner, find_speed, make_runner, run_points
 
 os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
@@ -26,8 +27,12 @@ DOCS = Path(__file__).resolve().parent.parent / "docs" / "sweep.md"
 PRESETS = (("gnilka-1a", "1A: three clearances, valve seat"),
            ("gnilka-1b", "1B: three clearances, no valve seat"),
            ("gnilka-1c", "1C: two clearances (rocker pinned), valve seat"),
-           ("gnilka-2", "example 2 (and 3): three clearances, valve seat"))
-SCAN = list(range(4000, 16001, 2000))  # rev/min
+           ("gnilka-2", "example 2 (and 3): three clearances, valve seat"),
+           ("ramped-cam", "1A's mechanism on a dwell-and-ramps cam with lash"),
+           ("ohv-pushrod-1a", "the train-type preset (ohv-pushrod) of 1A's data"))
+CAMPBELL = (("gnilka-1a", "F7"), ("ramped-cam", "F7"))  # the seat force's orders against speed
+CAMPBELL_RPM = list(range(2000, 16001, 500))
+SCAN = list(range(1000, 16001, 1000))  # rev/min
 CHART_RPM = "run.rpm=6000:14000:250"
 SPRING = "members.valve_spring.stiffness=150:350:50"
 MAP_RPM = "run.rpm=8000:14000:250"
@@ -42,9 +47,13 @@ def speeds_table(runner) -> str:  # type: ignore[no-untyped-def]
             if criterion == "bounce-speed" and seat_index(spec) is None:
                 cells.append("no seat")
                 continue
-            result = find_speed(criterion, lambda rpm, spec=spec: with_run_overrides(spec, rpm=rpm), SCAN, runner)
+            result = find_speed(criterion, lambda rpm, spec=spec: with_steady(with_run_overrides(spec, rpm=rpm)),
+                                SCAN, runner)
             steps = len(result.history)
-            cells.append(f"{result.speed:,.0f} ({steps} runs)" if result.speed else result.message)
+            intervals = "; ".join(f"{i.low:,.0f}-{i.high:,.0f}" + ("" if i.above is not None else "+")
+                                  for i in result.intervals)
+            cells.append(f"{result.speed:,.0f} ({steps} runs; intervals {intervals})" if result.speed
+                         else result.message)
         rows.append(cells)
     return table(["preset", "mechanism", "jump speed (rev/min)", "bounce speed (rev/min)"], rows)
 
@@ -65,7 +74,7 @@ def chart_blocks(runner) -> dict[str, str]:  # type: ignore[no-untyped-def]
     from vtool.app.sweep_charts import metric_chart, metric_map
 
     blocks = {}
-    for name, _ in PRESETS:
+    for name, _ in PRESETS[:4]:  # the thesis presets (plan_sweep cannot yet find the ramped cam's lift table)
         plan = plan_sweep(name, [CHART_RPM])
         results = run_points(plan.points, runner).results
         units = dict(metric_columns(plan.spec))
@@ -80,10 +89,26 @@ def chart_blocks(runner) -> dict[str, str]:  # type: ignore[no-untyped-def]
     return blocks
 
 
+def campbell_block(runner, name: str, quantity: str) -> str:  # type: ignore[no-untyped-def]
+    """``vtool sweep NAME --set run.rpm=2000:16000:500 --steady --campbell QUANTITY``'s map."""
+    from vtool.app.sweep_charts import campbell_map
+    from vtool.solvers.studies.orders import campbell, with_orders
+    from vtool.solvers.studies.sweep import Point
+
+    spec = with_steady(with_orders(load_preset(name), (quantity,)))
+    points = [Point(i, (("run.rpm", rpm),), with_run_overrides(spec, rpm=rpm)) for i, rpm in enumerate(CAMPBELL_RPM)]
+    results = run_points(points, runner).results
+    data = campbell([(float(dict(r.values)["run.rpm"]), r.metrics) for r in results if r.ok], spec, quantity)
+    return "```text\n" + campbell_map(data) + "\n```\n"
+
+
 def deterministic_blocks(runner=None) -> dict[str, str]:  # type: ignore[no-untyped-def]
-    """The tables a test regenerates (no wall times in them)."""
+    """The tables and maps a test regenerates (no wall times in them)."""
     runner = runner or SerialRunner()
-    return {"sweep-speeds": speeds_table(runner), "sweep-spring": spring_table(runner)}
+    blocks = {"sweep-speeds": speeds_table(runner), "sweep-spring": spring_table(runner)}
+    for name, quantity in CAMPBELL:
+        blocks[f"sweep-campbell-{name}"] = campbell_block(runner, name, quantity)
+    return blocks
 
 
 def main() -> None:

@@ -200,30 +200,49 @@ def plate_truncation_table() -> Table:
         for q in ("displacement", "velocity", "acceleration"):
             h, g = getattr(coarse, q), getattr(fine, q)
             k = int(np.argmax(np.abs(h)))
-            converged = not (q == "acceleration" and not coarse.acceleration_converged)
-            rows.append([load, q, f"{h[k]:.4f}", f"{coarse.tau[k]:.3f}",
-                         f"{g[int(np.argmax(np.abs(g)))]:.4f}",
-                         f"{change[q]:+.2f}" + ("" if converged else " (does not converge)"),
+            sign = "+" if h[k] > 0 else "-"  # the peaks refined between the samples (exact series)
+            fine_sign = "+" if g[int(np.argmax(np.abs(g)))] > 0 else "-"
+            tag = ""
+            if q == "acceleration" and not coarse.acceleration_defined:
+                tag = " (does not converge)"
+            elif q == "acceleration" and not coarse.acceleration_converged:
+                tag = " (not converged)"
+            rows.append([load, q, f"{coarse.extreme(q, sign):.4f}", f"{coarse.tau[k]:.3f}",
+                         f"{fine.extreme(q, fine_sign):.4f}", f"{change[q]:+.2f}" + tag,
                          "yes" if peak_at_end(h, coarse.tau) else "no"])
     return header, rows
 
 
 # ----------------------------------------------------------------------------
 
+def session(*args: str, exit_code: int = 0) -> str:
+    """``$ vtool ARGS`` and its output (and ``$ echo $?`` when it is to fail), as console lines."""
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    result = CliRunner().invoke(cli, list(args))
+    if result.exit_code != exit_code:
+        raise RuntimeError(f"vtool {' '.join(args)} exited {result.exit_code}, not {exit_code}: {result.output}")
+    text = f"$ vtool {' '.join(args)}\n{result.output.rstrip()}\n"
+    return text + (f"$ echo $?\n{exit_code}\n" if exit_code else "")
+
+
 def console(*args: str) -> Callable[[], str]:
     """A block holding ``vtool ARGS`` and its output, as a console session."""
+    return lambda: f"```console\n{session(*args)}```\n"
 
-    def run() -> str:
-        from click.testing import CliRunner
 
-        from vtool.app.cli.main import cli
-
-        result = CliRunner().invoke(cli, list(args))
-        if result.exit_code != 0:
-            raise RuntimeError(f"vtool {' '.join(args)} failed: {result.output}")
-        return f"```console\n$ vtool {' '.join(args)}\n{result.output.rstrip()}\n```\n"
-
-    return run
+def plate_console() -> str:
+    """docs/plate.md's command examples: their output as printed today (wall times vary; the test ignores
+    them)."""
+    parts = [session("plate", "modes", "plate-table2", "--case", "A1"),
+             session("plate", "transient", "plate-table2", "--case", "A1", "--load", "uniform", "--scheme", "rk4",
+                     "--wh", "1.0", "--no-plot"),
+             session("plate", "transient", "plate-table2", "--case", "A9", "--load", "point", "--scheme", "modal",
+                     "--no-plot"),
+             session("plate", "transient", "plate-table2", "--wh", "3.0", exit_code=2)]
+    return "```\n" + "\n".join(parts) + "```\n"
 
 
 def render(fn: Callable[[], Table]) -> Callable[[], str]:
@@ -250,6 +269,7 @@ for key, fn in (
     ((PLATE_DOC, "plate-table2"), render(plate_frequency_table)),
     ((PLATE_DOC, "plate-transient-a1"), render(plate_transient_table)),
     ((PLATE_DOC, "plate-truncation"), render(plate_truncation_table)),
+    ((PLATE_DOC, "plate-console"), plate_console),
 ):
     BLOCKS[key] = fn
 

@@ -99,8 +99,10 @@ def worst_block(results: list[PresetStudy]) -> str:
             return f"{text} ({name.removeprefix('gnilka-')})" if value > 0 else text
 
         slowest = max(row.wall_time for _, row in measured)
-        notes = {row.note for _, row in measured if row.note}
-        note = "; ".join(sorted(notes))
+        parts = [(name, part) for name, row in measured for part in row.note.split("; ") if part]
+        pulled = sorted({name.removeprefix("gnilka-") for name, part in parts if part.startswith("closed contacts pulled")})
+        notes = sorted({part for _, part in parts if not part.startswith("closed contacts pulled")})
+        note = "; ".join(([f"closed contacts pulled ({', '.join(pulled)})"] if pulled else []) + notes)
         if refused:
             note = f"refused for {refused} preset(s); " + note
         body.append([backend, setting, fmt(slowest, ".3f"), worst("unmatched_events", "d"),

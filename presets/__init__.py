@@ -100,25 +100,52 @@ def loader_for(kind: str) -> Any:
     return importlib.import_module(kind_named(kind).loader)
 
 
-def load_document(doc: dict[str, Any], folder: str | os.PathLike[str] | None = None) -> Any:
+@dataclass(frozen=True)
+class Override:
+    """A value for a preset field given outside the file (``vtool solve --rpm``: ``run.rpm``, named
+    ``--rpm`` in an error). The loader reads it like the file's own value: checked once, there."""
+
+    path: str
+    value: Any
+    source: str = ""
+
+
+def load_document(doc: dict[str, Any], folder: str | os.PathLike[str] | None = None,
+                  overrides: tuple[Override, ...] = ()) -> Any:
     """Validate a parsed preset document and return its frozen spec.
 
     ``folder`` is the preset file's folder: a file the preset names (a cam
     lift table, a boom pulse CSV) resolves against it, for every kind and
     every command (None: the working folder, for a document with no file).
+    ``overrides`` are set into the document first (the loader's
+    ``with_overrides``) and checked with it; an error on one names its source.
     """
     if not isinstance(doc, dict):
         raise InputError("<preset>", type(doc).__name__, "a TOML document (a table)")
+    kind = kind_named(kind_of(doc))
+    loader = importlib.import_module(kind.loader)
+    if overrides:
+        taken = {path for _, path in kind.overrides}  # the fields this kind takes from outside the file
+        for o in overrides:
+            if o.path not in taken:
+                raise InputError(o.source or o.path, o.value, f"no {o.source or o.path} for a {kind.name} preset")
+        doc = loader.with_overrides(doc, {o.path: o.value for o in overrides})
     try:
-        return loader_for(kind_of(doc)).load(doc, None if folder is None else Path(folder))
+        return loader.load(doc, None if folder is None else Path(folder))
     except RecursionError:
         raise InputError("<preset>", "values nested too deep", "the fields of a preset") from None
+    except InputError as exc:
+        source = next((o.source for o in overrides if o.path == exc.field and o.source), None)
+        if source is None:
+            raise
+        raise InputError(source, exc.value, exc.expected, exc.unit) from None
 
 
-def load_preset(name_or_path: str | os.PathLike[str]) -> Any:
-    """Find, parse and validate a preset; returns the spec for its kind."""
+def load_preset(name_or_path: str | os.PathLike[str], overrides: tuple[Override, ...] = ()) -> Any:
+    """Find, parse and validate a preset (with ``overrides`` of some of its fields); returns the spec
+    for its kind."""
     path = find_preset(name_or_path)
-    return load_document(read_document(path), path.parent)
+    return load_document(read_document(path), path.parent, overrides)
 
 
 _LIFT_TABLE_LINE = re.compile(r"^[ \t]*lift_table[ \t]*=.*$", re.MULTILINE)
@@ -135,7 +162,7 @@ def self_contained_text(path: Path) -> tuple[str, str | None]:
     """
     text = path.read_text(encoding="utf-8")
     doc = parse_text(text, str(path))
-    cam = doc.get("cam") if kind_of(doc) == "valvetrain" else None
+    cam = doc.get("cam")  # (a [cam] table: a valve-train preset's; any other kind's loader refuses one)
     name = cam.get("lift_table") if isinstance(cam, dict) else None
     if not isinstance(name, str) or not name or Path(name).is_absolute():
         return text, None

@@ -178,7 +178,7 @@ def cam_charts(spec: Any, points: int = 721) -> list[Chart]:
 
     fit = cam_fit(spec.cam)
     u = spec.unit_system.length
-    omega = spec.run.rpm * math.pi / 30.0
+    omega = spec.run.omega
     angles = np.linspace(0.0, 360.0, points)
     rows = derivatives(fit.c0, fit.a, fit.b, np.radians(angles))
     names = [("lift", u), ("velocity", f"{u}/s"), ("acceleration", f"{u}/s^2"), ("jerk", f"{u}/s^3")]
@@ -213,6 +213,35 @@ def scan_charts(scan: Any, unit: str, subject: str = "") -> list[Chart]:
     return [Chart("measured scan: raw against smoothed (per cam degree)", CAM_ANGLE, panels, subject)]
 
 
+def cam_shape_charts(spec: Any, points: int = 720) -> list[Chart]:
+    """``vtool cam show --plot`` with a follower: the ground profile (cam frame), its radius of curvature
+    against the law angle, and the pressure angle (and a finger's ratio) against cam angle."""
+    from vtool.solvers.model.camshape import cam_profile, contact
+
+    u = spec.unit_system.length
+    follower = spec.follower
+    profile = cam_profile(follower, spec.lift_law, points)
+    c = contact(follower, spec.lift_law, np.radians(profile.law_angle_deg))
+    limit = 5.0 * follower.base_radius  # an inflection's infinite radius clipped
+    rho = np.clip(profile.curvature_radius, -limit, limit)
+    charts = [
+        Chart(f"cam profile ({u}, cam frame)", with_unit("x", u),
+              (Panel((curve("profile", np.append(profile.x, profile.x[0]), np.append(profile.y, profile.y[0])),
+                      curve("base circle", follower.base_radius * np.cos(np.linspace(0, 2 * math.pi, 361)),
+                            follower.base_radius * np.sin(np.linspace(0, 2 * math.pi, 361)))),
+                     with_unit("y", u)),), spec.title),
+        Chart(f"radius of curvature ({u}; clipped at +-{limit:g})", "law angle (deg)",
+              (Panel((curve("radius of curvature", profile.law_angle_deg, rho),), with_unit("radius", u)),),
+              spec.title),
+        Chart("pressure angle (deg)", CAM_ANGLE,
+              (Panel((curve("pressure angle", c.cam_angle_deg, c.pressure_angle_deg),), "pressure angle (deg)"),),
+              spec.title)]
+    if follower.arrangement == "finger":
+        charts.append(Chart("finger ratio dV/du (-)", CAM_ANGLE,
+                            (Panel((curve("ratio", c.cam_angle_deg, c.ratio),), "ratio (-)"),), spec.title))
+    return charts
+
+
 # ----------------------------------------------------------------------------
 # sonic boom
 
@@ -245,7 +274,7 @@ PLATE_QUANTITIES = ("displacement", "velocity", "acceleration")
 def plate_response_chart(resp: Any, exact: Any, quantity: str, subject: str = "") -> Chart:
     """One centre history of a transient run against the exact modal solution (dimensionless)."""
     curves = [curve(f"{resp.case} {resp.scheme}", resp.tau, getattr(resp, quantity))]
-    if exact is not None and not (quantity == "acceleration" and not exact.acceleration_converged):
+    if exact is not None and not (quantity == "acceleration" and not exact.acceleration_defined):
         curves.append(curve("exact", resp.tau, np.interp(resp.tau, exact.tau, getattr(exact, quantity))))
     return Chart(f"centre {quantity}, {resp.load} step load", "t / T (exact fundamental period) (-)",
                  (Panel(tuple(curves), PLATE_LABELS[quantity]),), subject)

@@ -24,8 +24,11 @@ A loader module has ``load(doc, folder=None) -> spec`` (``folder``: the
 preset's folder, against which a file it names is found: a cam lift table,
 a boom pulse CSV) and ``dump(spec) -> doc``. A solve function has
 ``solve(spec, csv_path, plot, as_json, **flags)``, where ``flags`` are the
-kind's :attr:`Kind.run_options` as keyword arguments (``--dt`` is ``dt``);
-``vtool solve`` refuses any other flag for the kind. A TUI screen module
+kind's :attr:`Kind.run_options` that are not preset fields, as keyword
+arguments (``--every-step`` is ``every_step``); those that are preset fields
+(:attr:`Kind.overrides`: ``--rpm`` is ``run.rpm``) are set into the document
+and checked by the loader (the loader module then has ``with_overrides(doc,
+{path: value}) -> doc``). ``vtool solve`` refuses any other flag for the kind. A TUI screen module
 has ``SCREEN``, its :class:`~vtool.app.tui.base.DomainScreen` class; one
 screen may show several kinds (the boom screen: walls and floors).
 """
@@ -51,6 +54,9 @@ class Kind:
     screen: str
     #: the flags of ``vtool solve`` that apply to this kind beyond --csv/--plot/--json
     run_options: tuple[str, ...] = ()
+    #: those of them that are preset fields: flag -> field path, set into the document before the load
+    #: (:class:`vtool.presets.Override`), so the loader checks them once, as the file's own values
+    overrides: tuple[tuple[str, str], ...] = ()
 
 
 KINDS: dict[str, Kind] = {
@@ -58,7 +64,10 @@ KINDS: dict[str, Kind] = {
                        "vtool.solvers.model.spec:MechanismSpec", "vtool.presets.valvetrain",
                        "vtool.app.cli.solve:run_valvetrain", "vtool.app.tui.valvetrain",
                        ("--backend", "--dt", "--rpm", "--degrees", "--every-step", "--events",
-                        "--max-steps", "--impact", "--start", "--format")),
+                        "--max-steps", "--impact", "--start", "--orders", "--format"),
+                       (("--backend", "run.backend"), ("--dt", "run.time_step"), ("--rpm", "run.rpm"),
+                        ("--degrees", "run.degrees"), ("--impact", "contact.impact"),
+                        ("--start", "initial.velocities"))),
     "boom_wall": Kind("boom_wall", "sonic-boom wall assessment",
                       "vtool.assessments.sonic_boom.spec:BoomWallSpec", "vtool.presets.boom",
                       "vtool.app.cli.boom:solve_preset", "vtool.app.tui.boom"),

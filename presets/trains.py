@@ -22,8 +22,9 @@ Parts (each table's numbers in the preset's unit system):
   (``lift``: L = lift/2 (1 + sin θ), the thesis' cam), ``"table"`` (the
   [cam] keys ``angles``/``lifts`` or ``lift_table``, ``harmonics`` or
   ``tolerance``) or ``"polydyne"`` (``lift``, ``ramp_height``, ``ramp_deg``,
-  ``flank_deg``: the ramped polydyne of :mod:`vtool.presets.ramped_cam`,
-  sampled every ``step_deg`` and fitted to ``tolerance``); ``angle_basis =
+  ``flank_deg``, the nose at ``nose_deg``: the ramped polydyne of
+  :mod:`vtool.presets.ramped_cam`, sampled every ``step_deg`` and fitted to
+  ``tolerance``); ``angle_basis =
   "crank"`` reads every angle of the table as crank degrees (halved: the cam
   turns once per two crank turns);
 * ``[train.seat]``: ``lash`` (the follower clearance on the base circle, in
@@ -108,6 +109,13 @@ def _section(t: Table, units: UnitSystem, element: str, extra: tuple[str, ...] =
     return member
 
 
+def _part(train: Table, key: str) -> Table:
+    """A required part's table (``train.KEY``)."""
+    table = train.table(key)
+    assert table is not None  # required=True raises when absent
+    return table
+
+
 def _length(t: Table, key: str, units: UnitSystem, default: float | None = None) -> float:
     return t.number(key, unit=units.length, default=default, min_exclusive=0.0, max_value=1e4)
 
@@ -124,13 +132,16 @@ def polydyne_table(t: Table, units: UnitSystem) -> tuple[list[float], list[float
     scale = _angle_scale(t)
     lift = _length(t, "lift", units)
     ramp = t.number("ramp_height", unit=units.length, min_value=0.0, max_exclusive=lift)
-    ramp_deg = scale * t.number("ramp_deg", unit="deg", min_exclusive=0.0, max_value=180.0)
-    flank_deg = scale * t.number("flank_deg", unit="deg", min_exclusive=0.0, max_value=180.0)
+    unit = "cam deg" if scale == 1.0 else "crank deg"
+    ramp_deg = scale * t.number("ramp_deg", unit=unit, min_exclusive=0.0, max_value=180.0 / scale)
+    flank_deg = scale * t.number("flank_deg", unit=unit, min_exclusive=0.0, max_value=180.0 / scale)
     if ramp_deg + flank_deg >= 180.0:
-        raise InputError(t.field("flank_deg"), flank_deg / scale, "ramp_deg + flank_deg < 180 cam degrees", "deg")
+        raise InputError(t.field("flank_deg"), flank_deg / scale,
+                         f"ramp_deg + flank_deg < {180.0 / scale:g} (half a cam turn)", unit)
+    nose = t.number("nose_deg", unit="deg", default=0.0, min_value=-360.0, max_value=360.0)
     step = t.number("step_deg", unit="deg", default=MODEL_STEP_DEG, min_value=0.05, max_value=5.0)
     angles = np.arange(0.0, 360.0, step)
-    lifts = ramped_lift(angles, lift=lift, ramp_height=ramp, ramp_deg=ramp_deg, flank_deg=flank_deg)
+    lifts = ramped_lift(angles - nose, lift=lift, ramp_height=ramp, ramp_deg=ramp_deg, flank_deg=flank_deg)
     return angles.tolist(), lifts.tolist()
 
 
@@ -183,8 +194,7 @@ def _follower(train: Table, units: UnitSystem, kind: str | None, required: bool)
 
 
 def _seat(train: Table, units: UnitSystem, coordinate: int) -> dict[str, Any]:
-    t = train.table("seat")
-    assert t is not None
+    t = _part(train, "seat")
     doc: dict[str, Any] = {"coordinate": coordinate, "name": "seat"}
     if t.has("lash") == t.has("position"):
         raise InputError(t.field("lash"), t.raw("lash"), "either lash or position, not both", units.length)
@@ -219,7 +229,7 @@ def _initial(doc: dict[str, Any], closed: list[str], preload: float, ratio: floa
 
 def ohv_pushrod(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """Gnilka's layout (gnilka-1a's coordinates and members) from its parts."""
-    pushrod_t, rocker_t, valve_t = (train.table(k) for k in ("pushrod", "rocker", "valve"))
+    pushrod_t, rocker_t, valve_t = (_part(train, k) for k in ("pushrod", "rocker", "valve"))
     pushrod_length = _length(pushrod_t, "length", units)
     pushrod = _section(pushrod_t, units, "bar")
     cam_arm, valve_arm = _length(rocker_t, "cam_arm", units), _length(rocker_t, "valve_arm", units)
@@ -229,7 +239,7 @@ def ohv_pushrod(train: Table, units: UnitSystem, folder: Path | None) -> dict[st
     for t in (pushrod_t, rocker_t, valve_t):
         t.finish()
     tip = cam_arm + valve_arm
-    spring = spring_model(train.table("spring"), units, 4, 9, (tip + 0.2 * cam_arm, 0.0))
+    spring = spring_model(_part(train, "spring"), units, 4, 9, (tip + 0.2 * cam_arm, 0.0))
     coordinates = _coordinates(
         ("follower (pushrod lower end)", "translation"), ("left rocker tip", "translation"),
         ("left rocker tip rotation", "rotation"), ("right rocker tip / valve stem top / spring end", "translation"),
@@ -251,7 +261,7 @@ def ohv_pushrod(train: Table, units: UnitSystem, folder: Path | None) -> dict[st
 
 def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """Bucket on the valve: cam -> bucket (q1) -> stem top / retainer (q2) -> valve head (q3)."""
-    bucket_t, valve_t = train.table("bucket"), train.table("valve")
+    bucket_t, valve_t = _part(train, "bucket"), _part(train, "valve")
     bucket = {"mass": bucket_t.number("mass", unit=units.mass, min_exclusive=0.0, max_value=1e9),
               "stiffness": bucket_t.number("stiffness", unit=units.stiffness, min_exclusive=0.0, max_value=1e16)}
     bucket_length = _length(bucket_t, "length", units, default=1.0)
@@ -259,7 +269,7 @@ def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[
     valve = _section(valve_t, units, "bar")
     bucket_t.finish()
     valve_t.finish()
-    spring = spring_model(train.table("spring"), units, 2, 4, (0.0, -bucket_length))
+    spring = spring_model(_part(train, "spring"), units, 2, 4, (0.0, -bucket_length))
     coordinates = _coordinates(("bucket (cam contact)", "translation"),
                                ("valve stem top / retainer / spring end", "translation"),
                                ("valve head", "translation")) + spring.coordinates
@@ -274,7 +284,7 @@ def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[
 
 def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """End-pivot roller finger: pivot support, two beams (pivot-roller, roller-pad), valve (module doc)."""
-    finger_t, pivot_t, valve_t = train.table("finger"), train.table("pivot"), train.table("valve")
+    finger_t, pivot_t, valve_t = _part(train, "finger"), _part(train, "pivot"), _part(train, "valve")
     a = _length(finger_t, "roller_arm", units)
     b = finger_t.number("valve_arm", unit=units.length, min_exclusive=a, max_value=1e4)
     geometry = {"roller_arm": a, "valve_arm": b}
@@ -289,7 +299,7 @@ def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dic
     valve = _section(valve_t, units, "bar")
     for t in (finger_t, pivot_t, valve_t):
         t.finish()
-    spring = spring_model(train.table("spring"), units, 7, 9, (b, 0.0))
+    spring = spring_model(_part(train, "spring"), units, 7, 9, (b, 0.0))
     coordinates = _coordinates(
         ("finger pivot (lash adjuster)", "translation"), ("finger pivot rotation", "rotation"),
         ("finger at the roller (cam contact)", "translation"), ("finger rotation at the roller", "rotation"),
@@ -324,8 +334,7 @@ def expand(doc: dict[str, Any], folder: Path | None = None) -> dict[str, Any]:
     assert train is not None
     kind = train.string("type", choices=TYPES)
     built = BUILDERS[kind](train, units, folder)
-    cam_t = train.table("cam")
-    assert cam_t is not None
+    cam_t = _part(train, "cam")
     law = _law(cam_t, units, folder)
     follower = _follower(train, units, built["follower_kind"], required=kind != OHV_PUSHROD)
     seat = _seat(train, units, built["seat"])
@@ -379,7 +388,7 @@ def law_spec_of(law: dict[str, Any], units: UnitSystem) -> Any:
 
 def train_parameters(doc: dict[str, Any]) -> list[tuple[tuple[str, ...], str]]:
     """(path, unit kind) of every number a train's form may edit: ``("train", "finger", "roller_arm")``."""
-    result = []
+    result: list[tuple[tuple[str, ...], str]] = []
     train = doc.get("train", {})
     for part, table in train.items():
         if not isinstance(table, dict):

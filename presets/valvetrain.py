@@ -9,9 +9,11 @@ Every number is finite and within a stated physical range (:data:`BOUNDS`,
 :data:`RUN_LIMITS`, the counts below), checked before any numerics, so no
 preset can reach the solver with values its floating-point arithmetic cannot
 carry. The ranges are wide (the same numbers in either unit system) and are
-listed in ``docs/limits.md``. The [run] settings are checked by
-:func:`check_run`, which also checks ``--rpm``, ``--dt``, ``--degrees`` and
-``--backend`` overrides (:func:`with_run_overrides`).
+listed in ``docs/limits.md``. The [run] settings are read by one function,
+:func:`_run`, whatever gave them: the preset, ``vtool solve``'s ``--rpm``,
+``--dt``, ``--degrees`` and ``--backend`` (set into the document by
+:func:`with_overrides` before the load), a TUI field, or a study's
+:func:`with_run_overrides`.
 
 A missing [damping] section loads with the default (ratio 0.1 on every mode,
 factor 1) and a :class:`vtool.errors.PresetWarning` saying so.
@@ -19,8 +21,9 @@ factor 1) and a :class:`vtool.errors.PresetWarning` saying so.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
-import math
+import json
 import re
 import warnings
 from dataclasses import replace
@@ -28,20 +31,22 @@ from pathlib import Path
 from typing import Any
 
 from vtool.errors import InputError, PresetWarning
-from vtool.presets.fields import Table, as_float
+from vtool.presets.fields import Table
 from vtool.presets.follower import dump_follower, load_checks, load_follower
 from vtool.presets.lift_table import read_lift_table
 from vtool.presets.trains import expand
-from vtool.solvers.backends import DEFAULT
+from vtool.solvers.backends import DEFAULT, available
 from vtool.solvers.model.assembly import split_members, unsplit_members
 from vtool.solvers.model.hertz import MIN_RESTITUTION, check_restitution
 from vtool.solvers.model.spec import (
     BAR,
     BEAM,
+    BETA_RANGE,
     CONTACT_LAWS,
     ELEMENT_SIZE,
     ENABLED,
     EXTERNAL,
+    GAMMA_RANGE,
     HERTZ,
     IMPACT_LAWS,
     INTERNAL,
@@ -104,7 +109,9 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
 
     ``folder`` resolves a ``[cam] lift_table`` file (default: the working folder).
     """
+    train = ""
     if isinstance(doc, dict) and "train" in doc:  # a train type: expanded to the explicit form first
+        train = json.dumps(doc["train"])
         doc = expand(doc, folder)
     top = Table(doc, "")
     top.check_unknown(TOP_KEYS)
@@ -137,6 +144,12 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     follower_table = top.table("follower", required=False)
     follower = None if follower_table is None else load_follower(
         follower_table, units, lambda t: _law(t, cam.coordinate, units, folder))
+    if follower is not None:
+        from vtool.solvers.model.camshape import undercut_warning
+
+        undercut = undercut_warning(follower, follower.lift or cam)
+        if undercut is not None:
+            warnings.warn(PresetWarning(undercut), stacklevel=2)
     checks_table = top.table("checks", required=False)
     checks = () if checks_table is None else load_checks(checks_table, units)
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)  # type: ignore[arg-type]
@@ -157,6 +170,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         contact=contact,
         follower=follower,
         checks=checks,
+        train=train,
     )
     spec = split_members(spec)
     if seat is not None and seat.lash is not None:
@@ -530,13 +544,13 @@ def _quantity_names(coordinates, cam, seat, clearances) -> tuple[set[int], set[i
 QUANTITY = re.compile(r"q(\d+)(?:-q(\d+))?|F(\d+)")
 
 
-def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...]:
-    value = t.raw("quantities", [])
+def _quantities(t: Table, numbers: set[int], forces: set[int], key: str = "quantities") -> tuple[str, ...]:
+    value = t.raw(key, [])
     expected = (f"a list of 'q<i>', 'q<i>-q<j>' (i, j in {sorted(numbers)}) or 'F<i>' "
                 f"(i in {sorted(forces)})")
     if not isinstance(value, list):
-        raise InputError(t.field("quantities"), value, expected)
-    _count(t.field("quantities"), value, MAX_QUANTITIES, "quantities")
+        raise InputError(t.field(key), value, expected)
+    _count(t.field(key), value, MAX_QUANTITIES, "quantities")
     for item in value:
         match = QUANTITY.fullmatch(item) if isinstance(item, str) else None
         ok = match is not None and (
@@ -544,18 +558,19 @@ def _quantities(t: Table, numbers: set[int], forces: set[int]) -> tuple[str, ...
             or (match[1] is not None and int(match[1]) in numbers and (match[2] is None or int(match[2]) in numbers))
         )
         if not ok:
-            raise InputError(t.field("quantities"), item, expected)
+            raise InputError(t.field(key), item, expected)
     return tuple(value)
 
 
 RUN_KEYS = ("rpm", "degrees", "time_step", "backend", "output_interval", "beta", "gamma", "quantities",
-            "cycles", "steady", "jump_angle", "jump_gap", "bounce_lift")
+            "cycles", "steady", "jump_angle", "jump_gap", "bounce_lift", "orders", "highest_order")
 #: [run] cycle-by-cycle and criteria ranges: key -> (min, max, unit)
 CYCLE_LIMITS: dict[str, tuple[float, float, str]] = {
     "cycles": (1, 10_000, "cam cycles"),
     "max_cycles": (2, 10_000, "cam cycles"),
     "tolerance": (1e-12, 1.0, "(relative change per cycle)"),
     "jump_angle": (0.0, 360.0, "deg"),
+    "highest_order": (1, 1000, "cam orders"),
 }
 
 
@@ -588,6 +603,8 @@ def _cycles(t: Table, units: Any) -> dict[str, Any]:
 
 
 def _run(t: Table, names: tuple[set[int], set[int]], units: Any) -> RunSpec:
+    """The [run] table: every value checked here, once (ranges :data:`RUN_LIMITS`, Newmark's
+    ``BETA_RANGE``/``GAMMA_RANGE``, the installed back ends); below the loader a RunSpec is trusted."""
     t.check_unknown(RUN_KEYS)
     def limited(key: str, default: float | None = None) -> float:
         low, high, unit = RUN_LIMITS[key]
@@ -596,56 +613,23 @@ def _run(t: Table, names: tuple[set[int], set[int]], units: Any) -> RunSpec:
     rpm = limited("rpm")
     degrees = limited("degrees")
     time_step = limited("time_step")
-    backend = t.string("backend", default=DEFAULT)
+    backend = t.string("backend", default=DEFAULT, choices=tuple(available()))
     output_interval = limited("output_interval", 1.0)
-    beta = t.number("beta", default=1.0 / 6.0)
-    gamma = t.number("gamma", default=0.5)
+    beta = t.number("beta", default=1.0 / 6.0, min_exclusive=BETA_RANGE[0], max_value=BETA_RANGE[1])
+    gamma = t.number("gamma", default=0.5, min_value=GAMMA_RANGE[0], max_value=GAMMA_RANGE[1])
     quantities = _quantities(t, *names)
     cycles = _cycles(t, units)
+    cycles["orders"] = _quantities(t, *names, key="orders")
+    low, high, _ = CYCLE_LIMITS["highest_order"]
+    cycles["highest_order"] = t.integer("highest_order", default=24, min_value=int(low), max_value=int(high))
     t.finish()
-    return check_run(RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities, **cycles))
-
-
-def check_run_value(key: str, value: Any, field: str | None = None) -> Any:
-    """One [run] setting checked against :data:`RUN_LIMITS` (and beta, gamma, backend); returns it.
-
-    ``field`` names it in the error (default ``run.KEY``; the CLI passes ``--rpm``).
-    """
-    field = field or f"run.{key}"
-    if key == "backend":
-        from vtool.solvers.backends import available
-
-        if value not in available():
-            raise InputError(field, value, f"one of the installed back ends: {', '.join(available())}")
-        return value
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise InputError(field, value, "a number")
-    number = as_float(value)
-    if key == "beta":
-        low, high, unit, text = 0.0, 0.5, "", "> 0 and <= 0.5"
-        ok = math.isfinite(number) and low < number <= high
-    elif key == "gamma":
-        low, high, unit, text = 0.5, 1.0, "", ">= 0.5 and <= 1"
-        ok = math.isfinite(number) and low <= number <= high
-    else:
-        low, high, unit = RUN_LIMITS[key]
-        text = f">= {low:g} and <= {high:g}"
-        ok = math.isfinite(number) and low <= number <= high
-    if not ok:
-        raise InputError(field, value, text, unit)
-    return number
-
-
-def check_run(run: RunSpec) -> RunSpec:
-    """The [run] settings checked by :func:`check_run_value`, field by field; returns ``run``."""
-    for key in ("rpm", "degrees", "time_step", "output_interval", "beta", "gamma", "backend"):
-        check_run_value(key, getattr(run, key))
-    return run
+    return RunSpec(rpm, degrees, time_step, backend, output_interval, beta, gamma, quantities, **cycles)
 
 
 def dump(spec: MechanismSpec) -> dict[str, Any]:
-    """The preset document for a spec (inverse of :func:`load`)."""
-    spec = unsplit_members(spec)
+    """The preset document for a spec (inverse of :func:`load`); a spec entered by train type dumps as its
+    [train] while its model is what the type gives (:func:`train_document`)."""
+    given, spec = spec, unsplit_members(spec)
     doc: dict[str, Any] = {"kind": "valvetrain", "title": spec.title}
     if spec.notes:
         doc["notes"] = spec.notes
@@ -698,26 +682,51 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         damping["layers"] = layers
     doc["damping"] = damping
     r = spec.run
-    doc["run"] = {
-        "rpm": r.rpm, "degrees": r.degrees, "time_step": r.time_step, "backend": r.backend,
-        "output_interval": r.output_interval, "beta": r.beta, "gamma": r.gamma,
-    }
-    if r.quantities:
-        doc["run"]["quantities"] = list(r.quantities)
-    if r.cycles:
-        doc["run"]["cycles"] = r.cycles
-    if r.steady_tolerance:
-        doc["run"]["steady"] = {"tolerance": r.steady_tolerance, "max_cycles": r.steady_max_cycles}
-    if r.jump_angle != 1.0:
-        doc["run"]["jump_angle"] = r.jump_angle
-    for key in ("jump_gap", "bounce_lift"):
-        if getattr(r, key) is not None:
-            doc["run"][key] = getattr(r, key)
+    doc["run"] = _dump_run(r)
     if spec.follower is not None:
         doc["follower"] = dump_follower(spec.follower, _law_doc)
     if spec.checks:
         doc["checks"] = {c.name: c.limit for c in spec.checks}
-    return doc
+    return train_document(given, doc) or doc
+
+
+TRAIN_KEEPS = ("kind", "title", "notes", "units", "gravity", "contact", "damping", "run", "checks")
+
+
+def train_document(spec: MechanismSpec, explicit: dict[str, Any]) -> dict[str, Any] | None:
+    """The train-type document of a spec entered by type, while its model is still what the type gives
+    (else None: the explicit form, e.g. after a member was split or a clearance pinned)."""
+    if not spec.train:
+        return None
+    doc = {key: explicit[key] for key in TRAIN_KEEPS if key in explicit}
+    doc["train"] = json.loads(spec.train)
+    doc["initial"] = {"velocities": spec.initial.velocities}
+    try:
+        again = load(copy.deepcopy(doc))
+    except InputError:  # e.g. a lift_table file the saved copy's folder does not hold
+        return None
+    return doc if again == spec else None
+
+
+def _dump_run(r: RunSpec) -> dict[str, Any]:
+    run: dict[str, Any] = {"rpm": r.rpm, "degrees": r.degrees, "time_step": r.time_step, "backend": r.backend,
+                           "output_interval": r.output_interval, "beta": r.beta, "gamma": r.gamma}
+    if r.quantities:
+        run["quantities"] = list(r.quantities)
+    if r.cycles:
+        run["cycles"] = r.cycles
+    if r.steady_tolerance:
+        run["steady"] = {"tolerance": r.steady_tolerance, "max_cycles": r.steady_max_cycles}
+    if r.jump_angle != 1.0:
+        run["jump_angle"] = r.jump_angle
+    for key in ("jump_gap", "bounce_lift"):
+        if getattr(r, key) is not None:
+            run[key] = getattr(r, key)
+    if r.orders:
+        run["orders"] = list(r.orders)
+    if r.highest_order != 24:
+        run["highest_order"] = r.highest_order
+    return run
 
 
 RPM_IN_TITLE = re.compile(r"\b\d{1,3}(?:,\d{3})*(?:\.\d+)?\s*RPM\b|\b\d+(?:\.\d+)?\s*RPM\b", re.IGNORECASE)
@@ -733,7 +742,7 @@ def rpm_title(title: str, rpm: float) -> str:
 
 
 def with_run_overrides(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
-    """The spec with some [run] settings changed, checked by :func:`check_run` as the loader does.
+    """The spec with some [run] settings changed, read by the loader's own [run] reader (:func:`_run`).
 
     ``changes`` uses the preset's [run] keys (rpm, degrees, time_step, backend,
     output_interval, beta, gamma); ``None`` values are ignored. A changed speed
@@ -743,8 +752,30 @@ def with_run_overrides(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
     unknown = sorted(set(given) - set(RUN_KEYS))
     if unknown:
         raise InputError(f"run.{unknown[0]}", given[unknown[0]], f"one of: {', '.join(RUN_KEYS)}")
-    run = check_run(dataclasses.replace(spec.run, **given))
+    names = _quantity_names(spec.coordinates, spec.cam, spec.seat, spec.clearances)
+    run = _run(Table(_dump_run(spec.run) | given, "run"), names, spec.unit_system)
     title = spec.title
     if "rpm" in given and run.rpm != spec.run.rpm:
         title = rpm_title(title, run.rpm)
     return dataclasses.replace(spec, run=run, title=title)
+
+
+def with_overrides(doc: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
+    """The preset document with values given outside it (``vtool solve``'s flags, by field path:
+    ``run.rpm``, ``contact.impact``, ...) set, for the loader to check once like any other field. An impact
+    law for the mechanism (``contact.impact``) applies to every clearance, dropping their own; a changed
+    speed is written into the title as :func:`with_run_overrides` does."""
+    result = copy.deepcopy(doc)
+    for path, value in overrides.items():
+        table, _, key = path.rpartition(".")
+        if not isinstance(result.get(table), dict):
+            result[table] = {}
+        result[table][key] = value
+    if "contact.impact" in overrides:
+        for clearance in result.get("clearances", []):
+            if isinstance(clearance, dict):
+                clearance.pop("impact", None)
+    rpm = overrides.get("run.rpm")
+    if rpm is not None and isinstance(result.get("title", ""), str) and rpm != doc.get("run", {}).get("rpm"):
+        result["title"] = rpm_title(result.get("title", ""), float(rpm))
+    return result

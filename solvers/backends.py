@@ -19,13 +19,20 @@ The contract every back end follows (subclass :class:`Backend`)
 3. ``check(mechanism, options)``: raise :class:`vtool.errors.InputError` for
    settings a user can fix (time step beyond the stability limit, tolerances
    out of range), before any work.
-4. ``integrate(problem, options, builder, progress, cancel) -> dict``: run
-   the :class:`~vtool.solvers.model.contact.ContactProblem` from its static start to
-   the end, adding rows and events to the
-   :class:`~vtool.solvers.trace.TraceBuilder`; apply the shared event rules
-   (kernel functions ``impact`` and ``settle``); return the statistics
-   (``steps``, ``peak``, ``peak_late``, ``peak_overlap``, ``configurations``, ``settings``; optionally
-   ``compile_time``, ``plain_steps`` and ``kernel``, see :class:`~vtool.solvers.trace.RunStatistics`).
+4. ``integrate(problem, options, builder, progress, cancel) -> RunStats``:
+   run the :class:`~vtool.solvers.model.contact.ContactProblem` from its
+   static start (:meth:`~vtool.solvers.model.contact.ContactProblem.start_state`)
+   to the end, adding rows and events to the
+   :class:`~vtool.solvers.trace.TraceBuilder`. Between events a back end
+   integrates the configuration's equations
+   (:meth:`~vtool.solvers.model.contact.ContactProblem.accelerations`) and
+   watches the monitors (``monitors``: a gap while open, a contact force
+   while closed; an event is a monitor reaching zero); at an event it calls
+   :meth:`~vtool.solvers.model.contact.ContactProblem.transition`, the
+   shared event and impact rules (opening, the impact laws, the release of
+   pulling contacts), which records the events. Those methods are plain
+   Python over NumPy arrays; the Newmark back end runs the same rules in
+   its compiled kernel. Return the figures as a :class:`RunStats`.
    ``progress(f)`` is called with the fraction done (0..1) between chunks,
    ``cancel()`` polled between chunks (a true answer stops the run).
 5. Errors: a run that cannot be completed (divergence, endless chattering,
@@ -46,7 +53,7 @@ import math
 import time as wallclock
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache, lru_cache
 from importlib.metadata import EntryPoint, entry_points
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -54,7 +61,9 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from vtool.errors import InputError
 from vtool.solvers.model.spec import DEFAULT_BACKEND
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # (numpy too: `vtool --help` imports this module and no numerics)
+    import numpy as np
+
     from vtool.solvers.model.contact import ContactProblem
     from vtool.solvers.model.mechanism import Mechanism
     from vtool.solvers.model.spec import MechanismSpec, RunSpec
@@ -64,6 +73,23 @@ ENTRY_POINT_GROUP = "vtool.backends"
 
 Progress = Callable[[float], None]
 Cancel = Callable[[], bool]
+
+
+@dataclass(frozen=True)
+class RunStats:
+    """What :meth:`Backend.integrate` returns: the run's own figures, which :meth:`Backend.simulate`
+    turns into the trace's :class:`~vtool.solvers.trace.RunStatistics` and peaks."""
+
+    steps: int  # integration steps taken (a piecewise back end: its samples)
+    peak: np.ndarray  # largest contact force of each clearance over the run (force unit)
+    peak_late: np.ndarray | None = None  # the same after the first revolution
+    peak_overlap: np.ndarray | None = None  # largest overlap of each compliant contact (length)
+    configurations: tuple[int, ...] | None = None  # masks built (None: the contact problem's built layers)
+    settings: dict[str, Any] = field(default_factory=dict)  # the back end's own settings, for the record
+    compile_time: float = 0.0  # s spent compiling or loading compiled code, not in the wall time
+    plain_steps: int = 0  # of the steps, those run as plain Python
+    kernel: str = ""  # what ran the last steps, when a back end has several ways
+    sort: bool = False  # the rows were added out of time order: the builder sorts them
 
 
 @dataclass(frozen=True)
@@ -133,6 +159,10 @@ class Backend(ABC):
     fixed_step: ClassVar[bool] = False
     reference: ClassVar[bool] = False
     library_dependent: ClassVar[bool] = False
+    #: the cost guard's default step limit for this back end (None: vtool.solvers.cost.MAX_STEPS)
+    max_steps: ClassVar[float | None] = None
+    #: what to try when a run's result is not to be trusted (the trace's warnings say it)
+    remedy: ClassVar[str] = "another back end to compare"
 
     @classmethod
     def stable_step(cls, mechanism: Mechanism) -> float:
@@ -164,7 +194,7 @@ class Backend(ABC):
 
     @abstractmethod
     def integrate(self, problem: ContactProblem, options: Any, builder: TraceBuilder,
-                  progress: Progress | None, cancel: Cancel | None) -> dict[str, Any]:
+                  progress: Progress | None, cancel: Cancel | None) -> RunStats:
         """Run the contact problem into the builder; return the statistics (see the contract)."""
 
     def simulate(self, mechanism: Mechanism, options: Any = None, progress: Progress | None = None,
@@ -183,19 +213,19 @@ class Backend(ABC):
             problem = ContactProblem.for_run(mechanism, rules)
             builder = TraceBuilder(mechanism.spec, problem.source_numbers, problem.omega, stream)
             stats = self.integrate(problem, options, builder, progress, cancel)
-            compile_time = float(stats.get("compile_time", 0.0))
+            compile_time = stats.compile_time
             writing = stream.seconds if stream is not None else 0.0  # the CSV's share, not the solver's
             wall = wallclock.perf_counter() - started - compile_time - writing
         spec = mechanism.spec
-        settings = dict(stats.get("settings", {}))
+        settings = dict(stats.settings)
         settings.update(rpm=spec.run.rpm, degrees=spec.run.degrees,
                         impact=sorted({spec.impact_law(c) for c in spec.clearances if c.rigid}),
                         rocker_scale=spec.contact.rocker_scale, start_velocities=spec.initial.velocities)
         if any(not c.rigid for c in spec.clearances):
             settings["contact"] = {c.name: c.contact for c in spec.clearances if not c.rigid}
-        statistics = RunStatistics(self.name, int(stats["steps"]), len(builder.events), wall,
-                                   tuple(sorted(stats.get("configurations", problem.tables.layers))), settings,
-                                   compile_time=compile_time, plain_steps=int(stats.get("plain_steps", 0)),
-                                   kernel=str(stats.get("kernel", "")))
-        return builder.build(stats["peak"], statistics, stats.get("peak_late"), sort=stats.get("sort", False),
-                             peak_overlap=stats.get("peak_overlap"))
+        built = problem.tables.layers if stats.configurations is None else stats.configurations
+        statistics = RunStatistics(self.name, stats.steps, len(builder.events), wall, tuple(sorted(built)), settings,
+                                   compile_time=compile_time, plain_steps=stats.plain_steps, kernel=stats.kernel,
+                                   remedy=self.remedy)
+        return builder.build(stats.peak, statistics, stats.peak_late, sort=stats.sort,
+                             peak_overlap=stats.peak_overlap)

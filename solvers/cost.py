@@ -18,11 +18,18 @@ the CSV table and its text: measured 3.7 GB peak for 900,000 rows of 47
 values, which this counts as 2.9 GB), plus the ``2^n_c`` configuration tables
 of ``6 n²`` floats.
 
-:func:`check` refuses a run above :data:`MAX_STEPS` steps or
-:data:`MAX_BYTES` bytes with one line giving the estimate and how to proceed
-(``--max-steps``, fewer degrees, a coarser step or output interval). At about
-1 million Newmark steps per second on the development machine, the default
-limit bounds a run at roughly a minute.
+:func:`check` refuses a run above its back end's step limit
+(:func:`max_steps_for`) or :data:`MAX_BYTES` bytes with one line giving the
+estimate and how to proceed (``--max-steps``, fewer degrees, a coarser step
+or output interval). At about 1 million Newmark steps per second on the
+development machine, :data:`MAX_STEPS` bounds a run at roughly a minute. A
+scipy sample costs far more (solve_ivp calls Python for every stage of
+every step, and restarts at every event): 0.16 ms per estimated sample on
+gnilka-1a with every contact linear at k = 1e10 lbf/in (14.6 s for 9.2e4),
+so scipy's limit is :data:`MAX_SCIPY_STEPS`, about the same minute; its
+estimate grows with the stiffest linear contact through omega_max (k = 1e13
+gives 2.3e7 samples for 720 deg of 1A: refused, where it used to run for
+more than 300 s).
 """
 
 from __future__ import annotations
@@ -36,6 +43,8 @@ from vtool.units import cam_speed
 
 #: Default largest number of steps (or samples) of one run.
 MAX_STEPS = 5e7
+#: ... of a scipy run (module doc: a sample costs about 160 Newmark steps).
+MAX_SCIPY_STEPS = 5e5
 #: Default largest memory of one run's output (bytes).
 MAX_BYTES = 2e9
 #: Samples per period of the highest natural frequency (exact, scipy).
@@ -102,9 +111,15 @@ class CostError(InputError):
         return f"run too large: {c.describe()} ({c.backend}, {c.t_end:.3g} s of motion), {limit}"
 
 
+def max_steps_for(backend: str) -> float:
+    """The default step limit of a back end (module doc)."""
+    limit = backends.get(backend).max_steps  # a back end may set its own (the scipy back end's steps cost more)
+    return MAX_STEPS if limit is None else limit
+
+
 def check(cost: Estimate, max_steps: float | None = None, max_bytes: float | None = None) -> Estimate:
     """Refuse (:class:`CostError`, exit 2) a run above the limits; returns ``cost``."""
-    max_steps = MAX_STEPS if max_steps is None else max_steps
+    max_steps = max_steps_for(cost.backend) if max_steps is None else max_steps
     max_bytes = MAX_BYTES if max_bytes is None else max_bytes
     if not cost.steps >= 1.0:
         raise CostError(cost, max_steps, max_bytes, "short")

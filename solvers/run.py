@@ -166,4 +166,8 @@ def simulate(
     except NUMERICAL_FAILURES as exc:
         raise RunError(f"{spec.run.backend} run failed ({type(exc).__name__}: {str(exc)[:80]}); likely "
                        "input: the time step, or stiffnesses and masses of very different size") from None
-    return _check_finite(trace)
+    trace = _check_finite(trace)
+    sign = trace.force_sign_warning()
+    if sign is not None:
+        warnings.warn(PresetWarning(sign), stacklevel=2)
+    return trace

@@ -19,7 +19,7 @@ import numpy as np
 
 from vtool.files import open_atomic
 from vtool.solvers.model.configurations import closed_names, configuration_label, thesis_number
-from vtool.solvers.model.spec import EXTERNAL, MechanismSpec
+from vtool.solvers.model.spec import ENABLED, EXTERNAL, MechanismSpec
 from vtool.solvers.newmark import layout
 
 OPENED = "opened"
@@ -33,6 +33,8 @@ EVENT_KINDS: dict[int, str] = {int(layout.EV_OPENED): OPENED, int(layout.EV_CLOS
 EPISODE_WINDOW_DEG = 0.1
 #: A seat re-opening that closes again within this (degrees) is a bounce, not the cam lifting the valve.
 BOUNCE_WINDOW_DEG = 90.0
+#: a closed rigid contact force below -this share of the run's largest peak force is flagged (Trace.tensile_forces)
+TENSILE_FRACTION = 1e-6
 
 #: Episode kinds by the clearance's state before and after the burst of events.
 SEPARATION, IMPACT, BOUNCE, FLICKER = "separation", "impact", "bounce", "flicker"
@@ -84,6 +86,7 @@ class RunStatistics:
     compile_time: float = 0.0  # s spent compiling (or loading) the kernel, not in wall_time
     plain_steps: int = 0  # of ``steps``, those run as plain Python (before the compiled kernel was ready)
     kernel: str = ""  # newmark: what ran its last steps, "native", "numba" or "plain" (newmark.kernel_kind)
+    remedy: str = ""  # the back end's advice when a result is not to be trusted (Backend.remedy)
 
 
 @dataclass(frozen=True)
@@ -144,6 +147,42 @@ class Trace:
     peak_force_after_first_revolution: np.ndarray | None = None  # per clearance, over every step
     peak_overlap: np.ndarray | None = None  # per clearance, largest overlap of a compliant contact
     cycles: Cycles | None = None  # a run cycle by cycle (run.cycles, run.steady): how it went
+
+    # ----- results that should not be trusted -----
+    def tensile_forces(self) -> np.ndarray:
+        """Per clearance, the most tensile (negative) force an enabled rigid contact carried while closed,
+        over the output rows (0.0: never; compliant and pinned clearances 0.0: they may pull).
+
+        A closed rigid contact only pushes: every back end releases it when its force reaches zero. A
+        force below -:data:`TENSILE_FRACTION` of the run's largest peak force is a release the back end
+        missed (solve_ivp looks for sign changes only between its own steps: a loose ``rtol`` lets a
+        force cross zero and back within one step), and what follows it is not to be trusted.
+        """
+        result = np.zeros(len(self.spec.clearances))
+        if not self.contact_force.size:
+            return result
+        scale = TENSILE_FRACTION * max(float(np.max(self.peak_force, initial=0.0)), 1e-300)
+        for k, c in enumerate(self.spec.clearances):
+            if c.rigid and c.state == ENABLED:
+                least = float(np.min(self.contact_force[:, k]))
+                result[k] = least if least < -scale else 0.0
+        return result
+
+    def force_sign_warning(self) -> str | None:
+        """One line naming the contacts that pulled while closed (:meth:`tensile_forces`), or None."""
+        tensile = self.tensile_forces()
+        if not tensile.any():
+            return None
+        unit = self.spec.unit_system.force
+        named = []
+        for k in np.flatnonzero(tensile):
+            row = int(np.argmin(self.contact_force[:, k]))
+            named.append(f"{self.force_label(int(k))} ({self.spec.clearances[k].name}) {tensile[k]:.4g} {unit} "
+                         f"at {self.cam_angle[row]:.1f} deg")
+        backend = self.statistics.backend
+        remedy = self.statistics.remedy or "another back end to compare"
+        return (f"contact forces of the wrong sign: {', '.join(named)}: a closed contact pulled, a release "
+                f"the {backend} back end missed; the events and peaks after it are not to be trusted ({remedy})")
 
     # ----- columns by the engineer's names -----
     def coordinate(self, number: int, rows: slice = slice(None)) -> np.ndarray:
@@ -309,21 +348,12 @@ class Trace:
             opened_at = e.cam_angle
         return result
 
-    def per_revolution(self, angles: list[float]) -> list[int]:
-        """Counts of the given angles in each whole cam revolution after the first."""
-        revolutions = int(self.cam_angle[-1] // 360.0) if len(self.cam_angle) else 0
-        counts = [0] * max(revolutions - 1, 0)
-        for angle in angles:
-            index = int(angle // 360.0) - 1
-            if 0 <= index < len(counts):
-                counts[index] += 1
-        return counts
-
     def summary(self) -> dict:
         """Counts, peaks and seating velocities per clearance, and the run statistics."""
         units = self.spec.unit_system
         clearances = []
         late = self.peak_force_after_first_revolution
+        tensile = self.tensile_forces()
         for i, c in enumerate(self.spec.clearances):
             impacts = self.events_at(c.name, (CLOSED,))
             episodes = self.episodes(c.name)
@@ -340,6 +370,7 @@ class Trace:
                 "peak_force": float(self.peak_force[i]),
                 "peak_force_after_first_revolution": None if late is None else float(late[i]),
                 "peak_force_unit": units.force,
+                "tensile_force": float(tensile[i]),  # the most tensile force while closed: 0 unless it pulled
                 "contact": c.contact,
             }
             if not c.rigid and self.peak_overlap is not None:
@@ -381,6 +412,7 @@ class Trace:
                 for e in self.events
             ],
             "clearances": clearances,
+            "warnings": [w for w in (self.force_sign_warning(),) if w is not None],
         } | self.follower_summary()
 
     def follower_summary(self) -> dict:

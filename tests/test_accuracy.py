@@ -139,3 +139,28 @@ def test_cli_refuses_a_non_valvetrain_preset() -> None:
     # the shared wrong-kind check (presets/kinds.py require_kind): one house line, as `vtool modes`
     assert result.output.strip().splitlines() == [
         "error: preset: got 'plate', expected a valvetrain preset for `vtool accuracy`"]
+
+
+def test_a_wrong_late_peak_is_not_hidden_by_the_start_shock_and_a_pull_is_noted() -> None:
+    """The whole-run peaks of gnilka-1a are its start shock; a run whose peaks after the first revolution are
+    3.77 times the reference's (scipy's +277 % on 1D at rtol 1e-6) must show a 277 % peak-force error, and one
+    whose closed rocker pulled must say so."""
+    import numpy as np
+
+    from tests.valvetrain_cases import spec_from, thesis_doc
+    from vtool.solvers.run import simulate
+    from vtool.solvers.studies.accuracy import compare
+
+    doc = thesis_doc("gnilka-1a")
+    doc["run"]["degrees"] = 400.0
+    reference = simulate(spec_from(doc))
+    late = reference.peak_force_after_first_revolution
+    assert late is not None and np.all(late < reference.peak_force)  # the start shock is the run's peak
+    wrong = replace(reference, peak_force_after_first_revolution=3.77 * late)
+    assert compare(wrong, reference, "scipy", "test").peak_force_error == pytest.approx(2.77, rel=1e-9)
+    forces = reference.contact_force.copy()
+    row = int(np.argmax(forces[:, 1] > 0))  # a row where the rocker is closed
+    forces[row, 1] = -1000.0
+    pulled = compare(replace(reference, contact_force=forces), reference, "scipy", "test", "scipy 1.17.1")
+    assert pulled.note == "closed contacts pulled: F2 -1e+03 lbf; scipy 1.17.1"
+    assert compare(reference, reference, "newmark", "test").note == ""

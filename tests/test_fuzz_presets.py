@@ -1,19 +1,24 @@
-"""Preset fuzzer: any valve-train preset gives a run, one clean line (exit 2 or 1), never a traceback.
+"""Preset fuzzer: any preset of any kind gives a result, one clean line (exit 2 or 1), never a traceback.
 
-A seeded hypothesis fuzzer mutates the shipped valve-train presets (delete or
-add keys, a contact made compliant (linear or hertz), numbers scaled by 1e-8 to 1e8, wrong types, 0, negatives, NaN, +-inf, 1e+-300, ints too large for
-a float, huge arrays and strings, duplicated entries, invalid UTF-8, tables
-and arrays nested 5,000 deep) and runs each through ``vtool solve`` in
-process. Every case must end with exit code 0, 1 or 2; a non-zero exit prints
-exactly one ``error:``/``run failed:`` line on stderr (``warning:`` lines
-aside), leaves no CSV and no temporary file, and every case finishes within
-:data:`CASE_SECONDS`. Runs are short (``--max-steps`` 20,000, base runs of
-90 degrees) so the CI cost stays low.
+A seeded hypothesis fuzzer mutates the shipped presets of every kind
+(:data:`KIND_BASES`: valve trains, the table cam (its CSV beside the
+preset, and written inline), sonic-boom walls and floors, condensed plates)
+(delete or add keys, a contact made compliant (linear or hertz), numbers
+scaled by 1e-8 to 1e8, wrong types, 0, negatives, NaN, +-inf, 1e+-300, ints
+too large for a float, huge arrays and strings, duplicated entries, invalid
+UTF-8, tables and arrays nested 5,000 deep) and runs each through ``vtool
+solve`` in process. Every case must end with exit code 0, 1 or 2; a
+non-zero exit prints exactly one ``error:``/``run failed:`` line on stderr
+(``warning:`` lines aside), leaves no CSV and no temporary file, and every
+case finishes within :data:`CASE_SECONDS`. Runs are short (valve trains:
+``--max-steps`` 20,000, base runs of 90 degrees; boom and plate presets cut
+to a few cases, :func:`small_doc`) so the CI cost stays low.
 
-CI runs :data:`CI_CASES` cases; ``VTOOL_FUZZ_CASES=10000`` runs more (the
-figures in docs/limits.md come from that run, with ``VTOOL_FUZZ_LOG=FILE``
-collecting one line per case). The regression tests below
-hold the reproducers of every signature issue 14 listed.
+CI runs :data:`CI_CASES` valve-train cases and :data:`CI_KIND_CASES` of
+every other kind; ``VTOOL_FUZZ_CASES=3000`` runs that many of every kind
+(``VTOOL_FUZZ_KINDS=plate,boom_wall`` picks kinds; ``VTOOL_FUZZ_LOG=FILE``
+collects one line per case). The regression tests below hold the
+reproducers of every signature issue 14 listed.
 """
 
 from __future__ import annotations
@@ -37,10 +42,31 @@ from vtool.errors import InputError, PresetWarning, RunError
 from vtool.presets import PRESET_DIR, load_document, parse_text, read_document
 
 CI_CASES = 250
-CASES = int(os.environ.get("VTOOL_FUZZ_CASES", CI_CASES))
+CI_KIND_CASES = 25  # of each kind other than the valve trains, in the suite
+CASES = os.environ.get("VTOOL_FUZZ_CASES")
 CASE_SECONDS = 60.0
 FUZZ_MAX_STEPS = "20000"
-VALVETRAIN = sorted(p.stem for p in PRESET_DIR.glob("gnilka-*.toml"))
+VALVETRAIN = sorted(p.stem for p in PRESET_DIR.glob("gnilka-*.toml")) + ["ohv-pushrod-1a"]
+TABLE_CAM = "ramped-cam"
+#: kind -> the shipped presets it mutates ("table_cam": ramped-cam with its CSV beside it, or inline)
+KIND_BASES: dict[str, list[str]] = {
+    "valvetrain": VALVETRAIN,
+    "table_cam": [TABLE_CAM, f"{TABLE_CAM}+inline"],
+    "boom_wall": ["boom-brick-wall"],
+    "boom_floor": ["boom-tall-building"],
+    "plate": ["plate-table2", "plate-table3", "plate-irs"],
+}
+ONLY_KINDS = [k for k in os.environ.get("VTOOL_FUZZ_KINDS", "").split(",") if k]
+
+
+def cases_of(kind: str) -> int:
+    """How many cases of ``kind`` this run makes (module doc)."""
+    if ONLY_KINDS and kind not in ONLY_KINDS:
+        return 0
+    if CASES is not None:
+        return int(CASES)
+    return CI_CASES if kind == "valvetrain" else CI_KIND_CASES
+
 
 BAD_VALUES: list[Any] = [
     0, 0.0, -1, -1.0, math.nan, math.inf, -math.inf, 1e300, -1e300, 1e-300, 5e-324, 10**400, -(10**400),
@@ -51,7 +77,30 @@ BAD_VALUES: list[Any] = [
 
 def base_doc(name: str) -> dict[str, Any]:
     doc = tomllib.loads((PRESET_DIR / f"{name}.toml").read_text(encoding="utf-8"))
-    doc["run"]["degrees"] = 90.0
+    doc.setdefault("run", {})["degrees"] = 90.0
+    return doc
+
+
+def small_doc(name: str) -> dict[str, Any]:
+    """A shipped preset of any kind made cheap to run (a fuzz case takes well under a second unmutated)."""
+    if name.endswith("+inline"):  # the table cam with its lift table written into the preset
+        from vtool.presets.lift_table import read_lift_table
+
+        doc = base_doc(name.removesuffix("+inline"))
+        angles, lifts = read_lift_table("cam.lift_table", doc["cam"].pop("lift_table"), PRESET_DIR, "in")
+        doc["cam"].update(angles=angles, lifts=lifts)
+        return doc
+    doc = tomllib.loads((PRESET_DIR / f"{name}.toml").read_text(encoding="utf-8"))
+    if doc.get("kind") == "plate":
+        doc["cases"] = doc["cases"][:2]
+        doc["study"].update(convergence_meshes=[2, 4], frequencies=3)
+        doc["transient"].update(cases=[c["name"] for c in doc["cases"]], loads=["uniform", "point"],
+                                omega_max_h=[1.0], periods=0.5, exact_modes=20)
+    elif doc.get("kind", "").startswith("boom"):
+        doc["design"]["points"] = 20
+        doc["boom"]["positive_durations"] = doc["boom"]["positive_durations"][:1]
+    else:
+        doc["run"]["degrees"] = 90.0
     return doc
 
 
@@ -72,10 +121,10 @@ def at(doc: Any, path: tuple[Any, ...]) -> Any:
 
 
 @st.composite
-def mutated_text(draw: st.DrawFn) -> bytes:
-    """A shipped valve-train preset with one to three mutations, as file bytes."""
-    doc = base_doc(draw(st.sampled_from(VALVETRAIN)))
-    if draw(st.integers(0, 3)) == 0:  # a compliant contact (docs/contact.md), then mutated like the rest
+def mutated_text(draw: st.DrawFn, kind: str = "valvetrain") -> bytes:
+    """A shipped preset of ``kind`` (:data:`KIND_BASES`) with one to three mutations, as file bytes."""
+    doc = small_doc(draw(st.sampled_from(KIND_BASES[kind])))
+    if doc.get("clearances") and draw(st.integers(0, 3)) == 0:  # a compliant contact (docs/contact.md)
         clearance = draw(st.sampled_from(doc["clearances"]))
         law = draw(st.sampled_from(["linear", "hertz"]))
         clearance["contact"] = law
@@ -111,7 +160,7 @@ def mutated_text(draw: st.DrawFn) -> bytes:
     try:
         text = tomli_w.dumps(doc)
     except (TypeError, ValueError):  # e.g. a list mixing tables and numbers: no TOML for it
-        text = tomli_w.dumps(base_doc(VALVETRAIN[0]))
+        text = tomli_w.dumps(small_doc(KIND_BASES[kind][0]))
     data = text.encode("utf-8")
     raw = draw(st.sampled_from(["none"] * 8 + ["utf8", "nest-array", "nest-table", "truncate"]))
     if raw == "utf8":
@@ -126,23 +175,27 @@ def mutated_text(draw: st.DrawFn) -> bytes:
     return data
 
 
-def check_case(tmp_path: Path, data: bytes) -> tuple[int, float]:
+def check_case(tmp_path: Path, data: bytes, kind: str = "valvetrain") -> tuple[int, float]:
     """Run one preset through `vtool solve`; assert the house rules; return (exit code, seconds)."""
     folder = tmp_path / f"case{time.monotonic_ns()}"
     folder.mkdir()
     preset = folder / "case.toml"
     preset.write_bytes(data)
+    inputs = ["case.toml"]
+    if kind == "table_cam":  # the lift table beside the preset, as shipped
+        (folder / f"{TABLE_CAM}.csv").write_bytes((PRESET_DIR / f"{TABLE_CAM}.csv").read_bytes())
+        inputs.append(f"{TABLE_CAM}.csv")
     out = folder / "out.csv"
+    limits = ["--max-steps", FUZZ_MAX_STEPS] if kind in ("valvetrain", "table_cam") else []
     started = time.perf_counter()
-    result = CliRunner().invoke(cli, ["solve", str(preset), "--csv", str(out), "--json",
-                                      "--max-steps", FUZZ_MAX_STEPS])
+    result = CliRunner().invoke(cli, ["solve", str(preset), "--csv", str(out), "--json", *limits])
     seconds = time.perf_counter() - started
     assert result.exception is None or isinstance(result.exception, SystemExit), (
         f"{type(result.exception).__name__}: {result.exception}")
     assert result.exit_code in (0, 1, 2)
     assert seconds < CASE_SECONDS
-    leftovers = sorted(p.name for p in folder.iterdir()) == ["case.toml"] + (
-        ["out.csv"] if result.exit_code == 0 else [])
+    leftovers = sorted(p.name for p in folder.iterdir()) == sorted(inputs + (
+        ["out.csv"] if result.exit_code == 0 else []))
     assert leftovers, sorted(p.name for p in folder.iterdir())
     errors = [line for line in result.stderr.splitlines() if not line.startswith("warning: ")]
     if result.exit_code == 0:
@@ -160,7 +213,7 @@ def check_case(tmp_path: Path, data: bytes) -> tuple[int, float]:
         Path(keep, f"slow-{seconds:.0f}s-{time.monotonic_ns()}.toml").write_bytes(data)
 
     rss_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    log(f"preset exit={result.exit_code} seconds={seconds:.3f} maxrss_mb={rss_mb:.0f} "
+    log(f"preset kind={kind} exit={result.exit_code} seconds={seconds:.3f} maxrss_mb={rss_mb:.0f} "
         f"{errors[0][:60] if errors else ''}")
     return result.exit_code, seconds
 
@@ -173,14 +226,45 @@ def log(line: str) -> None:
             handle.write(line + "\n")
 
 
+def fuzz(kind: str) -> None:
+    """``cases_of(kind)`` mutated presets of ``kind`` through :func:`check_case` (seeded)."""
+    count = cases_of(kind)
+    if not count:
+        pytest.skip(f"VTOOL_FUZZ_KINDS leaves out {kind}")
+
+    @seed(14)
+    @settings(max_examples=count, deadline=None, database=None, derandomize=False,
+              suppress_health_check=list(HealthCheck))
+    @given(data=mutated_text(kind))
+    def one(data: bytes) -> None:
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as folder:
+            check_case(Path(folder), data, kind)
+
+    one()
+
+
 @pytest.mark.slow
-@seed(14)
-@settings(max_examples=CASES, deadline=None, database=None, derandomize=False,
-          suppress_health_check=list(HealthCheck))
-@given(data=mutated_text())
-def test_mutated_presets_never_give_a_traceback_or_a_hang(tmp_path_factory: pytest.TempPathFactory,
-                                                         data: bytes) -> None:
-    check_case(tmp_path_factory.mktemp("fuzz"), data)
+@pytest.mark.parametrize("kind", list(KIND_BASES))
+def test_mutated_presets_never_give_a_traceback_or_a_hang(kind: str) -> None:
+    fuzz(kind)
+
+
+def test_every_kind_of_preset_is_fuzzed() -> None:
+    """Every preset kind the loader knows has fuzz bases, each base loads and runs cleanly unmutated."""
+    from vtool.presets.kinds import KINDS
+
+    kinds = {load_document(small_doc(name), PRESET_DIR).kind for bases in KIND_BASES.values()
+             for name in bases}
+    assert kinds == set(KINDS)
+    for kind, bases in KIND_BASES.items():
+        for name in bases:
+            import tempfile
+
+            with tempfile.TemporaryDirectory() as folder:
+                code, _ = check_case(Path(folder), tomli_w.dumps(small_doc(name)).encode(), kind)
+            assert code == 0, (kind, name)
 
 
 # ----- regression tests: the reproducers of issue 14 ---------------------------------------------

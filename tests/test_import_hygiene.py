@@ -105,3 +105,21 @@ def test_the_kinds_table_names_importable_code() -> None:
         assert isinstance(resolve(kind.spec_type), type)
         assert hasattr(resolve(kind.loader), "load") and callable(resolve(kind.solve))
         assert resolve(kind.screen).__name__ == kind.screen
+
+
+def test_every_module_sits_in_an_import_contract() -> None:
+    """Each top-level module of vtool/ and each layer package is named by an import-linter contract
+    (the layers, or the core's forbidden contract): a new core module must be placed."""
+    import tomllib
+
+    from tests import typing_tree
+
+    config = tomllib.loads((typing_tree.ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    named: set[str] = set()
+    for contract in config["tool"]["importlinter"]["contracts"]:
+        for layer in contract.get("layers", []):
+            named |= {part.strip() for part in layer.replace("|", ":").split(":")}
+        named |= set(contract.get("source_modules", []))
+    modules = {f"vtool.{path.stem}" for path in (typing_tree.ROOT / "vtool").glob("*.py") if path.stem != "__init__"}
+    modules |= {f"vtool.{folder}" for folder in typing_tree.FOLDERS}
+    assert modules - named == set(), f"modules in no import contract: {sorted(modules - named)}"

@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vtool.assessments.plate.assembly import Plate
-from vtool.assessments.plate.exact import step_response
+from vtool.assessments.plate.exact import CONVERGED_CHANGE, step_histories, step_response
 from vtool.assessments.plate.model import Case, MasterSelection, build_model
 from vtool.assessments.plate.transient import (
     RK4_STABILITY_LIMIT,
@@ -86,7 +86,10 @@ def test_exact_reference_convergence_is_reported() -> None:
     uniform = step_response(PLATE, "uniform", t, 200)
     point = step_response(PLATE, "point", t, 200)
     assert uniform.change_displacement < 1e-4 and uniform.change_velocity < 0.01
-    assert uniform.acceleration_converged and not point.acceleration_converged
+    # converged means a peak that halving the modes moves by at most 1 %: the uniform-load acceleration's
+    # terms decay like 1/(mn) and its peak moves 7.5 % from 100 to 200 modes, so it is not
+    assert uniform.change_acceleration > CONVERGED_CHANGE
+    assert not uniform.acceleration_converged and not point.acceleration_converged
     assert point.change_acceleration > 0.3  # the series diverges: halving the modes halves the peak
     # at t = 0 the uniform-load acceleration is the Fourier series of the uniform load: p0/ρh
     assert uniform.acceleration[0] * PLATE.mass_per_area == pytest.approx(1.0, abs=0.05)
@@ -149,3 +152,28 @@ def test_single_master_model_is_an_sdof_oscillator() -> None:
     omega = np.sqrt(model.K[0, 0] / model.M[0, 0])
     w = model.centre_row[0] * model.f_uniform[0] / model.K[0, 0] * (1 - np.cos(omega * tau * s.period))
     assert np.allclose(resp.displacement * s.displacement, w, rtol=1e-10, atol=1e-15)
+
+
+def test_the_exact_peak_is_found_between_its_samples() -> None:
+    """The exact series is known at every instant: its peak is refined between the samples, here against a
+    grid 10,000 times finer around the extreme sample (the 200-mode acceleration peak was read 0.017 % low)."""
+    coarse = exact_histories(PLATE, "uniform", 1.5, 200)
+    s = scales(PLATE, "uniform")
+    evaluate = step_histories(PLATE, "uniform", 200)
+    for index, name in enumerate(("displacement", "velocity", "acceleration")):
+        samples = getattr(coarse, name)
+        k = int(np.argmax(np.abs(samples)))
+        sign = 1.0 if samples[k] > 0 else -1.0
+        fine = np.linspace(coarse.tau[k - 1], coarse.tau[k + 1], 20001)
+        scale = s.load / (s.displacement, s.velocity, s.acceleration)[index]
+        dense = evaluate(fine * s.period)[index] * scale
+        best = float(dense.max() if sign > 0 else dense.min())
+        refined = coarse.extremes[name][0 if sign > 0 else 1]
+        assert sign * refined >= sign * samples[k]
+        assert refined == pytest.approx(best, rel=1e-9, abs=1e-12)
+    gain = coarse.extremes["acceleration"][0] / coarse.acceleration.max() - 1
+    assert gain > 1e-5  # the grid read it low
+    # peak errors are measured against the refined exact extreme
+    exact_peak = coarse.extremes["displacement"][0]
+    assert peak_error_pct(np.array([0.0, 1.01 * exact_peak]), coarse.displacement,
+                          coarse.extremes["displacement"]) == pytest.approx(1.0, rel=1e-12)

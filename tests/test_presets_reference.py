@@ -41,7 +41,7 @@ def test_the_reference_states_the_loaders_ranges_units_and_defaults(reads: dict)
     assert run["run.output_interval"].defaults == {"1"}
     assert run["members.*.length"].type == "number"  # a named table's keys under `*`
     assert "clearances[].restitution" in run and "damping.layers[].mode_ratios.<number>" in run
-    assert run["members.*.length"].units == {"in", "m"}  # each unit system a valvetrain preset may declare
+    assert run["members.*.length"].units == {"in", "m", "mm"}  # each unit system a valvetrain preset may declare
 
 
 def test_recording_notes_each_read_once_with_its_pattern() -> None:

@@ -107,3 +107,50 @@ def test_a_run_that_cannot_settle_stops_at_max_cycles_and_says_so() -> None:
     assert trace.cycles.change > 1e-6
     text = window_text(trace)
     assert text.startswith("warning: did not settle in 8 cycles") and "changed by" in text
+
+
+def test_order_amplitudes_as_sweep_metrics_and_their_campbell_data_follow_the_closed_form() -> None:
+    """The linear train at three speeds: the order-1 column equals the closed form at each speed, the others
+    vanish, and the Campbell data line up the same numbers by speed and order."""
+    from vtool.solvers.studies.orders import campbell, with_orders
+    from vtool.solvers.studies.sweep import Point, SerialRunner, run_points
+
+    speeds = [2000.0, 3000.0, 4000.0]
+    specs = [with_orders(spec_from(linear_doc() | {"run": linear_doc()["run"] | {"rpm": rpm}}), ("q2",))
+             for rpm in speeds]
+    results = run_points([Point(i, (("run.rpm", r),), s) for i, (r, s) in enumerate(zip(speeds, specs, strict=True))],
+                         SerialRunner()).results
+    data = campbell([(r, res.metrics) for r, res in zip(speeds, results, strict=True)], specs[0], "q2")
+    for j, spec in enumerate(specs):
+        kept, x0, X = periodic_response(spec)
+        exact = abs(X[list(kept).index(1)])
+        assert results[j].metrics["q2_order_1"] == pytest.approx(exact, rel=1e-6)
+        assert data.amplitude[0, j] == results[j].metrics["q2_order_1"]
+        assert np.nanmax(data.amplitude[1:, j]) < 1e-6 * exact
+    assert data.unit == "in" and len(data.frequencies) >= 1
+
+
+def test_orders_of_an_unknown_quantity_are_one_line_of_bad_input() -> None:
+    from vtool.errors import InputError
+    from vtool.solvers.studies.orders import with_orders
+
+    with pytest.raises(InputError, match="--orders: got 'F9'"):
+        with_orders(load_preset("gnilka-1a"), ("F9",))
+
+
+def test_cli_orders_and_campbell() -> None:
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    solved = CliRunner().invoke(cli, ["solve", "gnilka-1a", "--orders", "F7"])
+    assert solved.exit_code == 0, solved.output
+    assert "evaluated: after the first revolution (cam angle 360-850 deg)" in solved.output
+    assert "start-up shock (first revolution): startup_peak_force" in solved.output
+    assert "F7 in cam orders over 1 cycle (cam angle 360-720 deg" in solved.output
+    swept = CliRunner().invoke(cli, ["sweep", "gnilka-1a", "--set", "run.rpm=9000:10000:500", "--campbell", "F7",
+                                     "--steady", "--workers", "1"])
+    assert swept.exit_code == 0, swept.output
+    assert "F7: amplitude per cam order and speed" in swept.output and "natural frequencies: " in swept.output
+    bad = CliRunner().invoke(cli, ["sweep", "gnilka-1a", "--set", "damping.factor=1,2", "--campbell", "F7"])
+    assert bad.exit_code == 2 and "--campbell" in bad.output

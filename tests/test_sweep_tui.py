@@ -63,17 +63,21 @@ async def test_bad_range_shows_one_line_and_runs_nothing() -> None:
 
 
 async def test_cancel_stops_and_keeps_finished_points() -> None:
-    app = PaneApp(values="9000:12000:2", fixed="run.degrees=2000")
+    app = PaneApp(values="9000:12000:20", fixed="run.degrees=2000")
     async with app.run_test(size=(140, 50)) as pilot:
         pane = app.query_one(SweepPane)
         pane.run_sweep()
+        for _ in range(3000):  # the points are checked first
+            await pilot.pause(0.02)
+            if pane.status_text.startswith("running"):
+                break
         await pilot.pause(0.3)
         await pilot.click("#sweep-cancel")
         await app.workers.wait_for_complete()
         await pilot.pause()
         await pilot.pause()
         assert pane.status_text.startswith("stopped:"), pane.status_text
-        assert len(pane.outcome.results) < 1501
+        assert len(pane.outcome.results) < 151
 
 
 async def test_several_workers_run_under_textual_and_its_stderr_is_kept() -> None:
@@ -141,16 +145,18 @@ async def test_points_are_checked_off_the_ui_thread_and_cancel_stops_the_check(m
     app = PaneApp(values="9000:9100:10", fixed="run.degrees=100", metric="peak_F1")
     async with app.run_test(size=(140, 50)) as pilot:
         pane = app.query_one(SweepPane)
+        await pilot.pause()
+        loads_on_ui_thread.clear()  # (the pane reads its preset's metric names when it is made)
         await _run(pilot, pane)
         assert pane.status_text.startswith("finished: 11 of 11 points"), pane.status_text
         assert not loads_on_ui_thread
         pane.query_one("#sweep-values", Input).value = "1000:100999:1"  # 100,000 points
         pane.run_sweep()
-        for _ in range(200):  # the screen stays live while the worker checks
+        for _ in range(1500):  # the screen stays live while the worker checks
             await pilot.pause(0.02)
-            if "checking 100000 points" in pane.status_text:
+            if "checking 100000 points: " in pane.status_text:
                 break
-        assert "checking 100000 points" in pane.status_text, pane.status_text
+        assert "checking 100000 points: " in pane.status_text, pane.status_text
         assert pane.running
         await pilot.click("#sweep-cancel")
         await app.workers.wait_for_complete()
@@ -163,12 +169,41 @@ async def test_points_are_checked_off_the_ui_thread_and_cancel_stops_the_check(m
 
 
 async def test_a_metric_with_no_value_at_any_point_is_said_not_drawn() -> None:
-    """spring_margin is empty at 100 degrees (the valve never reaches full lift): plotext's chart of
-    all-NaN series raised IndexError and ended the app."""
-    app = PaneApp(values="10000,11000", fixed="run.degrees=100", metric="spring_margin")
+    """seating_velocity_max is empty at 100 degrees (the valve has not come back to its seat): plotext's
+    chart of all-NaN series raised IndexError and ended the app."""
+    app = PaneApp(values="10000,11000", fixed="run.degrees=100", metric="seating_velocity_max")
     async with app.run_test(size=(140, 50)) as pilot:
         pane = app.query_one(SweepPane)
         await _run(pilot, pane)
         assert pane.status_text.startswith("finished: 2 of 2 points"), pane.status_text
-        assert pane.chart.function is None and "no point has a value of spring_margin" in str(pane.chart.content)
+        assert pane.chart.function is None
+        assert "no point has a value of seating_velocity_max" in str(pane.chart.content)
     assert app._exception is None
+
+
+async def test_a_speed_sweep_shows_the_intervals_and_a_two_field_sweep_the_map() -> None:
+    """1A at 5,000, 6,000 and 7,000 rev/min (850 deg): the intervals where the follower leaves the cam and the
+    valve bounces are those of the library's metrics at those speeds; a second swept field puts the map
+    (sweep_charts.metric_map) above the table."""
+    from vtool.app.sweep_charts import metric_map
+    from vtool.solvers.studies.metrics import metric_columns
+    from vtool.solvers.studies.sweep import scan_intervals
+
+    app = PaneApp(values="5000,6000,7000", metric="cam_separations")
+    async with app.run_test(size=(140, 50)) as pilot:
+        pane = app.query_one(SweepPane)
+        await _run(pilot, pane)
+        results = pane.outcome.results
+        jumps = scan_intervals(results, "run.rpm", "jump-speed")
+        assert jumps and jumps[0][1] == 7000  # (in contact during lift at 5,000: 1A leaves the cam from 5,391)
+        text = str(pane.intervals.content)
+        assert text.startswith(f"the follower leaves the cam during lift: {jumps[0][0]:g}-7000 rev/min; the valve "
+                               "bounces on its seat: ") and "vtool sweep --find bisects the edges" in text
+        pane.query_one("#sweep-fixed", Input).value = "damping.factor=0.5,1"
+        await _run(pilot, pane)
+        plan, results = pane.plan, pane.outcome.results
+        axes = [f for f in plan.fields if f[0] in ("run.rpm", "damping.factor")]
+        units = dict(metric_columns(plan.spec))
+        assert pane.table.text.startswith(metric_map(results, axes, "cam_separations", units["cam_separations"]))
+        assert str(pane.intervals.content) == ""  # two fields: no speed intervals
+

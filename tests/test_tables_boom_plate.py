@@ -27,8 +27,11 @@ _VERSIONS = re.compile(r"numpy [0-9][^,|]*, scipy [0-9][^|]*")
 _DONE: dict[object, str] = {}
 
 
+_WALL = re.compile(r"\b\d+(?:\.\d+)? ms\b")  # the console blocks' wall times (plate-console)
+
+
 def _normal(text: str) -> str:
-    return _VERSIONS.sub("numpy X, scipy Y", text)
+    return _WALL.sub("T ms", _VERSIONS.sub("numpy X, scipy Y", text))
 
 
 @pytest.mark.parametrize(("path", "name"), list(tables.BLOCKS), ids=lambda v: getattr(v, "name", v))

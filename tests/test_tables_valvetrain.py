@@ -68,7 +68,7 @@ def test_exact_and_newmark_rows_of_every_preset_reproduce(studies: dict, name: s
 def test_scipy_rows_reproduce_under_the_recorded_versions(studies: dict, name: str) -> None:
     theirs = [row for row in committed(tables.DOC, f"accuracy-{name.removeprefix('gnilka-')}") if row[0] == "scipy"]
     assert theirs, "no scipy rows committed"
-    if any(row[-1] != library_versions() for row in theirs):
+    if any(not row[-1].endswith(library_versions()) for row in theirs):  # (a note may come before them)
         pytest.skip(f"committed scipy rows are for {theirs[0][-1]}; installed: {library_versions()}")
     ours = [row for row in tables.deterministic(tables.accuracy_block(studies[name])) if row[0] == "scipy"]
     assert ours == theirs, HINT

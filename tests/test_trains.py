@@ -73,3 +73,130 @@ def test_explicit_tables_beside_a_train_are_refused() -> None:
     doc = _doc("ohv-pushrod-1a") | {"members": {}}
     with pytest.raises(InputError, match="members"):
         load_document(doc)
+
+
+# ----- the engineering presets: stress, checks, outputs, back ends, studies ---------------------------
+
+NEW = ("ohc-finger-follower", "direct-acting-bucket")
+
+
+def _short(name: str, degrees: float = 420.0, **run):  # type: ignore[no-untyped-def]
+    from vtool.presets.valvetrain import with_run_overrides
+
+    return with_run_overrides(load_preset(name), degrees=degrees, **run)
+
+
+def test_max_contact_pressure_over_the_cycle_is_the_largest_closed_form_row() -> None:
+    import math
+
+    from vtool.solvers.model.camshape import law_derivatives
+
+    spec = _short("direct-acting-bucket")
+    trace = simulate(spec)
+    follower = spec.follower
+    L, _, ddL, _ = law_derivatives(spec.lift_law, np.radians(trace.cam_angle))
+    R = follower.base_radius + L + ddL  # flat face: R* is the cam's radius r_b + L + L''
+    E = 1.0 / ((1 - follower.cam_poisson**2) / follower.cam_modulus
+               + (1 - follower.follower_poisson**2) / follower.follower_modulus)
+    F = np.maximum(trace.force("cam"), 0.0)
+    p0 = np.sqrt(F * E / (math.pi * follower.width * R))
+    stress = trace.summary()["contact_stress"]
+    assert stress["max_contact_pressure"] == pytest.approx(p0.max(), rel=1e-6)
+    assert stress["max_contact_pressure_angle_deg"] == trace.cam_angle[np.argmax(p0)]
+    assert stress["pressure_unit"] == "MPa" and 300.0 < stress["max_contact_pressure"] < 1500.0
+    assert stress["min_film_thickness"] is not None and stress["length_unit"] == "mm"
+    text = trace.summary_text()
+    assert "max pressure" in text and "MPa" in text and "PASS" in text
+
+
+def test_csv_has_the_contact_stress_columns_with_units() -> None:
+    trace = simulate(_short("ohc-finger-follower", 60.0))
+    header = trace.csv_text().splitlines()[0].split(",")
+    for column in ("cam_normal_force (N)", "cam_contact_pressure (MPa)", "cam_half_width (mm)",
+                   "cam_film_thickness (mm)"):
+        assert column in header
+
+
+def test_checks_fail_with_a_negative_margin_and_unknown_names_are_refused() -> None:
+    import dataclasses
+
+    from vtool.solvers.model.spec import CheckLimit
+    from vtool.solvers.studies.checks import evaluate
+
+    spec = _short("direct-acting-bucket", 60.0)
+    tight = dataclasses.replace(spec, checks=(CheckLimit("contact_pressure_max", 100.0),
+                                              CheckLimit("cam_radius_min", 100.0)))
+    trace = simulate(tight)
+    pressure, radius = evaluate(tight, trace)
+    assert not pressure.passed and pressure.margin == pytest.approx(100.0 - pressure.value)
+    assert pressure.unit == "MPa" and radius.unit == "mm" and not radius.passed
+    assert "FAIL" in trace.summary_text()
+    doc = _doc("direct-acting-bucket")
+    doc["checks"]["contact_presure_max"] = 1.0
+    with pytest.raises(InputError, match="did you mean `contact_pressure_max`"):
+        load_document(doc)
+
+
+@pytest.mark.parametrize("name", NEW)
+def test_new_presets_agree_on_every_back_end(name: str) -> None:
+    from vtool.solvers.backends import available
+
+    spec = _short(name, 200.0)
+    traces = {backend: simulate(_short(name, 200.0, backend=backend)) for backend in available()}
+    events = {b: [(e.clearance, e.kind) for e in t.events] for b, t in traces.items()}
+    assert len(set(map(tuple, events.values()))) == 1, events
+    peak = {b: t.summary()["contact_stress"]["max_contact_pressure"] for b, t in traces.items()}
+    assert max(peak.values()) - min(peak.values()) <= 1e-3 * max(peak.values()), peak
+    assert spec.unit_system.name == "mm-N-s"
+
+
+@pytest.mark.parametrize("name", NEW)
+def test_new_presets_have_a_jump_speed(name: str) -> None:
+    from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.studies.sweep import SerialRunner, find_speed
+
+    spec = load_preset(name)
+    result = find_speed("jump-speed", lambda rpm: with_run_overrides(spec, rpm=rpm),
+                        list(range(1000, 8001, 1000)), SerialRunner())
+    assert result.speed is not None and 1000 < result.speed < 8000
+
+
+def test_crank_degrees_are_halved_and_a_free_length_gives_the_preload() -> None:
+    doc = _doc("direct-acting-bucket")
+    cam = doc["train"]["cam"]
+    cam.update(angle_basis="crank", ramp_deg=2 * cam["ramp_deg"], flank_deg=2 * cam["flank_deg"])
+    spring = doc["train"]["spring"]
+    del spring["preload"]
+    spring.update(installed_length=38.0, free_length=38.0 + 230.0 / 35.0)
+    crank, cam_degrees = load_document(doc), load_preset("direct-acting-bucket")
+    assert crank.cam == cam_degrees.cam
+    assert crank.initial.spring_preload == pytest.approx(230.0, rel=1e-12)
+
+
+def test_presets_expand_and_cam_show_csv(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    runner = CliRunner()
+    result = runner.invoke(cli, ["presets", "expand", "ohc-finger-follower"])
+    assert result.exit_code == 0 and "[members.finger_roller_arm]" in result.output
+    explicit = tmp_path / "explicit.toml"
+    explicit.write_text(result.output.split("\n", 1)[1], encoding="utf-8")
+    assert load_preset(explicit) == load_preset("ohc-finger-follower")
+    target = tmp_path / "profile.csv"
+    result = runner.invoke(cli, ["cam", "show", "direct-acting-bucket", "--csv", str(target)])
+    assert result.exit_code == 0 and "no undercut" in result.output
+    lines = target.read_text(encoding="utf-8").splitlines()
+    assert lines[0].startswith("law_angle (deg),lift (mm),x (mm),y (mm),polar_radius (mm)") and len(lines) == 721
+    result = runner.invoke(cli, ["cam", "show", "gnilka-1a", "--csv", str(tmp_path / "x.csv")])
+    assert result.exit_code == 2 and "[follower]" in result.output
+
+
+def test_an_undercut_cam_warns_on_loading() -> None:
+    from vtool.errors import PresetWarning
+
+    doc = _doc("direct-acting-bucket")
+    doc["train"]["follower"]["base_radius"] = 10.0
+    with pytest.warns(PresetWarning, match="undercuts at law angles"):
+        load_document(doc)

@@ -96,3 +96,64 @@ async def test_at_120x40_with_the_form_the_peak_forces_and_plate_errors_are_in_v
         line = next(line for line in text.splitlines() if f"▕{free.case} " in line)
         for error in free.errors_pct:
             assert f"{error:.3f}" in line, (free.case, error, line)
+
+
+async def test_the_sweep_tabs_inputs_are_labelled_and_readable_beside_the_form() -> None:
+    """The sweep tab's four inputs and its metric had no labels (a placeholder vanishes with a
+    value), and at 120 x 40 beside the form the values input showed "9000:12"."""
+    from textual.widgets import Input, Label, Select
+
+    from vtool.app.tui.screenshots import svg_text
+    from vtool.app.tui.sweep import SweepPane
+
+    app = make_app()
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        app.screen.tabs.active = "tab-sweep"
+        await pilot.pause()
+        await pilot.pause(0.2)
+        pane = app.screen.query_one(SweepPane)
+        for editor in [*pane.query(Input), *pane.query(Select)]:
+            siblings = list(editor.parent.children)
+            before = siblings[siblings.index(editor) - 1]
+            assert isinstance(before, Label), editor.id
+        text = svg_text(app.export_screenshot(), 120)
+        for shown in ("field run.rpm", "values 9000:12000:250", "metric spring_margin", "CSV file sweep.csv"):
+            assert shown in text, shown
+        assert "fixed " in text
+
+
+async def test_a_table_cam_preset_saved_from_the_tui_has_its_table_inline(tmp_path: Path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Saved from the presets folder, the copy kept ``lift_table = "ramped-cam.csv"``, a path the
+    copy's own folder does not have (docs/cams.md: a saved preset writes the table inline)."""
+    import tomllib
+
+    from vtool.app.tui.dialogs import PathDialog
+    from vtool.presets import find_preset, load_preset, valvetrain
+
+    shipped = Path(find_preset("ramped-cam"))
+    monkeypatch.chdir(shipped.parent)  # where the relative reference still loads
+    app = make_app("ramped-cam", config_dir=tmp_path)
+    target = tmp_path / "elsewhere" / "mine.toml"
+    target.parent.mkdir()
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        app.screen.form.row("run.rpm").editor.value = "5000"
+        await pilot.pause()
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        assert isinstance(app.screen, PathDialog)
+        app.screen.query_one("#path-input").value = str(target)
+        await pilot.press("enter")
+        await pilot.pause()
+        assert app.screen.status_log[-1].startswith(f"saved {target} (comments kept"), app.screen.status_log[-1]
+    text = target.read_text()
+    cam = tomllib.loads(text)["cam"]
+    assert "lift_table" not in cam and len(cam["angles"]) == len(cam["lifts"]) > 10
+    assert 'inline copy of lift_table = "ramped-cam.csv"' in text
+    assert "# Prescribed coordinates." in text  # the file's own comments stay
+    monkeypatch.chdir(tmp_path)
+    saved = load_preset(str(target))
+    expected = valvetrain.dump(load_preset("ramped-cam"))
+    expected["run"]["rpm"] = 5000
+    assert valvetrain.dump(saved) == expected

@@ -1,20 +1,33 @@
-"""A seeded monkey: random keys, clicks and pasted garbage across the three screens, no crash.
+"""A seeded monkey: random keys, clicks and pasted garbage across the three screens and the sweep tab.
 
-Each sequence starts a fresh app (the valve-train screen, its default preset
-cut to a short run so runs finish inside a sequence) and sends ``EVENTS``
-random events: screen keys (run, cancel, save, export, open, help, tabs,
-f2-f4), field navigation and typing, clicks anywhere (dialogs included) and
-pasted text (long digit runs, ``1e999``, ``nan``, control characters,
-paths that cannot be written). The app must never hit an uncaught
-exception; an error dialog is the expected answer to bad input.
+Each sequence starts a fresh app on one of four places, by seed: the sweep
+tab with a pool of ``SWEEP_WORKERS`` processes, the valve-train screen (its
+preset cut to a short run so runs finish inside a sequence), the sonic-boom
+screen and the plate screen. It sends ``EVENTS`` random events: screen keys
+(run, cancel, save, export, open, help, tabs, f2-f4), field navigation and
+typing, clicks anywhere (dialogs included), pasted text (long digit runs,
+``1e999``, ``nan``, control characters, paths that cannot be written) and
+sweep actions (show the tab, run, cancel, export). The monkey fails when
 
-CI runs one sequence of 30 events (about 11 s; docs/tui.md, "Monkey test",
-says where a sequence's time goes); ``VTOOL_MONKEY=1000`` runs 1,000
-sequences of 50 events and prints what it found::
+* the app hits an uncaught exception, or
+* a status line (a screen's or the sweep tab's) or an error dialog shows an
+  error the sequence did not ask for. Bad input is answered by its one-line
+  message (a field, the value, the allowed range) and a failed run by its
+  reason: those are asked for. An error that is neither, the app words as
+  "... could not be completed: ..." (a run or a sweep failing for a reason of
+  the program's, like the pool error "bad value(s) in fds_to_keep"), and a
+  form the loader failed on with something other than its one-line message
+  shows "invalid form: ...": those fail the monkey (:func:`unexpected`).
 
-    VTOOL_MONKEY=1000 .venv/bin/python -m pytest -q -n 0 -s tests/test_tui_monkey.py
+CI runs one sequence of 30 events (seed 0: the sweep tab; about 15 s);
+``VTOOL_MONKEY=300`` runs 300 sequences of 50 events, the four starts in
+turn, and prints what it found::
 
-A failure names the seed; ``VTOOL_MONKEY_SEED=<seed> VTOOL_MONKEY=1`` replays it.
+    VTOOL_MONKEY=300 .venv/bin/python -m pytest -q -n 0 -s tests/test_tui_monkey.py
+
+A failure names the seed; ``VTOOL_MONKEY_SEED=<seed> VTOOL_MONKEY=1`` replays it
+(``VTOOL_MONKEY_SEED=N VTOOL_MONKEY=K`` runs seeds N to N+K-1, so a long run can
+be split over processes).
 """
 
 from __future__ import annotations
@@ -38,6 +51,9 @@ SEQUENCES = int(os.environ.get("VTOOL_MONKEY", "1"))
 EVENTS = int(os.environ.get("VTOOL_MONKEY_EVENTS", "50" if "VTOOL_MONKEY" in os.environ else "30"))
 FIRST_SEED = int(os.environ.get("VTOOL_MONKEY_SEED", "0"))
 SIZES = ((80, 24), (120, 40), (100, 30))
+STARTS = ("sweep", "valvetrain", "boom", "plate")  # by seed, in turn
+PRESETS = {"sweep": "gnilka-1d", "valvetrain": "gnilka-1d", "boom": "boom-brick-wall", "plate": "plate-table2"}
+SWEEP_WORKERS = 3  # a process pool, whatever the machine's core count
 
 SCREEN_KEYS = ("ctrl+r", "ctrl+r", "escape", "escape", "ctrl+s", "ctrl+e", "ctrl+o", "ctrl+f", "ctrl+t",
                "f1", "f2", "f3", "f4", "enter", "enter")
@@ -48,13 +64,24 @@ TYPED_KEYS = tuple("0123456789.-eE+x,[] ") + ("plus", "minus", "left_square_brac
 GARBAGE = ("1" * 400, "9" * 40, "-" + "9" * 320, "1e999", "-1e999", "1e-400", "nan", "inf", "-0", "0",
            "", "   ", "abc", "ünï©ødé ☃", "1,2,,3", "[[x]]", "0.5, 1e308, 1e309", "\x00", "a\nb",
            "\t", "/nonexistent/dir/x.toml", "/proc/version", "gnilka-1b", "boom-tall-building",
-           "plate-table3", ".", "..", "x" * 300, "1_000", "0x1F", "1e5", "-5", "3.14159")
+           "plate-table3", ".", "..", "x" * 300, "1_000", "0x1F", "1e5", "-5", "3.14159",
+           "9000:9500:250", "1:1e9:1", "run.degrees=30", "damping.factor=0.5,2", "run.rpm=", "x.y.z=1")
+SWEEP_ACTIONS = ("#sweep-run", "#sweep-run", "#sweep-cancel", "#sweep-export", "tab")
+
+#: what the app shows for an error that no input asked for (see the module doc)
+UNEXPECTED = ("could not be completed", "invalid form:")
+
+
+def unexpected(text: str) -> bool:
+    """True for a status or dialog message of an error that is not the answer to bad input or a failed run."""
+    return any(marker in text for marker in UNEXPECTED)
 
 
 @dataclass
 class Found:
     crashes: list[str] = field(default_factory=list)
-    internal: list[str] = field(default_factory=list)  # error dialogs for non-user errors
+    unexpected: list[str] = field(default_factory=list)  # status lines and dialogs no input asked for
+    sweeps: int = 0  # sweeps that ran to their end or were stopped (the pool did start)
 
 
 def garbage(rng: random.Random) -> str:
@@ -63,22 +90,62 @@ def garbage(rng: random.Random) -> str:
     return rng.choice(GARBAGE)
 
 
+def sweep_pane(app):  # type: ignore[no-untyped-def]
+    """The valve-train screen's sweep pane when that screen is on top (no dialog), else None."""
+    from vtool.app.tui.sweep import SweepPane
+    from vtool.app.tui.valvetrain import ValveTrainScreen
+
+    if not isinstance(app.screen, ValveTrainScreen):
+        return None
+    return app.screen.query_one(SweepPane)
+
+
+async def show_sweep_tab(pilot, app):  # type: ignore[no-untyped-def]
+    """Show the sweep tab; at its first showing, a pool of SWEEP_WORKERS and short runs."""
+    from textual.widgets import Input
+
+    pane = sweep_pane(app)
+    if pane is None:
+        return None
+    app.screen.tabs.active = "tab-sweep"
+    await pilot.pause()
+    if pane.sweep_workers != SWEEP_WORKERS:
+        await pilot.pause()
+        pane.sweep_workers = SWEEP_WORKERS
+        pane.query_one("#sweep-fixed", Input).value = "run.degrees=40"
+    return pane
+
+
 async def send(pilot, app, rng: random.Random) -> str:  # type: ignore[no-untyped-def]
     """One random event; returns its description."""
     roll = rng.random()
-    if roll < 0.35:
+    if roll < 0.33:
         key = rng.choice(SCREEN_KEYS)
-    elif roll < 0.6:
+    elif roll < 0.56:
         key = rng.choice(MOVE_KEYS)
-    elif roll < 0.75:
+    elif roll < 0.7:
         key = rng.choice(TYPED_KEYS)
-    elif roll < 0.88:
+    elif roll < 0.82:
         text = garbage(rng)
         target = app.focused
         if target is not None:
             target.post_message(events.Paste(text))
         await pilot.pause()
         return f"paste {text[:20]!r} into {type(target).__name__}"
+    elif roll < 0.9:
+        action = rng.choice(SWEEP_ACTIONS)
+        pane = await show_sweep_tab(pilot, app)
+        if pane is None:
+            return f"sweep {action} (no sweep tab on top)"
+        if action == "tab":
+            pane.query_one("#sweep-field").focus()
+            await pilot.pause()
+        else:
+            try:
+                await pilot.click(action)
+            except OutOfBounds:
+                pass
+        return f"sweep {action}"
     else:
         width, height = app.size
         x, y = rng.randrange(width), rng.randrange(height - 1)  # the footer's Quit would end the app
@@ -91,33 +158,70 @@ async def send(pilot, app, rng: random.Random) -> str:  # type: ignore[no-untype
     return key
 
 
-def internal_errors(app, start: int) -> list[str]:  # type: ignore[no-untyped-def]
-    return [t for t in app.errors_shown[start:] if t.startswith("the run could not be completed")]
+class Messages:
+    """Every status and dialog message of a sequence, read as it grows (screens and panes as they appear)."""
+
+    def __init__(self, app) -> None:  # type: ignore[no-untyped-def]
+        self.app = app
+        self.logs: dict[int, tuple[str, list[str]]] = {}
+        self.read: dict[int, int] = {}
+
+    def new(self) -> list[str]:
+        from vtool.app.tui.base import DomainScreen
+        from vtool.app.tui.sweep import SweepPane
+
+        for screen in self.app.screen_stack:
+            if isinstance(screen, DomainScreen):
+                self.logs.setdefault(id(screen), (screen.MODE, screen.status_log))
+                for pane in screen.query(SweepPane):
+                    self.logs.setdefault(id(pane), ("sweep tab", pane.status_log))
+        self.logs.setdefault(id(self.app), ("dialog", self.app.errors_shown))
+        fresh = []
+        for key, (where, log) in self.logs.items():
+            fresh += [f"{where}: {text}" for text in log[self.read.get(key, 0):]]
+            self.read[key] = len(log)
+        return fresh
 
 
 async def one_sequence(seed: int, found: Found, tmp_path) -> None:  # type: ignore[no-untyped-def]
     rng = random.Random(seed)
-    app = create_app("gnilka-1d", remember=False, chart_color=False)
+    start = STARTS[seed % len(STARTS)]
+    app = create_app(PRESETS[start], remember=False, chart_color=False)
     done: list[str] = []
     try:
         async with app.run_test(size=rng.choice(SIZES)) as pilot:
             await pilot.pause()
-            app.screen.form.row("run.degrees").editor.value = "40"  # runs finish within a sequence
-            await pilot.pause()
+            if start in ("valvetrain", "sweep"):
+                app.screen.form.row("run.degrees").editor.value = "40"  # runs finish within a sequence
+                await pilot.pause()
+            if start == "sweep":
+                await show_sweep_tab(pilot, app)
+                await pilot.click("#sweep-run")
+                done.append("sweep #sweep-run")
+            messages = Messages(app)
             for _ in range(EVENTS):
                 done.append(await send(pilot, app, rng))
+                found.unexpected += [f"seed {seed}: {text} after {done[-5:]}" for text in messages.new()
+                                     if unexpected(text)]
                 if app._exception is not None or not app.is_running:
                     break
+            for _ in range(200):  # a sweep still going is let finish (a few seconds), then stopped
+                pane = sweep_pane(app)
+                if pane is None or not pane.running:
+                    break
+                await pilot.pause(0.05)
             app.workers.cancel_all()
             await pilot.pause()
+            found.unexpected += [f"seed {seed}: {text} at the end" for text in messages.new() if unexpected(text)]
+            found.sweeps += sum(text.startswith(("finished: ", "stopped: ")) for where, log in messages.logs.values()
+                                if where == "sweep tab" for text in log)
     except Exception as exc:  # the monkey's one job: record what escaped the app
         where = " | ".join(line.strip().replace("\n", " ") for line in traceback.format_tb(exc.__traceback__)[-4:])
         found.crashes.append(f"seed {seed}: {type(exc).__name__}: {exc} after {done[-5:]} at {where}")
-        return
-    found.internal += [f"seed {seed}: {t}" for t in internal_errors(app, 0)]
 
 
-async def test_monkey_finds_no_crash(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+def quick_pilot(monkeypatch, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """The monkey's pilot settings, its folder and config (see the comments)."""
     # Textual's pilot waits after every key until the *process* is idle (process CPU time
     # standing still, at most 1 s per wait). A run computing in a worker thread keeps the
     # process busy, so every event sent during a run waited the full second: that was most
@@ -131,22 +235,48 @@ async def test_monkey_finds_no_crash(tmp_path, monkeypatch) -> None:  # type: ig
     monkeypatch.setattr(textual_wait, "SLEEP_IDLE", 0.0005)
     monkeypatch.chdir(tmp_path)  # saves and exports land here
     monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path))
+
+
+async def test_monkey_finds_no_crash_and_no_unexpected_error(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    quick_pilot(monkeypatch, tmp_path)
     found = Found()
     started = time.perf_counter()
     for seed in range(FIRST_SEED, FIRST_SEED + SEQUENCES):
-        crashes = len(found.crashes)
+        before = len(found.crashes) + len(found.unexpected)
         await one_sequence(seed, found, tmp_path)
-        if SEQUENCES > 10:  # a long run reports as it goes (pytest -s), a crash at once
-            for line in found.crashes[crashes:]:
+        if SEQUENCES > 10:  # a long run reports as it goes (pytest -s), a finding at once
+            for line in (found.crashes + found.unexpected)[before:]:
                 print("  ", line[:2000], flush=True)
-            print(f"seed {seed}: {len(found.crashes)} crashes so far, "
-                  f"{time.perf_counter() - started:.0f} s", flush=True)
+            print(f"seed {seed}: {len(found.crashes)} crashes, {len(found.unexpected)} unexpected errors, "
+                  f"{found.sweeps} sweeps so far, {time.perf_counter() - started:.0f} s", flush=True)
     elapsed = time.perf_counter() - started
     print(f"\nTUI monkey: {SEQUENCES} sequences of {EVENTS} events in {elapsed:.0f} s: "
-          f"{len(found.crashes)} crashes, {len(found.internal)} internal-error dialogs")
-    for line in found.crashes + found.internal:
+          f"{len(found.crashes)} crashes, {len(found.unexpected)} unexpected errors, {found.sweeps} sweeps "
+          f"ran (pool of {SWEEP_WORKERS} workers)")
+    for line in found.crashes + found.unexpected:
         print("  ", line[:300])
     assert not found.crashes, "\n".join(found.crashes)
+    assert not found.unexpected, "\n".join(found.unexpected)
+
+
+async def test_the_monkey_fails_on_an_error_no_input_asked_for(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """The sweep tab's pool failing to start (issue 37: "bad value(s) in fds_to_keep" on every Run, shown
+    in the status line, no exception: the old monkey saw nothing) fails the monkey's sweep sequence."""
+    import vtool.solvers.studies.sweep as sweep
+
+    def pool_fails(*args, **kwargs):  # type: ignore[no-untyped-def]
+        raise ValueError("bad value(s) in fds_to_keep")  # what _posixsubprocess raised
+
+    quick_pilot(monkeypatch, tmp_path)
+    monkeypatch.setattr(sweep, "make_runner", pool_fails)
+    found = Found()
+    await one_sequence(0, found, tmp_path)  # seed 0 starts on the sweep tab and runs it
+    assert not found.crashes, found.crashes
+    assert found.unexpected and all("fds_to_keep" in line or "could not be completed" in line
+                                    for line in found.unexpected), found.unexpected
+    assert unexpected("failed: the run could not be completed: singular matrix")
+    assert not unexpected("cannot run: members.pushrod.length: got -5, expected > 0 in")
+    assert not unexpected("error: --set run.rpm: got '5000:4000:250', expected a step with the sign of stop - start (-)")
 
 
 async def test_paging_a_choice_list_before_it_is_laid_out_is_harmless() -> None:

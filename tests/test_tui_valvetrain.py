@@ -113,7 +113,22 @@ async def test_opens_on_valvetrain_and_1a_run_draws_the_library_charts() -> None
         assert screen.selected_quantities() == ("q7",)
         assert screen.displacement_chart.chart_text == charts.displacement_chart(expected, ("q7",), w, h,
                                                                                  color=False)
-        assert untimed(screen.query_one("#summary").text) == untimed(expected.summary_text())
+        from vtool.solvers.studies.metrics import evaluation_summary
+
+        assert untimed(screen.query_one("#summary").text) == untimed(
+            expected.summary_text() + "\n\n" + "\n".join(evaluation_summary(expected)["lines"]))
+        # the order spectrum of the seat force (F7) over the evaluated cycle, as the library computes it
+        from vtool.app.order_charts import order_chart
+        from vtool.solvers.studies.orders import natural_frequencies, spectrum
+
+        screen.tabs.active = "tab-orders"
+        await pilot.pause()
+        w, h = screen.order_chart.chart_size
+        orders = spectrum(expected, "F7")
+        frequencies = natural_frequencies(expected)
+        assert screen.order_chart.chart_text == orders.table(6) + "\n" + order_chart(
+            orders, frequencies, width=w, height=max(h - 10 - len(frequencies), 8), color=False)
+        assert "F7 in cam orders over 1 cycle (cam angle 360-720 deg" in screen.order_chart.chart_text
         kinds = [type(m) for m in screen.messages_seen]
         assert kinds[-1] is SimulationFinished
         assert all(k is RunProgressed for k in kinds[:-1])

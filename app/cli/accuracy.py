@@ -16,9 +16,8 @@ def accuracy(preset: str, degrees: float | None, csv_path: Path | None, markdown
     """The speed/accuracy trade of a valve-train preset: Newmark (dt 1e-4 to 1e-7 s, beta 1/6 and 1/4)
     and scipy (rtol 1e-4 to 1e-11) against the exact back end: wall time, steps, events, and errors in
     event angles, peak contact forces, valve seating velocity and valve lift."""
-    from vtool.presets import load_preset
+    from vtool.presets import Override, load_preset
     from vtool.presets.kinds import require_kind
-    from vtool.presets.valvetrain import with_run_overrides
     from vtool.solvers.studies.accuracy import (
         accuracy_study,
         table_markdown,
@@ -26,9 +25,9 @@ def accuracy(preset: str, degrees: float | None, csv_path: Path | None, markdown
         write_table_csv,
     )
 
-    spec = load_preset(preset)
+    # --degrees is the preset's run.degrees: the loader checks it, as the file's own value
+    spec = load_preset(preset, () if degrees is None else (Override("run.degrees", degrees, "--degrees"),))
     require_kind(spec, "valvetrain", "`vtool accuracy`")
-    spec = with_run_overrides(spec, degrees=degrees)
     _, rows = accuracy_study(spec)
     unit = spec.unit_system.length
     click.echo(f"{spec.title}: {spec.run.degrees:g} degrees at {spec.run.rpm:g} rev/min, errors against the exact back end")

@@ -1,4 +1,5 @@
-"""``vtool cam show PRESET [--plot] [--json]``: the cam's lift, its fit, spectrum and derivatives."""
+"""``vtool cam show PRESET [--plot] [--json] [--csv FILE]``: the cam's lift, its fit, spectrum and derivatives,
+and with a follower the cam's shape."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from pathlib import Path
 import click
 
 from vtool.app.cli.options import figure_option, write_figure
+from vtool.errors import InputError
 
 
 @click.group()
@@ -19,10 +21,14 @@ def cam() -> None:
 @click.argument("preset")
 @click.option("--plot", is_flag=True, help="Draw lift, velocity, acceleration and jerk against cam angle.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
+@click.option("--csv", "csv_path", type=click.Path(),
+              help="With a [follower]: write the ground profile (polar and Cartesian, curvature) for grinding.")
 @figure_option
-def show(preset: str, plot: bool, as_json: bool, figure_path: Path | None) -> None:
+def show(preset: str, plot: bool, as_json: bool, csv_path: str | None, figure_path: Path | None) -> None:
     """Fit error, velocity/acceleration/jerk extremes at the preset's speed, the
-    acceleration spectrum, and warnings where a lift table's acceleration jumps."""
+    acceleration spectrum, and warnings where a lift table's acceleration jumps.
+    With a follower ([follower] or a train type): the cam's shape, radius of
+    curvature, undercut, pressure angle and a finger's ratio."""
     from vtool.presets import load_preset
     from vtool.solvers.model.cam import cam_report, report_text
 
@@ -30,7 +36,17 @@ def show(preset: str, plot: bool, as_json: bool, figure_path: Path | None) -> No
     from vtool.presets.kinds import require_kind
 
     require_kind(spec, "valvetrain", "`vtool cam`")
+    if csv_path is not None:
+        from vtool.files import check_output_path
+
+        check_output_path(csv_path, "--csv")
+        if spec.follower is None:
+            raise InputError("--csv", csv_path, "a preset with a [follower] (the profile needs its geometry)")
     report = cam_report(spec)
+    if spec.follower is not None:
+        from vtool.solvers.model.camshape import shape_report
+
+        report["shape"] = shape_report(spec)
     if spec.seat is not None:
         from vtool.solvers.model.lash import lash_of
 
@@ -42,11 +58,22 @@ def show(preset: str, plot: bool, as_json: bool, figure_path: Path | None) -> No
         if spec.seat is not None:
             u = spec.unit_system.length
             click.echo(f"seat position {report['seat_position']:.6g} {u}, lash {report['lash']:.6g} {u}")
+        if "shape" in report:
+            from vtool.solvers.model.camshape import shape_text
+
+            click.echo(shape_text(report["shape"]))
+    if csv_path is not None:
+        from vtool.files import write_atomic
+        from vtool.solvers.model.camshape import profile_csv_text
+
+        write_atomic(csv_path, profile_csv_text(spec), "--csv")
+        if not as_json:
+            click.echo(f"wrote the cam profile to {csv_path}")
     if plot or figure_path is not None:
         from vtool.app.plots import chart_text
-        from vtool.presets.charts import cam_charts
+        from vtool.presets.charts import cam_charts, cam_shape_charts
 
-        charts = cam_charts(spec)
+        charts = cam_charts(spec) + (cam_shape_charts(spec) if spec.follower is not None else [])
         from vtool.presets.cam_scan import preset_scan
 
         scan = preset_scan(preset, spec.unit_system)

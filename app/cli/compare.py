@@ -26,24 +26,16 @@ def compare(preset: str, impacts: tuple[str, ...], starts: tuple[str, ...] | Non
     step, and print side by side: events, episodes per clearance (separations/impacts/bounces/flickers),
     the first throw-off angle in each revolution after the first, peak contact forces after the first
     revolution, valve seating velocities and the largest valve lift."""
-    import dataclasses
-
     from vtool.files import write_atomic
     from vtool.markdown import table as markdown_table
-    from vtool.presets import load_preset
+    from vtool.presets import Override, load_preset
+    from vtool.presets.kinds import require_kind
     from vtool.solvers.studies.compare import cell, table
     from vtool.solvers.studies.compare import compare as run_compare
 
-    spec = load_preset(preset)
-    from vtool.presets.kinds import require_kind
-
+    # --degrees is the preset's run.degrees: the loader checks it, as the file's own value
+    spec = load_preset(preset, () if degrees is None else (Override("run.degrees", degrees, "--degrees"),))
     require_kind(spec, "valvetrain", "`vtool compare`")
-    if degrees is not None:
-        from vtool.errors import InputError
-
-        if not 0.0 < degrees <= 36000.0:
-            raise InputError("--degrees", degrees, "> 0 and <= 36000", "deg")
-        spec = dataclasses.replace(spec, run=dataclasses.replace(spec.run, degrees=degrees))
     from vtool.app.cli.solve import announce_compile
 
     variants = run_compare(spec, impacts, starts, before_run=lambda: announce_compile(spec, impacts=impacts))

@@ -30,25 +30,6 @@ start_option = click.option(
     help=f"Start velocities to compare (comma-separated from {', '.join(START_VELOCITIES)}); default: the preset's.")
 
 
-def _one(field: str, allowed: tuple[str, ...]):  # type: ignore[no-untyped-def]
-    def convert(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
-        if value is not None and value not in allowed:
-            from vtool.errors import InputError
-
-            raise InputError(field, value, f"one of: {', '.join(allowed)}")
-        return value
-
-    return convert
-
-
-impact_option = click.option(
-    "--impact", default=None, callback=_one("--impact", IMPACT_LAWS),
-    help=f"Impact law for every clearance ({', '.join(IMPACT_LAWS)}); default: the preset's.")
-start_velocities_option = click.option(
-    "--start", default=None, callback=_one("--start", START_VELOCITIES),
-    help=f"Start velocities ({', '.join(START_VELOCITIES)}); default: the preset's.")
-
-
 def _figure_path(ctx: click.Context, param: click.Parameter, value: str | None):  # type: ignore[no-untyped-def]
     if value is None:
         return None

@@ -45,3 +45,23 @@ def copy_command(name: str, dest: Path, force: bool) -> None:
     text, note = self_contained_text(source)  # a lift-table file is written in: the copy loads anywhere
     write_atomic(target, text, "DEST")
     click.echo(f"copied {source.stem} to {target}" + (f" ({note})" if note else ""))
+
+
+@presets.command("expand")
+@click.argument("name")
+def expand_command(name: str) -> None:
+    """Print a train-type preset ([train] type = ...) as the explicit model it expands to
+    (coordinates, members, clearances, cam, follower); an explicit preset prints unchanged."""
+    import tomli_w
+
+    from vtool.presets import read_document
+    from vtool.presets.trains import expand
+
+    path = find_preset(name)
+    doc = read_document(path)
+    if "train" not in doc:
+        click.echo(path.read_text(encoding="utf-8"), nl=False)
+        return
+    explicit = expand(doc, path.parent)
+    click.echo(f"# {path.stem}: the explicit model of its [train] (vtool presets expand; presets/trains.py)")
+    click.echo(tomli_w.dumps(explicit), nl=False)

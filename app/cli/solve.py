@@ -1,12 +1,14 @@
 """``vtool solve PRESET``: the one batch entry point for every preset kind.
 
 The preset's kind picks what runs, from the one kinds table
-(:data:`vtool.presets.kinds.KINDS`). The valve-train flags are checked at the
-flag, by the same function the preset loader uses
-(:func:`vtool.presets.valvetrain.check_run_value`); ``--backend`` lists the
-installed back ends. The output path is checked before the run starts, and
-a run's cost is estimated and refused above ``--max-steps`` before the back
-end starts (:mod:`vtool.solvers.cost`).
+(:data:`vtool.presets.kinds.KINDS`). A flag that is a preset field
+(``--rpm`` is ``run.rpm``, the table's ``overrides``) is not checked here: it
+is set into the preset document and the loader checks it once, with the
+file's own values, naming the flag in its error (docs/architecture.md walks
+``--rpm`` and ``--dt`` through). ``--backend`` lists the installed back ends.
+The output path is checked before the run starts, and a run's cost is
+estimated and refused above ``--max-steps`` before the back end starts
+(:mod:`vtool.solvers.cost`).
 """
 
 from __future__ import annotations
@@ -16,28 +18,11 @@ from typing import Any
 
 import click
 
-from vtool.app.cli.options import (
-    figure_option,
-    impact_option,
-    start_velocities_option,
-    write_figure,
-)
+from vtool.app.cli.options import figure_option, write_figure
 from vtool.errors import InputError
 from vtool.solvers.backends import available
-from vtool.solvers.cost import MAX_STEPS
-
-
-def _run_flag(key: str) -> Any:
-    """A click callback checking a [run] override with the loader's own check."""
-
-    def callback(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
-        if value is None:
-            return None
-        from vtool.presets.valvetrain import check_run_value
-
-        return check_run_value(key, value, f"--{param.name}" if key != "time_step" else "--dt")
-
-    return callback
+from vtool.solvers.cost import MAX_SCIPY_STEPS, MAX_STEPS
+from vtool.solvers.model.spec import IMPACT_LAWS, START_VELOCITIES
 
 
 def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
@@ -49,14 +34,12 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @click.command()
 @click.argument("preset")
 @click.option("--backend", type=click.Choice(available()), help="Back end; default: the preset's.")
-@click.option("--dt", type=float, callback=_run_flag("time_step"),
-              help="Time step (s, 1e-12 to 0.1); default: the preset's.")
-@click.option("--rpm", type=float, callback=_run_flag("rpm"),
-              help="Cam speed (rev/min, 0.001 to 1e6); default: the preset's.")
-@click.option("--degrees", type=float, callback=_run_flag("degrees"),
-              help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's.")
+@click.option("--dt", type=float, help="Time step (s, 1e-12 to 0.1); default: the preset's run.time_step.")
+@click.option("--rpm", type=float, help="Cam speed (rev/min, 0.001 to 1e6); default: the preset's run.rpm.")
+@click.option("--degrees", type=float,
+              help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's run.degrees.")
 @click.option("--max-steps", type=float, callback=_max_steps,
-              help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}).")
+              help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}; scipy {MAX_SCIPY_STEPS:.0e}).")
 @click.option("--csv", "--out", "csv_path", type=click.Path(),  # a str: '' stays '' in the error
               help="Write the response as CSV (per output interval, or per step with --every-step).")
 @click.option("--format", "file_format", type=click.Choice(["csv", "parquet"]),
@@ -67,12 +50,15 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @figure_option
 @click.option("--json", "as_json", is_flag=True, help="Print the summary (with the event list) as JSON.")
 @click.option("--events", "show_events", is_flag=True, help="Also print the event list.")
-@impact_option
-@start_velocities_option
+@click.option("--impact", help=f"Impact law for every clearance ({', '.join(IMPACT_LAWS)}); default: the preset's.")
+@click.option("--start", help=f"Start velocities ({', '.join(START_VELOCITIES)}); default: the preset's.")
+@click.option("--orders", "orders", metavar="QUANTITY",
+              help="Also print the cam-order spectrum of QUANTITY (q7, q1-q9, F7) over the evaluated cycles: "
+                   "a table, and with --plot a chart with the natural frequencies marked.")
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
           max_steps: float | None, csv_path: str | None, every_step: bool, plot: bool, as_json: bool,
-          show_events: bool, impact: str | None, start: str | None, figure_path: Path | None,
-          file_format: str | None) -> None:
+          show_events: bool, orders: str | None, impact: str | None, start: str | None,
+          figure_path: Path | None, file_format: str | None) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
@@ -80,7 +66,7 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
     statistics). Files are written only when the run succeeds.
     """
     from vtool.files import check_output_path
-    from vtool.presets import load_preset
+    from vtool.presets import Override, find_preset, kind_of, load_document, read_document
     from vtool.presets.kinds import KINDS, resolve
 
     if as_json and plot:
@@ -90,25 +76,30 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
         raise InputError("--format", file_format, "an output file to write (--out PATH)")
     if csv_file is not None and file_format is None and str(csv_file).lower().endswith((".parquet", ".pq")):
         file_format = "parquet"
-    spec = load_preset(preset)
-    kind = KINDS[spec.kind]
+    path = find_preset(preset)
+    doc = read_document(path)
+    kind = KINDS[kind_of(doc)]
     given = {"--backend": backend, "--dt": dt, "--rpm": rpm, "--degrees": degrees,
              "--max-steps": max_steps, "--every-step": every_step or None,
-             "--events": show_events or None, "--impact": impact, "--start": start,
+             "--events": show_events or None, "--impact": impact, "--start": start, "--orders": orders,
              "--format": None if file_format == "csv" else file_format}
     for flag, value in given.items():
         if value is not None and flag not in kind.run_options:
-            raise InputError(flag, value, f"no {flag} for {preset}: it is a {spec.kind} preset "
+            raise InputError(flag, value, f"no {flag} for {preset}: it is a {kind.name} preset "
                              f"({flag} applies to {', '.join(applies_to(flag)) or 'no'} presets)")
+    fields = dict(kind.overrides)
+    overrides = tuple(Override(fields[flag], value, flag) for flag, value in given.items()
+                      if flag in fields and value is not None)
+    spec = load_document(doc, path.parent, overrides)
     flags = {FLAG_ARGUMENTS[flag]: value for flag, value in given.items()
-             if flag in kind.run_options and value is not None}
+             if flag in kind.run_options and flag not in fields and value is not None}
     resolve(kind.solve)(spec, csv_file, plot, as_json, figure=figure_path, **flags)
 
 
 #: ``vtool solve``'s run flags and the keyword that carries each to a kind's solve function
 FLAG_ARGUMENTS = {"--backend": "backend", "--dt": "dt", "--rpm": "rpm", "--degrees": "degrees",
                   "--max-steps": "max_steps", "--every-step": "every_step", "--events": "show_events",
-                  "--impact": "impact", "--start": "start", "--format": "file_format"}
+                  "--impact": "impact", "--start": "start", "--orders": "orders", "--format": "file_format"}
 
 
 def applies_to(flag: str) -> list[str]:
@@ -118,22 +109,15 @@ def applies_to(flag: str) -> list[str]:
     return [name for name, kind in KINDS.items() if flag in kind.run_options]
 
 
-def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *, backend: str | None = None,
-                   dt: float | None = None, rpm: float | None = None, degrees: float | None = None,
-                   every_step: bool = False, show_events: bool = False, max_steps: float | None = None,
-                   impact: str | None = None, start: str | None = None, figure: Path | None = None,
-                   file_format: str | None = None) -> None:
-    """``vtool solve`` for a valvetrain preset: the run flags as preset overrides, the run, its summary."""
+def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *, every_step: bool = False,
+                   show_events: bool = False, max_steps: float | None = None, figure: Path | None = None,
+                   orders: str | None = None, file_format: str | None = None) -> None:
+    """``vtool solve`` for a valvetrain preset (its flags that are preset fields already in ``spec``): the
+    run and its summary."""
     from vtool.app.cli.progress import DelayedProgress
     from vtool.files import json_text
-    from vtool.presets.valvetrain import with_run_overrides
     from vtool.solvers.run import simulate
 
-    if impact is not None or start is not None:
-        from vtool.solvers.studies.compare import with_model
-
-        spec = with_model(spec, impact, start)
-    spec = with_run_overrides(spec, backend=backend, time_step=dt, rpm=rpm, degrees=degrees)
     parquet = False
     if csv_path is not None:
         from vtool.solvers.parquet import output_format
@@ -169,10 +153,26 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
                                  stream=stream, before_run=before_run)
     finally:
         progress.close()
+    from vtool.solvers.studies.metrics import evaluation_summary
+
+    evaluation = evaluation_summary(trace)
+    spectrum = None
+    if orders is not None:
+        from vtool.solvers.studies.orders import spectrum as order_spectrum
+
+        spectrum = order_spectrum(trace, orders)
     if as_json:
-        click.echo(json_text(trace.summary()))
+        summary = trace.summary() | {"evaluation": evaluation}
+        if spectrum is not None:
+            summary["orders"] = spectrum.as_dict()
+        click.echo(json_text(summary))
     else:
         click.echo(trace.summary_text())
+        click.echo("")
+        click.echo("\n".join(evaluation["lines"]))
+        if spectrum is not None:
+            click.echo("")
+            click.echo(spectrum.table())
         if show_events:
             click.echo("")
             click.echo(trace.event_table())
@@ -182,6 +182,11 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
         from vtool.app.valvetrain_charts import all_charts
 
         click.echo(all_charts(trace))
+        if spectrum is not None:
+            from vtool.app.order_charts import order_chart
+            from vtool.solvers.studies.orders import natural_frequencies
+
+            click.echo(order_chart(spectrum, natural_frequencies(trace)))
     if figure is not None:
         from vtool.presets.charts import trace_charts
 

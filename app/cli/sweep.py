@@ -64,10 +64,19 @@ class CountProgress:
 @click.option("--map", "as_map", is_flag=True, help="Character heat map of --metric over two swept fields.")
 @click.option("--metric", default="spring_margin", show_default=True, help="Metric for --plot and --map.")
 @click.option("--every-step", is_flag=True, help="Metrics from every time step instead of the output rows.")
+@click.option("--steady", is_flag=True, help="Run every point to steady state (run.steady's defaults) unless the "
+                                            "preset sets run.cycles or run.steady; the metrics cover the last cycle.")
+@click.option("--orders", "orders", multiple=True, metavar="QUANTITY",
+              help="Also report QUANTITY's (q7, q1-q9, F7) cam-order amplitudes, orders 1 to run.highest_order "
+                   "(24), as metrics QUANTITY_order_K (for --metric, --plot, --map).")
+@click.option("--campbell", metavar="QUANTITY",
+              help="Campbell (waterfall) map of QUANTITY's order amplitudes against run.rpm, the natural "
+                   "frequencies drawn as the orders they meet.")
 @figure_option
 def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | None, scheduler: str | None,
           csv_path: Path | None, resume: bool, timing: bool, as_json: bool, plot: bool, as_map: bool,
-          metric: str, every_step: bool, figure_path: Path | None, file_format: str | None) -> None:
+          metric: str, every_step: bool, figure_path: Path | None, steady: bool, orders: tuple[str, ...],
+          campbell: str | None, file_format: str | None) -> None:
     """Run a valve-train preset over a grid of field values and report per-point metrics.
 
     \b
@@ -114,6 +123,10 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     elif not sets:
         raise InputError("--set", None, "at least one FIELD=VALUES (or --find jump-speed)")
     plan = plan_sweep(preset, list(sets))
+    if steady or orders or campbell:
+        plan = _with_settings(plan, steady, orders + ((campbell,) if campbell else ()))
+    if campbell and not any(f == "run.rpm" for f, _ in plan.fields):
+        raise InputError("--campbell", campbell, "a sweep over run.rpm")
     if find == "bounce-speed" and seat_index(plan.spec) is None:
         raise InputError("--find", find, "a preset with a valve seat (this one has none)")
     names = {name: unit for name, unit in metric_columns(plan.spec)}
@@ -132,7 +145,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         sink = SweepFile(csv_path, plan.fields, plan.spec, resume=resume, timing=timing) if (
             csv_path and not parquet) else None
         progress = CountProgress(f"{len(plan.points)} points")
-        keep = not parquet or as_json or plot or as_map or figure_path is not None
+        keep = not parquet or as_json or plot or as_map or bool(campbell) or figure_path is not None
         try:
             if parquet:
                 outcome = _run_to_parquet(plan, runner, csv_path, every_step, timing, keep, progress)
@@ -150,11 +163,19 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     results = outcome.results
     if sink is not None and outcome.skipped:
         click.echo(f"resumed: {outcome.skipped} of {outcome.total} points were already in {csv_path}", err=True)
+    from vtool.solvers.studies.metrics import Criteria
+    from vtool.solvers.studies.steady import steady_text
+
+    length = plan.spec.unit_system.length
     if as_json:
-        click.echo(json.dumps(results_json(results, plan.fields, plan.spec, preset), indent=2))
+        click.echo(json.dumps(results_json(results, plan.fields, plan.spec, preset)
+                              | {"evaluation": steady_text(plan.spec),
+                                 "criteria": Criteria.of(plan.spec).as_dict(length)}, indent=2))
     else:
         if results and not parquet:
             click.echo(results_table(results, plan.fields, plan.spec))
+        click.echo(steady_text(plan.spec))  # which cycles the metrics cover, and by which criteria
+        click.echo(Criteria.of(plan.spec).text(length))
         n = outcome.total - outcome.skipped
         click.echo(f"{n} points in {outcome.wall_time:.2f} s ({1000 * outcome.wall_time / max(n, 1):.1f} ms per "
                    f"point, {runner.workers} worker{'s' if runner.workers > 1 else ''})")
@@ -167,6 +188,12 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
             click.echo(metric_chart(results, axes, metric, names[metric]))
         if as_map:
             click.echo(metric_map(results, axes, metric, names[metric]))
+    if results and campbell:
+        from vtool.app.sweep_charts import campbell_map
+        from vtool.solvers.studies.orders import campbell as campbell_data
+
+        rows = [(float(dict(r.values)["run.rpm"]), r.metrics) for r in results if r.ok]
+        click.echo(campbell_map(campbell_data(rows, plan.spec, campbell)))
     if results and figure_path is not None:  # the --plot chart, and the --map as a grey map
         from vtool.presets.charts import sweep_chart, sweep_map
 
@@ -244,3 +271,19 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
         buffer = io.StringIO()
         csv.writer(buffer, lineterminator="\n").writerows([header] + rows)
         write_atomic(csv_path, buffer.getvalue())
+
+
+def _with_settings(plan, steady: bool, orders: tuple[str, ...]):  # type: ignore[no-untyped-def]
+    """The plan with every point (and its base spec) run to steady state and reporting these order amplitudes."""
+    import dataclasses
+
+    from vtool.solvers.studies.orders import with_orders
+    from vtool.solvers.studies.steady import with_steady
+
+    def change(spec):  # type: ignore[no-untyped-def]
+        spec = with_orders(spec, orders) if orders else spec
+        return with_steady(spec) if steady else spec
+
+    return dataclasses.replace(plan, spec=change(plan.spec),
+                               points=tuple(dataclasses.replace(p, spec=change(p.spec)) for p in plan.points))
+

@@ -34,7 +34,7 @@ from abc import ABCMeta, abstractmethod
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from textual.app import ComposeResult
 from textual.binding import Binding, BindingType
@@ -49,6 +49,9 @@ from vtool.app.tui.messages import FieldEdited, RunProgressed
 from vtool.app.tui.widgets import KeyFooter
 from vtool.errors import InputError
 from vtool.presets import kind_of, loader_for
+
+if TYPE_CHECKING:
+    from vtool.app.tui.presetfile import FileReference
 
 PROGRESS_INTERVAL = 0.05  # s between progress messages: the bar needs no more
 NARROW = 120  # columns below which a finished run hides the form
@@ -102,6 +105,8 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
     MODE: ClassVar[str] = ""
     DEFAULT_PRESET: ClassVar[str] = ""
     TITLE_TEXT: ClassVar[str] = ""
+    #: keys of a preset file that name another file, written inline on save (:mod:`.presetfile`)
+    FILE_REFERENCES: ClassVar[tuple[FileReference, ...]] = ()
 
     def __init__(self) -> None:
         super().__init__()
@@ -412,7 +417,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
             source = None
         text, kept = save_text(source, self.loaded_doc, document,
                                lambda doc: loader.dump(loader.load(doc)),
-                               lambda: tomli_w.dumps(loader.dump(loader.load(document))))
+                               lambda: tomli_w.dumps(loader.dump(loader.load(document))), self.FILE_REFERENCES)
         write_atomic(path, text)
         return kept
 

@@ -166,7 +166,8 @@ Valve-train dynamics, sonic-boom and plate checks.
 - `]` / `[` play faster / slower (x1 plays a run in 10 s)
 
 Fields show their unit on the right; a starred label is a value changed
-from the loaded preset. A bad value shows the same message as the CLI
+from the loaded preset. A field reached by `tab` has its value selected:
+typing replaces it (a click or an arrow key edits in place). A bad value shows the same message as the CLI
 below the field. The status line keeps every message (it wraps, never cuts).
 """
 

@@ -323,9 +323,6 @@ class ParamForm(VerticalScroll, can_focus=False):
     def has_field(self, name: str) -> bool:
         return any(f.name == name for f in self.fields)
 
-    def set_value(self, path: Path | str, text: str) -> None:
-        self.row(path).set_text(text)
-
     def value(self, path: Path | str) -> str:
         return self.row(path).text
 

@@ -175,7 +175,7 @@ def transient_chart(run: PlateRun, quantity: str, width: int, height: int, color
 
     resp, exact = run.response, run.exact
     series = {f"{resp.case} {resp.scheme}": getattr(resp, quantity)}
-    if not (quantity == "acceleration" and not exact.acceleration_converged):
+    if not (quantity == "acceleration" and not exact.acceleration_defined):
         series["exact"] = np.interp(resp.tau, exact.tau, getattr(exact, quantity))
     return line_chart(resp.tau, series, title=f"centre {quantity}, {resp.load} step load",
                       xlabel="t / T (exact fundamental period)", ylabel=QUANTITY_LABELS[quantity],

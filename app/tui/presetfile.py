@@ -8,6 +8,12 @@ each changed value with a trailing ``# was <old value>`` note (kept after the
 value's own comment, replaced on the next save). Keys the form removed are
 removed; keys it added are appended to their table.
 
+A key that points at another file (``[cam] lift_table``: a path resolved
+against the preset's folder) is replaced by the values the loader read from
+it, written inline (``angles``, ``lifts``), so the saved preset does not
+depend on the folder it is saved in; the inline values carry a note naming
+the file they came from.
+
 The text written is checked: the preset loader must read it back to the
 same document as ``edited``. When it does not (a file laid out in a way the
 path walk cannot follow), the caller writes the plain dump instead and says
@@ -18,7 +24,7 @@ from __future__ import annotations
 
 import re
 import tomllib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -61,15 +67,41 @@ def _merge(node: Any, old: Any, new: Any) -> None:
             del node[key]
 
 
-def round_trip_text(original: str, loaded: dict[str, Any], edited: dict[str, Any]) -> str:
-    """``original`` (TOML text) with the changes from ``loaded`` to ``edited`` written in."""
+#: (table, key naming a file, the keys of ``edited`` that hold its values inline)
+FileReference = tuple[tuple[str, ...], str, tuple[str, ...]]
+
+
+def _inline(doc: Any, edited: dict[str, Any], references: Sequence[FileReference]) -> None:
+    """Replace each file reference of ``doc`` (tomlkit) by the inline values of ``edited``."""
+    for table, key, inline_keys in references:
+        node, values = doc, edited
+        for name in table:
+            node = node.get(name) if isinstance(node, dict) else None
+            values = values.get(name) if isinstance(values, dict) else None
+        if not isinstance(node, dict) or key not in node or not isinstance(values, dict):
+            continue
+        source = node[key]
+        del node[key]
+        for name in inline_keys:
+            if name in values:
+                node[name] = values[name]
+        if inline_keys and inline_keys[0] in node:
+            node[inline_keys[0]].comment(f"inline copy of {key} = {tomlkit.item(source).as_string()}")
+
+
+def round_trip_text(original: str, loaded: dict[str, Any], edited: dict[str, Any],
+                    references: Sequence[FileReference] = ()) -> str:
+    """``original`` (TOML text) with the changes from ``loaded`` to ``edited`` written in, and its
+    file ``references`` written inline."""
     doc = tomlkit.parse(original)
     _merge(doc, loaded, edited)
+    _inline(doc, edited, references)
     return tomlkit.dumps(doc)
 
 
 def save_text(source: Path | None, loaded: dict[str, Any], edited: dict[str, Any],
-              normalize: Callable[[dict[str, Any]], Any], plain: Callable[[], str]) -> tuple[str, bool]:
+              normalize: Callable[[dict[str, Any]], Any], plain: Callable[[], str],
+              references: Sequence[FileReference] = ()) -> tuple[str, bool]:
     """The text to save and whether the source file's comments and layout were kept.
 
     ``normalize`` turns a document into something comparable (the loader's
@@ -78,7 +110,7 @@ def save_text(source: Path | None, loaded: dict[str, Any], edited: dict[str, Any
     """
     if source is not None and source.is_file():
         try:
-            text = round_trip_text(source.read_text(encoding="utf-8"), loaded, edited)
+            text = round_trip_text(source.read_text(encoding="utf-8"), loaded, edited, references)
             if normalize(tomllib.loads(text)) == normalize(edited):
                 return text, True
         except (OSError, ValueError, TypeError, KeyError, IndexError, tomlkit.exceptions.TOMLKitError):

@@ -35,7 +35,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.message import Message
 from textual.widget import Widget
-from textual.widgets import Button, Input, ProgressBar, Select, Static
+from textual.widgets import Button, Input, Label, ProgressBar, Select, Static
 from textual.worker import Worker, WorkerState, get_current_worker
 
 from vtool.app.tui.widgets import ChartView, ChoiceSelect, TextPanel
@@ -72,6 +72,20 @@ def descriptor_stderr() -> Iterator[None]:
                 sys.stderr = replaced
 
 
+def failure_text(error: BaseException | None) -> str:
+    """A failed sweep in one line: a bad input or a failed run as it says itself; anything else
+    (a failure of the program, not of the input) says the sweep could not be completed."""
+    from vtool.errors import InputError, RunError
+
+    if isinstance(error, InputError):
+        return error.one_line()
+    lines = str(error).strip().splitlines() if error is not None else []
+    text = lines[0].strip() if lines else ""
+    if isinstance(error, RunError):
+        return text or "a run failed"
+    return f"the sweep could not be completed: {text or type(error).__name__}"
+
+
 class SweepProgressed(Message):
     """``done`` of ``total`` points are finished (``checking``: validated, before any runs)."""
 
@@ -103,10 +117,11 @@ class SweepPane(Widget):
 
     DEFAULT_CSS = """
     SweepPane { height: 1fr; }
-    SweepPane Horizontal { height: auto; }
+    SweepPane .sweep-row { height: 1; }
+    SweepPane .sweep-label { width: auto; padding: 0 1; color: $text-muted; }
     SweepPane Input { width: 1fr; }
-    SweepPane #sweep-metric { width: 30; }
-    SweepPane Button { min-width: 10; }
+    SweepPane #sweep-metric { width: 28; }
+    SweepPane Button { width: auto; min-width: 0; margin-right: 1; }
     SweepPane #sweep-status { height: auto; }
     SweepPane ChartView { height: 2fr; }
     SweepPane TextPanel { height: 1fr; }
@@ -122,6 +137,7 @@ class SweepPane(Widget):
         self.plan: Any = None
         self.outcome: Any = None
         self.worker: Worker[Any] | None = None
+        self.status_log: list[str] = []  # every status message, in order (tests read them)
         # lazy: the widgets are made when the pane is first shown (a tab not yet opened costs the screen's
         # start nothing: the valve-train screen's Sweep tab was 25 of its widgets)
         self.composed = not lazy
@@ -130,21 +146,31 @@ class SweepPane(Widget):
         if not self.composed:
             return
         field, values, fixed, metric = self._initial
+        csv = "sweep.csv"
         with Vertical():
-            with Horizontal():
-                yield Input(field, placeholder="field, e.g. run.rpm", id="sweep-field")
-                yield Input(values, placeholder="start:stop:step or a,b,c", id="sweep-values")
-                yield Input(fixed, placeholder="fixed settings, e.g. run.degrees=460", id="sweep-fixed")
+            # each input has its label on its left; compact widgets, one line each (the chart gets the height)
+            with Horizontal(classes="sweep-row"):
+                yield Label("field", classes="sweep-label")
+                yield Input(field, placeholder="e.g. run.rpm", id="sweep-field", compact=True)
+                yield Label("values", classes="sweep-label")
+                yield Input(values, placeholder="start:stop:step or a,b,c", id="sweep-values", compact=True)
+            with Horizontal(classes="sweep-row"):
+                yield Label("fixed", classes="sweep-label")
+                yield Input(fixed, placeholder="e.g. run.degrees=460; damping.factor=2", id="sweep-fixed",
+                            compact=True)
+                yield Label("metric", classes="sweep-label")
                 names = self._metric_names()
                 yield ChoiceSelect([(m, m) for m in names], value=metric if metric in names else names[0],
-                                   allow_blank=False, id="sweep-metric")
-            with Horizontal():
-                yield Button("Run", id="sweep-run", variant="primary")
-                yield Button("Cancel", id="sweep-cancel")
-                yield Input("sweep.csv", placeholder="CSV file", id="sweep-csv")
-                yield Button("Export CSV", id="sweep-export")
+                                   allow_blank=False, compact=True, id="sweep-metric")
+            with Horizontal(classes="sweep-row"):
+                yield Button("Run", id="sweep-run", variant="primary", compact=True)
+                yield Button("Cancel", id="sweep-cancel", compact=True)
+                yield Label("CSV file", classes="sweep-label")
+                yield Input(csv, placeholder="e.g. sweep.csv", id="sweep-csv", compact=True)
+                yield Button("Export CSV", id="sweep-export", compact=True)
             yield ProgressBar(total=1, show_eta=True, id="sweep-progress")
             yield Static("", id="sweep-status", markup=False)
+            yield Static("", id="sweep-intervals", markup=False)
             yield ChartView("run a sweep to see the chart", id="sweep-chart")
             yield TextPanel("", id="sweep-table")
 
@@ -176,6 +202,12 @@ class SweepPane(Widget):
     def status_text(self) -> str:
         return str(self.status.content)
 
+    def set_status(self, text: str, log: bool = True) -> None:
+        """Show ``text`` on the pane's status line; every message but progress is kept in ``status_log``."""
+        if log:
+            self.status_log.append(text)
+        self.status.update(text)
+
     @property
     def chart(self) -> ChartView:
         return self.query_one("#sweep-chart", ChartView)
@@ -202,7 +234,7 @@ class SweepPane(Widget):
         """Start the worker: it checks every point (errors on the status line), then runs them."""
         self.plan = None
         self.query_one("#sweep-progress", ProgressBar).update(total=None, progress=0)
-        self.status.update("checking the points ... (Cancel stops)")
+        self.set_status("checking the points ... (Cancel stops)")
         self.worker = self._work(self.preset, self.assignments())
 
     @work(thread=True, exclusive=True, exit_on_error=False, group="sweep")
@@ -239,22 +271,29 @@ class SweepPane(Widget):
     def cancel(self) -> None:
         if self.running and self.worker is not None:
             self.worker.cancel()
-            self.status.update("stopping ...")
+            self.set_status("stopping ...")
 
     def export_csv(self, path: str | Path | None = None) -> None:
+        from vtool.errors import InputError
         from vtool.files import write_atomic
         from vtool.solvers.studies.sweep import results_csv
 
         if self.outcome is None or not self.outcome.results:
-            self.status.update("error: nothing to export (run a sweep first)")
+            self.set_status("error: nothing to export (run a sweep first)")
             return
         target = Path(path or self._input("csv").value.strip() or "sweep.csv")
         try:
             write_atomic(target, results_csv(self.outcome.results, self.plan.fields, self.plan.spec))
-        except OSError as exc:
-            self.status.update(f"error: {target}: {exc.strerror}")
+        except InputError as exc:
+            self.set_status(f"error: {exc.one_line()}")
             return
-        self.status.update(f"wrote {len(self.outcome.results)} rows to {target}")
+        except OSError as exc:
+            self.set_status(f"error: {target}: {exc.strerror}")
+            return
+        except ValueError:  # a NUL in the path
+            self.set_status(f"error: {InputError('CSV file', str(target), 'a file path without NUL').one_line()}")
+            return
+        self.set_status(f"wrote {len(self.outcome.results)} rows to {target}")
 
     # ----- handlers -----
     @on(Button.Pressed, "#sweep-run")
@@ -276,26 +315,49 @@ class SweepPane(Widget):
 
     def on_sweep_progressed(self, message: SweepProgressed) -> None:
         self.query_one("#sweep-progress", ProgressBar).update(total=message.total, progress=message.done)
-        if message.checking and message.done == 1:
-            self.status.update(f"checking {message.total} points ... (Cancel stops)")
-        elif not message.checking and message.done == 0:
-            self.status.update(f"running {message.total} points ...")
+        if not self.running:
+            return  # a late message of a stopped worker
+        # (every message says it: progress messages collapse, so a particular one may never arrive)
+        if message.checking:
+            self.set_status(f"checking {message.total} points: {message.done} valid ... (Cancel stops)", log=False)
+        else:
+            self.set_status(f"running {message.total} points ... (Cancel stops)", log=message.done == 0)
 
     def on_sweep_finished(self, message: SweepFinished) -> None:
         if message.outcome is None:  # refused or stopped before any point ran
-            self.status.update(f"error: {message.error}" if message.error else
+            self.set_status(f"error: {message.error}" if message.error else
                                f"stopped while checking the points ({message.checked} checked): nothing ran")
             return
         self.plan = message.plan
         self.outcome = message.outcome
         done = len(message.outcome.results)
         state = "finished" if message.outcome.complete else "stopped"
-        self.status.update(f"{state}: {done} of {message.outcome.total} points in {message.outcome.wall_time:.2f} s")
+        self.set_status(f"{state}: {done} of {message.outcome.total} points in {message.outcome.wall_time:.2f} s")
         self._draw()
 
     def on_worker_state_changed(self, event: Worker.StateChanged) -> None:
         if event.worker is self.worker and event.state == WorkerState.ERROR:
-            self.status.update(f"error: {event.worker.error}")
+            self.set_status(f"error: {failure_text(event.worker.error)}")
+
+    @property
+    def intervals(self) -> Static:
+        return self.query_one("#sweep-intervals", Static)
+
+    @staticmethod
+    def _intervals_text(results: Any, axes: list) -> str:  # type: ignore[type-arg]
+        """The speed intervals of a one-field sweep over run.rpm where the follower leaves the cam or the valve
+        bounces, on the scanned speeds (``vtool sweep --find`` bisects their edges)."""
+        from vtool.solvers.studies.sweep import CRITERIA, scan_intervals
+
+        if len(axes) != 1 or axes[0][0] != "run.rpm":
+            return ""
+        parts = []
+        for criterion in CRITERIA:
+            words = CRITERIA[criterion][2]
+            found = scan_intervals(results, "run.rpm", criterion)
+            spans = ", ".join(f"{a:g}-{b:g}" if a != b else f"{a:g}" for a, b in found) or "at no scanned speed"
+            parts.append(f"{words}: {spans}" + (" rev/min" if found else ""))
+        return "; ".join(parts) + " (scanned speeds; vtool sweep --find bisects the edges)"
 
     def _draw(self) -> None:
         from vtool.solvers.studies.metrics import metric_columns
@@ -305,11 +367,17 @@ class SweepPane(Widget):
             return
         results, plan, metric = self.outcome.results, self.plan, self.metric
         units = dict(metric_columns(plan.spec))
-        self.table.set_text(results_table(results, plan.fields, plan.spec))
+        axes = [f for f in plan.fields if len({dict(r.values)[f[0]] for r in results}) > 1]
+        self.intervals.update(self._intervals_text(results, axes))
+        table = results_table(results, plan.fields, plan.spec)
+        if len(axes) == 2 and metric in units:  # a grid of two fields: the map above the table
+            from vtool.app.sweep_charts import metric_map
+
+            table = metric_map(results, axes, metric, units[metric]) + "\n\n" + table
+        self.table.set_text(table)
         if metric not in units:
             self.chart.plot(None)
             return
-        axes = [f for f in plan.fields if len({dict(r.values)[f[0]] for r in results}) > 1]
         values = [r.metrics.get(metric) for r in results]
         if not axes or not any(isinstance(v, int | float) and math.isfinite(v) for v in values):
             self.chart.placeholder = (f"no point has a value of {metric}" if axes else

@@ -46,7 +46,7 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
     u = spec.unit_system
     unit = {"length": u.length, "area": f"{u.length}^2", "inertia": f"{u.length}^4",
             "pressure": u.pressure, "specific_weight": u.specific_weight, "density": u.density,
-            "stiffness": u.stiffness, "mass": u.mass}
+            "stiffness": u.stiffness, "mass": u.mass, "force": u.force}
     installed = tuple(backends.available())
     backend_choices = installed if doc["run"]["backend"] in installed else (doc["run"]["backend"], *installed)
     fields = [
@@ -57,6 +57,10 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
         Field(("run", "beta"), "Newmark beta", group="Run"),
         Field(("run", "gamma"), "Newmark gamma", group="Run"),
         Field(("run", "output_interval"), "output every", "deg", group="Run"),
+    ]
+    if "train" in doc:  # entered by train type: its parameters (presets/trains.py), not the expanded members
+        return fields + train_fields(doc, unit) + damping_fields(doc)
+    fields += [
         *([Field(("cam", "amplitude"), "cam amplitude", u.length, group="Cam and spring")]
           if "amplitude" in doc["cam"] else
           [Field(("cam", key), f"cam {key}", u.length if key == "tolerance" else "", group="Cam and spring")
@@ -85,8 +89,14 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
         for key, label, kind in MEMBER_KEYS:
             if key in member and key != "stiffness":
                 fields.append(Field(("members", name, key), label, unit[kind], group=group))
-    fields.append(Field(("damping", "factor"), "global factor", group="Damping (modal ratios)"))
-    fields.append(Field(("damping", "default_ratio"), "default ratio", group="Damping (modal ratios)"))
+    fields += damping_fields(doc)
+    fields.append(Field(("gravity",), "gravity", u.acceleration, group="Mechanism"))
+    return fields
+
+
+def damping_fields(doc: dict[str, Any]) -> list[Field]:
+    fields = [Field(("damping", "factor"), "global factor", group="Damping (modal ratios)"),
+              Field(("damping", "default_ratio"), "default ratio", group="Damping (modal ratios)")]
     for i, layer in enumerate(doc["damping"].get("layers", [])):
         closed = "+".join(layer["closed"]) or "none closed"
         fields.append(Field(("damping", "layers", i, "default_ratio"), f"{closed}: ratio",
@@ -94,7 +104,19 @@ def valvetrain_fields(spec: Any, doc: dict[str, Any]) -> list[Field]:
         for mode in layer.get("mode_ratios", {}):
             fields.append(Field(("damping", "layers", i, "mode_ratios", mode), f"{closed}: mode {mode}",
                                 group="Damping (modal ratios)"))
-    fields.append(Field(("gravity",), "gravity", u.acceleration, group="Mechanism"))
+    return fields
+
+
+def train_fields(doc: dict[str, Any], unit: dict[str, str]) -> list[Field]:
+    """A train type's numbers, one group per part ("Train: spring"), and its limits ([checks])."""
+    from vtool.presets.trains import train_parameters
+
+    kinds = unit | {"deg": "deg", "": ""}
+    fields = []
+    for path, kind in train_parameters(doc):
+        part, key = path[1], path[2]
+        fields.append(Field(path, key.replace("_", " ")[:15], kinds.get(kind, kind),
+                            group=f"Train ({doc['train'].get('type', '')}): {part}"))
     return fields
 
 
@@ -122,6 +144,8 @@ class ValveTrainScreen(DomainScreen):
     TITLE_TEXT = "VALVE TRAIN"
     # hidden from the footer (its keys are full at 80 columns); listed in the help and docs/tui.md
     BINDINGS: ClassVar[list[BindingType]] = [Binding("ctrl+g", "save_report", "Report", show=False)]
+    # a table cam's file is written inline (docs/cams.md): a saved copy must not depend on its folder
+    FILE_REFERENCES = ((("cam",), "lift_table", ("angles", "lifts")),)
 
     def result_panes(self) -> list[TabPane]:
         """The result tabs, in order: a new tab is one more pane in this list."""
@@ -138,6 +162,8 @@ class ValveTrainScreen(DomainScreen):
             TabPane("Events", TextPanel("no run yet", id="events"), id="tab-events"),
             TabPane("Summary", TextPanel("no run yet", id="summary"), id="tab-summary"),
             TabPane("Anim.", MechanismAnimation(id="animation", color=color), id="tab-animation"),
+            TabPane("Orders", ChartView("the cam-order spectrum of the seat force appears here after a run",
+                                        id="order-chart", color=color), id="tab-orders"),
             TabPane("Sweep", SweepPane(self.DEFAULT_PRESET, workers=None, id="sweep", lazy=True), id="tab-sweep"),
         ]
 
@@ -164,6 +190,10 @@ class ValveTrainScreen(DomainScreen):
     @property
     def configuration_chart(self) -> ChartView:
         return self.query_one("#configuration-chart", ChartView)
+
+    @property
+    def order_chart(self) -> ChartView:
+        return self.query_one("#order-chart", ChartView)
 
     @property
     def quantity_list(self) -> SelectionList[str]:
@@ -194,7 +224,7 @@ class ValveTrainScreen(DomainScreen):
 
     def clear_results(self) -> None:
         self.results = None
-        for chart in (self.force_chart, self.displacement_chart, self.configuration_chart):
+        for chart in (self.force_chart, self.displacement_chart, self.configuration_chart, self.order_chart):
             chart.plot(None)
         self.query_one("#events", TextPanel).set_text("no run yet")
         self.query_one("#summary", TextPanel).set_text("no run yet")
@@ -251,12 +281,34 @@ class ValveTrainScreen(DomainScreen):
         self.force_chart.plot(lambda w, h, c: charts.force_chart(trace, w, h, color=c))
         self.plot_displacements()
         self.configuration_chart.plot(lambda w, h, c: charts.configuration_chart(trace, w, h, color=c))
-        summary = trace.summary_text()
+        from vtool.solvers.studies.metrics import evaluation_summary
+
+        summary = trace.summary_text() + "\n\n" + "\n".join(evaluation_summary(trace)["lines"])
         events = trace.event_table() if trace.events else "no events"
+        self.plot_orders(trace)
         self.query_one("#summary", TextPanel).set_text(summary)
         self.query_one("#events", TextPanel).set_text(events)
         self.query_one("#side-panel", TextPanel).set_text(f"{summary}\n\nevents\n{events}")
         self.animation.show_trace(trace)
+
+    def plot_orders(self, trace: Any) -> None:
+        """The spectrum of the default quantity (run.orders' first, else the seat force) over the evaluated
+        cycles: its table and chart with the natural frequencies marked; a run without a whole evaluated
+        cycle says so."""
+        from vtool.errors import InputError
+        from vtool.solvers.studies.orders import default_quantity, natural_frequencies, spectrum
+
+        try:
+            orders = spectrum(trace, default_quantity(trace.spec))
+        except InputError as exc:
+            self.order_chart.placeholder = f"no spectrum: {exc}"
+            self.order_chart.plot(None)
+            return
+        frequencies = natural_frequencies(trace)
+        from vtool.app.order_charts import order_chart
+
+        self.order_chart.plot(lambda w, h, c: orders.table(6) + "\n" + order_chart(
+            orders, frequencies, width=w, height=max(h - 10 - len(frequencies), 8), color=c))
 
     def plot_displacements(self) -> None:
         trace = self.results

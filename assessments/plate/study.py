@@ -235,7 +235,7 @@ def window_warnings(exact: dict[str, ExactHistories], periods: float) -> list[st
     out = []
     for load, ex in exact.items():
         for q in QUANTITIES:
-            if q == "acceleration" and not ex.acceleration_converged:
+            if q == "acceleration" and not ex.acceleration_defined:
                 continue
             if peak_at_end(getattr(ex, q), ex.tau):
                 k = int(np.argmax(np.abs(getattr(ex, q))))

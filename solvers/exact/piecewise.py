@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from vtool.errors import InputError, RunError
-from vtool.solvers.backends import Backend, Cancel, Progress
+from vtool.solvers.backends import Backend, Cancel, Progress, RunStats
 from vtool.solvers.exact.statespace import StateSpace, from_layer
 from vtool.solvers.model.contact import ContactProblem, OrderedLayer
 from vtool.solvers.model.mechanism import Mechanism
@@ -370,10 +370,10 @@ class PiecewiseRun(ABC):
         new_c = self.settle(new_c, t, x, v, a)
         return new_c, x, v, a
 
-    def statistics(self, settings: dict[str, Any]) -> dict[str, Any]:
+    def statistics(self, settings: dict[str, Any]) -> RunStats:
         self.flush_rows()
-        return {"steps": self.steps, "peak": self.peak, "peak_late": self.peak_late, "peak_overlap": self.peak_overlap,
-                "configurations": tuple(sorted(self.spaces)), "settings": settings}
+        return RunStats(self.steps, self.peak, self.peak_late, self.peak_overlap, tuple(sorted(self.spaces)),
+                        settings)
 
 
 def refuse_hertz(mechanism: Mechanism, backend: str) -> None:
@@ -397,7 +397,7 @@ class PiecewiseBackend(Backend):
         return compile_notice(cls.name, kernel_laws(spec, impacts))
 
     def integrate(self, problem: ContactProblem, options: Any, builder: TraceBuilder,
-                  progress: Progress | None, cancel: Cancel | None) -> dict[str, Any]:
+                  progress: Progress | None, cancel: Cancel | None) -> RunStats:
         run = self.run_class(problem, options, builder)  # type: ignore[call-arg]
         run.execute(progress, cancel)
         return run.statistics(self.settings(options))

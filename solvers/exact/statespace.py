@@ -107,13 +107,6 @@ class StateSpace:
         """u'(t), shaped as :meth:`basis`."""
         return fourier_basis(self.omega, self.n_harmonics, t, rate=True)
 
-    def fit_instants(self) -> np.ndarray:
-        """2K+1 instants equally spaced over a period: u at them is an invertible (DFT) matrix."""
-        count = 2 * self.n_harmonics + 1
-        if self.omega <= 0.0 or count == 1:
-            return np.zeros(1)
-        return 2.0 * math.pi / self.omega * np.arange(count) / count
-
     def forcing(self, t: float) -> np.ndarray:
         return self.B @ self.basis(t)
 

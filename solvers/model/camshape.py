@@ -336,3 +336,84 @@ def contact(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> Contact:
 def model_lift(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> np.ndarray:
     """The model's cam-coordinate lift at cam angles θ (rad): the law, or a finger's V a/b."""
     return contact(follower, law, theta).model_lift
+
+
+# ----- reports (``vtool cam show``) ------------------------------------------------------------------
+
+def shape_report(spec, points: int = 3600) -> dict:  # type: ignore[no-untyped-def]
+    """The cam's shape for ``vtool cam show``: base radius, curvature, undercut, pressure angle, ratio."""
+    follower = spec.follower
+    law = spec.lift_law
+    u = spec.unit_system.length
+    profile = cam_profile(follower, law, points)
+    c = contact(follower, law, np.linspace(0.0, 2.0 * math.pi, points, endpoint=False))
+    rho = profile.curvature_radius
+    convex = rho[rho > 0.0]
+    report = {
+        "follower": follower.kind, "arrangement": follower.arrangement, "length_unit": u,
+        "base_radius": follower.base_radius, "roller_radius": follower.roller_radius,
+        "largest_profile_radius": float(profile.radius.max()),
+        "min_convex_curvature_radius": float(convex.min()) if convex.size else None,
+        "min_curvature_radius": float(rho.min()),
+        "undercut_deg": [list(pair) for pair in profile.undercut],
+        "max_pressure_angle_deg": float(np.abs(c.pressure_angle_deg).max()),
+        "max_valve_lift": float(c.valve_lift.max()),
+    }
+    if follower.kind == FLAT:
+        report["max_contact_travel"] = float(np.nanmax(np.abs(c.contact_travel)))
+        if follower.face_diameter is not None:
+            report["face_radius"] = 0.5 * follower.face_diameter
+    if follower.arrangement == FINGER:
+        lifting = c.lift > 1e-3 * max(float(c.lift.max()), 1e-300)
+        report["ratio_min"] = float(c.ratio[lifting].min()) if lifting.any() else float(c.ratio.min())
+        report["ratio_max"] = float(c.ratio.max())
+        report["ratio_base_circle"] = float(c.ratio[np.argmin(c.lift)])
+    return report
+
+
+def shape_text(report: dict) -> str:
+    """:func:`shape_report` as lines."""
+    u = report["length_unit"]
+    lines = [f"cam shape ({report['follower']} follower, {report['arrangement']}): base radius "
+             f"{report['base_radius']:.5g} {u}, largest profile radius {report['largest_profile_radius']:.5g} {u}"]
+    rho = report["min_convex_curvature_radius"]
+    lines.append(f"  radius of curvature: smallest convex {'-' if rho is None else f'{rho:.5g}'} {u}, "
+                 f"smallest {report['min_curvature_radius']:.5g} {u} (negative: concave or undercut)")
+    if report["undercut_deg"]:
+        spans = ", ".join(f"{a:.2f}..{b:.2f}" for a, b in report["undercut_deg"])
+        lines.append(f"  warning: the cam undercuts (the follower cannot follow the law) at law angles {spans} deg")
+    else:
+        lines.append("  no undercut")
+    lines.append(f"  largest pressure angle {report['max_pressure_angle_deg']:.4g} deg, "
+                 f"largest valve lift {report['max_valve_lift']:.5g} {u}")
+    if "max_contact_travel" in report:
+        face = f" (face radius {report['face_radius']:.4g} {u})" if "face_radius" in report else ""
+        lines.append(f"  contact travel on the flat face: up to {report['max_contact_travel']:.4g} {u}{face}")
+    if "ratio_min" in report:
+        lines.append(f"  finger ratio dV/du: {report['ratio_base_circle']:.5g} on the base circle, "
+                     f"{report['ratio_min']:.5g} .. {report['ratio_max']:.5g} over the event")
+    return "\n".join(lines)
+
+
+def profile_csv_text(spec, step_deg: float = 0.5) -> str:  # type: ignore[no-untyped-def]
+    """The ground profile for grinding: per law angle, lift, Cartesian and polar point, radius of curvature
+    (cam frame: y along the follower at law angle 0, angles in degrees)."""
+    follower, law = spec.follower, spec.lift_law
+    u = spec.unit_system.length
+    profile = cam_profile(follower, law, int(round(360.0 / step_deg)))
+    header = (f"law_angle (deg),lift ({u}),x ({u}),y ({u}),polar_radius ({u}),polar_angle (deg),"
+              f"curvature_radius ({u})")
+    rows = np.column_stack([profile.law_angle_deg, profile.lift, profile.x, profile.y, profile.radius,
+                            profile.polar_angle_deg, profile.curvature_radius])
+    return header + "\n" + "\n".join(",".join(f"{v:.10g}" for v in row) for row in rows) + "\n"
+
+
+def undercut_warning(follower: FollowerSpec, law: CamSpec) -> str | None:
+    """One line when the cam undercuts (the follower cannot follow the law there), else None."""
+    spans = cam_profile(follower, law).undercut
+    if not spans:
+        return None
+    named = ", ".join(f"{a:.1f}..{b:.1f}" for a, b in spans[:4]) + (" ..." if len(spans) > 4 else "")
+    return (f"follower: the cam undercuts at law angles {named} deg ({follower.kind} follower, base radius "
+            f"{follower.base_radius:g}): the follower cannot follow the lift law there, and the contact stress "
+            f"there is not computed (a larger base circle, a smaller roller or a gentler nose)")

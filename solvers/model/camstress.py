@@ -36,8 +36,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from vtool.solvers.model.camshape import contact
-from vtool.solvers.model.spec import FollowerSpec, MechanismSpec
+from vtool.solvers.model.camshape import Contact, contact
+from vtool.solvers.model.spec import CamSpec, FollowerSpec, MechanismSpec
 
 TABLE_POINTS = 7200  # one revolution, every 0.05 degree
 DH_COEFFICIENT = 2.65
@@ -90,8 +90,7 @@ def stress_table(spec: MechanismSpec) -> StressTable:
     """The contact data of one revolution, in the preset's units."""
     follower = spec.follower
     assert follower is not None
-    theta = np.linspace(0.0, 2.0 * math.pi, TABLE_POINTS, endpoint=False)
-    c = contact(follower, spec.lift_law, theta)
+    c = revolution(follower, spec.lift_law)
     units = spec.unit_system
     oil = follower.oil
     return StressTable(
@@ -113,7 +112,7 @@ def _periodic(table: StressTable, values: np.ndarray, angles_deg: np.ndarray) ->
 def stress_rows(spec: MechanismSpec, cam_angle_deg: np.ndarray, model_force: np.ndarray) -> dict[str, np.ndarray]:
     """Normal force, p₀, half-width and (with an oil) film thickness at output rows."""
     table = stress_table(spec)
-    omega = spec.run.rpm * math.pi / 30.0
+    omega = spec.run.omega
     angles = np.asarray(cam_angle_deg, dtype=float)
     curvature = _periodic(table, table.curvature, angles)
     with np.errstate(divide="ignore"):
@@ -161,12 +160,16 @@ def stress_summary(spec: MechanismSpec, cam_angle_deg: np.ndarray, model_force: 
             j = int(np.argmin(h))
             result.update(min_film_thickness=float(h[j]) if np.isfinite(h[j]) else None,
                           min_film_thickness_angle_deg=float(cam_angle_deg[j]))
-    table = stress_table(spec)
-    theta = np.radians(table.angles_deg)
-    c = contact(spec.follower, spec.lift_law, theta)  # type: ignore[arg-type]
+    c = revolution(spec.follower, spec.lift_law)  # type: ignore[arg-type]
     result.update(min_cam_curvature_radius=float(np.min(c.curvature_radius)),
                   max_pressure_angle_deg=float(np.max(np.abs(c.pressure_angle_deg))))
     return result
+
+
+@lru_cache(maxsize=16)
+def revolution(follower: FollowerSpec, law: CamSpec) -> Contact:
+    """The contact over one revolution (:data:`TABLE_POINTS` angles), computed once per follower and law."""
+    return contact(follower, law, np.linspace(0.0, 2.0 * math.pi, TABLE_POINTS, endpoint=False))
 
 
 def stress_text(s: dict) -> list[str]:

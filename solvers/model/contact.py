@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vtool.errors import RunError
 from vtool.solvers.model.configurations import (
     clearance_bit,
     compliant_terms,
@@ -58,7 +59,7 @@ from vtool.solvers.model.spec import (
     THESIS,
 )
 from vtool.solvers.newmark import layout
-from vtool.solvers.trace import EVENT_KINDS
+from vtool.solvers.trace import EVENT_KINDS, OPENED, TraceBuilder
 
 LAW_CODES = {MOMENTUM: layout.LAW_MOMENTUM, LOCAL: layout.LAW_LOCAL, THESIS: layout.LAW_THESIS}
 SOFT_CODES = {RIGID: 0, LINEAR: layout.SOFT_LINEAR, HERTZ: layout.SOFT_HERTZ}
@@ -311,6 +312,28 @@ class EventRules:
     zeno_stop: int = 400
 
 
+@dataclass(frozen=True)
+class LayerOperator:
+    """z̈_F = on_z z + on_zd ż + on_aP z̈_P + on_src s: a configuration's equations solved for the free
+    accelerations (M_FF⁻¹ times the layer's rows), with the index maps between the full coordinates and
+    the layer's (free ``kept``, prescribed ``source``, ``group``)."""
+
+    free: np.ndarray  # full coordinate of each free z index
+    prescribed: np.ndarray  # 3 x the source of each prescribed z index (its x in the sources' vector)
+    group: np.ndarray  # z index of each full coordinate
+    on_z: np.ndarray
+    on_zd: np.ndarray
+    on_aP: np.ndarray
+    on_src: np.ndarray
+
+    @classmethod
+    def of(cls, layer: OrderedLayer, n: int) -> LayerOperator:
+        nf = layer.nf
+        solve = np.linalg.inv(layer.M[:nf, :nf])
+        return cls(layer.kept[:nf].astype(np.int64), 3 * layer.source.astype(np.int64), layer.group,
+                   -solve @ layer.K[:nf], -solve @ layer.C[:nf], -solve @ layer.M[:nf, nf:], -solve @ layer.S[:nf])
+
+
 class ContactProblem:
     """The clearances, sources, configurations and impact laws of one mechanism at one cam speed."""
 
@@ -395,7 +418,9 @@ class ContactProblem:
     def sources_at(self, t: float) -> np.ndarray:
         """(x, v, a) of every source at t, as the kernel's src vector."""
         src = np.zeros(3 * self.ns)
-        from vtool.solvers.newmark import kernel  # numba: only the back ends that call it load it
+        from vtool.solvers.newmark import (
+            kernel,  # numba: only the back ends that call it load it (lazy)
+        )
 
         s = self.series
         kernel.fill_sources(self.ns, self.nh, s.omega, s.const, s.cos, s.sin, t, src)
@@ -423,6 +448,79 @@ class ContactProblem:
                    int(ev_i[r, 3])) for r in range(int(ist[layout.I_NEV]))]
         return new, events
 
+    # ----- the Python-level contract a back end integrates against (vtool.solvers.backends, point 4) -----
+    # Rigid and linear contacts: a Hertz contact's force is the kernel's hertz_law (the Newmark and
+    # piecewise back ends), so a back end written against these methods alone refuses one.
+
+    def operator(self, mask: int) -> LayerOperator:
+        """Configuration ``mask``'s equations as :meth:`accelerations` uses them (made once per mask)."""
+        operators = self.__dict__.setdefault("_operators", {})
+        if mask not in operators:
+            operators[mask] = LayerOperator.of(self.build(mask), self.n)
+        return operators[mask]  # type: ignore[no-any-return]  # the dict holds LayerOperators only
+
+    def layer_vectors(self, mask: int, t: float, x: np.ndarray, v: np.ndarray,
+                      a: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+        """The configuration's layer vectors (z, ż[, z̈]) in its order (free coordinates, then the prescribed
+        ones from the sources at t), and the sources' (x, v, a) vector."""
+        op, src = self.operator(mask), self.sources_at(t)
+        parts = (x, v) if a is None else (x, v, a)
+        return (*(np.concatenate((w[op.free], src[op.prescribed + i])) for i, w in enumerate(parts)), src)
+
+    def accelerations(self, mask: int, t: float, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """ẍ of every coordinate in configuration ``mask`` at t, from (x, v) of every coordinate:
+        M_FF z̈_F = -(K_FF z_F + C_FF ż_F) - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F s(t)
+        (F free, P prescribed; S the sources' pull through closed linear contacts)."""
+        op, src = self.operator(mask), self.sources_at(t)
+        z = np.concatenate((x[op.free], src[op.prescribed]))
+        zd = np.concatenate((v[op.free], src[op.prescribed + 1]))
+        aP = src[op.prescribed + 2]
+        zdd = np.concatenate((op.on_z @ z + op.on_zd @ zd + op.on_aP @ aP + op.on_src @ src, aP))
+        return zdd[op.group]
+
+    def project(self, mask: int, t: float, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(x, v) made to satisfy configuration ``mask``'s ties: tied coordinates take their free
+        coordinate's values, those on a source the source's."""
+        layer = self.build(mask)
+        z, zd, _ = self.layer_vectors(mask, t, x, v)
+        return z[layer.group], zd[layer.group]
+
+    def monitors(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """Each clearance's monitor at t: its gap while open, its contact force while closed (a linear
+        contact: its overlap), NaN where not monitored. An event is a monitored clearance's value going
+        below zero (:attr:`monitored`)."""
+        z, zd, zdd, src = self.layer_vectors(mask, t, x, v, a)
+        values = np.full(self.ncl, np.nan)
+        forces = self.contact_forces(mask, t, x, v, a)
+        for k, (kind, ahead, behind) in enumerate(self.tables.mk[mask, :, :layout.MK_M]):
+            if kind in (layout.MK_GAP, layout.MK_OVERLAP):
+                other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
+                values[k] = (1.0 if kind == layout.MK_GAP else -1.0) * (z[ahead] - other) + self.gap_noise
+            elif kind == layout.MK_FORCE:
+                values[k] = forces[k]
+        return values
+
+    def contact_forces(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """Each clearance's contact force at t (compression positive; 0 while open)."""
+        z, zd, zdd, src = self.layer_vectors(mask, t, x, v, a)
+        n, ns, m = self.n, self.ns, len(z)
+        forces = np.zeros(self.ncl)
+        for k, kind in enumerate(self.tables.mk[mask, :, layout.MK_KIND]):
+            if kind in (layout.MK_FORCE, layout.MK_OVERLAP):
+                row = self.tables.mon[mask, k]
+                forces[k] = (row[:m] @ z + row[n:n + m] @ zd + row[2 * n:2 * n + m] @ zdd
+                             + row[3 * n:3 * n + 3 * ns] @ src + row[3 * n + 3 * ns])
+        return forces
+
+    @property
+    def monitored(self) -> np.ndarray:
+        """Which clearances are watched for events (enabled ones)."""
+        return self.cl[:, layout.CL_MON].astype(bool)
+
+    def transitions(self, builder: TraceBuilder) -> Transitions:
+        """The event rules for one run into ``builder`` (see :class:`Transitions`)."""
+        return Transitions(self, builder)
+
     def label(self, mask: int) -> str:
         return configuration_label(self.spec, mask)
 
@@ -433,3 +531,89 @@ class ContactProblem:
 
     def angle_to_time(self, degrees: float) -> float:
         return degrees * math.pi / 180.0 / self.omega
+
+
+class Transitions:
+    """The shared event and impact rules of one run, as a back end calls them (plain Python; the
+    Newmark kernel runs the same rules compiled):
+
+    * :meth:`start`: the static start, its pulling contacts released (settled);
+    * :meth:`apply`: at an event, open the closed clearances whose force reached zero, apply the impact
+      laws of those whose gap closed (after ``zeno_stick`` rapid events, closing contacts stick), settle,
+      record every event in the builder; ``zeno_stop`` rapid events stop the run (RunError).
+    """
+
+    def __init__(self, problem: ContactProblem, builder: TraceBuilder) -> None:
+        from vtool.solvers.newmark import (
+            build as kernel_build,  # the compiled rules, or plain until cached
+        )
+
+        self.problem, self.builder = problem, builder
+        self.rules = kernel_build.rules(problem.hertz, problem.momentum)
+        self.ip, self.fp = problem.parameters()
+        ncl = problem.ncl
+        self.ev_f, self.ev_i = np.zeros((4 * ncl + 4, 2)), np.zeros((4 * ncl + 4, 4), dtype=np.int64)
+        self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
+        self.rapid, self.last_event = 0, -math.inf
+
+    def start(self) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+        """(configuration, x, v, a) at t = 0: the mechanism's static start, settled (fresh arrays)."""
+        start = self.problem.mechanism.start
+        x, v, a = start.q.copy(), start.qd.copy(), start.qdd.copy()
+        mask = self.settle(self.problem.start_mask, 0.0, x, v, a)
+        return mask, x, v, self.problem.accelerations(mask, 0.0, x, v)
+
+    def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
+        """Release the contacts that pull in configuration ``mask`` at t (events recorded); the new mask."""
+        problem, tables, m = self.problem, self.problem.tables, self.problem.n
+        while True:
+            self.ist[layout.I_NEV] = 0
+            result = int(self.rules.settle(self.ip, self.fp, problem.cl, problem.clf, tables.ci, tables.cm,
+                                           tables.cp, tables.mk, tables.mon, mask, t, x, v, a,
+                                           problem.sources_at(t), self.ev_f, self.ev_i, self.ist, np.zeros(m),
+                                           np.zeros(m), np.zeros(m), np.zeros(m), problem.hertz))
+            self.take_events()
+            if result >= 0:
+                return result
+            mask = -1 - result
+            problem.build(mask)
+
+    def take_events(self) -> None:
+        count = int(self.ist[layout.I_NEV])
+        self.builder.add_events(self.ev_f[:count], self.ev_i[:count])
+        self.ist[layout.I_NEV] = 0
+
+    def apply(self, mask: int, t: float, x: np.ndarray, v: np.ndarray,
+              crossed: list[int]) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+        """The configuration and (x, v, a) after the events of the clearances ``crossed`` at t."""
+        problem = self.problem
+        x, v = x.copy(), v.copy()
+        bits = problem.cl[:, layout.CL_BIT]
+        new = mask
+        closing = np.zeros(problem.ncl, dtype=np.int64)
+        for k in crossed:
+            if mask & bits[k]:
+                new &= ~int(bits[k])
+            else:
+                closing[k] = 1
+        self.rapid = self.rapid + 1 if t - self.last_event <= problem.zeno_window else 0
+        self.last_event = t
+        if self.rapid >= problem.rules.zeno_stop:
+            raise RunError(f"chattering contact at t = {t:.6g} s in configuration {problem.label(mask)}")
+        src = problem.sources_at(t)
+        for k in range(problem.ncl):
+            if (mask & bits[k]) and not (new & bits[k]):
+                u = 0.0
+                if problem.cl[k, layout.CL_SOFT]:  # a linear contact's parts leave with their relative velocity
+                    self.rules.snap_shut(problem.cl, k, x, src)
+                    u = float(self.rules.relative_velocity(problem.cl, k, v, src))
+                self.builder.add_event(t, k, OPENED, u, mask, new)
+        if closing.any():
+            self.ist[layout.I_NEV] = 0
+            new = int(self.rules.impact(self.ip, self.fp, problem.cl, problem.clf, problem.mass, new, closing, src,
+                                        x, v, self.rapid >= problem.rules.zeno_stick, self.ev_f, self.ev_i, self.ist,
+                                        t, problem.momentum))
+            self.take_events()
+        a = problem.accelerations(new, t, x, v)
+        new = self.settle(new, t, x, v, a)
+        return new, x, v, problem.accelerations(new, t, x, v)

@@ -30,10 +30,6 @@ class Modes:
     omega: np.ndarray
     shapes: np.ndarray
 
-    @property
-    def n_rigid(self) -> int:
-        return int(np.count_nonzero(self.omega == 0.0))
-
 
 def undamped_modes(M: np.ndarray, K: np.ndarray) -> Modes:
     """Solve K φ = ω² M φ; rigid-body eigenvalues are set to exactly zero.

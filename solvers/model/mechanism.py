@@ -120,10 +120,6 @@ class Mechanism:
         return [self.layer(closed) for closed in possible_layers(self.spec)]
 
     @property
-    def built_layers(self) -> list[Layer]:
-        return list(self._layers.values())
-
-    @property
     def start_layer(self) -> Layer:
         return self.layer(frozenset(self.spec.initial.closed))
 

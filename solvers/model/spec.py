@@ -244,6 +244,11 @@ class DampingSpec:
         return LayerDampingSpec(tuple(sorted(closed)), self.default_ratio)
 
 
+#: Newmark's parameters as a run may set them: 0 < beta <= 1/2, 1/2 <= gamma <= 1 (the one statement of the
+#: rule: the preset loader reads them with these bounds, the Newmark back end's check refuses the same).
+BETA_RANGE = (0.0, 0.5)  # (exclusive, inclusive)
+GAMMA_RANGE = (0.5, 1.0)  # (inclusive, inclusive)
+
 #: The back end a run uses when its settings name none (the registry's default,
 #: :data:`vtool.solvers.backends.DEFAULT`; the one place outside the registry a back end is named).
 DEFAULT_BACKEND = "newmark"
@@ -274,6 +279,9 @@ class RunSpec:
     jump_angle: float = 1.0
     jump_gap: float | None = None
     bounce_lift: float | None = None
+    # quantities whose cam-order amplitudes (orders 1..highest_order over the evaluated cycles) are metrics
+    orders: tuple[str, ...] = ()
+    highest_order: int = 24
 
     @property
     def omega(self) -> float:
@@ -376,6 +384,9 @@ class MechanismSpec:
     contact: ContactSpec = field(default_factory=ContactSpec)
     follower: FollowerSpec | None = None  # cam shape and contact stress (presets' [follower] table)
     checks: tuple[CheckLimit, ...] = ()  # limits signed off (presets' [checks] table)
+    #: JSON text of the preset's [train] table when it was entered by train type (provenance: a saved copy
+    #: keeps the type's parameters while the model is still what they expand to; see presets/trains.py)
+    train: str = field(default="", compare=False)
     kind: str = field(default="valvetrain", init=False)
 
     @property

@@ -81,10 +81,25 @@ import numpy as np
 
 from vtool import compile_estimate, numba_cache
 from vtool.errors import InputError, RunError
-from vtool.solvers.backends import AccuracyKnobs, AccuracySetting, Backend, Cancel, Progress
+from vtool.solvers.backends import (
+    AccuracyKnobs,
+    AccuracySetting,
+    Backend,
+    Cancel,
+    Progress,
+    RunStats,
+)
 from vtool.solvers.model.contact import ContactProblem
 from vtool.solvers.model.mechanism import Mechanism
-from vtool.solvers.model.spec import HERTZ, MOMENTUM, RIGID, MechanismSpec, RunSpec
+from vtool.solvers.model.spec import (
+    BETA_RANGE,
+    GAMMA_RANGE,
+    HERTZ,
+    MOMENTUM,
+    RIGID,
+    MechanismSpec,
+    RunSpec,
+)
 from vtool.solvers.newmark import build as kernel_build
 from vtool.solvers.newmark import layout
 from vtool.solvers.newmark import native as kernel_native
@@ -200,10 +215,11 @@ def check_settings(mechanism: Mechanism, options: NewmarkOptions) -> None:
     dt = options.time_step
     if not dt > 0.0:
         raise InputError("run.time_step", dt, "> 0", "s")
-    if not 0.0 < options.beta <= 0.5:
-        raise InputError("run.beta", options.beta, "> 0 and <= 0.5")
-    if not 0.5 <= options.gamma <= 1.0:
-        raise InputError("run.gamma", options.gamma, ">= 0.5 and <= 1")
+    (beta_low, beta_high), (gamma_low, gamma_high) = BETA_RANGE, GAMMA_RANGE  # the loader's bounds
+    if not beta_low < options.beta <= beta_high:
+        raise InputError("run.beta", options.beta, f"> {beta_low:g} and <= {beta_high:g}")
+    if not gamma_low <= options.gamma <= gamma_high:
+        raise InputError("run.gamma", options.gamma, f">= {gamma_low:g} and <= {gamma_high:g}")
     if not options.refine >= 1:
         raise InputError("refine", options.refine, ">= 1")
     limit = stability_limit(options.beta, options.gamma, highest_frequency(mechanism))
@@ -220,6 +236,7 @@ class NewmarkBackend(Backend):
 
     name = "newmark"
     fixed_step = True
+    remedy = "a smaller time step, or the exact back end"
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> NewmarkOptions:
@@ -247,15 +264,15 @@ class NewmarkBackend(Backend):
         check_settings(mechanism, options)
 
     def integrate(self, problem: ContactProblem, options: NewmarkOptions, builder: TraceBuilder,
-                  progress: Progress | None, cancel: Cancel | None) -> dict[str, Any]:
+                  progress: Progress | None, cancel: Cancel | None) -> RunStats:
         run = KernelRun(problem, options, builder)
         run.execute(progress, cancel)
         o = options
-        return {"steps": int(run.ist[layout.I_STEPS]), "peak": run.peak[layout.PEAK_ALL].copy(),
-                "peak_late": run.peak[layout.PEAK_LATE].copy(), "peak_overlap": run.peak[layout.PEAK_OVERLAP].copy(),
-                "compile_time": run.compile_time, "plain_steps": run.plain_steps, "kernel": run.kernel,
-                "settings": {"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
-                             "refine_after_events": o.refine}}
+        return RunStats(int(run.ist[layout.I_STEPS]), run.peak[layout.PEAK_ALL].copy(),
+                        run.peak[layout.PEAK_LATE].copy(), run.peak[layout.PEAK_OVERLAP].copy(),
+                        compile_time=run.compile_time, plain_steps=run.plain_steps, kernel=run.kernel,
+                        settings={"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
+                                  "refine_after_events": o.refine})
 
 
 def kernel_kind(module: ModuleType) -> str:

@@ -28,6 +28,7 @@ from scipy.optimize import minimize_scalar
 
 from vtool.errors import InputError, RunError
 from vtool.solvers.backends import AccuracyKnobs, AccuracySetting
+from vtool.solvers.cost import MAX_SCIPY_STEPS
 from vtool.solvers.exact.backend import peak_brackets
 from vtool.solvers.exact.piecewise import PiecewiseBackend, PiecewiseRun
 from vtool.solvers.exact.statespace import StateSpace
@@ -58,6 +59,8 @@ class ScipyBackend(PiecewiseBackend):
 
     name = "scipy"
     library_dependent = True
+    max_steps = MAX_SCIPY_STEPS
+    remedy = "a tighter rtol, or the exact back end"
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> ScipyOptions:

@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -118,9 +119,14 @@ def _stress(spec: MechanismSpec, trace: Any) -> dict:
 
 
 def _geometry(spec: MechanismSpec) -> Any:
+    return _cached_profile(spec.follower, spec.lift_law)
+
+
+@lru_cache(maxsize=16)
+def _cached_profile(follower: Any, law: Any) -> Any:
     from vtool.solvers.model.camshape import cam_profile
 
-    return cam_profile(spec.follower, spec.lift_law)  # type: ignore[arg-type]
+    return cam_profile(follower, law)
 
 
 def _contact_pressure(spec: MechanismSpec, trace: Any) -> float | None:
@@ -145,19 +151,17 @@ def _radius(spec: MechanismSpec, trace: Any) -> float | None:
 def _pressure_angle(spec: MechanismSpec, trace: Any) -> float | None:
     if spec.follower is None:
         return None
-    from vtool.solvers.model.camshape import contact
+    from vtool.solvers.model.camstress import revolution
 
-    theta = np.linspace(0.0, 2.0 * math.pi, 3600, endpoint=False)
-    return float(np.abs(contact(spec.follower, spec.lift_law, theta).pressure_angle_deg).max())
+    return float(np.abs(revolution(spec.follower, spec.lift_law).pressure_angle_deg).max())
 
 
 def _travel(spec: MechanismSpec, trace: Any) -> float | None:
     if spec.follower is None or spec.follower.kind != "flat":
         return None
-    from vtool.solvers.model.camshape import law_derivatives
+    from vtool.solvers.model.camstress import revolution
 
-    theta = np.linspace(0.0, 2.0 * math.pi, 3600, endpoint=False)
-    return float(np.abs(law_derivatives(spec.lift_law, theta)[1]).max())
+    return float(np.nanmax(np.abs(revolution(spec.follower, spec.lift_law).contact_travel)))
 
 
 def _seating(spec: MechanismSpec, trace: Any) -> float | None:

@@ -6,21 +6,22 @@ event count and the physical episodes per clearance
 (:meth:`vtool.solvers.trace.Trace.episodes`), the first throw-off angle in
 each revolution after the first (a separation episode at the cam while the
 cam is above mid-stroke, 0-180 degrees into the revolution), the peak contact forces
-after the first revolution, the seating velocities and the largest valve
-lift.
+and the seating velocities after the first revolution (the window of
+:mod:`vtool.solvers.studies.metrics`, which ``vtool solve`` and ``vtool
+sweep`` report too), and the largest valve lift.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
 from vtool.solvers.model.spec import IMPACT_LAWS, START_VELOCITIES, MechanismSpec
 from vtool.solvers.run import simulate
+from vtool.solvers.studies.metrics import run_metrics
 from vtool.solvers.trace import SEPARATION, Trace
 
 
@@ -85,10 +86,12 @@ class Variant:
         for i in range(len(spec.clearances)):
             row[f"peak {t.force_label(i)} after rev 1 ({spec.unit_system.force})"] = (
                 None if late is None else float(late[i]))
-        if seat is not None:
-            v = seat["seating_velocities"]
-            row[f"seating velocity max ({spec.unit_system.velocity})"] = max(v) if v else None
-            row[f"seating velocity mean ({spec.unit_system.velocity})"] = float(np.mean(v)) if v else None
+        if seat is not None:  # in the evaluated window, as the peaks (not the start-up shock)
+            metrics = run_metrics(t)
+            for name, key in (("max", "seating_velocity_max"), ("mean", "seating_velocity_mean")):
+                value = metrics[key]
+                row[f"seating velocity {name} after rev 1 ({spec.unit_system.velocity})"] = (
+                    None if math.isnan(value) else value)
         if valve is not None:
             row[f"max valve lift ({spec.unit_system.length})"] = float(
                 (t.coordinate(valve) - spec.seat.position).max()) if spec.seat is not None else None

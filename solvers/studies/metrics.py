@@ -87,6 +87,11 @@ Metrics (also in docs/sweep.md):
 ``wall_time`` (s)
     Wall time of the back end's run (not deterministic: kept out of files
     that are compared).
+``<quantity>_order_<k>`` (the quantity's unit)
+    For each quantity in ``run.orders`` (``F7``, ``q7``, ``q1-q9``): its
+    amplitude at cam order k = 1 .. ``run.highest_order`` (default 24) over
+    the whole cycles of the window (:mod:`vtool.solvers.studies.orders`;
+    NaN above the Nyquist order of the output interval).
 """
 
 from __future__ import annotations
@@ -97,11 +102,14 @@ from functools import lru_cache
 
 import numpy as np
 
+from vtool.errors import InputError
 from vtool.solvers.model.configurations import clearance_bit
 from vtool.solvers.model.spec import EXTERNAL, REMOVED, CamSpec, MechanismSpec
+from vtool.solvers.studies.orders import order_column, quantity_unit, spectrum
+from vtool.solvers.studies.window import REVOLUTION, evaluation_window, window_text
 from vtool.solvers.trace import CLOSED, Trace
 
-REVOLUTION = 360.0
+__all__ = ["evaluation_window", "window_text"]  # (the window is shared with vtool.solvers.studies.orders)
 NAN = float("nan")
 #: the lift event: lift above the base circle by more than this share of the total lift
 LIFT_EVENT_FRACTION = 5e-3
@@ -234,28 +242,6 @@ class Criteria:
                 "lift_event_start_deg": self.lift_event[0], "lift_event_end_deg": self.lift_event[1]}
 
 
-# ----- the window -----
-
-def evaluation_window(trace: Trace) -> tuple[float, float]:
-    """The cam angles (deg) the metrics cover: see the module doc."""
-    if trace.cycles is not None:
-        return trace.cycles.window
-    end = float(trace.cam_angle[-1]) if len(trace.cam_angle) else 0.0
-    return (REVOLUTION, end) if end > REVOLUTION else (0.0, end)
-
-
-def window_text(trace: Trace) -> str:
-    """One line: which cycles the metrics cover, and whether they settled."""
-    if trace.cycles is not None:
-        return trace.cycles.text()
-    start, end = evaluation_window(trace)
-    if start == 0.0:
-        return (f"evaluated: the whole run (cam angle 0-{end:g} deg), start-up shock included: not a steady "
-                "state (set run.cycles or run.steady)")
-    return (f"evaluated: after the first revolution (cam angle {start:g}-{end:g} deg), not checked for a "
-            "steady state (set run.cycles or run.steady)")
-
-
 def metric_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
     """(name, unit) of every metric, in report order; ``""`` for counts."""
     u = spec.unit_system
@@ -273,7 +259,13 @@ def metric_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
     columns += [(f"peak_{force_label(spec, i)}", u.force) for i in range(len(spec.clearances))]
     columns += [("spring_margin", u.force), ("startup_peak_force", u.force), ("startup_seating_velocity", u.velocity),
                 ("cycles", ""), ("cycle_change", ""), ("events", ""), ("wall_time", "s")]
-    return columns
+    return columns + order_columns(spec)
+
+
+def order_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
+    """The amplitude of every ``run.orders`` quantity at cam orders 1..``run.highest_order`` (its unit)."""
+    return [(order_column(q, k), quantity_unit(spec, q)) for q in spec.run.orders
+            for k in range(1, spec.run.highest_order + 1)]
 
 
 # ----- intervals -----
@@ -439,10 +431,46 @@ def run_metrics(trace: Trace, window: tuple[float, float] | None = None) -> dict
     metrics["cycle_change"] = trace.cycles.change if trace.cycles is not None else NAN
     metrics["events"] = trace.statistics.events
     metrics["wall_time"] = trace.statistics.wall_time
+    for quantity in spec.run.orders:  # over the whole cycles of the evaluated window (NaN: none to analyse)
+        try:
+            orders = spectrum(trace, quantity)
+        except InputError:
+            orders = None
+        for k in range(1, spec.run.highest_order + 1):
+            metrics[order_column(quantity, k)] = (orders.amplitude_of(k) if orders is not None
+                                                  and k <= orders.nyquist else NAN)
     return metrics
 
 
 def failed_metrics(spec: MechanismSpec) -> dict[str, float]:
     """All metrics NaN (a run that failed), with the same keys."""
     return {name: NAN for name, _ in metric_columns(spec)}
+
+
+def evaluation_summary(trace: Trace) -> dict:
+    """What a run's summary adds: the window, the criteria, and the window's and the start-up's metrics,
+    as lines of text and as JSON-ready values (units as ``*_unit`` keys, NaN as None)."""
+    spec = trace.spec
+    units = dict(metric_columns(spec))
+    metrics = run_metrics(trace)
+    criteria = Criteria.of(spec)
+    start, end = evaluation_window(trace)
+
+    def shown(name: str) -> str:
+        value = metrics[name]
+        text = "-" if isinstance(value, float) and math.isnan(value) else f"{value:.6g}"
+        return f"{name} {text}{' ' + units[name] if units[name] else ''}"
+
+    window = ["cam_separations", "cam_separation_angle", "cam_separation_duration", "seat_bounces",
+              "seating_velocity_max", "lift_loss"] + [n for n in units if n.startswith("peak_")]
+    lines = [window_text(trace), criteria.text(spec.unit_system.length),
+             "in the window: " + ", ".join(shown(n) for n in window),
+             "start-up shock (first revolution): " + ", ".join(shown(n) for n in ("startup_peak_force",
+                                                                               "startup_seating_velocity"))]
+    values = {n: (None if isinstance(v, float) and math.isnan(v) else v) for n, v in metrics.items()
+              if n != "wall_time"}
+    return {"lines": lines, "window_deg": [start, end], "text": lines[0],
+            "settled": None if trace.cycles is None else trace.cycles.settled,
+            "criteria": criteria.as_dict(spec.unit_system.length),
+            "metrics": values | {f"{n}_unit": units[n] for n in values if units.get(n)}}
 

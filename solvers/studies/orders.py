@@ -23,14 +23,61 @@ orders): the orders that excite that mode at this speed.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from vtool.errors import InputError
-from vtool.solvers.studies.metrics import REVOLUTION, evaluation_window
+from vtool.solvers.model.configurations import mask_of
+from vtool.solvers.model.spec import ENABLED, MechanismSpec
+from vtool.solvers.studies.window import REVOLUTION, evaluation_window
 from vtool.solvers.trace import Trace
+
+
+def quantity_unit(spec: MechanismSpec, quantity: str) -> str:
+    """The unit of ``q7``, ``q1-q9`` or ``F2`` (a rotation's coordinate: rad)."""
+    text = quantity.replace(" ", "")
+    if text.startswith("F"):
+        return spec.unit_system.force
+    number = int(text[1:].split("-")[0])
+    if number <= spec.n_coordinates and spec.coordinates[number - 1].motion == "rotation":
+        return "rad"
+    return spec.unit_system.length
+
+
+def order_column(quantity: str, order: int) -> str:
+    return f"{quantity.replace(' ', '')}_order_{order}"
+
+
+def default_quantity(spec: MechanismSpec) -> str:
+    """The quantity a run's spectrum shows by default: ``run.orders``' first, else the force at the valve seat
+    (the valve spring's end on it), else at the cam."""
+    if spec.run.orders:
+        return spec.run.orders[0]
+    seat = next((c for c in spec.clearances if spec.seat is not None and c.behind == spec.seat.coordinate), None)
+    cam = next(c for c in spec.clearances if c.behind == spec.cam.coordinate)
+    return f"F{(seat or cam).ahead}"
+
+
+def with_orders(spec: MechanismSpec, quantities: tuple[str, ...], field: str = "--orders") -> MechanismSpec:
+    """The spec with ``quantities`` added to ``run.orders`` (checked: ``qN``, ``qN-qM`` over the coordinates, cam
+    and seat, or ``FN`` with N the coordinate ahead of a clearance)."""
+    numbers = set(range(1, spec.n_coordinates + 1)) | {spec.cam.coordinate}
+    if spec.seat is not None:
+        numbers.add(spec.seat.coordinate)
+    forces = {c.ahead for c in spec.clearances}
+    for quantity in quantities:
+        match = re.fullmatch(r"q(\d+)(?:-q(\d+))?|F(\d+)", quantity.replace(" ", ""))
+        ok = match is not None and (int(match[3]) in forces if match[3] else
+                                    int(match[1]) in numbers and (match[2] is None or int(match[2]) in numbers))
+        if not ok:
+            raise InputError(field, quantity, f"'q<i>', 'q<i>-q<j>' (i, j in {sorted(numbers)}) or 'F<i>' "
+                                              f"(i in {sorted(forces)})")
+    added = tuple(q for q in dict.fromkeys(quantities) if q not in spec.run.orders)
+    return dataclasses.replace(spec, run=dataclasses.replace(spec.run, orders=spec.run.orders + added))
 
 
 @dataclass(frozen=True)
@@ -123,16 +170,21 @@ def spectrum(trace: Trace, quantity: str) -> Spectrum:
 
 
 def natural_frequencies(trace: Trace) -> list[tuple[str, float]]:
-    """(configuration, natural frequency in Hz) of the configurations the run visited, lowest first per
-    configuration (the free coordinates' undamped modes)."""
+    """(configuration, natural frequency in Hz) of the configurations the run visited."""
+    return natural_frequencies_of(trace.spec, sorted({int(m) for m in np.unique(trace.configuration)}))
+
+
+def natural_frequencies_of(spec: MechanismSpec, masks: list[int] | None = None) -> list[tuple[str, float]]:
+    """(configuration, natural frequency in Hz) of the given configurations (default: the start's), lowest
+    first per configuration: the undamped modes of the free coordinates (the cam and a closed seat hold
+    theirs); a configuration with no free coordinate has none."""
     from vtool.solvers.model.contact import ContactProblem
     from vtool.solvers.model.damping import undamped_modes
     from vtool.solvers.model.mechanism import assemble
 
-    mechanism = assemble(trace.spec)
-    problem = ContactProblem.for_run(mechanism)
+    problem = ContactProblem.for_run(assemble(spec))
     result = []
-    for mask in sorted({int(m) for m in np.unique(trace.configuration)}):
+    for mask in masks if masks is not None else [problem.start_mask]:
         layer = problem.build(mask)
         nf = layer.nf
         if nf == 0:
@@ -141,6 +193,39 @@ def natural_frequencies(trace: Trace) -> list[tuple[str, float]]:
         for omega in sorted(float(w) for w in modes.omega if w > 0):
             result.append((problem.label(mask), omega / (2 * math.pi)))
     return result
+
+
+@dataclass(frozen=True)
+class Campbell:
+    """Order amplitudes of one quantity against cam speed (a sweep's ``<quantity>_order_<k>`` metrics):
+    ``amplitude[k - 1, j]`` at order k and speed ``rpm[j]``; ``frequencies`` (configuration, Hz) are the
+    natural frequencies drawn as the lines order = f_n 60 / rpm."""
+
+    quantity: str
+    unit: str
+    rpm: np.ndarray
+    amplitude: np.ndarray
+    frequencies: list[tuple[str, float]]
+
+    def line(self, hz: float) -> np.ndarray:
+        """The cam order of a natural frequency at each speed."""
+        return hz * 60.0 / self.rpm
+
+
+def campbell(rows: list[tuple[float, dict[str, float]]], spec: MechanismSpec, quantity: str) -> Campbell:
+    """The Campbell (waterfall) data of ``quantity`` from (rpm, metrics) rows of a sweep whose specs have
+    ``quantity`` in ``run.orders``; the natural frequencies of the start configuration and of every
+    clearance closed (:func:`natural_frequencies_of`)."""
+    if quantity not in spec.run.orders:
+        raise InputError("--campbell", quantity, f"a quantity in run.orders ({', '.join(spec.run.orders) or 'none'})")
+    rows = sorted(rows, key=lambda r: r[0])
+    rpm = np.array([r[0] for r in rows], dtype=float)
+    amplitude = np.array([[m.get(order_column(quantity, k), math.nan) for _, m in rows]
+                          for k in range(1, spec.run.highest_order + 1)], dtype=float)
+    closed = mask_of(spec, tuple(c.name for c in spec.clearances if c.state == ENABLED))
+    start = mask_of(spec, spec.initial.closed)
+    return Campbell(quantity, quantity_unit(spec, quantity), rpm, amplitude,
+                    natural_frequencies_of(spec, sorted({start, closed})))
 
 
 def dominant_near(spectrum_: Spectrum, frequencies: list[tuple[str, float]], band: float = 0.15,

@@ -10,7 +10,11 @@ For a preset and the top of its speed range (``rpm_max``) the study
    elements, one run each at ``rpm_max``, until doubling n changes every
    measured result by less than ``tolerance`` (relative): the peak force at
    every clearance and the largest seating velocity. The recommended n is the
-   last one before that converged doubling. Peak forces are taken over the
+   last one before that converged doubling. The results are those of the
+   evaluated window (:func:`vtool.solvers.studies.metrics.evaluation_window`:
+   after the first revolution, or the last cycle of a run to steady state),
+   as ``vtool solve`` and ``vtool sweep`` report them, not the start-up
+   shock. Peak forces are taken over the
    output rows (every ``output_interval`` degrees), not over every step: with
    rigid contacts the one-step force spike of an impact grows without bound
    as the element at the contact shrinks (gnilka-1a at 12,000 rpm, left
@@ -46,6 +50,7 @@ from vtool.solvers.model.cam import (
 )
 from vtool.solvers.model.mechanism import assemble
 from vtool.solvers.model.spec import EXTERNAL, MechanismSpec
+from vtool.solvers.studies.metrics import evaluation_window, run_metrics
 from vtool.units import cam_speed
 
 
@@ -90,15 +95,17 @@ def measure(spec: MechanismSpec) -> tuple[dict[str, float], int, float]:
     from vtool.solvers.run import simulate
 
     trace = simulate(spec)
-    summary = trace.summary()
+    metrics = run_metrics(trace)  # the evaluated window, as solve and sweep report it: not the start-up shock
+    start, end = evaluation_window(trace)
+    rows = (trace.cam_angle >= start) & (trace.cam_angle <= end)
+    sampled = trace.contact_force[rows].max(axis=0) if rows.any() else np.zeros(len(spec.clearances))
     results = {}
-    sampled = trace.contact_force.max(axis=0) if len(trace.time) else np.zeros(len(spec.clearances))
     for c, peak in zip(spec.clearances, sampled, strict=True):
         results[f"peak {c.name} force"] = float(peak)
     if "max seating velocity" in result_names(spec):
-        seating = [v for e in summary["clearances"] for v in e.get("seating_velocities", [])]
-        results["max seating velocity"] = max(seating, default=0.0)
-    return results, summary["steps"], summary["wall_time_s"]
+        seating = metrics["seating_velocity_max"]
+        results["max seating velocity"] = 0.0 if math.isnan(seating) else float(seating)
+    return results, trace.statistics.steps, trace.statistics.wall_time
 
 
 def relative_change(new: dict[str, float], old: dict[str, float]) -> float:

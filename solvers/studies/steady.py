@@ -146,7 +146,7 @@ def cycle_change(before: Trace, after: Trace) -> tuple[float, str]:
     for k in peaks:
         changes[k] = _relative(m0[k], m1[k], force_scale)
     lift = total_lift(spec.cam)
-    omega = spec.run.rpm * math.pi / 30.0
+    omega = spec.run.omega
     changes["lift_loss"] = _relative(m0["lift_loss"], m1["lift_loss"], lift)
     changes["seating_velocity_max"] = _relative(m0["seating_velocity_max"], m1["seating_velocity_max"], lift * omega)
     what = max(changes, key=lambda k: changes[k])

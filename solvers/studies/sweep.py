@@ -625,6 +625,24 @@ def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan
     return SpeedResult(criterion, speed, tuple(history), message, tuple(intervals))
 
 
+def scan_intervals(results: Sequence[PointResult], field: str, criterion: str) -> list[tuple[float, float]]:
+    """(first, last) swept value of every run of neighbouring points (in ``field``'s order) where ``criterion``
+    (a :data:`CRITERIA` name) holds: the intervals a scan shows, edges not bisected (``find_speed`` does)."""
+    metric, test, _ = CRITERIA[criterion]
+    points = sorted(((dict(r.values)[field], r) for r in results if r.ok), key=lambda vr: vr[0])
+    intervals: list[tuple[float, float]] = []
+    start = None
+    for k, (value, result) in enumerate(points):
+        if test(result.metrics[metric]):
+            start = value if start is None else start
+        elif start is not None:
+            intervals.append((start, points[k - 1][0]))
+            start = None
+    if start is not None:
+        intervals.append((start, points[-1][0]))
+    return intervals
+
+
 # ----- reports -----
 
 def report_columns(spec: MechanismSpec, timing: bool = True) -> list[tuple[str, str]]:

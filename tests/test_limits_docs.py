@@ -1,0 +1,27 @@
+"""docs/limits.md: the generated nominal runs and cost-guard line match a fresh regeneration
+(benchmarks/limits_docs.py)."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+from vtool.markdown import read_block
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _generator():  # type: ignore[no-untyped-def]
+    spec = importlib.util.spec_from_file_location("limits_docs", ROOT / "benchmarks" / "limits_docs.py")
+    module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+    spec.loader.exec_module(module)  # type: ignore[union-attr]
+    return module
+
+
+@pytest.mark.parametrize("name", ["limits-nominal", "limits-cost-guard"])
+def test_committed_limits_figures_are_regenerated_unchanged(name: str) -> None:
+    block = _generator().BLOCKS[name]()
+    assert read_block(ROOT / "docs" / "limits.md", name) == block, f"{name}: run python3 benchmarks/limits_docs.py"
+    assert "0.0944 s" not in block and "163 events" not in block  # the stale figures it replaced
