@@ -224,17 +224,20 @@ def accuracy_section(trace: Any) -> Section:
     settings = stats.settings
     step = settings.get("time_step_s")
     tolerance = next((settings[k] for k in ("time_tolerance_s", "time_tolerance") if k in settings), None)
-    if stats.backend == "newmark":
+    from vtool.solvers.backends import get
+
+    backend = get(stats.backend)  # what it is, by its flags (the registry's contract), not by its name
+    if backend.fixed_step:
         tolerance = tolerance if tolerance is not None else (None if step is None else 1e-6 * float(step))
-        note = ("Newmark's average/linear-acceleration scheme (beta, gamma above) is second-order accurate in the "
-                "step; events are located inside a step by root finding on the step's interpolant to the time "
-                "tolerance, and steps after an event are refined. Halve the step (vtool accuracy) to see how the "
-                "answers move.")
-    elif stats.backend == "exact":
-        note = ("The exact back end integrates each configuration's linear equations by the matrix exponential: "
-                "no step error; events are located by root finding on the exact solution to the time tolerance.")
+        note = ("A fixed-step scheme (Newmark's beta, gamma above: second-order accurate in the step); events "
+                "are located inside a step by root finding on the step's interpolant to the time tolerance, "
+                "and steps after an event are refined. Halve the step (vtool accuracy) to see how the answers "
+                "move.")
+    elif backend.reference:
+        note = ("Each configuration's linear equations are integrated exactly (the matrix exponential): no step "
+                "error; events are located by root finding on the exact solution to the time tolerance.")
     else:
-        note = "An adaptive integrator (solve_ivp) with the stated tolerances; events are terminal events."
+        note = "An adaptive integrator with the stated tolerances; events are located by its event functions."
     rows = [("back end", stats.backend), ("time step", "-" if step is None else f"{_g(step)} s"),
             ("event time tolerance", "-" if tolerance is None else f"{_g(tolerance)} s"),
             ("error estimate", "-" if stats.error_estimate is None else _g(stats.error_estimate))]

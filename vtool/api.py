@@ -105,7 +105,7 @@ class Model:
 
         changes = dict(fields or {}) | {f"run.{key}": value for key, value in run.items()}
         document = set_fields(self.document, changes)
-        if "run.rpm" in changes and self.kind == "valvetrain" and isinstance(document.get("title"), str):
+        if "run.rpm" in changes and self._takes("--rpm") and isinstance(document.get("title"), str):
             from vtool.presets.valvetrain import rpm_title
 
             try:  # the title names the new speed, as `vtool solve --rpm` does; a bad speed is the loader's
@@ -171,9 +171,16 @@ class Model:
 
         save_spec(self.spec, path)
 
+    def _takes(self, flag: str) -> bool:
+        """Whether this preset's kind takes a run flag (the kinds table says: presets/kinds.py)."""
+        from vtool.presets.kinds import KINDS
+
+        return flag in KINDS[self.kind].run_options
+
     def _require_valvetrain(self, what: str) -> None:
-        if self.kind != "valvetrain":
-            raise InputError("preset", self.title, f"a valvetrain preset for {what} (this one is {self.kind})")
+        from vtool.presets.kinds import require_kind
+
+        require_kind(self.spec, "valvetrain", what)
 
 
 @dataclass(frozen=True)
