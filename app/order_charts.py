@@ -15,11 +15,12 @@ def order_chart(spectrum: Spectrum, frequencies: list[tuple[str, float]], *, hig
     """Amplitude per cam order as a staircase up to ``highest`` (default: past the highest natural frequency
     in orders, at most the Nyquist order), with a line at each natural frequency's order; then the dominant
     orders near each natural frequency."""
+    from vtool.presets.charts import order_chart as order_data
+
     cam_hz = spectrum.rpm / 60.0
-    marks = [hz / cam_hz for _, hz in frequencies if hz / cam_hz <= spectrum.nyquist]
-    top = highest or min(spectrum.nyquist, max([20.0] + [1.2 * m for m in marks]))
-    keep = (spectrum.orders > 0) & (spectrum.orders <= top)
-    x, y = spectrum.orders[keep], spectrum.amplitude[keep]
+    data = order_data(spectrum, frequencies, highest)  # the figure's series and its range of orders
+    x, y = data.panels[0].curves[0].x, data.panels[0].curves[0].y
+    top = float(x[-1]) if len(x) else 0.0
     series = {f"{spectrum.quantity} ({spectrum.unit})": y}
     peak = float(y.max()) if len(y) else 1.0
     for label, hz in frequencies:

@@ -243,6 +243,36 @@ def cam_shape_charts(spec: Any, points: int = 720) -> list[Chart]:
 
 
 # ----------------------------------------------------------------------------
+# cam orders
+
+
+def order_chart(spectrum: Any, frequencies: list[tuple[str, float]], highest: float | None = None,
+                subject: str = "") -> Chart:
+    """``vtool solve --orders Q --plot``: amplitude per cam order as a staircase up to ``highest`` (default:
+    past the highest natural frequency in orders, at most the Nyquist order); the natural frequencies of
+    the visited configurations marked at their orders (omega_n / omega)."""
+    cam_hz = spectrum.rpm / 60.0
+    orders = [hz / cam_hz for _, hz in frequencies if hz / cam_hz <= spectrum.nyquist]
+    top = highest or min(spectrum.nyquist, max([20.0] + [1.2 * m for m in orders]))
+    keep = (spectrum.orders > 0) & (spectrum.orders <= top)
+    marks = (Mark("natural frequency", np.array([o for o in orders if o <= top])),)
+    panel = Panel((curve(with_unit(spectrum.quantity, spectrum.unit), spectrum.orders[keep],
+                         spectrum.amplitude[keep], step=True),), with_unit("amplitude", spectrum.unit))
+    return Chart(f"{spectrum.quantity}: amplitude per cam order at {spectrum.rpm:g} rev/min", "cam order (-)",
+                 (panel,), subject, marks)
+
+
+def campbell_chart(data: Any, subject: str = "") -> HeatMap:
+    """``vtool sweep --campbell Q``: log10 of the order amplitudes over cam speed and cam order."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        values = np.where(data.amplitude > 0, np.log10(data.amplitude), np.nan)
+    orders = np.arange(1, len(data.amplitude) + 1, dtype=float)
+    return HeatMap(f"{data.quantity}: amplitude per cam order and speed (log10)", "cam speed (rev/min)",
+                   "cam order (-)", f"log10 amplitude ({data.unit})", np.asarray(data.rpm, dtype=float), orders,
+                   values, subject)
+
+
+# ----------------------------------------------------------------------------
 # sonic boom
 
 

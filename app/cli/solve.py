@@ -188,9 +188,14 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
 
             click.echo(order_chart(spectrum, natural_frequencies(trace)))
     if figure is not None:
-        from vtool.presets.charts import trace_charts
+        from vtool.presets.charts import order_chart, trace_charts
 
-        write_figure(trace_charts(trace), figure)
+        charts = trace_charts(trace)
+        if spectrum is not None:  # the --orders spectrum, natural frequencies marked
+            from vtool.solvers.studies.orders import natural_frequencies
+
+            charts.append(order_chart(spectrum, natural_frequencies(trace), subject=trace.spec.title))
+        write_figure(charts, figure)
 
 
 def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()) -> None:

@@ -193,13 +193,16 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         from vtool.solvers.studies.orders import campbell as campbell_data
 
         rows = [(float(dict(r.values)["run.rpm"]), r.metrics) for r in results if r.ok]
-        click.echo(campbell_map(campbell_data(rows, plan.spec, campbell)))
-    if results and figure_path is not None:  # the --plot chart, and the --map as a grey map
-        from vtool.presets.charts import sweep_chart, sweep_map
+        waterfall = campbell_data(rows, plan.spec, campbell)
+        click.echo(campbell_map(waterfall))
+    if results and figure_path is not None:  # the --plot chart, the --map and the --campbell as grey maps
+        from vtool.presets.charts import campbell_chart, sweep_chart, sweep_map
 
         items: list = [sweep_chart(results, axes, metric, names[metric], plan.spec.title)]
         if as_map:
             items.append(sweep_map(results, axes, metric, names[metric], plan.spec.title))
+        if campbell:
+            items.append(campbell_chart(waterfall, plan.spec.title))
         write_figure(items, figure_path)
 
 
