@@ -147,6 +147,8 @@ MEANINGS: dict[str, dict[str, str]] = {
         "follower.lift": "The lift law at the cam when it is not [cam] (a finger's): [cam]'s keys.",
         "follower.lift.profile": "Harmonic or a lift table.",
         "follower.lift.lift_table": "CSV file of the law's lift against cam angle.",
+        "follower.lift.polyline": "A measured lift law as a polyline script of angle,lift points (as cam.polyline).",
+        "follower.lift.scan": "What a measured lift law's numbers are, and its smoothing (as cam.scan).",
         "follower.lift.angles": "Cam angles of the law's table.",
         "follower.lift.lifts": "Lifts of the law's table.",
         "follower.lift.harmonics": "Harmonics of the law's Fourier fit.",
