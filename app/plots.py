@@ -53,9 +53,13 @@ def _render(panels: list[Panel], *, xlabel: str, width: int, height: int, color:
             if len(panels) > 1:
                 plt.subplot(number, 1)
             plt.theme("pro" if color else "clear")
+            drawn = 0
             for label, xs, ys in panel.curves:
-                plt.plot(np.asarray(xs, dtype=float).tolist(), np.asarray(ys, dtype=float).tolist(),
-                         label=label, marker="braille")
+                xs, ys = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
+                if not np.isfinite(xs[np.isfinite(ys)]).any():  # nothing to draw (plotext fails on it)
+                    continue
+                plt.plot(xs.tolist(), ys.tolist(), label=label, marker="braille")
+                drawn += 1
             if xlim is not None:
                 plt.xlim(*xlim)
             if panel.ylim is not None:
@@ -64,7 +68,7 @@ def _render(panels: list[Panel], *, xlabel: str, width: int, height: int, color:
                 plt.yticks(list(panel.yticks[0]), list(panel.yticks[1]))
             if xlog:
                 plt.xscale("log")
-            plt.title(panel.title)
+            plt.title(panel.title if drawn else f"{panel.title}: no finite value to draw".lstrip(": "))
             plt.ylabel(panel.ylabel)
             if number == len(panels):
                 plt.xlabel(xlabel)

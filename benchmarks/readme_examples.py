@@ -20,8 +20,12 @@ README = Path(__file__).resolve().parent.parent / "README.md"
 
 
 def solve_1a() -> str:
+    """What ``vtool solve gnilka-1a`` prints: the summary, then the evaluation lines (window, criteria, the
+    window's metrics, the start-up shock)."""
+    from vtool.solvers.studies.metrics import evaluation_summary
+
     trace = simulate(load_preset("gnilka-1a"))
-    return "```\n" + trace.summary_text() + "\n```\n"
+    return "```\n" + trace.summary_text() + "\n\n" + "\n".join(evaluation_summary(trace)["lines"]) + "\n```\n"
 
 
 def main() -> None:

@@ -29,7 +29,9 @@ PRESETS = (("gnilka-1a", "1A: three clearances, valve seat"),
            ("gnilka-1c", "1C: two clearances (rocker pinned), valve seat"),
            ("gnilka-2", "example 2 (and 3): three clearances, valve seat"),
            ("ramped-cam", "1A's mechanism on a dwell-and-ramps cam with lash"),
-           ("ohv-pushrod-1a", "the train-type preset (ohv-pushrod) of 1A's data"))
+           ("ohv-pushrod-1a", "the train-type preset (ohv-pushrod) of 1A's data"),
+           ("direct-acting-bucket", "train type direct-acting (bucket tappet)"),
+           ("ohc-finger-follower", "train type finger-follower (overhead cam)"))
 CAMPBELL = (("gnilka-1a", "F7"), ("ramped-cam", "F7"))  # the seat force's orders against speed
 CAMPBELL_RPM = list(range(2000, 16001, 500))
 SCAN = list(range(1000, 16001, 1000))  # rev/min

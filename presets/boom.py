@@ -128,7 +128,7 @@ def _load(doc: dict[str, Any], base: str | Path | None) -> BoomWallSpec | BoomFl
     top = Table(doc, "")
     kind = top.string("kind", choices=KINDS)
     title = top.string("title", default="")
-    top.string("notes", default="")
+    top.string("notes", default="", multiline=True)
     units = UNIT_SYSTEMS[top.string("units", choices=tuple(UNIT_SYSTEMS))]
     for key in ("criterion", "criteria", "walls", "floors"):
         _short_list(top, key)

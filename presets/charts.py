@@ -236,7 +236,7 @@ def cam_shape_charts(spec: Any, points: int = 720) -> list[Chart]:
         Chart("pressure angle (deg)", CAM_ANGLE,
               (Panel((curve("pressure angle", c.cam_angle_deg, c.pressure_angle_deg),), "pressure angle (deg)"),),
               spec.title)]
-    if follower.arrangement == "finger":
+    if follower.arrangement in ("finger", "rocker"):
         charts.append(Chart("finger ratio dV/du (-)", CAM_ANGLE,
                             (Panel((curve("ratio", c.cam_angle_deg, c.ratio),), "ratio (-)"),), spec.title))
     return charts
@@ -259,7 +259,7 @@ def order_chart(spectrum: Any, frequencies: list[tuple[str, float]], highest: fl
     panel = Panel((curve(with_unit(spectrum.quantity, spectrum.unit), spectrum.orders[keep],
                          spectrum.amplitude[keep], step=True),), with_unit("amplitude", spectrum.unit))
     return Chart(f"{spectrum.quantity}: amplitude per cam order at {spectrum.rpm:g} rev/min", "cam order (-)",
-                 (panel,), subject, marks)
+                 (panel,), subject, marks, xlim=(0.0, float(top)))
 
 
 def campbell_chart(data: Any, subject: str = "") -> HeatMap:

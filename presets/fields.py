@@ -22,6 +22,7 @@ from __future__ import annotations
 import difflib
 import math
 import re
+import unicodedata
 from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -34,6 +35,9 @@ from vtool.errors import InputError
 MAX_LIST = 1000
 #: Longest string field (titles, notes, names).
 MAX_STRING = 10_000
+#: Unicode categories refused in a text field: controls, format characters (bidi overrides, zero-width),
+#: line and paragraph separators, surrogates.
+CONTROL_CATEGORIES = frozenset({"Cc", "Cf", "Zl", "Zp", "Cs"})
 
 
 #: The default of a read that has none (the key is required).
@@ -206,7 +210,11 @@ class Table:
             raise InputError(self.field(key), value, f"an integer {expected}")
         return value
 
-    def string(self, key: str, *, default: str | None = None, choices: tuple[str, ...] = ()) -> str:
+    def string(self, key: str, *, default: str | None = None, choices: tuple[str, ...] = (),
+               multiline: bool = False) -> str:
+        """A text field: one line of printable text (``multiline``: line breaks and tabs allowed too,
+        for notes); a control character (a newline in a name, an escape, a bidi override) is refused,
+        so that no text field can break a CSV row, a table or a terminal line."""
         self._note(key, "string", "", f"one of: {', '.join(choices)}" if choices else "", default, default is None)
         value = self._get(key, default, default is None)
         if not isinstance(value, str):
@@ -216,6 +224,12 @@ class Table:
             raise InputError(self.field(key), value, f"one of: {', '.join(choices)}")
         if len(value) > MAX_STRING:
             raise InputError(self.field(key), value, f"a string of at most {MAX_STRING:,} characters")
+        allowed = "\n\t\r" if multiline else ""
+        for position, char in enumerate(value):
+            if char not in allowed and unicodedata.category(char) in CONTROL_CATEGORIES:
+                words = "printable text" if multiline else "one line of printable text"
+                raise InputError(self.field(key), value, f"{words} (U+{ord(char):04X}, a control character, "
+                                 f"at position {position + 1})")
         return value
 
     def boolean(self, key: str, *, default: bool | None = None) -> bool:

@@ -6,7 +6,7 @@ the contact stress follow (:mod:`vtool.solvers.model.camshape`,
 
     [follower]
     kind = "roller"            # or "flat"
-    arrangement = "finger"     # or "translating" (bucket, tappet, roller lifter)
+    arrangement = "finger"     # or "translating" (bucket, tappet, roller lifter), "rocker" (centre pivot)
     base_radius = 16.0         # cam base circle (profile), length
     width = 10.0               # contact length (roller or cam lobe width), length
     roller_radius = 9.0        # roller only
@@ -15,7 +15,7 @@ the contact stress follow (:mod:`vtool.solvers.model.camshape`,
     cam_poisson = 0.3
     follower_modulus = 205000.0
     follower_poisson = 0.3
-    roller_arm = 20.0          # finger only (FingerSpec): pivot to roller centre, along the finger
+    roller_arm = 20.0          # finger or rocker only (FingerSpec): pivot to roller centre, along the lever
     valve_arm = 45.0           #   pivot to the valve pad's centre
     roller_height = 0.0        #   roller centre above the pivot-pad line
     cam_offset = 0.0           #   cam centre beyond the roller centre, along the finger
@@ -38,9 +38,9 @@ from vtool.errors import InputError
 from vtool.presets.fields import Table, closest
 from vtool.solvers.model.spec import (
     ARRANGEMENTS,
-    FINGER,
     FLAT,
     FOLLOWER_KINDS,
+    LEVERS,
     ROLLER,
     TRANSLATING,
     CamSpec,
@@ -84,9 +84,9 @@ def load_follower(t: Table, units: UnitSystem, read_law: Callable[[Table], CamSp
         moduli[f"{part}_poisson"] = t.number(f"{part}_poisson", default=STEEL_POISSON, min_value=0.0,
                                              max_exclusive=0.5)
     finger = None
-    if arrangement == FINGER:
+    if arrangement in LEVERS:
         if kind != ROLLER:
-            raise InputError(t.field("kind"), kind, 'roller for a finger follower (flat-faced fingers are not modelled)')
+            raise InputError(t.field("kind"), kind, f'roller for a {arrangement} (flat-faced levers are not modelled)')
         arm = t.number("roller_arm", unit=L, min_exclusive=0.0, max_value=LENGTH[1])
         valve = t.number("valve_arm", unit=L, min_exclusive=arm, max_value=LENGTH[1])
         height = t.number("roller_height", unit=L, default=0.0, min_value=-LENGTH[1], max_value=LENGTH[1])
@@ -96,7 +96,7 @@ def load_follower(t: Table, units: UnitSystem, read_law: Callable[[Table], CamSp
     else:
         for key in FINGER_KEYS:
             if t.has(key):
-                raise InputError(t.field(key), t.raw(key), 'only with arrangement = "finger"', L)
+                raise InputError(t.field(key), t.raw(key), 'only with arrangement = "finger" or "rocker"', L)
     lift_table = t.table("lift", required=False)
     lift = None if lift_table is None else read_law(lift_table)
     oil = None

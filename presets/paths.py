@@ -165,6 +165,34 @@ class SweepCancelled(Exception):
     """:func:`plan_sweep` stopped because its ``cancel`` said so (nothing was planned)."""
 
 
+def parse_assignments(sets: list[str] | tuple[str, ...], max_points: int = 100_000) -> list[tuple[str, list[Any]]]:
+    """``FIELD=VALUES`` texts (``--set`` of ``vtool sweep`` and ``vtool solve``) -> (path, values), in order;
+    each field once."""
+    fields: list[tuple[str, list[Any]]] = []
+    for text in sets:
+        path, sep, values = text.partition("=")
+        path = path.strip()
+        if not sep or not path:
+            raise InputError("--set", text, "FIELD=VALUES, e.g. run.rpm=9000:12000:250 or damping.factor=0.5,1,2")
+        if any(path == p for p, _ in fields):
+            raise InputError("--set", path, "each field set once")
+        parse_path(path)
+        fields.append((path, parse_values(path, values, max_points)))
+    return fields
+
+
+def apply_sets(doc: dict[str, Any], sets: list[str] | tuple[str, ...]) -> dict[str, Any]:
+    """``doc`` with ``FIELD=VALUE`` assignments (one value each: ``vtool solve --set``, the same paths and
+    values as a sweep's, a single point); the preset's loader then checks them."""
+    assignments = {}
+    for path, values in parse_assignments(sets, max_points=1_000):
+        if len(values) != 1:
+            raise InputError(f"--set {path}", ",".join(str(v) for v in values),
+                             "one value (a range or list is a sweep: vtool sweep)")
+        assignments[path] = values[0]
+    return set_fields(doc, assignments)
+
+
 @dataclass(frozen=True)
 class SweepPlan:
     """A validated sweep: the base document and spec, the swept fields with units, every point."""
@@ -191,16 +219,7 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000, *,
     folder = find_preset(preset).parent
     doc = read_document(find_preset(preset))
     require_kind(load_document(doc, folder), "valvetrain", "a sweep")
-    fields: list[tuple[str, list[Any]]] = []
-    for text in sets:
-        path, sep, values = text.partition("=")
-        path = path.strip()
-        if not sep or not path:
-            raise InputError("--set", text, "FIELD=VALUES, e.g. run.rpm=9000:12000:250 or damping.factor=0.5,1,2")
-        if any(path == p for p, _ in fields):
-            raise InputError("--set", path, "each field set once")
-        parse_path(path)
-        fields.append((path, parse_values(path, values, max_points)))
+    fields = parse_assignments(sets, max_points)
     return plan_document(doc, fields, max_points, folder, progress=progress, cancel=cancel)
 
 

@@ -137,7 +137,7 @@ def _cases(top: Table, plate: Plate, element: str, mesh: tuple[int, int]) -> tup
         grid = Mesh(plate, ELEMENTS[case_element], nx, ny)
         masters = _masters(t, grid, t.path)
         method = t.string("method", default="guyan", choices=METHODS)
-        note = t.string("note", default="")
+        note = t.string("note", default="", multiline=True)
         t.finish()
         cases.append(Case(name, case_element, nx, ny, masters, method, note))
     return tuple(cases)
@@ -192,7 +192,7 @@ def _load(doc: dict[str, Any]) -> PlateSpec:
     top = Table(doc, "")
     top.string("kind", choices=("plate",))
     title = top.string("title", default="")
-    notes = top.string("notes", default="")
+    notes = top.string("notes", default="", multiline=True)
     units_name = top.string("units", choices=tuple(UNIT_SYSTEMS))
     units = UNIT_SYSTEMS[units_name]
     plate = _plate(top.table("plate"), units)  # type: ignore[arg-type]

@@ -53,6 +53,11 @@ Types and the clearance names [damping] may use:
   ratio valve_arm/roller_arm; its cam coordinate moves as the geometric
   valve lift over that ratio (:func:`vtool.solvers.model.camshape.model_lift`),
   so the valve side follows the finger's varying ratio.
+* ``centre-pivot-rocker`` (OHC roller rocker on a shaft): ``[train.rocker]``
+  (``roller_arm``, ``valve_arm``, ``roller_height``, ``cam_offset`` and a
+  beam section; the roller beyond the pivot from the valve, the cam under
+  it), ``[train.valve]``; clearances ``cam``, ``seat``; the valve side
+  follows the rocker's varying ratio as a finger's does.
 """
 
 from __future__ import annotations
@@ -71,7 +76,8 @@ from vtool.units import UNIT_SYSTEMS, UnitSystem
 OHV_PUSHROD = "ohv-pushrod"
 DIRECT_ACTING = "direct-acting"
 FINGER_FOLLOWER = "finger-follower"
-TYPES = (OHV_PUSHROD, DIRECT_ACTING, FINGER_FOLLOWER)
+CENTRE_PIVOT_ROCKER = "centre-pivot-rocker"
+TYPES = (OHV_PUSHROD, DIRECT_ACTING, FINGER_FOLLOWER, CENTRE_PIVOT_ROCKER)
 
 #: top-level tables a train builds (refused beside [train])
 BUILT = ("coordinates", "members", "cam", "seat", "clearances", "follower")
@@ -285,12 +291,8 @@ def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[
 def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """End-pivot roller finger: pivot support, two beams (pivot-roller, roller-pad), valve (module doc)."""
     finger_t, pivot_t, valve_t = _part(train, "finger"), _part(train, "pivot"), _part(train, "valve")
-    a = _length(finger_t, "roller_arm", units)
-    b = finger_t.number("valve_arm", unit=units.length, min_exclusive=a, max_value=1e4)
-    geometry = {"roller_arm": a, "valve_arm": b}
-    for key in ("roller_height", "cam_offset"):
-        if finger_t.has(key):
-            geometry[key] = finger_t.number(key, unit=units.length, min_value=-1e4, max_value=1e4)
+    geometry = _lever(finger_t, units)
+    a, b = geometry["roller_arm"], geometry["valve_arm"]
     finger = _section(finger_t, units, "beam")
     pivot = {"mass": pivot_t.number("mass", unit=units.mass, min_exclusive=0.0, max_value=1e9),
              "stiffness": pivot_t.number("stiffness", unit=units.stiffness, min_exclusive=0.0, max_value=1e16)}
@@ -315,10 +317,54 @@ def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dic
             "clearances": [_clearance("cam", 3, n + 1, "external"), _clearance("pad", 7, 5, "internal"),
                            _clearance("seat", 8, n + 2, "external")] + spring.clearances,
             "closed": ["cam", "pad"], "preload": spring.preload, "ratio": b / a, "follower_kind": "roller",
-            "finger": geometry}
+            "finger": geometry, "arrangement": "finger"}
 
 
-BUILDERS = {OHV_PUSHROD: ohv_pushrod, DIRECT_ACTING: direct_acting, FINGER_FOLLOWER: finger_follower}
+def _lever(t: Table, units: UnitSystem) -> dict[str, float]:
+    """A lever's arms and offsets (:class:`vtool.solvers.model.spec.FingerSpec`)."""
+    a = _length(t, "roller_arm", units)
+    geometry = {"roller_arm": a,
+                "valve_arm": t.number("valve_arm", unit=units.length, min_exclusive=a if t.path.endswith("finger")
+                                      else 0.0, max_value=1e4)}
+    for key in ("roller_height", "cam_offset"):
+        if t.has(key):
+            geometry[key] = t.number(key, unit=units.length, min_value=-1e4, max_value=1e4)
+    return geometry
+
+
+def centre_pivot_rocker(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
+    """OHC roller rocker on a shaft (centre pivot): cam under the roller arm, valve under the valve arm.
+
+    Gnilka's rocker without the pushrod: q1 the rocker at the roller (cam contact), the shaft
+    grounded, the valve arm's end tied to the valve's top and spring (as gnilka-1a's q4), the valve
+    head's coordinate pointing the other way (beta map -q6).
+    """
+    rocker_t, valve_t = _part(train, "rocker"), _part(train, "valve")
+    geometry = _lever(rocker_t, units)
+    a, b = geometry["roller_arm"], geometry["valve_arm"]
+    rocker = _section(rocker_t, units, "beam")
+    valve_length = _length(valve_t, "length", units)
+    valve = _section(valve_t, units, "bar")
+    rocker_t.finish()
+    valve_t.finish()
+    spring = spring_model(_part(train, "spring"), units, 4, 7, (a + b, 0.0))
+    coordinates = _coordinates(
+        ("rocker at the roller (cam contact)", "translation"), ("rocker rotation at the roller", "rotation"),
+        ("rocker shaft rotation", "rotation"), ("rocker pad / valve stem top / spring end", "translation"),
+        ("rocker rotation at the pad", "rotation"), ("valve head", "translation")) + spring.coordinates
+    n = len(coordinates)
+    members = {
+        "rocker_roller_arm": _member("beam", a, [1, 0, 2, 3], rocker, (0.0, 0.0), 0.0),
+        "rocker_valve_arm": _member("beam", b, [0, 4, 3, 5], rocker, (a, 0.0), 0.0),
+    } | spring.members | {"valve": _member("bar", valve_length, [-6, 4], valve, (a + b, -valve_length), 90.0)}
+    return {"coordinates": coordinates, "members": members, "cam": n + 1, "seat": n + 2,
+            "clearances": [_clearance("cam", 1, n + 1, "external"), _clearance("seat", 6, n + 2, "external")]
+            + spring.clearances, "closed": ["cam"], "preload": spring.preload, "ratio": b / a,
+            "follower_kind": "roller", "finger": geometry, "arrangement": "rocker"}
+
+
+BUILDERS = {OHV_PUSHROD: ohv_pushrod, DIRECT_ACTING: direct_acting, FINGER_FOLLOWER: finger_follower,
+            CENTRE_PIVOT_ROCKER: centre_pivot_rocker}
 
 
 def expand(doc: dict[str, Any], folder: Path | None = None) -> dict[str, Any]:
@@ -342,8 +388,8 @@ def expand(doc: dict[str, Any], folder: Path | None = None) -> dict[str, Any]:
     explicit = {key: value for key, value in doc.items() if key not in ("train", "initial")}
     explicit |= {"coordinates": built["coordinates"], "members": built["members"]}
     cam: dict[str, Any] = {"coordinate": built["cam"], "name": "cam", "offset": law.pop("offset", "static-start")}
-    if follower is not None and kind == FINGER_FOLLOWER:
-        follower |= {"arrangement": "finger"} | built["finger"] | {"lift": dict(law)}
+    if follower is not None and "finger" in built:
+        follower |= {"arrangement": built["arrangement"]} | built["finger"] | {"lift": dict(law)}
         cam |= finger_cam(follower, law, units, folder)
     else:
         cam |= law

@@ -32,9 +32,7 @@ from typing import Any
 
 from vtool.errors import InputError, PresetWarning
 from vtool.presets.fields import Table
-from vtool.presets.follower import dump_follower, load_checks, load_follower
 from vtool.presets.lift_table import read_lift_table
-from vtool.presets.trains import expand
 from vtool.solvers.backends import DEFAULT, available
 from vtool.solvers.model.assembly import split_members, unsplit_members
 from vtool.solvers.model.hertz import MIN_RESTITUTION, check_restitution
@@ -111,13 +109,15 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     """
     train = ""
     if isinstance(doc, dict) and "train" in doc:  # a train type: expanded to the explicit form first
+        from vtool.presets.trains import expand
+
         train = json.dumps(doc["train"])
         doc = expand(doc, folder)
     top = Table(doc, "")
     top.check_unknown(TOP_KEYS)
     top.string("kind", choices=("valvetrain",))
     title = top.string("title", default="")
-    notes = top.string("notes", default="")
+    notes = top.string("notes", default="", multiline=True)
     units_name = top.string("units", choices=tuple(UNIT_SYSTEMS))
     units = UNIT_SYSTEMS[units_name]
     gravity = _magnitude(top, "gravity", units.acceleration, "gravity", default=units.gravity)
@@ -142,16 +142,22 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     damping = _damping(damping_table, names)
     contact = _contact(top.table("contact", required=False))
     follower_table = top.table("follower", required=False)
-    follower = None if follower_table is None else load_follower(
-        follower_table, units, lambda t: _law(t, cam.coordinate, units, folder))
-    if follower is not None:
+    follower = None
+    if follower_table is not None:  # (modules imported only by presets that use them: a sweep loads often)
+        from vtool.presets.follower import load_follower
         from vtool.solvers.model.camshape import undercut_warning
+
+        follower = load_follower(follower_table, units, lambda t: _law(t, cam.coordinate, units, folder))
 
         undercut = undercut_warning(follower, follower.lift or cam)
         if undercut is not None:
             warnings.warn(PresetWarning(undercut), stacklevel=2)
     checks_table = top.table("checks", required=False)
-    checks = () if checks_table is None else load_checks(checks_table, units)
+    checks: tuple = ()
+    if checks_table is not None:
+        from vtool.presets.follower import load_checks
+
+        checks = load_checks(checks_table, units)
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)  # type: ignore[arg-type]
     top.finish()
     spec = MechanismSpec(
@@ -684,6 +690,8 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
     r = spec.run
     doc["run"] = _dump_run(r)
     if spec.follower is not None:
+        from vtool.presets.follower import dump_follower
+
         doc["follower"] = dump_follower(spec.follower, _law_doc)
     if spec.checks:
         doc["checks"] = {c.name: c.limit for c in spec.checks}

@@ -56,7 +56,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cache, lru_cache
 from importlib.metadata import EntryPoint, entry_points
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
 
 from vtool.errors import InputError
 from vtool.solvers.model.spec import DEFAULT_BACKEND
@@ -64,7 +64,7 @@ from vtool.solvers.model.spec import DEFAULT_BACKEND
 if TYPE_CHECKING:  # (numpy too: `vtool --help` imports this module and no numerics)
     import numpy as np
 
-    from vtool.solvers.model.contact import ContactProblem
+    from vtool.solvers.model.contact import ContactProblem, EventRules
     from vtool.solvers.model.mechanism import Mechanism
     from vtool.solvers.model.spec import MechanismSpec, RunSpec
     from vtool.solvers.trace import CsvStream, Trace, TraceBuilder
@@ -73,6 +73,8 @@ ENTRY_POINT_GROUP = "vtool.backends"
 
 Progress = Callable[[float], None]
 Cancel = Callable[[], bool]
+#: A back end's own frozen options dataclass (NewmarkOptions, ExactOptions, ...).
+OptionsT = TypeVar("OptionsT")
 
 
 @dataclass(frozen=True)
@@ -142,7 +144,7 @@ def module_of(name: str) -> str:
 
 
 @cache
-def get(name: str) -> type[Backend]:
+def get(name: str) -> type[Backend[Any]]:
     """The back-end class registered under ``name``."""
     ep = _entry_points().get(name)
     if ep is None:
@@ -150,7 +152,7 @@ def get(name: str) -> type[Backend]:
     return ep.load()  # type: ignore[no-any-return]
 
 
-class Backend(ABC):
+class Backend(ABC, Generic[OptionsT]):
     """Base class of every back end: see the contract in the module doc."""
 
     name: ClassVar[str]
@@ -183,21 +185,25 @@ class Backend(ABC):
 
     @staticmethod
     @abstractmethod
-    def options_from_run(run: RunSpec, every_step: bool = False) -> Any:
+    def options_from_run(run: RunSpec, every_step: bool = False) -> OptionsT:
         """The back end's options from a preset's run settings."""
 
-    def default_options(self, mechanism: Mechanism) -> Any:
+    def default_options(self, mechanism: Mechanism) -> OptionsT:
         return self.options_from_run(mechanism.spec.run)
 
-    def check(self, mechanism: Mechanism, options: Any) -> None:  # noqa: B027 (optional hook)
+    def check(self, mechanism: Mechanism, options: OptionsT) -> None:  # noqa: B027 (optional hook)
         """Raise InputError for settings the user can fix (default: none to check)."""
 
+    def event_rules(self, options: OptionsT) -> EventRules | None:
+        """The settings of the shared event rules from the options (None: the defaults)."""
+        return None
+
     @abstractmethod
-    def integrate(self, problem: ContactProblem, options: Any, builder: TraceBuilder,
+    def integrate(self, problem: ContactProblem, options: OptionsT, builder: TraceBuilder,
                   progress: Progress | None, cancel: Cancel | None) -> RunStats:
         """Run the contact problem into the builder; return the statistics (see the contract)."""
 
-    def simulate(self, mechanism: Mechanism, options: Any = None, progress: Progress | None = None,
+    def simulate(self, mechanism: Mechanism, options: OptionsT | None = None, progress: Progress | None = None,
                  cancel: Cancel | None = None, stream: CsvStream | None = None) -> Trace:
         from vtool.solvers.model.contact import ContactProblem, EventRules
         from vtool.solvers.trace import RunStatistics, TraceBuilder
@@ -205,9 +211,7 @@ class Backend(ABC):
 
         options = options if options is not None else self.default_options(mechanism)
         self.check(mechanism, options)
-        rules = EventRules(rest_velocity=getattr(options, "rest_velocity", None),
-                           zeno_stick=getattr(options, "zeno_stick", 20),
-                           zeno_stop=getattr(options, "zeno_stop", 400))
+        rules = self.event_rules(options) or EventRules()
         with limited():
             started = wallclock.perf_counter()
             problem = ContactProblem.for_run(mechanism, rules)

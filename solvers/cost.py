@@ -18,6 +18,15 @@ the CSV table and its text: measured 3.7 GB peak for 900,000 rows of 47
 values, which this counts as 2.9 GB), plus the ``2^n_c`` configuration tables
 of ``6 n²`` floats.
 
+A CSV file written as the run goes (``vtool solve --csv``) holds the output
+rows, or with ``--every-step`` one row per step: ``steps + 1`` rows of
+``columns`` values, :data:`CSV_BYTES_PER_VALUE` characters each (measured:
+2.72 GB for the 6.04e6 steps of 3600 degrees of 1A at 100 rev/min, 42
+values a row, 10.7 characters a value). A streamed every-step run keeps
+only the interval rows in memory, so its memory estimate stays small while
+its file grows by the step: the file has its own estimate (``file_bytes``) and
+its own limit (:data:`MAX_FILE_BYTES`).
+
 :func:`check` refuses a run above its back end's step limit
 (:func:`max_steps_for`) or :data:`MAX_BYTES` bytes with one line giving the
 estimate and how to proceed (``--max-steps``, fewer degrees, a coarser step
@@ -43,6 +52,8 @@ from vtool.units import cam_speed
 
 #: Default largest number of steps (or samples) of one run.
 MAX_STEPS = 5e7
+#: Largest --max-steps a user may ask for.
+LARGEST_MAX_STEPS = 1e12
 #: ... of a scipy run (module doc: a sample costs about 160 Newmark steps).
 MAX_SCIPY_STEPS = 5e5
 #: Default largest memory of one run's output (bytes).
@@ -52,6 +63,10 @@ SAMPLES_PER_PERIOD = 16.0
 BYTES_PER_FLOAT = 8
 #: Bytes per output value over the whole run: float copies (8 x 6) and about 20 characters of CSV.
 BYTES_PER_VALUE = 8 * 6 + 20
+#: Characters per value of a CSV row (``'%.10g'`` and its comma; measured 10.7, see the module doc).
+CSV_BYTES_PER_VALUE = 11
+#: Default largest CSV file a run writes (bytes).
+MAX_FILE_BYTES = 2e9
 
 
 @dataclass(frozen=True)
@@ -63,16 +78,22 @@ class Estimate:
     rows: float
     bytes: float
     t_end: float  # s
+    file_rows: float = 0.0  # rows of the CSV file written as the run goes (0: none)
+    file_bytes: float = 0.0
 
     def describe(self) -> str:
-        return (f"{self.steps:.3g} steps, {self.rows:.3g} output rows, about "
-                f"{self.bytes / 1e6:,.0f} MB")
+        text = f"{self.steps:.3g} steps, {self.rows:.3g} output rows, about {self.bytes / 1e6:,.0f} MB"
+        if self.file_rows:
+            text += f" in memory and {self.file_bytes / 1e6:,.0f} MB of CSV ({self.file_rows:.3g} rows)"
+        return text
 
 
 def estimate(*, backend: str, rpm: float, degrees: float, time_step: float, output_interval: float,
              every_step: bool, omega_max: float, n_coordinates: int, n_sources: int,
-             n_clearances: int, n_quantities: int = 0) -> Estimate:
-    """The cost of one run (see module doc); all inputs in the preset's units."""
+             n_clearances: int, n_quantities: int = 0, csv: bool = False, csv_every_step: bool = False) -> Estimate:
+    """The cost of one run (see module doc); all inputs in the preset's units. ``every_step``: rows at every
+    step in memory; ``csv``: a CSV file is written as the run goes, with a row at every step if
+    ``csv_every_step``."""
     omega = cam_speed(rpm)
     t_end = math.radians(degrees) / omega if omega > 0 else math.inf
     if backends.get(backend).fixed_step:
@@ -83,7 +104,9 @@ def estimate(*, backend: str, rpm: float, degrees: float, time_step: float, outp
     columns = 3 * (n_coordinates + n_sources) + n_clearances + 2 + n_quantities
     tables = 2.0**n_clearances * 6 * n_coordinates**2
     size = rows * columns * BYTES_PER_VALUE + tables * BYTES_PER_FLOAT
-    return Estimate(backend, steps, rows, size, t_end)
+    file_rows = (steps + 1 if csv_every_step else degrees / output_interval + 1) if csv else 0.0
+    file_bytes = file_rows * (columns + 2) * CSV_BYTES_PER_VALUE  # (+ the configuration's two text cells)
+    return Estimate(backend, steps, rows, size, t_end, file_rows, file_bytes)
 
 
 class CostError(InputError):
@@ -103,8 +126,13 @@ class CostError(InputError):
             return (f"run too short: {c.t_end:.3g} s of motion is less than one time step ({c.backend}); "
                     "to proceed: more --degrees or a smaller --dt")
         if self.what == "steps":
+            allow = (f", or --max-steps {math.ceil(c.steps):d}" if c.steps <= LARGEST_MAX_STEPS
+                     else f" (more than the largest --max-steps, {LARGEST_MAX_STEPS:.0e})")
             limit = (f"more than the limit of {self.max_steps:.3g} steps; to proceed: fewer --degrees, "
-                     f"a higher --rpm, a larger --dt (fixed-step back ends), or --max-steps {math.ceil(c.steps):d}")
+                     f"a higher --rpm, a larger --dt (fixed-step back ends){allow}")
+        elif self.what == "file":
+            limit = (f"more than the limit of {MAX_FILE_BYTES / 1e9:g} GB of CSV; to proceed: fewer --degrees, "
+                     "a larger --dt, or no --every-step (a row every output interval)")
         else:
             limit = (f"more than the limit of {self.max_bytes / 1e9:g} GB of output; to proceed: fewer "
                      "--degrees, a larger run.output_interval, or no --every-step")
@@ -127,4 +155,6 @@ def check(cost: Estimate, max_steps: float | None = None, max_bytes: float | Non
         raise CostError(cost, max_steps, max_bytes, "steps")
     if not cost.bytes <= max_bytes:
         raise CostError(cost, max_steps, max_bytes, "memory")
+    if not cost.file_bytes <= MAX_FILE_BYTES:
+        raise CostError(cost, max_steps, max_bytes, "file")
     return cost

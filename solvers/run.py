@@ -34,8 +34,9 @@ CANONICAL_RUN = RunSpec(rpm=1.0, degrees=1.0, time_step=1.0)  # the run settings
 NUMERICAL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError)
 
 
-def run_cost(mechanism: Mechanism, every_step: bool = False) -> cost.Estimate:
-    """The estimated steps and memory of the spec's run on this mechanism."""
+def run_cost(mechanism: Mechanism, every_step: bool = False, csv: bool = False,
+             csv_every_step: bool = False) -> cost.Estimate:
+    """The estimated steps, memory and CSV size of the spec's run on this mechanism (:func:`cost.estimate`)."""
     spec = mechanism.spec
     r = spec.run
     omega_max = mechanism.highest_frequency
@@ -43,7 +44,8 @@ def run_cost(mechanism: Mechanism, every_step: bool = False) -> cost.Estimate:
     return cost.estimate(backend=r.backend, rpm=r.rpm, degrees=run_degrees(spec), time_step=r.time_step,
                          output_interval=r.output_interval, every_step=every_step, omega_max=omega_max,
                          n_coordinates=spec.n_coordinates, n_sources=n_sources,
-                         n_clearances=len(spec.clearances), n_quantities=len(r.quantities))
+                         n_clearances=len(spec.clearances), n_quantities=len(r.quantities), csv=csv,
+                         csv_every_step=csv_every_step)
 
 
 #: Assembled mechanisms kept per thread (the last few specs, run settings aside): a second run of
@@ -140,7 +142,8 @@ def simulate(
     backend = backends.get(spec.run.backend)()
     mechanism = _assemble(spec)
     in_memory_every_step = every_step and not (stream is not None and stream.thin)
-    cost.check(run_cost(mechanism, in_memory_every_step), max_steps, max_bytes)
+    cost.check(run_cost(mechanism, in_memory_every_step, csv=stream is not None, csv_every_step=every_step),
+               max_steps, max_bytes)
     for message in run_warnings(mechanism):
         warnings.warn(PresetWarning(message), stacklevel=2)
     if options is None:

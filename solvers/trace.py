@@ -93,10 +93,13 @@ class RunStatistics:
 class Cycles:
     """How a cycle-by-cycle run went (:mod:`vtool.solvers.studies.steady`); the trace holds every cycle.
 
-    ``settled`` is None for a fixed number of cycles (``run.cycles``); ``change`` is the largest relative
-    change from the cycle before to the last one, ``changed`` what moved that much; ``changes`` is that
-    change after each cycle (the first has none: NaN). ``peaks`` are the every-step peak contact forces
-    over the evaluated (last) cycle, ``startup_peaks`` over the first.
+    ``settled`` is None for a fixed number of cycles (``run.cycles``). ``period`` is the number of cycles
+    after which the motion repeats (1; 2 or more for a subharmonic orbit, whose last ``period`` cycles are
+    evaluated). ``change`` is the largest relative change of the continuous measures from the cycle a
+    period before to the last one, ``changed`` what moved that much, ``events_changed`` how the events per
+    clearance differ ("" when they repeat); ``changes`` is the cycle-to-cycle change after each cycle
+    (the first has none: NaN; inf where the events differ). ``peaks`` are the every-step peak contact
+    forces over the evaluated cycles, ``startup_peaks`` over the first (NaN after a periodic start).
     """
 
     count: int
@@ -108,22 +111,35 @@ class Cycles:
     peaks: np.ndarray
     startup_peaks: np.ndarray
     max_cycles: int = 0
+    period: int = 1
+    events_changed: str = ""
 
     @property
     def window(self) -> tuple[float, float]:
-        """The evaluated cycle's cam angles (deg): the last cycle."""
-        return 360.0 * (self.count - 1), 360.0 * self.count
+        """The evaluated cycles' cam angles (deg): the last ``period`` cycles."""
+        return 360.0 * (self.count - self.period), 360.0 * self.count
 
     def text(self) -> str:
-        """One line: which cycle is evaluated and whether the run settled."""
-        where = f"cycle {self.count} of {self.count} (cam angle {360.0 * (self.count - 1):g}-{360.0 * self.count:g} deg)"
-        moved = "" if self.count < 2 else f"; the last cycle changed by {self.change:.3g} ({self.changed})"
+        """One line: which cycles are evaluated and whether the run settled."""
+        start, end = self.window
+        which = (f"cycle {self.count} of {self.count}" if self.period == 1 else
+                 f"cycles {self.count - self.period + 1}-{self.count} of {self.count}")
+        where = f"{which} (cam angle {start:g}-{end:g} deg)"
+        before = "the cycle before" if self.period == 1 else f"the cycle {self.period} before"
+        moved = "" if self.count < 2 else f"; the last cycle changed by {self.change:.3g} from {before} ({self.changed})"
+        events = f"; events per cycle still change ({self.events_changed})" if self.events_changed else ""
         if self.settled is None:
-            return f"evaluated: {where}, a fixed number of cycles (run.cycles){moved}"
+            return f"evaluated: {where}, a fixed number of cycles (run.cycles){moved}{events}"
         if self.settled:
-            return f"evaluated: {where}, settled to {self.tolerance:g}{moved}"
-        return (f"warning: did not settle in {self.count} cycles (run.steady max_cycles = {self.max_cycles}): "
-                f"evaluated {where}{moved}, above the tolerance {self.tolerance:g}")
+            period = "" if self.period == 1 else f" repeating every {self.period} cycles (a subharmonic orbit),"
+            return f"evaluated: {where},{period} settled to {self.tolerance:g}{moved}"
+        return (f"warning: did not settle in {self.count} cycles (run.steady max_cycles = {self.max_cycles}), "
+                f"nor repeat every 2 to {MAX_PERIOD} cycles: evaluated {where}{moved}{events}, above the "
+                f"tolerance {self.tolerance:g}")
+
+
+#: the longest period (in cam cycles) a steady run looks for
+MAX_PERIOD = 4
 
 
 @dataclass(frozen=True)
@@ -221,9 +237,34 @@ class Trace:
         return self.coordinate_unit(int(re.findall(r"\d+", text)[0]))
 
     # ----- export -----
+    def valve_coordinate(self) -> int | None:
+        """The number of the coordinate that seats (ahead of the seat clearance), or None without a seat."""
+        seat = self.spec.seat
+        if seat is None:
+            return None
+        for c in self.spec.clearances:
+            if c.kind == EXTERNAL and c.behind == seat.coordinate and c.ahead in self.coordinate_numbers:
+                return c.ahead
+        return None
+
+    def valve_lift(self, rows: slice = slice(None)) -> np.ndarray:
+        """Valve lift off its seat: the seat clearance's gap ``q_valve - q_seat`` (length; 0 when seated)."""
+        valve = self.valve_coordinate()
+        if valve is None or self.spec.seat is None:
+            raise KeyError("valve_lift")
+        seat = self.spec.seat.coordinate
+        if seat in self.coordinate_numbers:
+            return self.coordinate(valve, rows) - self.coordinate(seat, rows)
+        return self.coordinate(valve, rows) - self.spec.seat.position
+
     def csv_columns(self, quantities: tuple[str, ...] = ()) -> tuple[list[str], list]:  # type: ignore[type-arg]
         """The CSV header (quantity names with units) and one function per numeric column that gives
-        the column's values on a slice of rows (so a long run is written block by block)."""
+        the column's values on a slice of rows (so a long run is written block by block).
+
+        Every name is unique: a preset quantity that is already a column (``q9``, ``F1``: the thesis
+        presets list seven) or is listed twice is written once. ``valve_lift`` (the seat clearance's
+        gap, :meth:`valve_lift`) follows the contact forces when the preset has a seat.
+        """
         units = self.spec.unit_system
         header = ["time (s)", "cam_angle (deg)"]
         columns: list = [lambda rows: self.time[rows], lambda rows: self.cam_angle[rows]]
@@ -235,8 +276,16 @@ class Trace:
         for i in range(len(self.spec.clearances)):
             header.append(f"{self.force_label(i)} ({units.force})")
             columns.append(lambda rows, i=i: self.contact_force[rows, i])
+        if self.valve_coordinate() is not None:
+            header.append(f"valve_lift ({units.length})")
+            columns.append(self.valve_lift)
+        names = {h.rpartition(" (")[0] for h in header}
         for expression in quantities:
-            header.append(f"{expression} ({self.quantity_unit(expression)})")
+            name = expression.replace(" ", "")
+            if name in names:
+                continue
+            names.add(name)
+            header.append(f"{name} ({self.quantity_unit(expression)})")
             columns.append(lambda rows, expression=expression: self.quantity(expression, rows))
         if self.spec.follower is not None:  # cam contact stress at each row (solvers/model/camstress.py)
             from vtool.solvers.model.camstress import row_unit, stress_rows
@@ -251,8 +300,11 @@ class Trace:
 
     def configuration_csv(self, mask: int) -> str:
         """The last two CSV columns of a configuration: its thesis number (or nothing) and closed clearances."""
+        from vtool.csvrows import csv_text
+
         number = thesis_number(self.spec, mask)
-        return f"{'' if number is None else number},{'+'.join(closed_names(self.spec, mask)) or 'none'}"
+        return csv_text([["" if number is None else number,
+                          "+".join(closed_names(self.spec, mask)) or "none"]]).removesuffix("\n")
 
     def write_csv_to(self, handle, quantities: tuple[str, ...] = (), chunk: int = 20_000,  # type: ignore[no-untyped-def]
                      header: bool = True, compiled: bool | None = None) -> None:

@@ -32,7 +32,7 @@ class RK4Options:
     time_tolerance: float = 1e-12  # s, event location
 
 
-class RK4Backend(Backend):
+class RK4Backend(Backend[RK4Options]):
     """Fixed-step RK4 between events (rigid and linear contacts)."""
 
     name = "rk4-test"

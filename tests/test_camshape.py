@@ -94,43 +94,58 @@ def test_roller_undercut_where_the_pitch_radius_is_below_the_roller() -> None:
 
 FINGER = FollowerSpec("roller", "finger", 16.0, 10.0, roller_radius=9.0,
                       finger=FingerSpec(roller_arm=20.0, valve_arm=36.0, roller_height=2.0, cam_offset=1.5))
+ROCKER = FollowerSpec("roller", "rocker", 16.0, 10.0, roller_radius=9.0,
+                      finger=FingerSpec(roller_arm=30.0, valve_arm=45.0, roller_height=2.0, cam_offset=1.0))
 
 
-def direct_finger(law: CamSpec, theta: float) -> tuple[float, float]:
+def lever_points(follower: FollowerSpec) -> tuple[np.ndarray, np.ndarray]:
+    """Roller centre Q0 and cam centre C at the base circle, as FingerSpec's docstring places them."""
+    f = follower.finger
+    R0 = follower.base_radius + follower.roller_radius
+    if follower.arrangement == "rocker":  # roller beyond the pivot, cam below it (y down)
+        Q0 = np.array([-f.roller_arm, f.roller_height])
+        return Q0, Q0 + np.array([-f.cam_offset, math.sqrt(R0**2 - f.cam_offset**2)])
+    Q0 = np.array([f.roller_arm, -f.roller_height])
+    return Q0, Q0 + np.array([f.cam_offset, -math.sqrt(R0**2 - f.cam_offset**2)])
+
+
+def direct_lever(follower: FollowerSpec, law: CamSpec, theta: float) -> tuple[float, float]:
     """(valve lift, roller radial lift) at cam angle θ by bracketing the contact condition (no Newton)."""
-    f = FINGER
-    R0 = f.base_radius + f.roller_radius
-    Q0 = np.array([20.0, -2.0])
-    C = Q0 + np.array([1.5, -math.sqrt(R0**2 - 1.5**2)])
+    R0 = follower.base_radius + follower.roller_radius
+    Q0, C = lever_points(follower)
     ref = math.atan2(*(Q0 - C)[::-1])
 
+    def roller(phi: float) -> np.ndarray:
+        return np.array([Q0[0] * math.cos(phi) - Q0[1] * math.sin(phi), Q0[0] * math.sin(phi) + Q0[1] * math.cos(phi)])
+
     def gap(phi: float) -> float:
-        Q = np.array([Q0[0] * math.cos(phi) - Q0[1] * math.sin(phi), Q0[0] * math.sin(phi) + Q0[1] * math.cos(phi)])
-        d = Q - C
+        d = roller(phi) - C
         delta = math.atan2(d[1], d[0]) - ref
         return math.hypot(*d) - R0 - float(law_derivatives(law, np.array([theta - delta]))[0, 0])
 
     phi = brentq(gap, -0.2, 0.8, xtol=1e-16, rtol=1e-15)
-    Q = np.array([Q0[0] * math.cos(phi) - Q0[1] * math.sin(phi), Q0[0] * math.sin(phi) + Q0[1] * math.cos(phi)])
-    return 36.0 * math.sin(phi), math.hypot(*(Q - C)) - R0
+    return follower.finger.valve_arm * math.sin(phi), math.hypot(*(roller(phi) - C)) - R0
 
 
+@pytest.mark.parametrize("follower", [FINGER, ROCKER], ids=["end-pivot finger", "centre-pivot rocker"])
 @pytest.mark.parametrize("angle_deg", [-60.0, -40.0, -25.0, 20.0, 45.0, 65.0])
-def test_finger_ratio_matches_a_finite_difference_of_the_direct_geometry(angle_deg: float) -> None:
+def test_finger_ratio_matches_a_finite_difference_of_the_direct_geometry(follower: FollowerSpec,
+                                                                         angle_deg: float) -> None:
     law = polydyne(lift=6.0)
     theta = math.radians(angle_deg)
-    c = contact(FINGER, law, np.array([theta]))
-    V, _ = direct_finger(law, theta)
+    c = contact(follower, law, np.array([theta]))
+    V, _ = direct_lever(follower, law, theta)
     assert c.valve_lift[0] == pytest.approx(V, abs=1e-10)
 
     def ratio(h: float) -> float:
-        (v1, u1), (v0, u0) = direct_finger(law, theta + h), direct_finger(law, theta - h)
+        (v1, u1), (v0, u0) = direct_lever(follower, law, theta + h), direct_lever(follower, law, theta - h)
         return (v1 - v0) / (u1 - u0)
 
     h = 2e-3
     richardson = (4.0 * ratio(h / 2) - ratio(h)) / 3.0
     assert c.ratio[0] == pytest.approx(richardson, rel=1e-8)
-    assert 1.5 < c.ratio[0] < 2.2  # about valve_arm / roller_arm, varying with the angle
+    nominal = follower.finger.valve_arm / follower.finger.roller_arm
+    assert 0.8 * nominal < c.ratio[0] < 1.2 * nominal  # about the arm ratio, varying with the angle
 
 
 def test_finger_ratio_varies_and_model_lift_is_the_valve_lift_over_the_nominal_ratio() -> None:

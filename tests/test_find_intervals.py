@@ -44,7 +44,8 @@ def check_edges(criterion: str, make_spec, result, step: float, reach: float,  #
                 upper: bool = True) -> None:
     """Around every bisected edge a fine scan (``step`` rev/min, ``reach`` either side) has its own edge (the
     lowest speed that holds for a lower edge, the highest for an upper one) within two steps of it: an edge
-    can be ragged on a scale below the step (1A's bounce ends at 12,165 rev/min but holds again at 12,185)."""
+    can be ragged on a scale below the step (where 1A's bounces end, near 12,000 rev/min, they stop and
+    start again within tens of rev/min)."""
     for interval in result.intervals:
         for edge, lower in ((interval.low, True), (interval.high, False)):
             if (interval.below if lower else interval.above) is None or not (lower or upper):
@@ -71,9 +72,10 @@ def test_two_windows_of_contact_loss_are_two_intervals_each_where_a_fine_scan_pu
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["gnilka-1a", "ramped-cam", "ohv-pushrod-1a"])
+@pytest.mark.parametrize("name", ["gnilka-1a", "ramped-cam", "ohv-pushrod-1a", "direct-acting-bucket",
+                                  "ohc-finger-follower"])
 def test_jump_speed_is_the_lowest_speed_a_brute_force_scan_shows_the_follower_off_the_cam(name: str) -> None:
-    """The thesis mechanism, the ramped cam and the train-type preset (ohv-pushrod-1a)."""
+    """The thesis mechanism, the ramped cam and the train-type presets."""
     make = preset_at(name)
     result = find_speed("jump-speed", make, list(range(1000, 20001, 1000)), SerialRunner())
     assert result.speed is not None
@@ -91,5 +93,88 @@ def test_the_bounce_speed_of_gnilka_1a_is_found_and_where_a_fine_scan_puts_it() 
     make = preset_at("gnilka-1a")
     result = find_speed("bounce-speed", make, list(range(1000, 20001, 1000)), SerialRunner())
     assert result.speed is not None and 1000 < result.speed < 5000
-    # the bounce speed (the lower edge); the upper end, near 12,200 rev/min, is ragged over 100 rev/min
+    # the bounce speed (the lower edge); the upper end, near 12,000 rev/min, is ragged over hundreds of rev/min
     check_edges("bounce-speed", make, result, step=20.0, reach=60.0, upper=False)
+
+
+def test_cli_find_writes_every_interval_to_csv_and_json(tmp_path) -> None:  # noqa: ANN001
+    """1A's bounce over 2,000-13,000 rev/min in 5,500 steps: one interval bisected at both ends, in the
+    CSV's intervals column and the JSON's intervals list, equal to find_speed's."""
+    import csv
+    import json
+
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    out = tmp_path / "find.csv"
+    args = ["sweep", "gnilka-1a", "--find", "bounce-speed", "--set", "run.rpm=2000,7500,13000", "--workers", "1"]
+    written = CliRunner().invoke(cli, args + ["--csv", str(out)])
+    assert written.exit_code == 0, written.output
+    header, row = list(csv.reader(out.read_text().splitlines()))
+    assert header == ["bounce_speed (rev/min)", "intervals (rev/min)", "message"]
+    result = find_speed("bounce-speed", preset_at("gnilka-1a"), [2000, 7500, 13000], SerialRunner())
+    (interval,) = result.intervals
+    assert row[1] == f"{interval.low:g}-{interval.high:g}" and row[0] == f"{result.speed:g}"
+    assert interval.below is not None and interval.above is not None  # both ends bracketed and bisected
+    shown = CliRunner().invoke(cli, args + ["--json"])
+    searches = json.loads(shown.stdout)["searches"]
+    assert searches[0]["intervals"] == [{"low_rpm": interval.low, "high_rpm": interval.high,
+                                         "below_rpm": interval.below, "above_rpm": interval.above}]
+
+
+class PatternRunner:
+    """A runner (the sweep's runner interface) that runs nothing: a point "holds" when its speed lies in one
+    of the given integer intervals, so that find_speed's bracketing and bisection can be checked on any
+    pattern of contact loss."""
+
+    workers = 1
+
+    def __init__(self, intervals: list[tuple[int, int]]) -> None:
+        self.intervals = intervals
+        self.runs = 0
+
+    def holds(self, rpm: float) -> bool:
+        return any(a <= rpm <= b for a, b in self.intervals)
+
+    def run(self, batches, every_step, on_results, cancel) -> bool:  # noqa: ANN001
+        from vtool.solvers.studies.sweep import PointResult
+
+        for batch in batches:
+            self.runs += len(batch)
+            on_results([PointResult(p.index, p.values, {"cam_separations": int(self.holds(dict(p.values)["run.rpm"]))})
+                        for p in batch])
+        return True
+
+
+def test_every_interval_a_scan_touches_is_found_with_exact_edges() -> None:
+    """Property (hypothesis): for any set of disjoint integer speed intervals whose edges fall between
+    different pairs of neighbouring scanned speeds (one change of state per bracket), every interval is
+    reported with its exact edges (tolerance 1 rev/min), and no other."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    spec = load_preset("gnilka-1a")
+    scan = list(range(1000, 20001, 1000))
+    brackets = st.lists(st.integers(0, len(scan) - 2), max_size=8, unique=True).map(sorted)
+
+    @st.composite
+    def patterns(draw) -> list[tuple[int, int]]:  # noqa: ANN001
+        """Changes of state at t = first speed of the new state, one in each chosen (scan[i], scan[i + 1]]."""
+        chosen = draw(brackets)
+        changes = [scan[i] + draw(st.integers(1, scan[i + 1] - scan[i])) for i in chosen]
+        changes = changes[: len(changes) // 2 * 2]
+        return [(changes[i], changes[i + 1] - 1) for i in range(0, len(changes), 2)]
+
+    @settings(max_examples=60, deadline=None)
+    @given(patterns())
+    def check(intervals: list[tuple[int, int]]) -> None:
+        runner = PatternRunner(intervals)
+        result = find_speed("jump-speed", lambda rpm: spec, scan, runner, bisector=runner)
+        assert [(i.low, i.high) for i in result.intervals] == intervals
+        for i in result.intervals:
+            assert i.below == i.low - 1 and i.above == i.high + 1  # bracketed to 1 rev/min either side
+        assert result.speed == (intervals[0][0] if intervals else None)
+        assert runner.runs <= len(scan) + 2 * len(intervals) * 10  # 10 bisections an edge: log2(1000)
+
+    check()

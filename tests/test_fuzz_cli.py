@@ -209,13 +209,17 @@ def test_a_read_only_folder_is_one_line(tmp_path: Path) -> None:
     assert result.exit_code == 2 and "read-only" in one_error_line(result)
 
 
-def test_a_symlink_is_written_through_and_kept(tmp_path: Path) -> None:
+def test_a_symlink_is_refused_and_kept(tmp_path: Path) -> None:
+    """Never written through (issue 37: a link planted in a shared folder redirected the write)."""
+    from vtool.errors import InputError
+
     real = tmp_path / "real.csv"
     real.write_text("old\n")
     link = tmp_path / "link.csv"
     link.symlink_to(real)
-    write_atomic(link, "new\n")
-    assert link.is_symlink() and real.read_text() == "new\n"
+    with pytest.raises(InputError, match="not a symbolic link"):
+        write_atomic(link, "new\n")
+    assert link.is_symlink() and real.read_text() == "old\n"
 
 
 def test_a_full_disk_is_a_run_error_and_leaves_the_old_file(tmp_path: Path, monkeypatch) -> None:  # type: ignore[no-untyped-def]

@@ -200,3 +200,52 @@ def test_an_undercut_cam_warns_on_loading() -> None:
     doc["train"]["follower"]["base_radius"] = 10.0
     with pytest.warns(PresetWarning, match="undercuts at law angles"):
         load_document(doc)
+
+
+def rocker_doc() -> dict:
+    """ohc-finger-follower's parts on a centre-pivot roller rocker (a shaft instead of the finger's pivot)."""
+    doc = _doc("ohc-finger-follower")
+    train = doc["train"]
+    train["type"] = "centre-pivot-rocker"
+    del train["finger"], train["pivot"]
+    train["rocker"] = {"roller_arm": 30.0, "valve_arm": 45.0, "roller_height": 2.0, "cam_offset": 1.0,
+                       "area": 80.0, "inertia": 1500.0, "modulus": 2.05e5, "density": 9e-9}
+    doc["run"]["quantities"] = ["q6", "F1"]
+    return doc
+
+
+def test_centre_pivot_rocker_follows_its_geometric_valve_lift_on_every_back_end() -> None:
+    from vtool.solvers.backends import available
+    from vtool.solvers.model.camshape import contact
+    from vtool.solvers.model.lash import base_and_ratio
+
+    spec = load_document(rocker_doc())
+    assert spec.follower.arrangement == "rocker" and spec.initial.lever_ratio == 1.5
+    assert [c.name for c in spec.clearances] == ["cam", "seat"]
+    # the model's lever: the roller coordinate moves 1/1.5 of the valve's, up to the beams' bending
+    assert base_and_ratio(spec)[1] == pytest.approx(1 / 1.5, rel=1e-3)
+    # and the cam coordinate is the geometric valve lift over that ratio
+    angles = np.array(spec.cam.angles)
+    c = contact(spec.follower, spec.lift_law, np.radians(angles))
+    lift = c.valve_lift / 1.5
+    np.testing.assert_allclose(np.array(spec.cam.lifts), lift - lift.min(), atol=1e-12)
+    assert np.ptp(c.ratio[c.lift > 0.5]) > 0.005  # the ratio varies with the angle
+    from vtool.presets.valvetrain import with_run_overrides
+
+    traces = [simulate(with_run_overrides(spec, degrees=120.0, backend=b)) for b in available()]
+    assert len({tuple((e.clearance, e.kind) for e in t.events) for t in traces}) == 1
+    assert all("cam contact (Hertz" in t.summary_text() for t in traces)
+
+
+def test_compare_and_size_take_a_train_preset() -> None:
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    runner = CliRunner()
+    result = runner.invoke(cli, ["compare", "direct-acting-bucket", "--impact", "local,thesis", "--degrees", "200"])
+    assert result.exit_code == 0, result.output
+    assert "local" in result.output and "thesis" in result.output and "(mm/s)" in result.output
+    result = runner.invoke(cli, ["size", "direct-acting-bucket", "--rpm-max", "3000", "--max-elements", "2"])
+    assert result.exit_code == 0, result.output
+    assert "harmonics" in result.output and "valve_spring" in result.output

@@ -119,15 +119,15 @@ async def test_opens_on_valvetrain_and_1a_run_draws_the_library_charts() -> None
             expected.summary_text() + "\n\n" + "\n".join(evaluation_summary(expected)["lines"]))
         # the order spectrum of the seat force (F7) over the evaluated cycle, as the library computes it
         from vtool.app.order_charts import order_chart
-        from vtool.solvers.studies.orders import natural_frequencies, spectrum
+        from vtool.solvers.studies.orders import dominant_text, natural_frequencies, spectrum
 
         screen.tabs.active = "tab-orders"
         await pilot.pause()
         w, h = screen.order_chart.chart_size
         orders = spectrum(expected, "F7")
         frequencies = natural_frequencies(expected)
-        assert screen.order_chart.chart_text == orders.table(6) + "\n" + order_chart(
-            orders, frequencies, width=w, height=max(h - 10 - len(frequencies), 8), color=False)
+        assert screen.order_chart.chart_text == orders.table(6) + "\n" + dominant_text(orders, frequencies) + "\n" + \
+            order_chart(orders, frequencies, width=w, height=max(h - 11 - len(frequencies), 8), color=False)
         assert "F7 in cam orders over 1 cycle (cam angle 360-720 deg" in screen.order_chart.chart_text
         kinds = [type(m) for m in screen.messages_seen]
         assert kinds[-1] is SimulationFinished

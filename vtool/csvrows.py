@@ -32,8 +32,10 @@ is imported only when its kernel is worth it (:func:`choose`).
 
 from __future__ import annotations
 
+import csv
+import io
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Sequence
 from types import ModuleType
 from typing import Any
 
@@ -206,3 +208,11 @@ def compile_notice() -> str | None:
 
     return (f"compiling the CSV writer, once (about {compile_estimate.about(COMPILE_REFERENCE_S)} s); "
             "later runs load it from the cache")
+
+
+def csv_text(rows: Iterable[Sequence[object]]) -> str:
+    """Rows of cells as CSV text (``\\n`` line ends), quoted by the csv module wherever a cell holds a
+    comma, a quote or a line break: the one way vtool writes a CSV row that holds text."""
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="\n").writerows(rows)
+    return buffer.getvalue()

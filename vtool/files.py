@@ -2,12 +2,19 @@
 
 :func:`write_atomic` writes a temporary file beside the target and renames it
 over the target, so an existing file is either replaced whole or left intact
-(also under SIGINT; SIGKILL can leave the hidden temporary, which the next
-write to the same path removes). It refuses, in one line
-(:class:`vtool.errors.InputError`), a missing or read-only folder, a folder or
-a device node at the output path, and an empty path; a symlink is written
-through to its target (the link itself is kept). A failure while writing (a
-full disk) is a :class:`vtool.errors.RunError`; nothing partial is left.
+(also under SIGINT and SIGTERM, which the CLI turns into the same interrupt:
+:func:`vtool.app.cli.main.main`; SIGKILL can leave the hidden temporary, which
+the next write to the same path removes). :func:`check_output_path` is the one
+check of an output path, run by every command before any work: it refuses, in
+one line (:class:`vtool.errors.InputError`), an empty path, a missing or
+read-only folder, and a folder, device, FIFO, socket or symbolic link at the
+path. A symbolic link is never followed: vtool opens files with ``O_NOFOLLOW``
+and renames over the path itself, so a link another user plants in a shared
+folder cannot redirect a write onto someone else's file (give the link's
+target instead). A rewritten file keeps its permission bits (a 0600 file
+stays 0600); a new one gets 0644 masked by the umask. A failure while
+writing (a full disk) is a :class:`vtool.errors.RunError`; nothing partial is
+left.
 
 :func:`is_file`, :func:`is_dir`, :func:`exists` and :func:`is_symlink` probe a path a user
 typed: a path the system cannot even look up (a name over 255 bytes, a NUL,
@@ -97,29 +104,55 @@ def clean_stale_temporaries(path: str | os.PathLike[str]) -> list[Path]:
 
 
 def check_output_path(path: str | os.PathLike[str], field: str = "output") -> Path:
-    """The real file to write for ``path`` (symlinks followed), or a one-line InputError."""
+    """``path`` if vtool may write a file there (see the module doc), else a one-line InputError."""
     if str(path) == "":
         raise InputError(field, "", "a file path")
     path = Path(path)
-    target = Path(os.path.realpath(path)) if is_symlink(path) else path
-    directory = target.parent if str(target.parent) else Path(".")
+    directory = path.parent if str(path.parent) else Path(".")
     if not is_dir(directory):
         raise InputError(field, str(path), f"a file in an existing folder ({directory} does not exist)")
     if not os.access(directory, os.W_OK | os.X_OK):
         raise InputError(field, str(path), f"a file in a writable folder ({directory} is read-only)")
     try:
-        mode = target.stat().st_mode
+        mode = path.lstat().st_mode
     except FileNotFoundError:
-        return target
-    except OSError as exc:
-        raise InputError(field, str(path), f"a writable file path ({exc.strerror})") from None
+        return path
+    except (OSError, ValueError) as exc:
+        reason = getattr(exc, "strerror", None) or "not a usable path"
+        raise InputError(field, str(path), f"a writable file path ({reason})") from None
+    if stat.S_ISLNK(mode):
+        raise InputError(field, str(path), "a file path that is not a symbolic link (vtool does not write "
+                         "through links; give the link's target)")
     if stat.S_ISDIR(mode):
         raise InputError(field, str(path), "a file path, not a folder")
     if not stat.S_ISREG(mode):
         raise InputError(field, str(path), "a regular file path (not a device, pipe or socket)")
-    if not os.access(target, os.W_OK):
+    if not os.access(path, os.W_OK):
         raise InputError(field, str(path), "a writable file (this one is read-only)")
-    return target
+    return path
+
+
+def open_no_follow(path: str | os.PathLike[str], flags: int, field: str = "output") -> int:
+    """``os.open`` that refuses a symbolic link as the last component (``O_NOFOLLOW``), in one line."""
+    try:
+        return os.open(path, flags | os.O_NOFOLLOW | getattr(os, "O_CLOEXEC", 0), 0o644)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise InputError(field, str(path), "a file path that is not a symbolic link") from None
+        raise InputError(field, str(path), f"a writable file path ({exc.strerror})") from None
+
+
+def output_mode(path: str | os.PathLike[str]) -> int:
+    """Permission bits for a file written at ``path``: the existing regular file's, else 0644 & ~umask."""
+    try:
+        st = os.lstat(path)
+        if stat.S_ISREG(st.st_mode):
+            return stat.S_IMODE(st.st_mode)
+    except OSError:
+        pass
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o644 & ~umask
 
 
 def write_atomic(path: str | os.PathLike[str], text: str, field: str = "output") -> None:
@@ -141,7 +174,7 @@ def open_atomic(path: str | os.PathLike[str], field: str = "output") -> Iterator
     target = check_output_path(path, field)
     directory = target.parent if str(target.parent) else Path(".")
     clean_stale_temporaries(target)
-    try:
+    try:  # mkstemp opens with O_CREAT | O_EXCL: never through a link
         fd, tmp = tempfile.mkstemp(prefix=f"{_tmp_prefix(target)}{os.getpid()}.", suffix=".tmp",
                                    dir=directory)
     except OSError as exc:
@@ -149,10 +182,11 @@ def open_atomic(path: str | os.PathLike[str], field: str = "output") -> Iterator
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
             yield handle
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, target)
+            handle.flush()
+            os.fchmod(handle.fileno(), output_mode(target))
+        if is_symlink(target):  # planted after the check: rename would replace the link, refuse instead
+            raise InputError(field, str(path), "a file path that is not a symbolic link")
+        os.replace(tmp, target)  # rename never follows a link at the target
     except OSError as exc:
         Path(tmp).unlink(missing_ok=True)
         reason = "the disk is full" if exc.errno in (errno.ENOSPC, errno.EDQUOT) else exc.strerror

@@ -6,11 +6,13 @@ from pathlib import Path
 
 import click
 
+from vtool.app.cli.options import OUTPUT
+
 
 @click.command()
 @click.argument("preset")
 @click.option("--degrees", type=float, help="Degrees of cam rotation; default: the preset's.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), help="Also write the table as CSV.")
+@click.option("--csv", "csv_path", type=OUTPUT, help="Also write the table as CSV.")
 @click.option("--markdown", is_flag=True, help="Print the table as Markdown (for reports).")
 def accuracy(preset: str, degrees: float | None, csv_path: Path | None, markdown: bool) -> None:
     """The speed/accuracy trade of a valve-train preset: Newmark (dt 1e-4 to 1e-7 s, beta 1/6 and 1/4)

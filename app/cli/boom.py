@@ -14,7 +14,7 @@ from typing import Any
 
 import click
 
-from vtool.app.cli.options import figure_option, write_figure
+from vtool.app.cli.options import OUTPUT, figure_option, json_alone, write_figure
 from vtool.errors import InputError
 
 PULSE_CHOICES = ("N", "P", "Q", "R", "T")
@@ -69,7 +69,7 @@ def _summary_lines(res: Any, quantity: str) -> list[str]:
 @click.option("--damping", type=float, default=0.0, show_default=True, help="Damping ratio zeta, [0, 1).")
 @click.option("--range", "grid", default="0:2.5:0.01", show_default=True, callback=_parse_range,
               help="tau/T values start:stop:step (inclusive).")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+@click.option("--csv", "csv_path", type=OUTPUT, default=None,
               help="Write the DAF curves to this CSV file.")
 @click.option("--json", "as_json", is_flag=True, help="Print the DAF curves as JSON (units named).")
 @click.option("--plot", is_flag=True, help="Draw the DAF curves in the terminal.")
@@ -83,6 +83,7 @@ def daf_command(kind: str, s: float, r1: float, r2: float | None, alpha: float |
 
     from vtool.assessments.sonic_boom import fourier, pulses, report, response, spectra
 
+    json_alone(as_json, plot=plot)
     response.check_damping(damping)
     ratio = spectra.ratio_grid(*grid)
     lines: list[str] = []
@@ -154,6 +155,7 @@ def _write(path: Path, text: str) -> None:
 
 def _preset_command(expected: str, name: str, preset: str, csv_path: Path | None, plot: bool,
                     as_json: bool, figure_path: Path | None) -> None:
+    json_alone(as_json, plot=plot)
     from vtool.presets import load_preset
     from vtool.presets.kinds import require_kind
 
@@ -164,7 +166,7 @@ def _preset_command(expected: str, name: str, preset: str, csv_path: Path | None
 
 _preset_options = [
     click.argument("preset"),
-    click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+    click.option("--csv", "csv_path", type=OUTPUT, default=None,
                  help="Write the allowable-pressure table to this CSV file."),
     click.option("--plot", is_flag=True, help="Draw the DAF and design curves in the terminal."),
     click.option("--json", "as_json", is_flag=True, help="Print the results as JSON."),

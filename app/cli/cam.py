@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from vtool.app.cli.options import figure_option, write_figure
+from vtool.app.cli.options import OUTPUT, figure_option, json_alone, write_figure
 from vtool.errors import InputError
 
 
@@ -21,10 +21,10 @@ def cam() -> None:
 @click.argument("preset")
 @click.option("--plot", is_flag=True, help="Draw lift, velocity, acceleration and jerk against cam angle.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
-@click.option("--csv", "csv_path", type=click.Path(),
+@click.option("--csv", "csv_path", type=OUTPUT,
               help="With a [follower]: write the ground profile (polar and Cartesian, curvature) for grinding.")
 @figure_option
-def show(preset: str, plot: bool, as_json: bool, csv_path: str | None, figure_path: Path | None) -> None:
+def show(preset: str, plot: bool, as_json: bool, csv_path: Path | None, figure_path: Path | None) -> None:
     """Fit error, velocity/acceleration/jerk extremes at the preset's speed, the
     acceleration spectrum, and warnings where a lift table's acceleration jumps.
     With a follower ([follower] or a train type): the cam's shape, radius of
@@ -32,14 +32,12 @@ def show(preset: str, plot: bool, as_json: bool, csv_path: str | None, figure_pa
     from vtool.presets import load_preset
     from vtool.solvers.model.cam import cam_report, report_text
 
+    json_alone(as_json, plot=plot)
     spec = load_preset(preset)
     from vtool.presets.kinds import require_kind
 
     require_kind(spec, "valvetrain", "`vtool cam`")
-    if csv_path is not None:
-        from vtool.files import check_output_path
-
-        check_output_path(csv_path, "--csv")
+    if csv_path is not None:  # the path was checked when the command line was read (options.OUTPUT)
         if spec.follower is None:
             raise InputError("--csv", csv_path, "a preset with a [follower] (the profile needs its geometry)")
     report = cam_report(spec)

@@ -7,7 +7,13 @@ from pathlib import Path
 
 import click
 
-from vtool.app.cli.options import figure_option, impact_laws_option, start_option, write_figure
+from vtool.app.cli.options import (
+    OUTPUT,
+    figure_option,
+    impact_laws_option,
+    start_option,
+    write_figure,
+)
 
 
 @click.command()
@@ -15,7 +21,7 @@ from vtool.app.cli.options import figure_option, impact_laws_option, start_optio
 @impact_laws_option
 @start_option
 @click.option("--degrees", type=float, help="Degrees of cam rotation; default: the preset's.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), help="Also write the table as CSV.")
+@click.option("--csv", "csv_path", type=OUTPUT, help="Also write the table as CSV.")
 @click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
 @click.option("--markdown", is_flag=True, help="Print the table as Markdown (for reports).")
 @click.option("--plot", is_flag=True, help="Draw each clearance's contact force, one curve per variant.")

@@ -19,6 +19,12 @@ process (benchmarks/bench_newmark.py, the second-process line). :func:`main`
 raises the first threshold (:data:`GC_THRESHOLDS`: cyclic garbage is still
 collected, only less often) and freezes the survivors before the interpreter
 exits (:func:`gc.freeze`), so that the exit does not scan them again.
+
+Signals: SIGTERM (what ``timeout``, ``kill`` and a cancelled CI job send) is
+handled like Ctrl+C (:class:`Terminated`, a KeyboardInterrupt): every file
+being written is cleaned up the same way (no hidden temporary is left, an
+existing output is kept), the message is ``terminated: ...`` and the exit
+code 143 (128 + 15).
 """
 
 from __future__ import annotations
@@ -26,6 +32,7 @@ from __future__ import annotations
 import gc
 import importlib
 import importlib.util
+import signal
 import sys
 import warnings
 from typing import Any
@@ -52,6 +59,21 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "report": ("vtool.app.cli.report", "report"),
     "tui": ("vtool.app.cli.tui", "tui"),
 }
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the program is, so that it unwinds exactly as Ctrl+C does."""
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated()
+
+
+def _interrupted(exc: BaseException | None) -> tuple[str, int]:
+    """The word and exit code of an interrupt: Ctrl+C 130, SIGTERM 143."""
+    while exc is not None and not isinstance(exc, KeyboardInterrupt):
+        exc = exc.__cause__ or exc.__context__
+    return ("terminated", 128 + signal.SIGTERM) if isinstance(exc, Terminated) else ("interrupted", 130)
 
 
 def _installed_commands() -> list[str]:
@@ -84,6 +106,10 @@ class LazyGroup(click.Group):
                 click.echo(f"error: {exc.one_line()}", err=True)
                 ctx.exit(2)
             except RunError as exc:
+                word, code = _interrupted(exc)
+                if code != 130:  # an interrupted study said where its finished part is: same words, SIGTERM's code
+                    click.echo(f"{word}: {one_line(str(exc), 400).removeprefix('interrupted: ')}", err=True)
+                    ctx.exit(code)
                 click.echo(f"run failed: {one_line(str(exc), 400)}", err=True)
                 ctx.exit(1)
 
@@ -100,12 +126,9 @@ class LazyGroup(click.Group):
         except click.ClickException as exc:
             click.echo(f"error: {one_line(exc.format_message(), 300)}", err=True)
             code = exc.exit_code
-        except click.exceptions.Abort:
-            click.echo("interrupted: nothing was written", err=True)
-            code = 130
-        except KeyboardInterrupt:
-            click.echo("interrupted: nothing was written", err=True)
-            code = 130
+        except (click.exceptions.Abort, KeyboardInterrupt) as exc:  # click turns an interrupt into Abort
+            word, code = _interrupted(exc)
+            click.echo(f"{word}: nothing was written", err=True)
         if standalone:
             sys.exit(code)
         return code
@@ -128,6 +151,7 @@ def cli() -> None:
 
 def main() -> None:
     gc.set_threshold(*GC_THRESHOLDS)
+    signal.signal(signal.SIGTERM, _terminate)  # cleaned up like Ctrl+C (see the module doc)
     try:
         cli(prog_name="vtool")
     finally:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import click
 
 from vtool.solvers.model.spec import IMPACT_LAWS, START_VELOCITIES
@@ -52,3 +54,34 @@ def write_figure(items, path) -> None:  # type: ignore[no-untyped-def]
 
     save_figure(items, path)
     click.echo(f"wrote {path}", err=True)
+
+
+class OutputPath(click.ParamType):
+    """An output file path, checked when the command line is read, before any work
+    (:func:`vtool.files.check_output_path`: an empty path, a missing or read-only folder, a folder,
+    device, FIFO, socket or symbolic link at the path are refused in one line, exit 2)."""
+
+    name = "path"
+
+    def convert(self, value: object, param: click.Parameter | None, ctx: click.Context | None) -> Path:
+        from vtool.files import check_output_path
+
+        field = (param.opts[0] if param is not None and param.opts else "output")
+        if param is not None and param.param_type_name == "argument":
+            field = (param.name or "output").upper()
+        return check_output_path(str(value), field)
+
+
+#: The one type of every output-file option (``--csv`` of every command).
+OUTPUT = OutputPath()
+
+
+def json_alone(as_json: bool, **others: bool) -> None:
+    """With ``--json`` the JSON document is alone on stdout: a chart flag beside it (``plot=True``,
+    ``map=True`` for ``--plot``, ``--map``) is refused in one line before any work."""
+    for name, given in others.items():
+        if as_json and given:
+            from vtool.errors import InputError
+
+            flag = f"--{name}"
+            raise InputError(flag, "with --json", f"one of --json (machine-readable stdout) or {flag}")

@@ -15,7 +15,7 @@ from typing import Any
 
 import click
 
-from vtool.app.cli.options import figure_option, write_figure
+from vtool.app.cli.options import OUTPUT, figure_option, json_alone, write_figure
 from vtool.errors import InputError
 
 RK4_LIMIT = 2.8  # thesis eq. 44; kept here so --help needs no numerics
@@ -51,7 +51,7 @@ def _width() -> int:
     return max(60, min(shutil.get_terminal_size((100, 24)).columns, 140))
 
 
-csv_option = click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+csv_option = click.option("--csv", "csv_path", type=OUTPUT,
                           help="Also write the results to this CSV file (header names units).")
 json_option = click.option("--json", "as_json", is_flag=True, help="Print JSON instead of tables.")
 
@@ -71,7 +71,7 @@ def plate() -> None:
 def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path | None, as_json: bool) -> None:
     """Lowest natural frequencies of each case against the exact ones (eq. 40), and omega_max."""
     from vtool.assessments.plate.model import build_model
-    from vtool.assessments.plate.report import modes_csv, modes_text
+    from vtool.assessments.plate.report import cases_modes_csv, modes_text
     from vtool.assessments.plate.vibration import free_vibration
 
     spec = _load_plate_spec(preset)
@@ -87,10 +87,7 @@ def modes(preset: str, case_name: str | None, count: int | None, csv_path: Path 
     else:
         click.echo("\n\n".join(modes_text(f, c) for c, f in results))
     if csv_path is not None:
-        text = "case,KS," + modes_csv(results[0][1]).splitlines()[0] + "\n"
-        for c, f in results:
-            text += "".join(f"{c.name},{f.size},{line}\n" for line in modes_csv(f).splitlines()[1:])
-        _write(csv_path, text)
+        _write(csv_path, cases_modes_csv([(c.name, f) for c, f in results]))
         click.echo(f"wrote {csv_path}", err=True)
 
 
@@ -124,7 +121,7 @@ def transient(preset: str, case_name: str | None, load: str, scheme: str, wh: fl
     from vtool.assessments.plate.report import case_run_dict, case_run_text, response_csv
     from vtool.assessments.plate.study import run_case
 
-    spec = _load_plate_spec(preset)
+    spec = _load_plate_spec(preset)  # with --json, the histories are not drawn (--plot is on by default)
     settings = spec.study.transient
     case = _cases(spec, case_name)[0]
     run = run_case(spec.study.plate, case, load, scheme, wh, periods or settings.periods,
@@ -164,6 +161,7 @@ def _write(path: Path, text: str) -> None:
 def study(preset: str, transient: bool, plot: bool, figure_path: Path | None, csv_path: Path | None,
           as_json: bool) -> None:
     """The thesis' Tables 2-5 regenerated: every case, its KS, errors and cost."""
+    json_alone(as_json, plot=plot)
     spec = _load_plate_spec(preset)
     solve_preset(spec, csv_path, plot, as_json, transient=transient, figure=figure_path)
 

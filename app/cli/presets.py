@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from vtool.errors import InputError
-from vtool.files import exists, is_dir, write_atomic
+from vtool.files import check_output_path, exists, is_dir, write_atomic
 from vtool.presets import find_preset, list_presets, self_contained_text
 
 
@@ -38,8 +38,11 @@ def show_command(name: str) -> None:
 @click.option("--force", is_flag=True, help="Overwrite an existing file.")
 def copy_command(name: str, dest: Path, force: bool) -> None:
     """Copy a preset to DEST (a file, or a folder to copy into) to edit it."""
+    if not is_dir(dest):
+        check_output_path(dest, "DEST")  # before any work
     source = find_preset(name)
     target = dest / source.name if is_dir(dest) else dest
+    check_output_path(target, "DEST")
     if exists(target) and not force:
         raise InputError("dest", str(target), "a path that does not exist yet (or --force)")
     text, note = self_contained_text(source)  # a lift-table file is written in: the copy loads anywhere

@@ -24,8 +24,8 @@ def size(preset: str, rpm_max: float, tolerance: float, max_elements: int) -> No
     from vtool.presets.kinds import require_kind
 
     require_kind(spec, "valvetrain", "`vtool size`")
-    if not rpm_max > 0 or rpm_max > 1e6:
-        raise InputError("--rpm-max", rpm_max, "> 0 and <= 1e6", "rev/min")
+    if not 1e-3 <= rpm_max <= 1e6:  # the range of run.rpm (presets.valvetrain.check_run_value)
+        raise InputError("--rpm-max", rpm_max, ">= 0.001 and <= 1e6", "rev/min")
     if not 0 < tolerance < 1:
         raise InputError("--tolerance", tolerance, "> 0 and < 1 (a fraction)")
     if not 1 <= max_elements <= 64:

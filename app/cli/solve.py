@@ -18,7 +18,7 @@ from typing import Any
 
 import click
 
-from vtool.app.cli.options import figure_option, write_figure
+from vtool.app.cli.options import OUTPUT, figure_option, json_alone, write_figure
 from vtool.errors import InputError
 from vtool.solvers.backends import available
 from vtool.solvers.cost import MAX_SCIPY_STEPS, MAX_STEPS
@@ -40,7 +40,7 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
               help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's run.degrees.")
 @click.option("--max-steps", type=float, callback=_max_steps,
               help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}; scipy {MAX_SCIPY_STEPS:.0e}).")
-@click.option("--csv", "--out", "csv_path", type=click.Path(),  # a str: '' stays '' in the error
+@click.option("--csv", "--out", "csv_path", type=OUTPUT,
               help="Write the response as CSV (per output interval, or per step with --every-step).")
 @click.option("--format", "file_format", type=click.Choice(["csv", "parquet"]),
               help="Format of the --csv/--out file (default: parquet for a .parquet file, else csv); Parquet "
@@ -55,29 +55,34 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 @click.option("--orders", "orders", metavar="QUANTITY",
               help="Also print the cam-order spectrum of QUANTITY (q7, q1-q9, F7) over the evaluated cycles: "
                    "a table, and with --plot a chart with the natural frequencies marked.")
+@click.option("--set", "sets", multiple=True, metavar="FIELD=VALUE",
+              help="Set a preset field for this run (dotted path as in `vtool sweep`, e.g. "
+                   "members.valve_spring.stiffness=300 or clearances[2].restitution=0.5); checked by the preset's loader.")
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
-          max_steps: float | None, csv_path: str | None, every_step: bool, plot: bool, as_json: bool,
+          max_steps: float | None, csv_path: Path | None, every_step: bool, plot: bool, as_json: bool,
           show_events: bool, orders: str | None, impact: str | None, start: str | None,
-          figure_path: Path | None, file_format: str | None) -> None:
+          figure_path: Path | None, file_format: str | None, sets: tuple[str, ...] = ()) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
     peak forces, valve seating velocities, bounces per revolution, run
     statistics). Files are written only when the run succeeds.
     """
-    from vtool.files import check_output_path
     from vtool.presets import Override, find_preset, kind_of, load_document, read_document
     from vtool.presets.kinds import KINDS, resolve
 
-    if as_json and plot:
-        raise InputError("--plot", "with --json", "one of --json (machine-readable stdout) or --plot")
-    csv_file = None if csv_path is None else Path(check_output_path(csv_path, "--csv") and csv_path)
+    json_alone(as_json, plot=plot)
+    csv_file = csv_path  # checked when the command line was read (options.OUTPUT)
     if file_format is not None and csv_file is None:
         raise InputError("--format", file_format, "an output file to write (--out PATH)")
     if csv_file is not None and file_format is None and str(csv_file).lower().endswith((".parquet", ".pq")):
         file_format = "parquet"
     path = find_preset(preset)
     doc = read_document(path)
+    if sets:
+        from vtool.presets.paths import apply_sets
+
+        doc = apply_sets(doc, sets)
     kind = KINDS[kind_of(doc)]
     given = {"--backend": backend, "--dt": dt, "--rpm": rpm, "--degrees": degrees,
              "--max-steps": max_steps, "--every-step": every_step or None,
@@ -171,8 +176,11 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
         click.echo("")
         click.echo("\n".join(evaluation["lines"]))
         if spectrum is not None:
+            from vtool.solvers.studies.orders import dominant_text, natural_frequencies
+
             click.echo("")
             click.echo(spectrum.table())
+            click.echo(dominant_text(spectrum, natural_frequencies(trace)))
         if show_events:
             click.echo("")
             click.echo(trace.event_table())

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from vtool.app.cli.options import figure_option, write_figure
+from vtool.app.cli.options import OUTPUT, figure_option, json_alone, write_figure
 
 DEFAULT_SCAN = "1000:20000:1000"
 
@@ -35,6 +35,20 @@ class CountProgress:
             self.bar = None
 
 
+def _workers(ctx: click.Context, param: click.Parameter, value: int | None) -> int | None:
+    from vtool.solvers.studies.sweep import check_workers
+
+    return None if value is None else check_workers(value)
+
+
+def _scheduler(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    from vtool.solvers.studies.sweep import parse_scheduler
+
+    if value is not None:
+        parse_scheduler(value)  # the one parser: refused here, before the preset is loaded
+    return value
+
+
 @click.command()
 @click.argument("preset")
 @click.option("--set", "sets", multiple=True, metavar="FIELD=VALUES",
@@ -46,10 +60,11 @@ class CountProgress:
                    "cam during lift (jump-speed) or the valve bounces on its seat (bounce-speed), each run to "
                    f"steady state; --set run.rpm gives the scan (default {DEFAULT_SCAN}), other --set fields a "
                    "grid of searches.")
-@click.option("--workers", type=int, help="Local worker processes (default: all cores; 1 = in this process).")
-@click.option("--scheduler", help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
+@click.option("--workers", type=int, callback=_workers,
+              help="Local worker processes (default: chosen from the measured cost of a point; 1 = in this process).")
+@click.option("--scheduler", callback=_scheduler, help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
                                   "processes) or local-threads:N.")
-@click.option("--csv", "--out", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("--csv", "--out", "csv_path", type=OUTPUT,
               help="Write one row per point (swept fields, status, metrics; units in the header), appended as "
                    "points finish.")
 @click.option("--format", "file_format", type=click.Choice(["csv", "parquet"]),
@@ -99,21 +114,19 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         run_points,
     )
 
+    json_alone(as_json, plot=plot, map=as_map)
     if resume and csv_path is None:
         raise InputError("--resume", True, "a --csv file to resume")
     if file_format is not None and csv_path is None:
         raise InputError("--format", file_format, "an output file to write (--out PATH)")
     parquet = False
     if csv_path is not None:
-        from vtool.files import check_output_path
         from vtool.solvers.parquet import output_format
 
         parquet = output_format(csv_path, file_format) == "parquet"
         if parquet and (resume or find is not None):
             raise InputError("--format", "parquet", "csv for --resume and --find (a Parquet sweep is written "
                              "whole at the end)")
-        if parquet:
-            check_output_path(csv_path, "--out")
     if find is not None:
         if not any(s.partition("=")[0].strip() == "run.rpm" for s in sets):
             sets = (f"run.rpm={DEFAULT_SCAN}",) + sets
@@ -137,7 +150,12 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         raise InputError("--map", len(axes), "exactly two swept fields with more than one value")
     if (plot or figure_path) and not axes:
         raise InputError("--plot", plan.fields[0][0] if plan.fields else None, "a swept field with two or more values")
-    runner = make_runner(workers, scheduler)  # a Dask scheduler is reached here, before any file is written
+    import time
+
+    started = time.perf_counter()  # the wall time counts a Dask cluster's or a pool's start-up
+    runner = make_runner(workers, scheduler,  # a Dask scheduler is reached here, before any file is written
+                         announce=lambda text: click.echo(text, err=True))
+    startup = time.perf_counter() - started
     try:
         if find is not None:
             _find(find, plan, runner, csv_path, as_json, every_step)
@@ -153,8 +171,14 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
                 outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress)
         except KeyboardInterrupt:
             progress.close()
-            where = (f"the finished points are in {csv_path}; run again with --resume to finish"
-                     if csv_path and not parquet else "nothing was kept (use --csv to keep finished points)")
+            if parquet:
+                where = "nothing was kept (an interrupted Parquet sweep is not written; --csv keeps points)"
+            elif sink is not None and (sink.written or resume):
+                where = f"the finished points are in {csv_path}; run again with --resume to finish"
+            elif sink is not None:
+                where = f"no point had finished: nothing was written ({csv_path} is as it was)"
+            else:
+                where = "nothing was kept (use --csv to keep finished points)"
             raise RunError(f"interrupted: {where}") from None
         finally:
             progress.close()
@@ -177,8 +201,10 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         click.echo(steady_text(plan.spec))  # which cycles the metrics cover, and by which criteria
         click.echo(Criteria.of(plan.spec).text(length))
         n = outcome.total - outcome.skipped
-        click.echo(f"{n} points in {outcome.wall_time:.2f} s ({1000 * outcome.wall_time / max(n, 1):.1f} ms per "
-                   f"point, {runner.workers} worker{'s' if runner.workers > 1 else ''})")
+        wall = startup + outcome.wall_time
+        begun = f", {startup:.2f} s of it starting the cluster" if startup >= 0.005 else ""
+        click.echo(f"{n} points in {wall:.2f} s ({1000 * wall / max(n, 1):.1f} ms per "
+                   f"point, {runner.workers} worker{'s' if runner.workers > 1 else ''}{begun})")
         if csv_path is not None:
             click.echo(f"wrote {outcome.total} rows to {csv_path}")
     if results and (plot or as_map):
@@ -253,8 +279,9 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
             for interval in result.intervals:
                 click.echo(f"  interval: {interval.text()}")
             click.echo(f"{criterion}: {result.message}")
+        intervals = ";".join(f"{format_value(i.low)}-{format_value(i.high)}" for i in result.intervals)
         rows.append([format_value(v) for _, v in key] + [format_value(result.speed) if result.speed else "",
-                                                         result.message])
+                                                         intervals, result.message])
         found.append(dict(key) | {criterion.replace("-", "_"): result.speed,
                                   f"{criterion.replace('-', '_')}_unit": "rev/min", "message": result.message,
                                   "history": [{"rpm": b.rpm, "holds": b.holds, "value": b.value, "stage": b.stage}
@@ -267,7 +294,7 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
                                "evaluation": steady_text(first), "searches": found}, indent=2))
     if csv_path is not None:
         header = [f"{f} ({u})" if u else f for f, u in others] + [f"{criterion.replace('-', '_')} (rev/min)",
-                                                                  "message"]
+                                                                  "intervals (rev/min)", "message"]
         import csv
         import io
 

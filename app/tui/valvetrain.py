@@ -296,7 +296,12 @@ class ValveTrainScreen(DomainScreen):
         cycles: its table and chart with the natural frequencies marked; a run without a whole evaluated
         cycle says so."""
         from vtool.errors import InputError
-        from vtool.solvers.studies.orders import default_quantity, natural_frequencies, spectrum
+        from vtool.solvers.studies.orders import (
+            default_quantity,
+            dominant_text,
+            natural_frequencies,
+            spectrum,
+        )
 
         try:
             orders = spectrum(trace, default_quantity(trace.spec))
@@ -307,8 +312,9 @@ class ValveTrainScreen(DomainScreen):
         frequencies = natural_frequencies(trace)
         from vtool.app.order_charts import order_chart
 
-        self.order_chart.plot(lambda w, h, c: orders.table(6) + "\n" + order_chart(
-            orders, frequencies, width=w, height=max(h - 10 - len(frequencies), 8), color=c))
+        text = orders.table(6) + "\n" + dominant_text(orders, frequencies)
+        self.order_chart.plot(lambda w, h, c: text + "\n" + order_chart(
+            orders, frequencies, width=w, height=max(h - 11 - len(frequencies), 8), color=c))
 
     def plot_displacements(self) -> None:
         trace = self.results

@@ -17,6 +17,7 @@ from vtool.assessments.plate.model import Case
 from vtool.assessments.plate.study import CaseRun, StudyResult, TransientRow
 from vtool.assessments.plate.transient import SIGNED_PEAK_FLOOR, SIGNS, ExactHistories, Response
 from vtool.assessments.plate.vibration import FreeVibration
+from vtool.csvrows import csv_text
 
 SIGNED_KEYS = tuple(q + s for q in ("displacement", "velocity", "acceleration") for s in SIGNS)
 ELEMENT_TITLES = {"bfs16": "16-DOF element (bfs16)", "mason24": "24-DOF element (mason24)"}
@@ -267,15 +268,16 @@ def study_dict(result: StudyResult) -> dict[str, Any]:
 
 
 def study_csv(result: StudyResult) -> str:
-    """One row per case and quantity (long format), header with units."""
-    lines = ["table,case,KS,load,omega_max_h,quantity,mode,value,unit"]
+    """One row per case and quantity (long format), header with units; text cells quoted as needed."""
+    rows: list[list[object]] = [["table", "case", "KS", "load", "omega_max_h", "quantity", "mode", "value", "unit"]]
     for f in result.free:
         for m, e in zip(f.exact, f.errors_pct, strict=True):
-            lines.append(f"frequency,{f.case},{f.size},,,frequency_error,{m.m}-{m.n},{e:.6g},%")
-        lines.append(f"frequency,{f.case},{f.size},,,omega_max_over_omega11,,{f.omega_max_ratio:.6g},1")
-        lines.append(f"cost,{f.case},{f.size},,,eigen_time,,{f.solve_seconds:.6g},s")
+            rows.append(["frequency", f.case, f.size, "", "", "frequency_error", f"{m.m}-{m.n}", f"{e:.6g}", "%"])
+        rows.append(["frequency", f.case, f.size, "", "", "omega_max_over_omega11", "", f"{f.omega_max_ratio:.6g}", "1"])
+        rows.append(["cost", f.case, f.size, "", "", "eigen_time", "", f"{f.solve_seconds:.6g}", "s"])
     for r in result.convergence:
-        lines.append(f"convergence,{r.element}-{r.n}x{r.n},{r.size},,,fundamental_error,1-1,{r.fundamental_error_pct:.6g},%")
+        rows.append(["convergence", f"{r.element}-{r.n}x{r.n}", r.size, "", "", "fundamental_error", "1-1",
+                     f"{r.fundamental_error_pct:.6g}", "%"])
     for r in result.transient:
         wh = "modal" if math.isnan(r.omega_max_h) else f"{r.omega_max_h:g}"
         for suffix, errors in (("_peak_error", r.errors_pct), ("_peak_error_4n_modes", r.errors_4n_pct),
@@ -283,10 +285,10 @@ def study_csv(result: StudyResult) -> str:
             for q, v in errors.items():
                 value = "" if math.isnan(v) else f"{v:.6g}"
                 name = q.replace("+", "_positive").replace("-", "_negative")
-                lines.append(f"transient,{r.case},{r.size},{r.load},{wh},{name}{suffix},,{value},%")
-        lines.append(f"cost,{r.case},{r.size},{r.load},{wh},time_loop,,{r.seconds:.6g},s")
-        lines.append(f"cost,{r.case},{r.size},{r.load},{wh},steps,,{r.steps},1")
-    return "\n".join(lines) + "\n"
+                rows.append(["transient", r.case, r.size, r.load, wh, f"{name}{suffix}", "", value, "%"])
+        rows.append(["cost", r.case, r.size, r.load, wh, "time_loop", "", f"{r.seconds:.6g}", "s"])
+        rows.append(["cost", r.case, r.size, r.load, wh, "steps", "", r.steps, "1"])
+    return csv_text(rows)
 
 
 def modes_text(free: FreeVibration, case: Case) -> str:
@@ -299,11 +301,23 @@ def modes_text(free: FreeVibration, case: Case) -> str:
     return "\n".join(lines)
 
 
+MODES_HEADER = ["mode", "m", "n", "exact_omega_rad_per_s", "model_omega_rad_per_s", "error_pct"]
+
+
+def modes_rows(free: FreeVibration) -> list[list[object]]:
+    """The rows of :func:`modes_csv` (no header)."""
+    return [[k, m.m, m.n, f"{m.omega:.9g}", f"{free.omega[k - 1]:.9g}", f"{e:.6g}"]
+            for k, (m, e) in enumerate(zip(free.exact, free.errors_pct, strict=True), start=1)]
+
+
 def modes_csv(free: FreeVibration) -> str:
-    lines = ["mode,m,n,exact_omega_rad_per_s,model_omega_rad_per_s,error_pct"]
-    for k, (m, e) in enumerate(zip(free.exact, free.errors_pct, strict=True), start=1):
-        lines.append(f"{k},{m.m},{m.n},{m.omega:.9g},{free.omega[k - 1]:.9g},{e:.6g}")
-    return "\n".join(lines) + "\n"
+    return csv_text([MODES_HEADER, *modes_rows(free)])
+
+
+def cases_modes_csv(results: list[tuple[str, FreeVibration]]) -> str:
+    """Several cases' modes in one CSV: ``case`` (quoted as needed) and ``KS`` columns first."""
+    return csv_text([["case", "KS", *MODES_HEADER]]
+                    + [[name, f.size, *row] for name, f in results for row in modes_rows(f)])
 
 
 def response_csv(resp: Response, exact: ExactHistories | None) -> str:

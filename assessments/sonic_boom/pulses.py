@@ -359,8 +359,9 @@ def read_pulse_csv(path: str | os.PathLike[str]) -> Pulse:
     """Read a ``time [s], pressure`` CSV (an optional header row) as a tabulated pulse.
 
     The file must be a regular file of bounded size (:data:`MAX_CSV_BYTES`,
-    :data:`MAX_CSV_ROWS`); an error names the row and echoes only the
-    offending cell, cut to a readable length.
+    :data:`MAX_CSV_ROWS`); an error names the file, the row and column and
+    what is wrong, never a cell's text (the path may name any file the user can
+    read: its content must not appear in a message).
     """
     path = Path(path)
     text = _read_bounded(path)
@@ -386,10 +387,11 @@ def read_pulse_csv(path: str | os.PathLike[str]) -> Pulse:
                 continue  # header
             column = next(i for i, c in enumerate(row[:2]) if not _is_number(c))
             raise InputError(f"{path.name} row {number} column {column + 1}",
-                             shorten(row[column].strip()), "a number (time [s], pressure)") from None
+                             f"<{len(row[column].strip())} characters that are not a number; not shown>",
+                             "a number (time [s], pressure)") from None
         if times and values[0] <= times[-1]:
-            raise InputError(f"{path.name} row {number}", values[0],
-                             f"a time > {times[-1]:g} (strictly increasing)", "s")
+            raise InputError(f"{path.name} row {number}", "a time not after the previous row's",
+                             "strictly increasing times", "s")
         times.append(values[0])
         pressures.append(values[1])
     return tabulated(np.array(times), np.array(pressures), label=f"csv:{path.name}",

@@ -69,7 +69,7 @@ class ExactOptions:
         return cls(run.output_interval, every_step)
 
 
-class ExactBackend(PiecewiseBackend):
+class ExactBackend(PiecewiseBackend[ExactOptions]):
     """Piecewise-exact back end (see module doc). Registered as ``exact``."""
 
     name = "exact"

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from vtool.errors import InputError, RunError
-from vtool.solvers.backends import Backend, Cancel, Progress, RunStats
+from vtool.solvers.backends import Backend, Cancel, OptionsT, Progress, RunStats
 from vtool.solvers.exact.statespace import StateSpace, from_layer
 from vtool.solvers.model.contact import ContactProblem, OrderedLayer
 from vtool.solvers.model.mechanism import Mechanism
@@ -384,7 +384,7 @@ def refuse_hertz(mechanism: Mechanism, backend: str) -> None:
                              f"({c.name}: nonlinear between events, so the exact solution does not apply)")
 
 
-class PiecewiseBackend(Backend):
+class PiecewiseBackend(Backend[OptionsT]):
     """A back end whose run is a :class:`PiecewiseRun` subclass (``run_class``)."""
 
     run_class: type[PiecewiseRun]
@@ -396,11 +396,11 @@ class PiecewiseBackend(Backend):
 
         return compile_notice(cls.name, kernel_laws(spec, impacts))
 
-    def integrate(self, problem: ContactProblem, options: Any, builder: TraceBuilder,
+    def integrate(self, problem: ContactProblem, options: OptionsT, builder: TraceBuilder,
                   progress: Progress | None, cancel: Cancel | None) -> RunStats:
         run = self.run_class(problem, options, builder)  # type: ignore[call-arg]
         run.execute(progress, cancel)
         return run.statistics(self.settings(options))
 
-    def settings(self, options: Any) -> dict[str, Any]:
+    def settings(self, options: OptionsT) -> dict[str, Any]:
         return {}

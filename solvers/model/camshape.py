@@ -66,7 +66,7 @@ import numpy as np
 
 from vtool.errors import InputError
 from vtool.solvers.model.cam import derivatives, lift_series
-from vtool.solvers.model.spec import FINGER, FLAT, CamSpec, FollowerSpec
+from vtool.solvers.model.spec import FLAT, LEVERS, ROCKER, CamSpec, FollowerSpec
 
 NEWTON_STEPS = 60
 NEWTON_TOLERANCE = 1e-12  # of the pitch radius R0
@@ -212,8 +212,12 @@ class FingerGeometry:
         if abs(finger.cam_offset) >= R0:
             raise InputError("follower.cam_offset", finger.cam_offset,
                              f"smaller than the pitch radius base_radius + roller_radius = {R0:g}")
-        Q0 = np.array([finger.roller_arm, -finger.roller_height])
-        C = Q0 + np.array([finger.cam_offset, -math.sqrt(R0**2 - finger.cam_offset**2)])
+        if follower.arrangement == ROCKER:  # centre pivot: roller beyond the pivot, the cam below it
+            Q0 = np.array([-finger.roller_arm, finger.roller_height])
+            C = Q0 + np.array([-finger.cam_offset, math.sqrt(R0**2 - finger.cam_offset**2)])
+        else:
+            Q0 = np.array([finger.roller_arm, -finger.roller_height])
+            C = Q0 + np.array([finger.cam_offset, -math.sqrt(R0**2 - finger.cam_offset**2)])
         return cls(Q0, C, finger.valve_arm, R0)
 
     def roller(self, phi: np.ndarray) -> np.ndarray:
@@ -287,7 +291,7 @@ def contact(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> Contact:
     theta = np.asarray(theta, dtype=float)
     ones = np.ones_like(theta)
     r_r = follower.roller_radius
-    if follower.arrangement == FINGER:
+    if follower.arrangement in LEVERS:
         g = FingerGeometry.of(follower)
         finger = follower.finger
         assert finger is not None
@@ -363,7 +367,7 @@ def shape_report(spec, points: int = 3600) -> dict:  # type: ignore[no-untyped-d
         report["max_contact_travel"] = float(np.nanmax(np.abs(c.contact_travel)))
         if follower.face_diameter is not None:
             report["face_radius"] = 0.5 * follower.face_diameter
-    if follower.arrangement == FINGER:
+    if follower.arrangement in LEVERS:
         lifting = c.lift > 1e-3 * max(float(c.lift.max()), 1e-300)
         report["ratio_min"] = float(c.ratio[lifting].min()) if lifting.any() else float(c.ratio.min())
         report["ratio_max"] = float(c.ratio.max())

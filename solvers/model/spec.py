@@ -295,7 +295,9 @@ ROLLER = "roller"
 FOLLOWER_KINDS = (FLAT, ROLLER)
 TRANSLATING = "translating"
 FINGER = "finger"
-ARRANGEMENTS = (TRANSLATING, FINGER)
+ROCKER = "rocker"
+ARRANGEMENTS = (TRANSLATING, FINGER, ROCKER)
+LEVERS = (FINGER, ROCKER)  # arrangements with a FingerSpec: end pivot, centre pivot
 
 
 @dataclass(frozen=True)
@@ -310,6 +312,12 @@ class FingerSpec:
     centre is above the roller, ``cam_offset`` further along x than the roller
     centre. The cam turns so that its surface at the roller runs from the
     valve end towards the pivot (positive sense of this y-down frame).
+
+    A centre-pivot rocker (arrangement ``rocker``) has the same parameters
+    with the roller on the other side of the pivot, at (-``roller_arm``,
+    ``roller_height``) (the rocker's line through the pivot and the pad),
+    and the cam below it: the cam lifts the roller and the valve arm opens
+    the valve.
     """
 
     roller_arm: float
@@ -333,7 +341,8 @@ class FollowerSpec:
     ``kind``: ``flat`` (a flat face, ``face_diameter`` wide) or ``roller``
     (``roller_radius``). ``arrangement``: ``translating`` (the follower moves
     along a line through the cam centre: bucket, tappet, roller lifter) or
-    ``finger`` (:class:`FingerSpec`, roller only). ``base_radius`` is the cam's
+    ``finger`` (end pivot) or ``rocker`` (centre pivot) (:class:`FingerSpec`,
+    roller only). ``base_radius`` is the cam's
     base-circle radius (profile, not pitch curve), ``width`` the contact
     length of the line contact. ``lift`` is the lift law at the cam when it
     is not the model's cam (a finger follower's: the model's cam coordinate

@@ -89,7 +89,7 @@ from vtool.solvers.backends import (
     Progress,
     RunStats,
 )
-from vtool.solvers.model.contact import ContactProblem
+from vtool.solvers.model.contact import ContactProblem, EventRules
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.spec import (
     BETA_RANGE,
@@ -231,7 +231,7 @@ def check_settings(mechanism: Mechanism, options: NewmarkOptions) -> None:
         )
 
 
-class NewmarkBackend(Backend):
+class NewmarkBackend(Backend[NewmarkOptions]):
     """Newmark back end (see module doc). Registered as ``newmark``."""
 
     name = "newmark"
@@ -262,6 +262,9 @@ class NewmarkBackend(Backend):
 
     def check(self, mechanism: Mechanism, options: NewmarkOptions) -> None:
         check_settings(mechanism, options)
+
+    def event_rules(self, options: NewmarkOptions) -> EventRules:
+        return EventRules(options.rest_velocity, options.zeno_stick, options.zeno_stop)
 
     def integrate(self, problem: ContactProblem, options: NewmarkOptions, builder: TraceBuilder,
                   progress: Progress | None, cancel: Cancel | None) -> RunStats:

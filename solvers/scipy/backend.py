@@ -54,7 +54,7 @@ class ScipyOptions:
         return cls(output_interval=run.output_interval, every_step=every_step)
 
 
-class ScipyBackend(PiecewiseBackend):
+class ScipyBackend(PiecewiseBackend[ScipyOptions]):
     """solve_ivp back end (see module doc). Registered as ``scipy``."""
 
     name = "scipy"

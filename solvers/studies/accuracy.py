@@ -38,12 +38,12 @@ the scipy and numpy versions and the CPU's BLAS kernels, which
 from __future__ import annotations
 
 import dataclasses
-import io
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from vtool.csvrows import csv_text
 from vtool.errors import InputError, RunError
 from vtool.files import write_atomic
 from vtool.markdown import table as markdown_table
@@ -215,8 +215,4 @@ def table_markdown(rows: list[AccuracyRow], length_unit: str = "in") -> str:
 
 
 def write_table_csv(path: str, rows: list[AccuracyRow], length_unit: str = "in") -> None:
-    buffer = io.StringIO()
-    buffer.write(",".join(header(length_unit)) + "\n")
-    for row in rows:
-        buffer.write(",".join(cell.replace(",", ";") for cell in cells(row)) + "\n")
-    write_atomic(path, buffer.getvalue())
+    write_atomic(path, csv_text([header(length_unit), *(cells(row) for row in rows)]), "--csv")

@@ -83,14 +83,17 @@ class Variant:
             row[f"{c['clearance']} episodes"] = (f"{ep[SEPARATION]}s/{ep['impact']}i/{ep['bounce']}b/"
                                                  f"{ep['flicker']}f")
         row["throw-off (deg)"] = [None if a is None else round(a, 2) for a in throw_off_angles(t)]
+        # the evaluated window (not the start-up shock), as solve and sweep report it
+        metrics = run_metrics(t)
+        window = "after rev 1" if t.cycles is None else (
+            "last cycle" if t.cycles.period == 1 else f"last {t.cycles.period} cycles")
         for i in range(len(spec.clearances)):
-            row[f"peak {t.force_label(i)} after rev 1 ({spec.unit_system.force})"] = (
-                None if late is None else float(late[i]))
-        if seat is not None:  # in the evaluated window, as the peaks (not the start-up shock)
-            metrics = run_metrics(t)
+            value = metrics[f"peak_{t.force_label(i)}"] if late is not None or t.cycles is not None else math.nan
+            row[f"peak {t.force_label(i)} {window} ({spec.unit_system.force})"] = None if math.isnan(value) else value
+        if seat is not None:
             for name, key in (("max", "seating_velocity_max"), ("mean", "seating_velocity_mean")):
                 value = metrics[key]
-                row[f"seating velocity {name} after rev 1 ({spec.unit_system.velocity})"] = (
+                row[f"seating velocity {name} {window} ({spec.unit_system.velocity})"] = (
                     None if math.isnan(value) else value)
         if valve is not None:
             row[f"max valve lift ({spec.unit_system.length})"] = float(

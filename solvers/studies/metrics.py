@@ -96,15 +96,16 @@ Metrics (also in docs/sweep.md):
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
 
 from vtool.errors import InputError
 from vtool.solvers.model.configurations import clearance_bit
-from vtool.solvers.model.spec import EXTERNAL, REMOVED, CamSpec, MechanismSpec
+from vtool.solvers.model.spec import EXTERNAL, REMOVED, CamSpec, MechanismSpec, RunSpec
 from vtool.solvers.studies.orders import order_column, quantity_unit, spectrum
 from vtool.solvers.studies.window import REVOLUTION, evaluation_window, window_text
 from vtool.solvers.trace import CLOSED, Trace
@@ -117,6 +118,7 @@ LIFT_EVENT_FRACTION = 5e-3
 GAP_FRACTION = 1e-3
 #: the lift event's resolution (bins per revolution)
 EVENT_BINS = 3600
+_NO_RUN = RunSpec(rpm=1.0, degrees=1.0, time_step=1.0)  # the run settings of a model's key
 
 #: metrics whose values depend on the machine, not the model
 TIMING_METRICS = ("wall_time",)
@@ -161,10 +163,11 @@ def _lash(spec: MechanismSpec) -> float:
     0 without a seat, or when the seat holds the valve off the cam nowhere)."""
     if seat_index(spec) is None:
         return 0.0
+    model = dataclasses.replace(spec, run=_NO_RUN, title="", notes="")  # the model alone: one lash per model
     try:
-        return _lash_of(spec)
+        return _lash_of(model)
     except TypeError:  # an unhashable spec (built by hand with lists)
-        return _lash_of.__wrapped__(spec)
+        return _lash_of.__wrapped__(model)
 
 
 @lru_cache(maxsize=32)
@@ -186,9 +189,9 @@ def _event_bins(cam: CamSpec, lash: float) -> np.ndarray:
     return lift - lash > LIFT_EVENT_FRACTION * max(float(lift.max()), 1e-300)
 
 
-def lift_event(spec: MechanismSpec) -> tuple[float, float]:
+def lift_event(spec: MechanismSpec, inside: np.ndarray | None = None) -> tuple[float, float]:
     """(start, end) of the lift event in deg, start in [0, 360), end > start (it may pass 360)."""
-    inside = lift_event_bins(spec)
+    inside = lift_event_bins(spec) if inside is None else inside
     if inside.all():
         return 0.0, REVOLUTION
     step = REVOLUTION / EVENT_BINS
@@ -202,11 +205,11 @@ def lift_event(spec: MechanismSpec) -> tuple[float, float]:
     return best
 
 
-def in_lift_event(spec: MechanismSpec, start_deg: float, end_deg: float) -> float:
-    """Degrees of [start_deg, end_deg] (absolute cam angles) inside the lift event."""
+def in_lift_event(inside: np.ndarray, start_deg: float, end_deg: float) -> float:
+    """Degrees of [start_deg, end_deg] (absolute cam angles) inside the lift event (``inside``:
+    :func:`lift_event_bins`)."""
     if end_deg <= start_deg:
         return 0.0
-    inside = lift_event_bins(spec)
     step = REVOLUTION / EVENT_BINS
     first, last = math.floor(start_deg / step), math.ceil(end_deg / step)
     bins = np.arange(first, last)
@@ -222,13 +225,15 @@ class Criteria:
     jump_gap: float
     bounce_lift: float
     lift_event: tuple[float, float]  # deg
+    bins: np.ndarray = field(repr=False, compare=False)  # lift_event_bins
 
     @classmethod
     def of(cls, spec: MechanismSpec) -> Criteria:
         r = spec.run
         default = GAP_FRACTION * total_lift(spec.cam)
+        bins = lift_event_bins(spec)
         return cls(r.jump_angle, default if r.jump_gap is None else r.jump_gap,
-                   default if r.bounce_lift is None else r.bounce_lift, lift_event(spec))
+                   default if r.bounce_lift is None else r.bounce_lift, lift_event(spec, bins), bins)
 
     def text(self, length: str) -> str:
         start, end = self.lift_event
@@ -299,10 +304,10 @@ def open_intervals(trace: Trace, index: int, window: tuple[float, float]) -> lis
     return intervals
 
 
-def _during_lift(trace: Trace) -> np.ndarray:
-    """Per output row: whether its cam angle lies in the lift event."""
+def _during_lift(trace: Trace, inside: np.ndarray) -> np.ndarray:
+    """Per output row: whether its cam angle lies in the lift event (``inside``: :func:`lift_event_bins`)."""
     bins = np.floor(np.mod(trace.cam_angle, REVOLUTION) / (REVOLUTION / EVENT_BINS)).astype(int) % EVENT_BINS
-    return lift_event_bins(trace.spec)[bins]
+    return inside[bins]
 
 
 def _largest(values: np.ndarray, angles: np.ndarray, a: float, b: float) -> float:
@@ -318,10 +323,10 @@ def leaves_the_cam(trace: Trace, window: tuple[float, float], criteria: Criteria
     if c.state == REMOVED:
         return []
     gap = trace.coordinate(c.ahead) - trace.coordinate(c.behind)
-    during = _during_lift(trace)
+    during = _during_lift(trace, criteria.bins)
     result = []
     for a, b in open_intervals(trace, cam, window):
-        if in_lift_event(spec, a, b) <= criteria.jump_angle:
+        if in_lift_event(criteria.bins, a, b) <= criteria.jump_angle:
             continue
         height = _largest(np.where(during, gap, 0.0), trace.cam_angle, a, b)
         if height > criteria.jump_gap:
@@ -423,7 +428,7 @@ def run_metrics(trace: Trace, window: tuple[float, float] | None = None) -> dict
     for i, c in enumerate(spec.clearances):
         metrics[f"peak_{force_label(spec, i)}"] = NAN if c.state == REMOVED else float(peaks[i])
     rows = (trace.cam_angle >= window[0]) & (trace.cam_angle <= window[1])
-    during = rows & _during_lift(trace)
+    during = rows & _during_lift(trace, criteria.bins)
     in_contact = during & ((trace.configuration & clearance_bit(spec, cam)) != 0)
     metrics["spring_margin"] = float(trace.contact_force[in_contact, cam].min()) if in_contact.any() else NAN
     metrics.update(_startup(trace, seat))

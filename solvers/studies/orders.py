@@ -241,3 +241,13 @@ def dominant_near(spectrum_: Spectrum, frequencies: list[tuple[str, float]], ban
         best = near[np.argsort(-spectrum_.amplitude[near], kind="stable")[:count]]
         result.append((label, hz, order, [(float(spectrum_.orders[i]), float(spectrum_.amplitude[i])) for i in best]))
     return result
+
+
+def dominant_text(spectrum_: Spectrum, frequencies: list[tuple[str, float]], band: float = 0.15) -> str:
+    """Lines: for each natural frequency, its cam order and the largest orders within ``band`` of it."""
+    lines = [f"dominant orders near each natural frequency (within {100 * band:g} %):"]
+    for label, hz, order, best in dominant_near(spectrum_, frequencies, band):
+        near = ", ".join(f"order {o:g}: {a:.4g} {spectrum_.unit}" for o, a in best) or "none below the Nyquist order"
+        lines.append(f"  {hz:9.1f} Hz ({label}, order {order:.2f}): {near}")
+    return "\n".join(lines)
+

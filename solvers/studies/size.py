@@ -220,7 +220,8 @@ def study_text(study: SizeStudy, title: str) -> str:
 
     header, rows = study_rows(study)
     lines = [title,
-             f"at {study.rpm_max:g} rpm, tolerance {100 * study.tolerance:g} % on peak forces and seating velocity",
+             f"at {study.rpm_max:g} rpm, tolerance {100 * study.tolerance:g} % on peak forces and seating velocity "
+             "in the evaluated window (after the first revolution, or the last cycle of run.steady)",
              f"highest cam harmonic that matters (acceleration >= {MATTERS:.0%} of the largest): "
              f"{study.cam_harmonic} ({study.cam_frequency_hz:.4g} Hz)",
              "starting-layer modes it can reach (<= 2x that frequency): "

@@ -30,7 +30,14 @@ The change from cycle k-1 to cycle k is the largest of
   (total lift times the cam speed in rad/s). A metric that appears or
   disappears (NaN on one side) counts as a change of 1.
 
-and the events per clearance must be the same in both cycles.
+and the events per clearance must be the same in both cycles. A run whose
+cycle-to-cycle change does not settle is also compared with the cycle 2 to
+``MAX_PERIOD`` (4) cycles before: a train that repeats every p cycles (a
+subharmonic orbit: 1A at 15,000 rev/min alternates 24 and 22 events a
+cycle) has settled with period p, and its last p cycles are evaluated (its
+spectrum then has orders in steps of 1/p). A run that neither settles nor
+repeats stops after ``max_cycles`` and says by how much its last cycle
+still moved and how its events per clearance changed.
 
 A periodic start (:class:`State`): a sweep carries the state at the end of
 a point's last cycle to the next point, velocities scaled by the ratio of
@@ -50,7 +57,7 @@ import numpy as np
 
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.studies.metrics import run_metrics, total_lift
-from vtool.solvers.trace import Cycles, Event, RunStatistics, Trace
+from vtool.solvers.trace import MAX_PERIOD, Cycles, Event, RunStatistics, Trace
 
 #: run.steady's defaults
 DEFAULT_TOLERANCE = 1e-3
@@ -130,9 +137,9 @@ def _event_counts(trace: Trace) -> dict[str, int]:
     return counts
 
 
-def cycle_change(before: Trace, after: Trace) -> tuple[float, str]:
-    """The largest relative change from one cycle's run to the next (see the module doc) and what it is;
-    (inf, "events ...") when the events per clearance differ."""
+def cycle_change(before: Trace, after: Trace) -> tuple[float, str, str]:
+    """The largest relative change of the continuous measures from one cycle's run to another (see the
+    module doc), what it is, and how the events per clearance differ ("" when they are the same)."""
     spec = after.spec
     n = spec.n_coordinates
     changes: dict[str, float] = {}
@@ -151,10 +158,20 @@ def cycle_change(before: Trace, after: Trace) -> tuple[float, str]:
     changes["seating_velocity_max"] = _relative(m0["seating_velocity_max"], m1["seating_velocity_max"], lift * omega)
     what = max(changes, key=lambda k: changes[k])
     c0, c1 = _event_counts(before), _event_counts(after)
-    if c0 != c1:
-        moved = ", ".join(f"{k} {c0[k]} -> {c1[k]}" for k in c1 if c0[k] != c1[k])
-        return math.inf, f"events per cycle changed: {moved}; {what} by {changes[what]:.3g}"
-    return changes[what], what
+    events = ", ".join(f"{k} {c0[k]} -> {c1[k]}" for k in c1 if c0[k] != c1[k])
+    return changes[what], what, events
+
+
+def _periodic(traces: list[Trace], tolerance: float) -> tuple[int, float, str, str] | None:
+    """(period, change, what, events) of the shortest period p = 2 .. MAX_PERIOD over which the last cycle
+    repeats the one p cycles before it (the first cycle, the start-up, left out), or None."""
+    for period in range(2, MAX_PERIOD + 1):
+        if len(traces) - 1 - period < 1:
+            break
+        change, what, events = cycle_change(traces[-1 - period], traces[-1])
+        if not events and change <= tolerance:
+            return period, change, what, events
+    return None
 
 
 def _shifted(trace: Trace, k: int, period: float, skip_first: bool) -> tuple[slice, list[Event]]:
@@ -212,24 +229,31 @@ def simulate_cycles(backend: Any, mechanism: Mechanism, *, every_step: bool = Fa
     current = base if start is None else start.start(base)
     traces: list[Trace] = []
     changes = [math.nan]
-    change, changed = math.nan, ""
+    change, changed, events = math.nan, "", ""
     settled: bool | None = None if fixed else False
+    period = 1
     for k in range(limit):
         part = None if progress is None else (lambda f, k=k: progress((k + f) / limit))
         trace = backend.simulate(current, options, progress=part if backend.supports_progress else None,
                                  cancel=cancel if backend.supports_cancel else None)
         traces.append(trace)
         if k > 0:
-            change, changed = cycle_change(traces[-2], trace)
-            changes.append(change)
-            if not fixed and change <= tolerance:
+            change, changed, events = cycle_change(traces[-2], trace)
+            changes.append(math.inf if events else change)
+            if not fixed and not events and change <= tolerance:
+                settled = True
+                break
+            repeating = None if fixed else _periodic(traces, tolerance)
+            if repeating is not None:
+                period, change, changed, events = repeating
                 settled = True
                 break
         state = State.at_end(trace, base.omega)
         current = state.start(base)
     if on_state is not None:
         on_state(State.at_end(traces[-1], base.omega))
-    cycles = Cycles(len(traces), settled, tolerance, change, changed, tuple(changes), traces[-1].peak_force.copy(),
-                    traces[0].peak_force.copy() if start is None else np.full_like(traces[0].peak_force, math.nan),
-                    max_cycles=limit)
+    peaks = np.max([t.peak_force for t in traces[-period:]], axis=0)
+    startup = traces[0].peak_force.copy() if start is None else np.full_like(traces[0].peak_force, math.nan)
+    cycles = Cycles(len(traces), settled, tolerance, change, changed, tuple(changes), peaks, startup,
+                    max_cycles=limit, period=period, events_changed=events)
     return concatenate(traces, spec, base.omega, cycles)

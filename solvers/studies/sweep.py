@@ -29,6 +29,7 @@ assignments). This module evaluates them and keeps the results:
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import functools
 import io
@@ -36,14 +37,15 @@ import logging
 import math
 import os
 import signal
+import stat
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import Any
 
+from vtool.csvrows import csv_text
 from vtool.errors import InputError, RunError
-from vtool.files import exists, write_atomic
+from vtool.files import check_output_path, exists, open_no_follow, write_atomic
 from vtool.solvers import backends
 from vtool.solvers.model.mechanism import Mechanism, assemble
 from vtool.solvers.model.spec import MechanismSpec
@@ -163,28 +165,53 @@ def chunks(points: Sequence[Point], workers: int, per_worker: int = 4, largest: 
 
 # ----- execution -----
 
-def _ignore_interrupt(stderr: str | None = None) -> None:
+def _ignore_interrupt(ready: Any = None, stderr: str | None = None) -> None:
     """Worker initializer: Ctrl+C is handled by the parent, which stops the pool cleanly; with
-    ``stderr`` (a file path), the worker's standard error (descriptor 2) is that file."""
+    ``stderr`` (a file path), the worker's standard error (descriptor 2) is that file; ``ready`` (a
+    semaphore) is released once the worker runs (see :meth:`ProcessRunner.start`)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if stderr is not None:
         target = os.open(stderr, os.O_WRONLY | os.O_APPEND)
         os.dup2(target, 2)
         os.close(target)
+    if ready is not None:
+        ready.release()
+
+
+#: Most local Dask workers (processes or threads) per core: ``local:N`` above this is refused.
+LOCAL_WORKERS_PER_CORE = 4
+
+
+def max_local_workers() -> int:
+    """The largest N of ``local:N`` / ``local-threads:N``: :data:`LOCAL_WORKERS_PER_CORE` per core."""
+    return LOCAL_WORKERS_PER_CORE * (os.cpu_count() or 1)
+
+
+SCHEDULER_FORMS = "tcp://HOST:PORT of a running Dask scheduler, local:N or local-threads:N"
 
 
 def parse_scheduler(text: str) -> tuple[str, int]:
-    """``tcp://HOST:PORT`` -> ("tcp", 0); ``local:N`` / ``local-threads:N`` -> (kind, N)."""
-    for kind in ("local-threads", "local"):
-        if text.startswith(kind + ":"):
-            count = text[len(kind) + 1:]
-            if not count.isdigit() or int(count) < 1:
-                break
-            return kind, int(count)
-    else:
-        if "://" in text:
+    """The one parser of ``--scheduler``: ``tcp://HOST:PORT`` -> ("address", 0); ``local:N`` /
+    ``local-threads:N`` -> (kind, N) with 1 <= N <= :func:`max_local_workers`.
+
+    Anything else (another protocol: ``tls://`` needs certificates vtool does not configure,
+    ``inproc://`` and ``ucx://`` are not for a command line; a missing host or port; a ``;``, a space
+    or a control character) is an InputError naming the accepted forms, before Dask is imported.
+    """
+    kind, sep, rest = text.partition(":")
+    if kind in ("local", "local-threads") and sep:
+        top = max_local_workers()
+        if not rest.isascii() or not rest.isdigit() or not 1 <= int(rest) <= top:
+            raise InputError("--scheduler", text, f"{kind}:N with N an integer from 1 to {top} "
+                             f"({LOCAL_WORKERS_PER_CORE} per core, {os.cpu_count() or 1} cores)")
+        return kind, int(rest)
+    if text.isascii() and text.isprintable() and not any(c in text for c in " ;"):
+        scheme, sep, address = text.partition("://")
+        host, colon, port = address.rpartition(":")
+        host_ok = bool(host) and all(c.isalnum() or c in ".-_" for c in host)
+        if scheme == "tcp" and sep and colon and host_ok and port.isdigit() and 1 <= int(port) <= 65535:
             return "address", 0
-    raise InputError("--scheduler", text, "tcp://HOST:PORT of a running Dask scheduler, local:N or local-threads:N")
+    raise InputError("--scheduler", text, SCHEDULER_FORMS)
 
 
 class DaskRunner:
@@ -199,10 +226,11 @@ class DaskRunner:
             if kind == "address":
                 self.client = Client(scheduler, timeout=timeout)
             else:
-                self.cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=kind == "local",
-                                            dashboard_address=None, silence_logs=logging.ERROR)
+                with _pool_start():
+                    self.cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=kind == "local",
+                                                dashboard_address=None, silence_logs=logging.ERROR)
                 self.client = Client(self.cluster)
-        except (OSError, TimeoutError) as exc:
+        except (OSError, TimeoutError, ValueError) as exc:
             raise InputError("--scheduler", scheduler,
                              f"a reachable Dask scheduler ({type(exc).__name__}: {str(exc).splitlines()[0][:80]})"
                              ) from None
@@ -230,8 +258,60 @@ class DaskRunner:
             self.cluster.close()
 
 
+@contextlib.contextmanager
+def _pool_start() -> Iterator[None]:
+    """Helper processes started inside this block import the installed ``vtool`` and never see Ctrl+C.
+
+    Ctrl+C: SIGINT is blocked in this thread while the block runs; the mask is inherited through
+    fork and exec, so a forkserver (or a Dask nanny) that is still importing numpy when the user
+    presses Ctrl+C no longer prints a second traceback after the clean message. In the main thread,
+    SIGINT and SIGTERM that reach this process meanwhile (through another thread, whose mask is its
+    own) are held and raised when the block ends, so the block is never left half-way (a worker
+    caught half-started when the pool is stopped prints a traceback of its own).
+
+    Import path: ``PYTHONSAFEPATH=1`` in the environment while the pool starts its helper processes.
+
+    multiprocessing starts the forkserver as ``python -c ...``, which puts the current folder first
+    on the helper's import path; it then imports the preloaded ``vtool`` modules, so a folder named
+    ``vtool`` in the current folder (an empty one will do) was imported instead of the installed
+    package and every worker died (BrokenProcessPool). With ``PYTHONSAFEPATH`` (Python 3.11's ``-P``)
+    the helper's path leaves the current folder out; the workers forked from it then take this
+    process's own path (multiprocessing's preparation data), so they import what this process did.
+    """
+    import threading
+
+    old = os.environ.get("PYTHONSAFEPATH")
+    os.environ["PYTHONSAFEPATH"] = "1"
+    held: list[int] = []
+    handlers = {}
+    if threading.current_thread() is threading.main_thread():
+        handlers = {sig: signal.signal(sig, lambda signum, frame: held.append(signum))
+                    for sig in (signal.SIGINT, signal.SIGTERM)}
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop("PYTHONSAFEPATH", None)
+        else:
+            os.environ["PYTHONSAFEPATH"] = old
+        signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
+    for signum in held[:1]:  # what arrived meanwhile, as it would have arrived
+        handler = handlers[signal.Signals(signum)]
+        if callable(handler):
+            handler(signum, None)
+        elif handler == signal.SIG_DFL and signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        elif handler == signal.SIG_DFL:
+            signal.raise_signal(signum)
+
+
 class ProcessRunner:
-    """A forkserver process pool of ``workers`` processes that ignore Ctrl+C (the parent stops them).
+    """A forkserver process pool of ``workers`` processes that ignore Ctrl+C (the parent stops them);
+    its helper processes import the installed ``vtool`` whatever the current folder holds
+    (:func:`_pool_start`).
 
     ``stderr``: a file the workers write their standard error to instead of the parent's (the TUI
     passes os.devnull: its terminal is Textual's screen).
@@ -244,13 +324,42 @@ class ProcessRunner:
         context = multiprocessing.get_context("forkserver")
         context.set_forkserver_preload(["vtool.solvers.studies.sweep", backends.module_of(backends.DEFAULT)])
         self.workers = workers
+        self.ready = context.Semaphore(0)
+        self.started = False
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt,
-                                        initargs=(stderr,))
+                                        initargs=(self.ready, stderr))
+
+    def start(self, timeout: float = 300.0) -> None:
+        """Start every worker and wait until each runs (inside :func:`_pool_start`).
+
+        A worker still unpickling its start-up data when the parent stops the pool finds the pool's
+        semaphores gone and prints a traceback; started all at once, before any point and with Ctrl+C
+        held back until they run, no worker is ever caught half-started.
+        """
+        if self.started:
+            return
+        with _pool_start():
+            # each submission to a pool without an idle worker starts one
+            futures = [self.pool.submit(os.getpid) for _ in range(self.workers)]
+            deadline = time.perf_counter() + timeout
+            running = 0
+            while running < self.workers:
+                if self.ready.acquire(timeout=0.1):
+                    running += 1
+                    continue
+                failed = next((f.exception() for f in futures if f.done() and f.exception() is not None), None)
+                if failed is not None:
+                    raise RunError(f"the sweep's worker processes did not start ({type(failed).__name__}: "
+                                   f"{str(failed)[:120]})")
+                if time.perf_counter() > deadline:
+                    raise RunError(f"the sweep's {self.workers} worker processes did not start within {timeout:g} s")
+        self.started = True
 
     def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
             cancel: Callable[[], bool]) -> bool:
         from concurrent.futures import FIRST_COMPLETED, wait
 
+        self.start()
         pending = {self.pool.submit(evaluate_chunk, b, every_step) for b in batches}
         try:
             while pending:
@@ -294,16 +403,117 @@ class SerialRunner:
         pass
 
 
-def make_runner(workers: int | None = None, scheduler: str | None = None, *, stderr: str | None = None) -> Any:
+#: Seconds a local pool needs before its workers return their first points: the forkserver's imports,
+#: the workers' start and each worker's first kernel load (benchmarks/bench_sweep_choice.py measures it:
+#: 1.1 s for the pool and about 1 s for the first point on the 2-core development machine).
+POOL_START_SECONDS = 2.0
+#: Work per chunk sent to a worker (s): fewer, larger chunks cost less in hand-offs.
+CHUNK_SECONDS = 0.25
+#: Points measured in this process before the choice (the first also loads the kernel: the last one counts).
+MEASURED_POINTS = 2
+
+
+@dataclass(frozen=True)
+class WorkerChoice:
+    """How the rest of a sweep runs: ``workers`` processes (1: in this process), ``chunk`` points a task."""
+
+    workers: int
+    chunk: int
+    reason: str
+
+
+def choose_workers(point_seconds: float, points: int, cores: int, load: float | None = None,
+                   start_seconds: float = POOL_START_SECONDS) -> WorkerChoice:
+    """Workers and chunk size for ``points`` more points of ``point_seconds`` each (measured).
+
+    The cores free for the sweep are ``cores + 1 - load`` (``load``: the one-minute load average, which
+    counts this process), from 1 to ``cores``; with ``w`` workers on ``f`` free cores the pool takes
+    ``start_seconds + points * point_seconds / min(w, f)`` against ``points * point_seconds`` serially,
+    and is chosen only when that saves more than a tenth of the serial time. A chunk holds about
+    :data:`CHUNK_SECONDS` of work, and there are at least two chunks per worker.
+    """
+    serial = points * point_seconds
+    free = float(cores) if load is None else min(float(cores), max(1.0, cores + 1.0 - load))
+    workers = min(cores, points, max(1, int(free + 0.5)))
+    where = f"{points} more point{'s' if points != 1 else ''} of {1000 * point_seconds:.3g} ms"
+    if workers < 2:
+        return WorkerChoice(1, points or 1, f"{where} run in this process ({free:.1f} of {cores} cores free)")
+    pooled = start_seconds + serial / min(workers, free)
+    if pooled > 0.9 * serial:
+        return WorkerChoice(1, points, f"{where} run in this process: {serial:.2g} s, where a pool of {workers} "
+                            f"would take about {pooled:.2g} s with its {start_seconds:g} s start-up")
+    chunk = max(1, min(math.ceil(CHUNK_SECONDS / max(point_seconds, 1e-6)), math.ceil(points / (2 * workers))))
+    return WorkerChoice(workers, chunk, f"{where} run on {workers} worker processes in chunks of {chunk}: about "
+                        f"{pooled:.2g} s against {serial:.2g} s in this process")
+
+
+class AutoRunner:
+    """The default local runner: measures a point in this process, then runs the rest there or on a pool
+    (:func:`choose_workers`); ``announce`` is told the choice (the CLI prints it on stderr)."""
+
+    def __init__(self, cores: int, stderr: str | None = None,
+                 announce: Callable[[str], None] | None = None) -> None:
+        self.cores = cores
+        self.workers = cores  # (for the caller's first grouping; the choice regroups)
+        self.stderr = stderr
+        self.announce = announce
+        self.choice: WorkerChoice | None = None
+        self.pool: ProcessRunner | None = None
+        self.serial = SerialRunner()
+
+    def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
+            cancel: Callable[[], bool]) -> bool:
+        points = [p for batch in batches for p in batch]
+        if self.choice is None:
+            seconds = 0.0
+            for point in points[:MEASURED_POINTS]:
+                started = time.perf_counter()
+                if not self.serial.run([[point]], every_step, on_results, cancel):
+                    return False
+                seconds = time.perf_counter() - started
+            points = points[MEASURED_POINTS:]
+            load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+            self.choice = choose_workers(seconds, len(points), self.cores, load)
+            self.workers = self.choice.workers
+            if self.announce is not None:
+                self.announce(f"sweep: {self.choice.reason}")
+        if not points:
+            return True
+        if self.choice.workers < 2:
+            return self.serial.run([points], every_step, on_results, cancel)
+        if self.pool is None:
+            self.pool = ProcessRunner(self.choice.workers, self.stderr)
+        return self.pool.run(chunks(points, self.choice.workers, per_worker=2, largest=self.choice.chunk),
+                             every_step, on_results, cancel)
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.close()
+
+
+def check_workers(workers: int) -> int:
+    """``workers`` if it is from 1 to :func:`max_local_workers`, else an InputError."""
+    top = max_local_workers()
+    if not 1 <= workers <= top:
+        raise InputError("--workers", workers, f"an integer from 1 to {top} ({LOCAL_WORKERS_PER_CORE} per core, "
+                         f"{os.cpu_count() or 1} cores)")
+    return workers
+
+
+def make_runner(workers: int | None = None, scheduler: str | None = None, *, stderr: str | None = None,
+                announce: Callable[[str], None] | None = None) -> Any:
     """The runner for these settings; a Dask scheduler is connected here (InputError if unreachable).
 
-    ``stderr``: where local worker processes write their standard error (see :class:`ProcessRunner`).
+    ``workers=None`` (the default) chooses from the measured cost of a point (:class:`AutoRunner`, which
+    tells ``announce`` what it chose). ``stderr``: where local worker processes write their standard error
+    (see :class:`ProcessRunner`).
     """
-    if scheduler:
+    if scheduler is not None:
         return DaskRunner(scheduler)
-    if workers is not None and workers < 1:
-        raise InputError("--workers", workers, "an integer >= 1")
-    count = workers or os.cpu_count() or 1
+    if workers is None:
+        cores = os.cpu_count() or 1
+        return SerialRunner() if cores == 1 else AutoRunner(cores, stderr, announce)
+    count = check_workers(workers)
     return SerialRunner() if count == 1 else ProcessRunner(count, stderr)
 
 
@@ -402,9 +612,7 @@ def csv_row(result: PointResult, metrics: Sequence[tuple[str, str]]) -> list[str
 
 
 def csv_lines(rows: Iterable[list[str]]) -> str:
-    buffer = io.StringIO()
-    csv.writer(buffer, lineterminator="\n").writerows(rows)
-    return buffer.getvalue()
+    return csv_text(rows)
 
 
 def results_csv(results: Sequence[PointResult], fields: Sequence[tuple[str, str]], spec: MechanismSpec,
@@ -414,23 +622,34 @@ def results_csv(results: Sequence[PointResult], fields: Sequence[tuple[str, str]
     return csv_lines([csv_header(fields, spec, timing)] + [csv_row(r, metrics) for r in results])
 
 
+#: Largest --resume file read (bytes): a sweep's CSV is a few hundred bytes a point.
+MAX_RESUME_BYTES = 256 * 1024 * 1024
+
+
 class SweepFile:
     """A CSV written as points finish, kept valid and resumable; see the module doc.
 
     Header: the swept fields (with units), ``status``, then the metrics (with
     units); ``timing=False`` leaves out machine-dependent columns (wall time)
     so that files from different execution paths compare byte for byte.
+
+    The file is touched only when the first point finishes (:attr:`written`): a
+    sweep stopped before that leaves an existing file as it was. A resumed file
+    is checked before it is read (a regular file, not a link, a FIFO or a
+    device, at most :data:`MAX_RESUME_BYTES`); the appends go through a
+    descriptor opened without following a link (``O_NOFOLLOW``).
     """
 
     def __init__(self, path: str | os.PathLike[str], fields: Sequence[tuple[str, str]], spec: MechanismSpec,
                  *, resume: bool = False, timing: bool = False) -> None:
-        self.path = Path(path)
+        self.path = check_output_path(path, "--csv")
         self.fields = [f for f, _ in fields]
         self.metrics = report_columns(spec, timing)
         self.spec = spec
         self.header = csv_header(fields, spec, timing)
         self.keys: dict[tuple[str, ...], int] = {}
         self.rows: list[list[str]] = []
+        self.resumed = resume
         if resume and exists(self.path):
             self._read_partial()
         elif resume:
@@ -438,18 +657,34 @@ class SweepFile:
         self.finished: set[int] = set()
         self.index_of: dict[tuple[str, ...], int] = {}
         self.handle: io.TextIOWrapper | None = None
+        self.written = False
 
     def _read_partial(self) -> None:
-        text = self.path.read_text(encoding="utf-8")
+        fd = open_no_follow(self.path, os.O_RDONLY | os.O_NONBLOCK, "--resume")  # a FIFO must not block
+        with os.fdopen(fd, "rb") as raw:
+            st = os.fstat(raw.fileno())
+            if not stat.S_ISREG(st.st_mode):
+                raise InputError("--resume", str(self.path), "a regular file (not a device, pipe or socket)")
+            if st.st_size > MAX_RESUME_BYTES:
+                raise InputError("--resume", str(self.path), f"a partial sweep file of at most "
+                                 f"{MAX_RESUME_BYTES // 2**20} MB (this one has {st.st_size:,} bytes)")
+            data = raw.read(MAX_RESUME_BYTES + 1)
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise InputError("--resume", str(self.path), "a partial sweep file (UTF-8 CSV text)") from None
         lines = text.split("\n")
         complete = lines[:-1]  # the last piece has no newline: empty, or a line cut by a kill
-        rows = list(csv.reader(complete))
+        try:
+            rows = list(csv.reader(complete))
+        except csv.Error:
+            rows = []
         if not rows or rows[0] != self.header:
             raise InputError("--resume", str(self.path), "a partial file of this same sweep (its header differs)")
         self.rows = [r for r in rows[1:] if len(r) == len(self.header)]
 
     def open(self, points: Sequence[Point]) -> None:
-        """Start (or continue) the file; marks the points already in it as finished."""
+        """Marks the points already in the file as finished; the file is written at the first new point."""
         index_of = {tuple(format_value(v) for _, v in p.values): p.index for p in points}
         kept = []
         for row in self.rows:
@@ -459,8 +694,13 @@ class SweepFile:
                 kept.append(row)
         self.rows = kept
         self.index_of = index_of
-        write_atomic(self.path, self._text([self.header] + kept))
-        self.handle = self.path.open("a", encoding="utf-8", newline="")
+
+    def _start(self) -> None:
+        """The file with its header and the kept rows, then a no-follow append descriptor on it."""
+        write_atomic(self.path, self._text([self.header] + self.rows), "--csv")
+        fd = open_no_follow(self.path, os.O_WRONLY | os.O_APPEND, "--csv")
+        self.handle = os.fdopen(fd, "a", encoding="utf-8", newline="")
+        self.written = True
 
     def finished_results(self, points: Sequence[Point]) -> dict[int, PointResult]:
         """The points read back from a resumed file (numbers parsed; empty cells NaN)."""
@@ -484,6 +724,8 @@ class SweepFile:
         return csv_lines(rows)
 
     def append(self, result: PointResult) -> None:
+        if self.handle is None:
+            self._start()
         assert self.handle is not None
         row = self.row(result)
         self.rows.append(row)
@@ -491,12 +733,14 @@ class SweepFile:
         self.handle.flush()
 
     def finish(self) -> None:
-        """Close, and rewrite the file atomically in point order."""
+        """Close, and rewrite the file atomically in point order (untouched if no point was added)."""
         if self.handle is not None:
             self.handle.close()
             self.handle = None
+        if not (self.written or self.resumed):
+            return
         rows = sorted(self.rows, key=lambda r: self.index_of.get(tuple(r[: len(self.fields)]), -1))
-        write_atomic(self.path, self._text([self.header] + rows))
+        write_atomic(self.path, self._text([self.header] + rows), "--csv")
 
 
 # ----- derived speeds -----
@@ -551,7 +795,7 @@ class SpeedResult:
 def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan: Sequence[float],
                runner: Any, *, tolerance: float = 1.0, every_step: bool = False,
                report: Callable[[Bracket], None] | None = None,
-               cancel: Callable[[], bool] | None = None) -> SpeedResult:
+               cancel: Callable[[], bool] | None = None, bisector: Any = None) -> SpeedResult:
     """Every cam-speed interval where ``criterion`` holds, each edge bisected to ``tolerance`` rev/min.
 
     The speeds ``scan`` (ascending) are run together on ``runner``; every change between neighbouring
@@ -559,7 +803,7 @@ def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan
     tolerance 1). A window of contact loss below a window of contact is its own interval; an interval
     narrower than the scan's step can fall between two scanned speeds unseen (scan finer). ``speed``
     is the lowest edge (the jump speed), None when the criterion holds at no scanned speed or already
-    at the lowest.
+    at the lowest. The bisections run one point at a time on ``bisector`` (default: in this process).
     """
     if criterion not in CRITERIA:
         raise InputError("--find", criterion, f"one of: {', '.join(CRITERIA)}")
@@ -585,7 +829,7 @@ def find_speed(criterion: str, make_spec: Callable[[float], MechanismSpec], scan
     if not any(holds):
         return SpeedResult(criterion, None, tuple(history), f"{words} at none of the scanned speeds "
                                                             f"(up to {scan[-1]:g} rev/min)")
-    serial = SerialRunner()
+    serial = bisector if bisector is not None else SerialRunner()
 
     def bisect(low: float, high: float, rising: bool) -> tuple[float, float]:
         """(the last speed on the low side, the first on the high side) of one edge."""
