@@ -64,7 +64,7 @@ KINDS: dict[str, Kind] = {
                        "vtool.solvers.model.spec:MechanismSpec", "vtool.presets.valvetrain",
                        "vtool.app.cli.solve:run_valvetrain", "vtool.app.tui.valvetrain",
                        ("--backend", "--dt", "--rpm", "--degrees", "--every-step", "--events",
-                        "--max-steps", "--impact", "--start", "--orders"),
+                        "--max-steps", "--impact", "--start", "--orders", "--format"),
                        (("--backend", "run.backend"), ("--dt", "run.time_step"), ("--rpm", "run.rpm"),
                         ("--degrees", "run.degrees"), ("--impact", "contact.impact"),
                         ("--start", "initial.velocities"))),

@@ -583,16 +583,20 @@ class CsvStream:
         self.last_time = -math.inf
         self.header_written = False
 
-    def write(self, block: Trace) -> None:
-        """Append a block of rows (a :class:`Trace` of its rows)."""
-        started = wallclock.perf_counter()
+    def check_order(self, block: Trace) -> None:
+        """A block that goes back in time is a RunError (see the class doc)."""
         if len(block.time):
             if block.time[0] < self.last_time or np.any(np.diff(block.time) < 0.0):
                 from vtool.errors import RunError
 
-                raise RunError(f"rows out of time order at t = {block.time[0]:.6g} s: the CSV cannot be "
+                raise RunError(f"rows out of time order at t = {block.time[0]:.6g} s: the file cannot be "
                                "streamed (a back end must hand rows over in time order)")
             self.last_time = float(block.time[-1])
+
+    def write(self, block: Trace) -> None:
+        """Append a block of rows (a :class:`Trace` of its rows)."""
+        started = wallclock.perf_counter()
+        self.check_order(block)
         block.write_csv_to(self.handle, self.quantities, header=not self.header_written,
                            compiled=True if self.thin else None)
         self.header_written = True

@@ -19,7 +19,7 @@ import tomli_w
 from click.testing import CliRunner
 from textual import events
 
-from tests.tui_helpers import put, run_and_wait, run_degrees
+from tests.tui_helpers import answer_path_dialog, put, run_and_wait, run_degrees
 from vtool.app import valvetrain_charts as charts
 from vtool.app.cli.main import cli
 from vtool.app.plots import shape_chart
@@ -309,18 +309,11 @@ async def test_csv_export_equals_vtool_solve_csv(tmp_path) -> None:  # type: ign
     app = make_app("gnilka-1c")
     async with app.run_test(size=(80, 24)) as pilot:
         await pilot.pause()
-        screen = app.screen
         await pilot.press("ctrl+e")  # nothing to export yet: a warning, no dialog
         await pilot.pause()
         assert not isinstance(app.screen, PathDialog)
         await run_and_wait(pilot, app)
-        await pilot.press("ctrl+e")
-        await pilot.pause()
-        assert isinstance(app.screen, PathDialog)
-        app.screen.query_one("#path-input").value = str(tmp_path / "tui.csv")
-        await pilot.press("enter")
-        await pilot.pause()
-        assert app.screen is screen
+        await answer_path_dialog(pilot, app, "ctrl+e", str(tmp_path / "tui.csv"))
     result = CliRunner().invoke(cli, ["solve", "gnilka-1c", "--csv", str(tmp_path / "cli.csv")])
     assert result.exit_code == 0, result.output
     assert (tmp_path / "tui.csv").read_text() == (tmp_path / "cli.csv").read_text()

@@ -76,3 +76,10 @@ class RunError(RuntimeError):
 
 class PresetWarning(UserWarning):
     """A preset loads, but a setting probably does not do what its author meant."""
+
+
+class PresetNote(UserWarning):
+    """What the loader assumed or converted (a scan's units, its smoothing): said once, not an error.
+
+    Issued through :func:`warnings.warn`; the CLI prints each as ``note: ...`` on stderr.
+    """
