@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ast
 from collections.abc import Iterator
+from functools import cache
 from pathlib import Path
 
 from vtool.presets.kinds import KINDS, resolve
@@ -38,10 +39,14 @@ OTHER_MEANINGS = {
 KERNEL_USERS = {"solvers/model/contact.py", "solvers/trace.py"}
 
 
+@cache
+def parsed() -> tuple[tuple[str, ast.Module], ...]:
+    return tuple((path.relative_to(ROOT).as_posix(), ast.parse(path.read_text(encoding="utf-8")))
+                 for folder in FOLDERS for path in sorted((ROOT / folder).rglob("*.py")))
+
+
 def sources() -> Iterator[tuple[str, ast.Module]]:
-    for folder in FOLDERS:
-        for path in sorted((ROOT / folder).rglob("*.py")):
-            yield path.relative_to(ROOT).as_posix(), ast.parse(path.read_text(encoding="utf-8"))
+    yield from parsed()
 
 
 def strings(node: ast.AST) -> Iterator[ast.Constant]:
