@@ -80,6 +80,15 @@ def test_only_the_kinds_table_compares_a_preset_kind() -> None:
     assert found == [], "dispatch on a preset kind outside presets/kinds.py:\n" + "\n".join(found)
 
 
+def test_the_kinds_docstring_table_is_the_table() -> None:
+    import vtool.presets.kinds as kinds
+
+    lines = (kinds.__doc__ or "").splitlines()
+    rules = [i for i, line in enumerate(lines) if line.startswith("==========")]
+    rows = [line.split() for line in lines[rules[1] + 1:rules[2]]]
+    assert rows == [[k.name, k.spec_type, k.loader, k.solve, k.screen] for k in KINDS.values()]
+
+
 def test_the_tui_finds_every_screen_through_the_kinds_table() -> None:
     from vtool.app.tui.app import SCREENS_BY_MODE, mode_for_kind
 
