@@ -178,3 +178,24 @@ async def test_a_metric_with_no_value_at_any_point_is_said_not_drawn() -> None:
         assert pane.status_text.startswith("finished: 2 of 2 points"), pane.status_text
         assert pane.chart.function is None and "no point has a value of seating_velocity_max" in str(pane.chart.content)
     assert app._exception is None
+
+
+async def test_export_while_the_next_sweep_is_checked_writes_the_last_finished_sweep(tmp_path: Path) -> None:
+    """TUI monkey, seeds 108 and 160: Export CSV pressed while a new sweep was being checked met the new
+    (empty) plan beside the last sweep's results (AttributeError)."""
+    app = PaneApp(values="10000,11000", fixed="run.degrees=100", metric="peak_F1")
+    async with app.run_test(size=(140, 50)) as pilot:
+        pane = app.query_one(SweepPane)
+        await _run(pilot, pane)
+        pane.query_one("#sweep-values", Input).value = "1000:100999:1"
+        pane.run_sweep()
+        await pilot.pause()
+        pane.export_csv(tmp_path / "last.csv")
+        await pilot.pause()
+        pane.cancel()
+        while pane.running:
+            await pilot.pause(0.05)
+        await pilot.pause()
+    assert app._exception is None
+    rows = (tmp_path / "last.csv").read_text().splitlines()
+    assert len(rows) == 3 and rows[1].startswith("10000,") and rows[2].startswith("11000,")
