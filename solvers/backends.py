@@ -176,6 +176,11 @@ class Backend(ABC, Generic[OptionsT]):
         return None
 
     @classmethod
+    def warm_up(cls, spec: MechanismSpec) -> None:
+        """Compile (or load from the cache) what a run of ``spec`` needs, ahead of the run (the TUI calls
+        it when a preset opens); default: nothing to compile."""
+
+    @classmethod
     def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:
         """The settings an accuracy study runs this back end at (default: none; see
         :mod:`vtool.solvers.studies.accuracy`)."""
