@@ -147,7 +147,7 @@ def get(name: str) -> type[Backend[Any]]:
     ep = _entry_points().get(name)
     if ep is None:
         raise InputError("run.backend", name, f"one of the installed back ends: {', '.join(available())}")
-    return ep.load()  # type: ignore[no-any-return]
+    return ep.load()
 
 
 class Backend(ABC, Generic[OptionsT]):

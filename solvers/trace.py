@@ -255,7 +255,7 @@ class Trace:
             return self.coordinate(valve, rows) - self.coordinate(seat, rows)
         return self.coordinate(valve, rows) - self.spec.seat.position
 
-    def csv_columns(self, quantities: tuple[str, ...] = ()) -> tuple[list[str], list]:  # type: ignore[type-arg]
+    def csv_columns(self, quantities: tuple[str, ...] = ()) -> tuple[list[str], list]:
         """The CSV header (quantity names with units) and one function per numeric column that gives
         the column's values on a slice of rows (so a long run is written block by block).
 
@@ -304,7 +304,7 @@ class Trace:
         return csv_text([["" if number is None else number,
                           "+".join(closed_names(self.spec, mask)) or "none"]]).removesuffix("\n")
 
-    def write_csv_to(self, handle, quantities: tuple[str, ...] = (), chunk: int = 20_000,  # type: ignore[no-untyped-def]
+    def write_csv_to(self, handle, quantities: tuple[str, ...] = (), chunk: int = 20_000,
                      header: bool = True, compiled: bool | None = None) -> None:
         """Write the CSV in blocks of ``chunk`` rows (memory stays bounded by the block, not the run).
 
@@ -574,7 +574,7 @@ class CsvStream:
     of every step. The file has every row; :attr:`rows` counts them.
     """
 
-    def __init__(self, handle, quantities: tuple[str, ...] = (), thin: bool = False) -> None:  # type: ignore[no-untyped-def]
+    def __init__(self, handle, quantities: tuple[str, ...] = (), thin: bool = False) -> None:
         self.handle = handle
         self.quantities = tuple(quantities)
         self.thin = thin

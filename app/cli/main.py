@@ -92,7 +92,7 @@ class LazyGroup(click.Group):
         module, attribute = COMMANDS[cmd_name]
         return getattr(importlib.import_module(module), attribute)
 
-    def invoke(self, ctx: click.Context):  # type: ignore[no-untyped-def]
+    def invoke(self, ctx: click.Context):
         with warnings.catch_warnings():
             # a library's deprecation notice is not the user's business: only our warnings are shown
             warnings.simplefilter("ignore", DeprecationWarning)

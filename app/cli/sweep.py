@@ -232,7 +232,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         write_figure(items, figure_path)
 
 
-def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):  # type: ignore[no-untyped-def]
+def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):
     """The sweep with its points written to a Parquet file as they finish (renamed into place at the end)."""
     from vtool.files import open_atomic_binary
     from vtool.solvers.parquet import SweepParquet
@@ -244,7 +244,7 @@ def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):  # 
         # (run_points finishes the sink, footer included, also when interrupted: the file is then removed)
 
 
-def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # type: ignore[no-untyped-def]
+def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:
     """One speed search per grid point of the fields other than run.rpm."""
     from vtool.files import write_atomic
     from vtool.presets.valvetrain import with_run_overrides
@@ -268,7 +268,7 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
         if key and not as_json:
             click.echo(", ".join(f"{k} = {format_value(v)}" for k, v in key))
 
-        def report(b):  # type: ignore[no-untyped-def]
+        def report(b):
             if not as_json:
                 click.echo(f"  {b.stage:<6} {b.rpm:>9g} rev/min  {'holds' if b.holds else 'no':<5}  "
                            f"({format_value(b.value)})")
@@ -303,14 +303,14 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
         write_atomic(csv_path, buffer.getvalue())
 
 
-def _with_settings(plan, steady: bool, orders: tuple[str, ...]):  # type: ignore[no-untyped-def]
+def _with_settings(plan, steady: bool, orders: tuple[str, ...]):
     """The plan with every point (and its base spec) run to steady state and reporting these order amplitudes."""
     import dataclasses
 
     from vtool.solvers.studies.orders import with_orders
     from vtool.solvers.studies.steady import with_steady
 
-    def change(spec):  # type: ignore[no-untyped-def]
+    def change(spec):
         spec = with_orders(spec, orders) if orders else spec
         return with_steady(spec) if steady else spec
 

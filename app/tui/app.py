@@ -24,7 +24,7 @@ from vtool.presets.kinds import KINDS, kind_named, resolve
 
 def screen_for_kind(kind: str) -> type[DomainScreen]:
     """The screen that shows presets of ``kind`` (the kinds table's screen module)."""
-    return resolve(kind_named(kind).screen).SCREEN  # type: ignore[no-any-return]  # a module's SCREEN class
+    return resolve(kind_named(kind).screen).SCREEN
 
 
 #: the app's modes (one per screen, several kinds may share one), in the kinds table's order

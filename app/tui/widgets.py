@@ -73,7 +73,7 @@ class TextPanel(ScrollableContainer):
         self._initial = text
         self.text = text
 
-    def compose(self):  # type: ignore[no-untyped-def]
+    def compose(self):
         yield Static(Text(self._initial, no_wrap=True), markup=False)
 
     def set_text(self, text: str) -> None:
