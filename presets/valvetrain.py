@@ -186,7 +186,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     if seat is not None and seat.lash is not None:
         from vtool.solvers.model.lash import seat_position
 
-        spec = replace(spec, seat=replace(spec.seat, position=float(seat_position(spec, seat.lash))))
+        spec = replace(spec, seat=replace(seat, position=float(seat_position(spec, seat.lash))))
     return spec
 
 

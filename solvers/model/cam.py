@@ -175,6 +175,7 @@ def fit_table(angles_deg: np.ndarray, lifts: np.ndarray, harmonics: int | None =
                 fitted += a[K - 1] * np.cos(K * theta) + b[K - 1] * np.sin(K * theta)
                 error = np.abs(lift - fitted).max()
             else:
+                assert projection is not None  # (made above when the angles are not uniform)
                 x = np.linalg.solve(R[: 2 * K + 1, : 2 * K + 1], projection[: 2 * K + 1])
                 error = np.abs(lift - Q[:, : 2 * K + 1] @ projection[: 2 * K + 1]).max()
             if error <= tolerance:

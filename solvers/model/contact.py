@@ -122,6 +122,13 @@ class ConfigurationTables:
     kernel's record is then made again (:meth:`record`).
     """
 
+    # the slot arrays, (re)made by _allocate
+    ci: np.ndarray
+    cm: np.ndarray
+    cp: np.ndarray
+    mk: np.ndarray
+    mon: np.ndarray
+
     def __init__(self, mechanism: Mechanism) -> None:
         spec = mechanism.spec
         self.mechanism = mechanism
