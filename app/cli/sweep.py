@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -18,7 +19,7 @@ class CountProgress:
 
     def __init__(self, label: str) -> None:
         self.label = label
-        self.bar = None
+        self.bar: Any = None  # click's progress bar, once shown
         self.shown = 0
 
     def __call__(self, done: int, total: int) -> None:
@@ -273,8 +274,10 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:
                 click.echo(f"  {b.stage:<6} {b.rpm:>9g} rev/min  {'holds' if b.holds else 'no':<5}  "
                            f"({format_value(b.value)})")
 
-        result = find_speed(criterion, lambda rpm, spec=spec: with_steady(with_run_overrides(spec, rpm=rpm)),
-                            scan, runner, every_step=every_step, report=report)
+        def at_speed(rpm: float, spec: Any = spec) -> Any:
+            return with_steady(with_run_overrides(spec, rpm=rpm))
+
+        result = find_speed(criterion, at_speed, scan, runner, every_step=every_step, report=report)
         if not as_json:
             for interval in result.intervals:
                 click.echo(f"  interval: {interval.text()}")

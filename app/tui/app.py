@@ -7,12 +7,13 @@ Textual mode (f2 / f3 / f4): switching keeps each screen's form and results.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, ClassVar
 
 from textual.app import App
 from textual.binding import Binding, BindingType
-from textual.screen import ModalScreen
+from textual.screen import ModalScreen, Screen
 
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.dialogs import ErrorDialog, HelpScreen, OpenDialog
@@ -41,8 +42,8 @@ class VtoolApp(App[None]):
     CSS_PATH = "vtool.tcss"
     TITLE = "vtool"
     ENABLE_COMMAND_PALETTE = False
-    HORIZONTAL_BREAKPOINTS: ClassVar[list[tuple[int, str]] | None] = [(0, "-narrow"), (120, "-wide"), (170, "-huge")]
-    MODES: ClassVar[dict[str, Any]] = dict(SCREENS_BY_MODE)
+    HORIZONTAL_BREAKPOINTS: list[tuple[int, str]] | None = [(0, "-narrow"), (120, "-wide"), (170, "-huge")]
+    MODES: ClassVar[dict[str, str | Callable[[], Screen[Any]]]] = dict(SCREENS_BY_MODE)
     BINDINGS: ClassVar[list[BindingType]] = [
         Binding("ctrl+o", "open", "Open", priority=True),
         Binding("f1", "help", "Help"),
