@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -18,7 +19,7 @@ class CountProgress:
 
     def __init__(self, label: str) -> None:
         self.label = label
-        self.bar = None
+        self.bar: Any = None  # click's progress bar, once shown
         self.shown = 0
 
     def __call__(self, done: int, total: int) -> None:
@@ -232,7 +233,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         write_figure(items, figure_path)
 
 
-def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):  # type: ignore[no-untyped-def]
+def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):
     """The sweep with its points written to a Parquet file as they finish (renamed into place at the end)."""
     from vtool.files import open_atomic_binary
     from vtool.solvers.parquet import SweepParquet
@@ -244,7 +245,7 @@ def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):  # 
         # (run_points finishes the sink, footer included, also when interrupted: the file is then removed)
 
 
-def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # type: ignore[no-untyped-def]
+def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:
     """One speed search per grid point of the fields other than run.rpm."""
     from vtool.files import write_atomic
     from vtool.presets.valvetrain import with_run_overrides
@@ -268,13 +269,15 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
         if key and not as_json:
             click.echo(", ".join(f"{k} = {format_value(v)}" for k, v in key))
 
-        def report(b):  # type: ignore[no-untyped-def]
+        def report(b):
             if not as_json:
                 click.echo(f"  {b.stage:<6} {b.rpm:>9g} rev/min  {'holds' if b.holds else 'no':<5}  "
                            f"({format_value(b.value)})")
 
-        result = find_speed(criterion, lambda rpm, spec=spec: with_steady(with_run_overrides(spec, rpm=rpm)),
-                            scan, runner, every_step=every_step, report=report)
+        def at_speed(rpm: float, spec: Any = spec) -> Any:
+            return with_steady(with_run_overrides(spec, rpm=rpm))
+
+        result = find_speed(criterion, at_speed, scan, runner, every_step=every_step, report=report)
         if not as_json:
             for interval in result.intervals:
                 click.echo(f"  interval: {interval.text()}")
@@ -303,14 +306,14 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
         write_atomic(csv_path, buffer.getvalue())
 
 
-def _with_settings(plan, steady: bool, orders: tuple[str, ...]):  # type: ignore[no-untyped-def]
+def _with_settings(plan, steady: bool, orders: tuple[str, ...]):
     """The plan with every point (and its base spec) run to steady state and reporting these order amplitudes."""
     import dataclasses
 
     from vtool.solvers.studies.orders import with_orders
     from vtool.solvers.studies.steady import with_steady
 
-    def change(spec):  # type: ignore[no-untyped-def]
+    def change(spec):
         spec = with_orders(spec, orders) if orders else spec
         return with_steady(spec) if steady else spec
 

@@ -85,11 +85,11 @@ def width_class(width: int, breakpoints: list[tuple[int, str]]) -> str:
     return max((b for b in breakpoints if width >= b[0]), key=lambda b: b[0], default=(0, ""))[1]
 
 
-class _AbstractScreenMeta(ABCMeta, type(Screen)):  # type: ignore[misc]
+class _AbstractScreenMeta(ABCMeta, type(Screen)):  # type: ignore[misc]  # a base computed at run time: Screen's metaclass
     """Screen's metaclass with abstract-method checks, so a domain screen must provide its hooks."""
 
 
-class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):
+class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):  # type: ignore[metaclass]  # (the metaclass above)
     """Form on the left, results on the right, progress and keys at the bottom."""
 
     BINDINGS: ClassVar[list[BindingType]] = [

@@ -256,9 +256,11 @@ class BoomScreen(DomainScreen):
             charts.append((chart, name, freq, series))
         await stack.mount_all([c for c, *_ in charts])
         for chart, name, freq, series in charts:
-            chart.plot(lambda w, h, c, name=name, freq=freq, series=series: line_chart(
-                freq, series, title=f"{name}: allowable p+ against frequency", xlabel="f [Hz]",
-                ylabel=f"p+ [{u.alt_pressure}]", width=w, height=h, color=c))
+            def draw(w: int, h: int, c: bool, name: str = name, freq: Any = freq, series: Any = series) -> str:
+                return line_chart(freq, series, title=f"{name}: allowable p+ against frequency", xlabel="f [Hz]",
+                                  ylabel=f"p+ [{u.alt_pressure}]", width=w, height=h, color=c)
+
+            chart.plot(draw)
         self.set_status(f"done: {len(a.rows)} limits, {len(a.structures)} structure(s)")
 
     def write_csv(self, path: str) -> None:

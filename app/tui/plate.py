@@ -312,7 +312,10 @@ class PlateScreen(DomainScreen):
         self.query_one("#case-text", TextPanel).set_text(case_text(run))
         self.query_one("#study-text", TextPanel).set_text(study_text(study))
         for q in ("displacement", "velocity", "acceleration"):
-            self.chart(q).plot(lambda w, h, c, q=q: transient_chart(run, q, w, h, c))
+            def draw(w: int, h: int, c: bool, q: str = q) -> str:
+                return transient_chart(run, q, w, h, c)
+
+            self.chart(q).plot(draw)
         self.set_status(f"done: {len(study.free)} cases, study {study.seconds:.1f} s; case {run.case.name} "
                         f"KS = {run.free.size}")
 

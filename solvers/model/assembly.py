@@ -100,7 +100,7 @@ def sub_elements(member: MemberSpec) -> list[MemberSpec]:
         return [member]
     c = member.coordinates
     if member.element == BAR:
-        chain = [(c[0],), *[(node,) for node in member.nodes], (c[1],)]
+        chain: list[tuple[int, ...]] = [(c[0],), *[(node,) for node in member.nodes], (c[1],)]
     else:
         pairs = list(zip(member.nodes[::2], member.nodes[1::2], strict=True))
         chain = [(c[0], c[2]), *pairs, (c[1], c[3])]

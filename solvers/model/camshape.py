@@ -344,7 +344,7 @@ def model_lift(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> np.nd
 
 # ----- reports (``vtool cam show``) ------------------------------------------------------------------
 
-def shape_report(spec, points: int = 3600) -> dict:  # type: ignore[no-untyped-def]
+def shape_report(spec, points: int = 3600) -> dict:
     """The cam's shape for ``vtool cam show``: base radius, curvature, undercut, pressure angle, ratio."""
     follower = spec.follower
     law = spec.lift_law
@@ -399,7 +399,7 @@ def shape_text(report: dict) -> str:
     return "\n".join(lines)
 
 
-def profile_csv_text(spec, step_deg: float = 0.5) -> str:  # type: ignore[no-untyped-def]
+def profile_csv_text(spec, step_deg: float = 0.5) -> str:
     """The ground profile for grinding: per law angle, lift, Cartesian and polar point, radius of curvature
     (cam frame: y along the follower at law angle 0, angles in degrees)."""
     follower, law = spec.follower, spec.lift_law

@@ -122,6 +122,13 @@ class ConfigurationTables:
     kernel's record is then made again (:meth:`record`).
     """
 
+    # the slot arrays, (re)made by _allocate
+    ci: np.ndarray
+    cm: np.ndarray
+    cp: np.ndarray
+    mk: np.ndarray
+    mon: np.ndarray
+
     def __init__(self, mechanism: Mechanism) -> None:
         spec = mechanism.spec
         self.mechanism = mechanism
@@ -311,7 +318,7 @@ class ConfigurationTables:
         self._publish(mask)
         return ordered
 
-    def _monitors(self, mask: int, part, group: np.ndarray, m: int, springs) -> None:  # type: ignore[no-untyped-def]
+    def _monitors(self, mask: int, part, group: np.ndarray, m: int, springs) -> None:
         """Force rows of the closed clearances, gap references of the open monitored ones.
 
         A rigid external contact's force is the row force r at its ahead
@@ -529,7 +536,7 @@ class ContactProblem:
         operators = self.__dict__.setdefault("_operators", {})
         if mask not in operators:
             operators[mask] = LayerOperator.of(self.build(mask), self.n)
-        return operators[mask]  # type: ignore[no-any-return]  # the dict holds LayerOperators only
+        return operators[mask]
 
     def layer_vectors(self, mask: int, t: float, x: np.ndarray, v: np.ndarray,
                       a: np.ndarray | None = None) -> tuple[np.ndarray, ...]:

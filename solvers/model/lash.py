@@ -23,7 +23,7 @@ from vtool.errors import InputError
 from vtool.solvers.model.spec import EXTERNAL, MechanismSpec
 
 
-def _seat_clearance(spec: MechanismSpec):  # type: ignore[no-untyped-def]
+def _seat_clearance(spec: MechanismSpec):
     for c in spec.clearances:
         if spec.seat is not None and c.kind == EXTERNAL and c.behind == spec.seat.coordinate:
             return c

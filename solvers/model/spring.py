@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -110,6 +111,10 @@ class SpringSpec:
             return 1.0 / float(np.sum(1.0 / segment_rates(self)))
         return self.rate
 
+    @overload
+    def force_at(self, length: float) -> float: ...
+    @overload
+    def force_at(self, length: np.ndarray) -> np.ndarray: ...
     def force_at(self, length: float | np.ndarray) -> float | np.ndarray:
         """The static force at a length: the table's (interpolated), else the pitch diagram's, else linear."""
         if self.table_lengths:
@@ -124,6 +129,10 @@ class SpringSpec:
         """Fixed-fixed surge frequencies f_j = (j/2) sqrt(k / m_a), Hz (time unit: s)."""
         return [0.5 * j * math.sqrt(self.rate / self.active_mass) for j in range(1, count + 1)]
 
+    @overload
+    def stress(self, force: float, factor: str = "bergstrasser") -> float: ...
+    @overload
+    def stress(self, force: np.ndarray, factor: str = "bergstrasser") -> np.ndarray: ...
     def stress(self, force: float | np.ndarray, factor: str = "bergstrasser") -> float | np.ndarray:
         """Corrected shear stress K 8 F D / (pi d^3)."""
         return stress_factor(self.index, factor) * 8.0 * force * self.coil_diameter / (math.pi * self.wire_diameter ** 3)

@@ -530,7 +530,7 @@ class SweepOutcome:
 
 
 def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False,
-               sink: Any = None, progress: Callable[[int, int], None] | None = None,
+               sink: Any = None, progress: Callable[[int, int], object] | None = None,
                cancel: Callable[[], bool] | None = None, keep: bool = True) -> SweepOutcome:
     """Evaluate ``points`` with ``runner``; results go to ``sink`` (a :class:`SweepFile`, or
     :class:`vtool.solvers.parquet.SweepParquet`) as they arrive.
