@@ -259,3 +259,12 @@ def describe(spec: SpringSpec, units: UnitSystem) -> str:
     return (f"{spec.name}: rate {spec.rate:.5g} {units.stiffness}, active mass {spec.active_mass:.4g} {units.mass} "
             f"(whole wire {spec.total_mass:.4g}), installed preload {spec.preload:.5g} {units.force}, "
             f"solid length {spec.solid_length:.4g} {units.length}, first surge {f:.5g} Hz")
+
+
+def describe_document(explicit: dict[str, Any]) -> list[str]:
+    """:func:`describe` of each data sheet of an expanded document (``vtool presets expand`` prints them)."""
+    from vtool.units import UNIT_SYSTEMS
+
+    units = UNIT_SYSTEMS[explicit["units"]]
+    n = len(explicit["coordinates"])
+    return [describe(s, units) for s in load_sheets(Table(explicit, ""), units, n)]

@@ -187,3 +187,81 @@ def test_explicit_form_round_trip_keeps_the_data_sheet() -> None:
     again = load(copy.deepcopy(explicit))
     assert again.springs == spec.springs
     assert again.members == spec.members
+
+
+def _pitch_bucket(rpm: float) -> dict:
+    """The bucket with a pitch-diagram spring whose segments close at 2C, C and 1.5C (C = 183.565 N), all
+    inside the lift: 140 N installed, 35 N/mm in series, 420 N at full lift (8 mm), past solid (29 mm)."""
+    doc = _bucket_doc()
+    spring = doc["train"]["spring"]
+    del spring["elements"]
+    spring.update(segment_coils=[2.0, 1.75, 1.5], segment_pitches=[6.0, 5.0, 5.5], free_length=37.0,
+                  installed_length=33.0)
+    doc["run"].update(rpm=rpm, degrees=360.0, time_step=2e-6, output_interval=0.25)
+    doc["checks"] = {"coil_bind_margin_min": 0.0}
+    return doc
+
+
+def test_slow_compression_closes_the_segments_in_the_pitch_diagrams_order() -> None:
+    from vtool.solvers.run import simulate
+
+    spec = load_document(_pitch_bucket(300.0))
+    sheet = spec.springs[0]
+    np.testing.assert_allclose(closing_forces(sheet), [2.0 * C, C, 1.5 * C], rtol=1e-12)
+    assert sheet.preload == pytest.approx(4.0 * C / 5.25, rel=1e-12)
+    trace = simulate(spec)
+    report = trace.summary()["springs"][0]
+    first = report["segment_first_touch_deg"]
+    assert all(a is not None for a in first)
+    # the cam turns from the nose (0 deg): the spring compresses from the start and relaxes towards 180 deg;
+    # the run starts at full lift, so every segment is closed at once: look at the re-closing on the next lift
+    angle = np.asarray(trace.cam_angle)
+    from vtool.solvers.model.spring import segment_gaps
+
+    gaps = segment_gaps(sheet, trace)
+    second_lift = angle >= 180.0
+    touch = [float(angle[second_lift][np.argmax(gaps[second_lift, i] <= 0.0)]) for i in range(3)]
+    assert sorted(range(3), key=lambda i: touch[i]) == [1, 2, 0]  # smallest pitch first (hand order)
+    # at each closing the spring's force (35 N/mm in series from the rest length) equals G d^4 (p - d)/(8 D^3)
+    length = sheet.rest_length - compression_sign_of(trace, sheet) * trace.coordinate(sheet.coordinate)
+    for i, a in enumerate(touch):
+        row = int(np.flatnonzero(angle == a)[0])
+        assert sheet.model_rate * (sheet.rest_length - length[row]) == pytest.approx(closing_forces(sheet)[i],
+                                                                                      rel=2e-2)
+    assert report["coil_bind_margin"] < 0.0 and "COIL BIND" in trace.summary_text()
+    check = next(c for c in trace.summary()["checks"] if c["name"] == "coil_bind_margin_min")
+    assert check["passed"] is False
+
+
+def compression_sign_of(trace, sheet) -> float:  # type: ignore[no-untyped-def]
+    from vtool.solvers.model.spring import compression_sign
+
+    return compression_sign(trace, sheet.coordinate)
+
+
+def test_clashing_preset_reports_coil_clash_only_at_high_speed() -> None:
+    from vtool.presets import load_preset
+    from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.run import simulate
+    from vtool.solvers.studies.metrics import run_metrics
+
+    spec = load_preset("nested-spring-clash")
+    fast = simulate(spec)
+    text = fast.summary_text()
+    assert "first coil clash at" in text and "not to be trusted" in text
+    assert fast.summary()["springs"][0]["first_coil_bind_deg"] is not None
+    slow = simulate(with_run_overrides(spec, rpm=3000.0))
+    assert slow.summary()["springs"][0]["first_coil_bind_deg"] is None
+    assert run_metrics(slow)["coil_bind_margin"] > 0.0 > run_metrics(fast)["coil_bind_margin"]
+
+
+def test_modes_lists_the_surge_frequencies_and_their_cam_orders() -> None:
+    from click.testing import CliRunner
+
+    from vtool.app.cli.main import cli
+
+    result = CliRunner().invoke(cli, ["modes", "direct-acting-bucket"])
+    assert result.exit_code == 0, result.output
+    f1 = 0.5 * math.sqrt(79300.0 * 256.0 / (8.0 * 13824.0 * 5.25) / 3.904810e-5)  # 473.1 Hz
+    assert f"{f1:.1f} Hz (order {f1 / 50.0:.1f})" in result.output
+    assert f"{2 * f1:.1f} Hz (order {2 * f1 / 50.0:.1f})" in result.output

@@ -312,3 +312,24 @@ def coil_bind_margin(springs: tuple[SpringSpec, ...], trace: object, rows: np.nd
         if s.segment_coils:
             margins.append(float(segment_gaps(s, trace)[chosen].min()))
     return min(margins) if margins else math.nan
+
+
+def surge_table(springs: tuple[SpringSpec, ...], rpm: float, count: int = 3) -> list[dict]:
+    """Per spring: its fixed-fixed surge frequencies (Hz) and their ratio to the cam frequency rpm/60
+    (the cam order a surge mode sits at: a lift harmonic of that order excites it)."""
+    cam_hz = rpm / 60.0
+    return [{"spring": s.name, "rate": s.rate, "active_mass": s.active_mass, "surge_hz": s.surge_frequencies(count),
+             "cam_hz": cam_hz, "surge_order": [f / cam_hz for f in s.surge_frequencies(count)]} for s in springs]
+
+
+def surge_text(table: list[dict], units: object) -> list[str]:
+    """Lines of :func:`surge_table` (``vtool modes``)."""
+    if not table:
+        return []
+    lines = ["", f"valve spring surge (fixed-fixed, (j/2) sqrt(k/m_a)), cam frequency {table[0]['cam_hz']:.4g} Hz:"]
+    for row in table:
+        lines.append(f"  {row['spring']}: rate {row['rate']:.5g} {units.stiffness}, active mass "  # type: ignore[attr-defined]
+                     f"{row['active_mass']:.4g} {units.mass}: "  # type: ignore[attr-defined]
+                     + ", ".join(f"{f:.1f} Hz (order {o:.1f})" for f, o in zip(row["surge_hz"], row["surge_order"],
+                                                                              strict=True)))
+    return lines
