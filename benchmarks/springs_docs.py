@@ -12,11 +12,10 @@ preset at its own speed (its [checks]) and
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
-from vtool.markdown import read_block, replace_block, table
+from vtool.markdown import table, write_or_check
 from vtool.presets import load_preset
 from vtool.presets.valvetrain import with_run_overrides
 
@@ -108,21 +107,7 @@ def blocks() -> dict[str, str]:
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    mode = parser.add_mutually_exclusive_group(required=True)
-    mode.add_argument("--write", action="store_true", help="rewrite the blocks")
-    mode.add_argument("--check", action="store_true", help="exit 1 if a block is not current")
-    args = parser.parse_args()
-    fresh = blocks()
-    if args.write:
-        for name, text in fresh.items():
-            changed = replace_block(DOC, name, text)
-            print(f"{name}: {'updated' if changed else 'unchanged'}", file=sys.stderr)
-        return 0
-    stale = [name for name, text in fresh.items() if read_block(DOC, name) != text]
-    for name in stale:
-        print(f"{name} is not current: run python benchmarks/springs_docs.py --write", file=sys.stderr)
-    return 1 if stale else 0
+    return write_or_check(DOC, blocks, "benchmarks/springs_docs.py", __doc__.splitlines()[0])
 
 
 if __name__ == "__main__":
