@@ -333,26 +333,45 @@ def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, An
     from vtool.solvers.model.cam import fit_table, junction_warning, normalize_table
 
     lift_table = t.string("lift_table", default="") or None
-    if lift_table is not None:
+    polyline = t.string("polyline", default="") or None  # a measured scan (presets/cam_scan.py)
+    if lift_table is not None and polyline is not None:
+        raise InputError(t.field("polyline"), polyline, "either lift_table or polyline, not both")
+    if lift_table is not None or polyline is not None:
         if t.has("angles") or t.has("lifts"):
             raise InputError(t.field("angles"), t.raw("angles"), "no inline table beside lift_table")
-        angles, lifts = read_lift_table(t.field("lift_table"), lift_table, folder, units.length)
+        if lift_table is not None:
+            angles, lifts = read_lift_table(t.field("lift_table"), lift_table, folder, units.length)
+        else:
+            from vtool.presets.cam_scan import read_polyline
+
+            angles, lifts = read_polyline(t.field("polyline"), polyline, folder)  # type: ignore[arg-type]
     else:
         angles = t.numbers("angles", unit="deg")
         lifts = t.numbers("lifts", unit=units.length)
+    scan = t.table("scan", required=False)
+    smoothed_harmonics = None
+    if scan is not None:  # units, angle, tappet/valve, smoothing of a measured scan
+        from vtool.presets.cam_scan import from_table
+
+        measured = from_table(scan, angles, lifts, units, t.path)
+        angles, lifts = measured.angles.tolist(), measured.lifts.tolist()
+        smoothed_harmonics = None if measured.smoothed is None else measured.smoothed.harmonics
     theta, lift = normalize_table(angles, lifts, t.path, units.length)
     if lift.min() < 0.0 or lift.max() <= 0.0:
         raise InputError(t.field("lifts"), float(lift.min()), "lifts >= 0 (0 = base circle), not all 0", units.length)
     harmonics = t.integer("harmonics", default=0, min_value=0) or None
     tolerance = t.number("tolerance", unit=units.length, required=False, min_exclusive=0.0)
+    if smoothed_harmonics is not None and harmonics is None and tolerance is None:
+        harmonics = smoothed_harmonics  # a smoothed scan is a series of this many harmonics
     if (harmonics is None) == (tolerance is None):
         raise InputError(t.field("harmonics"), harmonics, "either harmonics (>= 1) or tolerance, not both")
     fit_table(theta, lift, harmonics, tolerance, t.path, units.length)  # refuse a table that cannot be fitted
-    jumps = junction_warning(theta, lift, t.path)
+    # a smoothed scan is a band-limited series (its base circle clipped at 0 by the noise, said in its note)
+    jumps = None if smoothed_harmonics is not None else junction_warning(theta, lift, t.path)
     if jumps is not None:
         warnings.warn(PresetWarning(jumps), stacklevel=3)
     return dict(angles=tuple(theta.tolist()), lifts=tuple(lift.tolist()), harmonics=harmonics,
-                tolerance=tolerance, lift_table=lift_table)
+                tolerance=tolerance, lift_table=lift_table or polyline)
 
 
 def _seat(t: Table, n: int, cam: CamSpec, units: UnitSystem) -> SeatSpec:

@@ -425,12 +425,3 @@ class MechanismSpec:
             if c.name == name:
                 return c
         raise KeyError(name)
-
-    def coordinate_name(self, number: int) -> str:
-        if 1 <= number <= self.n_coordinates:
-            return self.coordinates[number - 1].name
-        if number == self.cam.coordinate:
-            return self.cam.name
-        if self.seat is not None and number == self.seat.coordinate:
-            return self.seat.name
-        raise KeyError(number)
