@@ -249,7 +249,9 @@ def test_clashing_preset_reports_coil_clash_only_at_high_speed() -> None:
     fast = simulate(spec)
     text = fast.summary_text()
     assert "first coil clash at" in text and "not to be trusted" in text
-    assert fast.summary()["springs"][0]["first_coil_bind_deg"] is not None
+    report = fast.summary()["springs"][0]
+    assert report["first_coil_bind_deg"] is not None
+    assert (report["stress_unit"], report["length_unit"], report["force_unit"]) == ("MPa", "mm", "N")
     slow = simulate(with_run_overrides(spec, rpm=3000.0))
     assert slow.summary()["springs"][0]["first_coil_bind_deg"] is None
     assert run_metrics(slow)["coil_bind_margin"] > 0.0 > run_metrics(fast)["coil_bind_margin"]

@@ -231,6 +231,9 @@ def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
     largest over the run and over the last cycle (min, max), the Goodman factor of the last cycle, surge."""
     angle = np.asarray(trace.cam_angle)  # type: ignore[attr-defined]
     last = angle >= angle[-1] - 360.0 if angle.size else angle.astype(bool)
+    u = trace.spec.unit_system  # type: ignore[attr-defined]
+    units = {"length_unit": u.length, "force_unit": u.force, "stress_unit": u.pressure,
+             "stiffness_unit": u.stiffness, "mass_unit": u.mass, "frequency_unit": "Hz", "angle_unit": "deg"}
     result = []
     for s in springs:
         q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]
@@ -251,7 +254,7 @@ def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
             "last_cycle_stress": [float(s.stress(f_lo)), float(s.stress(f_hi))],
             "fatigue_factor": s.fatigue_factor(f_lo, f_hi) if np.isfinite(f_hi) else 0.0,
             "surge_hz": s.surge_frequencies(3),
-        } | _clash(s, trace, angle))
+        } | units | _clash(s, trace, angle))
     return result
 
 
