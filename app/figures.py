@@ -24,7 +24,7 @@ Choices, written down here because the issue left them open:
 from __future__ import annotations
 
 import io
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -47,19 +47,21 @@ EVENT_MARKERS = {"separation": "v", "impact": "x"}
 Drawable = Chart | HeatMap
 
 
-def figure_format(path: str | Path, field: str = "--figure") -> str:
-    """The format a figure path asks for by its suffix, or a one-line InputError."""
+def output_format(path: str | Path, field: str, formats: Sequence[str] = FORMATS) -> str:
+    """The format an output path asks for by its suffix (one of ``formats``), or a one-line InputError."""
     suffix = Path(path).suffix.lower().lstrip(".")
-    if suffix not in FORMATS:
-        raise InputError(field, str(path), "a file ending in .png, .svg or .pdf")
+    if suffix not in formats:
+        names = [f".{f}" for f in formats]
+        raise InputError(field, str(path), f"a file ending in {', '.join(names[:-1])} or {names[-1]}")
     return suffix
 
 
-def check_figure_path(path: str | Path, field: str = "--figure") -> Path:
-    """``path`` if a figure may be written there (suffix and folder checked before any work)."""
+def check_output(path: str | Path, field: str, formats: Sequence[str] = FORMATS) -> Path:
+    """``path`` if a file of one of ``formats`` may be written there (suffix and folder checked before
+    any work is done)."""
     from vtool.files import check_output_path
 
-    figure_format(path, field)
+    output_format(path, field, formats)
     check_output_path(path, field)
     return Path(path)
 
@@ -119,8 +121,9 @@ def _draw_map(subfigure: Any, heat: HeatMap) -> None:
     ax.set_title(f"{heat.title}{blank}", fontsize="medium")
 
 
-def build_figure(items: Sequence[Drawable]) -> Any:
-    """One :class:`matplotlib.figure.Figure` with every chart and map stacked (see the module doc)."""
+def build_figure(items: Sequence[Drawable], caption: str = "") -> Any:
+    """One :class:`matplotlib.figure.Figure` with every chart and map stacked (see the module doc),
+    and a caption under them when given."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -135,31 +138,67 @@ def build_figure(items: Sequence[Drawable]) -> Any:
     subject = next((i.subject for i in items if i.subject), "")
     if subject:
         figure.suptitle(subject, fontsize="large")
+    if caption:
+        figure.supxlabel(caption, fontsize="small", style="italic")
     return figure
 
 
-def _save_options(fmt: str) -> dict[str, Any]:
+def _save_options(fmt: str, dpi: float) -> dict[str, Any]:
     metadata = {"png": {"Software": None}, "svg": {"Date": None}, "pdf": {"CreationDate": None}}[fmt]
-    return {"format": fmt, "dpi": DPI, "metadata": metadata}
+    return {"format": fmt, "dpi": dpi, "metadata": metadata}
 
 
-def figure_bytes(figure: Any, fmt: str) -> bytes:
-    """The figure rendered as PNG, SVG (text kept as text) or PDF."""
+def figure_bytes(figure: Any, fmt: str, dpi: float = DPI) -> bytes:
+    """The figure rendered as PNG (at ``dpi``), SVG (text kept as text) or PDF."""
     import matplotlib
 
     buffer = io.BytesIO()
     with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "vtool"}):
-        figure.savefig(buffer, **_save_options(fmt))
+        figure.savefig(buffer, **_save_options(fmt, dpi))
     return buffer.getvalue()
 
 
-def save_figure(items: Sequence[Drawable], path: str | Path, field: str = "--figure") -> Path:
+def save_figure(items: Sequence[Drawable], path: str | Path, field: str = "--figure", dpi: float = DPI) -> Path:
     """Draw ``items`` and write them to ``path`` (format by suffix), atomically."""
     from vtool.files import write_atomic_bytes
 
-    fmt = figure_format(path, field)
-    write_atomic_bytes(path, figure_bytes(build_figure(items), fmt), field)
+    fmt = output_format(path, field)
+    write_atomic_bytes(path, figure_bytes(build_figure(items), fmt, dpi), field)
     return Path(path)
+
+
+A4_IN = (8.27, 11.69)
+
+
+def text_pages(lines: Sequence[str], heading: str) -> list[Any]:
+    """A4 pages of fixed-width text (a report's tables): the font scaled down to fit the widest line
+    (4.5 to 9 pt), as many lines on a page as that font allows."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    widest = max((len(line) for line in lines), default=1)
+    size = max(4.5, min(9.0, 0.88 * A4_IN[0] * 72.0 / (0.6 * widest)))  # points: a mono glyph is 0.6 em wide
+    per_page = int(0.9 * A4_IN[1] * 72.0 / (1.25 * size))
+    pages = []
+    for start in range(0, max(len(lines), 1), per_page):
+        page = Figure(figsize=A4_IN)
+        FigureCanvasAgg(page)
+        page.text(0.06, 0.97, heading, fontsize=9, va="top", family="sans-serif")
+        page.text(0.06, 0.945, "\n".join(lines[start:start + per_page]), fontsize=size, va="top",
+                  family="monospace", linespacing=1.25)
+        pages.append(page)
+    return pages
+
+
+def pdf_document(pages: Iterable[Any], title: str) -> bytes:
+    """Figures as the pages of one PDF (matplotlib's PdfPages), no creation date (reproducible)."""
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    buffer = io.BytesIO()
+    with PdfPages(buffer, metadata={"Title": title, "Creator": "vtool", "CreationDate": None}) as pdf:
+        for page in pages:
+            pdf.savefig(page)
+    return buffer.getvalue()
 
 
 def svg_text(items: Sequence[Drawable]) -> str:

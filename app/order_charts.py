@@ -15,11 +15,12 @@ def order_chart(spectrum: Spectrum, frequencies: list[tuple[str, float]], *, hig
                 width: int = 100, height: int = 20, color: bool = True) -> str:
     """Amplitude per cam order as a staircase up to ``highest`` (default: past the highest natural frequency
     in orders, at most the Nyquist order), with a line at each natural frequency's order."""
+    from vtool.presets.charts import order_chart as order_data
+
     cam_hz = spectrum.rpm / 60.0
-    marks = [hz / cam_hz for _, hz in frequencies if hz / cam_hz <= spectrum.nyquist]
-    top = highest or min(spectrum.nyquist, max([20.0] + [1.2 * m for m in marks]))
-    keep = (spectrum.orders > 0) & (spectrum.orders <= top)
-    x, y = spectrum.orders[keep], spectrum.amplitude[keep]
+    data = order_data(spectrum, frequencies, highest)  # the figure's series and its range of orders
+    x, y = data.panels[0].curves[0].x, data.panels[0].curves[0].y
+    top = data.xlim[1] if data.xlim else float(x[-1])
     series = {f"{spectrum.quantity} ({spectrum.unit})": y}
     peak = float(y.max()) if len(y) else 1.0
     for label, hz in frequencies:

@@ -115,27 +115,6 @@ def line_chart(
     return _render([panel], xlabel=xlabel, width=width, height=height, color=color, xlog=xlog)
 
 
-def stacked_chart(
-    x: Sequence[float] | np.ndarray,
-    groups: Sequence[tuple[str, Mapping[str, Sequence[float] | np.ndarray]]],
-    *,
-    title: str = "",
-    xlabel: str = "",
-    width: int = 100,
-    height: int = 22,
-    color: bool = True,
-) -> str:
-    """Groups of series (one y unit each) as panels stacked over a common x, as text.
-
-    ``groups`` is ``[(ylabel, {label: values}), ...]``: quantities of different
-    units never share an axis; the title goes on the top panel.
-    """
-    xs = np.asarray(x, dtype=float)
-    panels = [Panel(_curves(xs, series, False), title if i == 0 else "", ylabel)
-              for i, (ylabel, series) in enumerate(groups)]
-    return _render(panels, xlabel=xlabel, width=width, height=height, color=color)
-
-
 def chart_text(chart: Chart, *, width: int = 100, height: int = 22, color: bool = True) -> str:
     """A :class:`vtool.chart.Chart` as text: its panels stacked, the title on the top one.
 

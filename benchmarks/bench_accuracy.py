@@ -14,14 +14,11 @@ docs/valvetrain.md are written by ``python3 benchmarks/tables_valvetrain.py``.
 
 from __future__ import annotations
 
-import os
 import sys
 
 from vtool.presets import load_preset
 from vtool.solvers.run import simulate
 from vtool.solvers.studies.accuracy import accuracy_study, compare, table_text, with_run
-
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
 
 def main(name: str = "gnilka-1a") -> None:

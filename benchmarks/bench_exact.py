@@ -15,7 +15,6 @@ The scan samples, events and peak forces are the columns a test regenerates.
 
 from __future__ import annotations
 
-import os
 import sys
 import time
 from pathlib import Path
@@ -26,8 +25,6 @@ from vtool.solvers.exact.backend import ExactBackend
 from vtool.solvers.model.mechanism import assemble
 from vtool.solvers.newmark.backend import NewmarkBackend
 from vtool.threads import limited
-
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
 TARGET_S = 0.050
 ROOT = Path(__file__).resolve().parent.parent

@@ -28,7 +28,6 @@ from vtool.markdown import replace_block, table
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "valvetrain.md"
 
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
 TARGET_WALL_S = 10.0
 TARGET_PEAK_MB = 400.0

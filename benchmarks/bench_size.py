@@ -18,7 +18,6 @@ Blocks written:
 from __future__ import annotations
 
 import math
-import os
 import sys
 from pathlib import Path
 
@@ -26,8 +25,6 @@ import numpy as np
 
 from vtool.errors import RunError
 from vtool.markdown import replace_block, table
-
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "cams.md"
 SIZE_CASES = {"size-1a": ("gnilka-1a", 12000.0), "size-ramped": ("ramped-cam", 4000.0)}

@@ -1,7 +1,8 @@
 """The Newmark kernel's cost per step on example 1A: this checkout against an earlier commit, alternating.
 
 Run: ``python3 benchmarks/bench_step_ab.py REF [--pairs N] [--whole]`` (N = 5 pairs by default; the first
-pair also compiles both kernels into their own temporary numba caches, about 15 s each). Each
+pair also compiles both kernels into their own temporary numba caches; an old REF runs with
+``VTOOL_KERNEL=compiled VTOOL_NATIVE=0``, numba's kernel in the process, as this checkout's). Each
 process times the kernel's calls (``bench_newmark.kernel_seconds``: the time inside ``run_chunk``
 over the steps, the best of 4 rounds of 5 runs) in a warm run of ``gnilka-1a``; the two versions
 alternate, so that a machine whose speed drifts slows both alike, and the ratio of the best of
@@ -19,8 +20,6 @@ import tempfile
 from pathlib import Path
 
 from bench_compile_ab import ROOT, arguments, layout
-
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
 TIMING = """
 import sys
@@ -58,7 +57,7 @@ print(best)
 
 
 def per_step(path_entry: Path | None, prefix: str, cache: str, whole: bool = False) -> float:
-    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache, VTOOL_KERNEL="compiled", VTOOL_NATIVE="0")  # (an old REF)
     if path_entry is not None:
         env["PYTHONPATH"] = os.pathsep.join([str(path_entry), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
     out = subprocess.run([sys.executable, "-c", (WHOLE if whole else TIMING).format(benchmarks=str(ROOT / "benchmarks"), prefix=prefix)],

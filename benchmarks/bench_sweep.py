@@ -31,8 +31,6 @@ from vtool.presets.paths import plan_sweep
 from vtool.solvers.run import simulate
 from vtool.solvers.studies.sweep import DaskRunner, ProcessRunner, SerialRunner, run_points
 
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
-
 TARGET_S = 10.0
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "sweep.md"
 

@@ -36,8 +36,6 @@ from vtool.solvers.studies.sweep import (
     run_points,
 )
 
-os.environ.setdefault("VTOOL_KERNEL", "compiled")
-
 
 def timed(make, points) -> tuple[float, str]:  # type: ignore[no-untyped-def]
     """Seconds from creating the runner to the last result, and the runner's announced choice."""

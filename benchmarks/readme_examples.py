@@ -7,14 +7,11 @@ regenerates it and compares every line but the wall time.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 from vtool.markdown import replace_block
 from vtool.presets import load_preset
 from vtool.solvers.run import simulate
-
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
 README = Path(__file__).resolve().parent.parent / "README.md"
 

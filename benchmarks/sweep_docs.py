@@ -21,8 +21,6 @@ from vtool.solvers.studies.metrics import metric_columns, seat_index
 from vtool.solvers.studies.steady import with_steady
 from vtool.solvers.studies.sweep import CRITERIA, SerialRunner, find_speed, make_runner, run_points
 
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
-
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "sweep.md"
 PRESETS = (("gnilka-1a", "1A: three clearances, valve seat"),
            ("gnilka-1b", "1B: three clearances, no valve seat"),

@@ -7,7 +7,6 @@ and exits 1 when a committed table differs). Every number in the blocks comes fr
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
@@ -15,8 +14,6 @@ from vtool.markdown import read_block, replace_block, table
 from vtool.presets import load_preset
 from vtool.solvers.studies.compare import cell, compare
 from vtool.solvers.studies.compare import table as comparison
-
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "valvetrain.md"
 PRESETS = ("gnilka-1a", "gnilka-2")

@@ -12,15 +12,12 @@ machine, 1755 on another, the same code).
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
 from vtool.markdown import read_block, replace_block, table, table_differences
 from vtool.presets import load_preset
 from vtool.solvers.studies.compliance import study
-
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "contact.md"
 PRESET = "gnilka-1a"

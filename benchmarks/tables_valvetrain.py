@@ -23,7 +23,6 @@ tests/test_tables_valvetrain.py checks it against the committed blocks.
 from __future__ import annotations
 
 import math
-import os
 import sys
 import time
 from collections.abc import Iterable
@@ -44,8 +43,6 @@ from vtool.solvers.studies.accuracy import (
     with_run,
 )
 from vtool.solvers.trace import CLOSED, OPENED, Trace
-
-os.environ.setdefault("VTOOL_KERNEL", "compiled")  # timed runs compile first (newmark: "First run")
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"

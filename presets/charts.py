@@ -194,6 +194,25 @@ def cam_charts(spec: Any, points: int = 721) -> list[Chart]:
     return charts
 
 
+def scan_charts(scan: Any, unit: str, subject: str = "") -> list[Chart]:
+    """A measured scan raw against smoothed: lift, velocity and acceleration per cam degree.
+
+    Raw derivatives are central differences of the samples (the noise they
+    carry is the point of the chart); smoothed ones are the series' own.
+    """
+    from vtool.presets.cam_scan import per_degree_derivatives, series_derivatives
+
+    raw_v, raw_a = per_degree_derivatives(scan.angles, scan.raw)
+    curves = {"raw scan": (scan.raw, raw_v, raw_a)}
+    if scan.smoothed is not None:
+        curves[f"smoothed ({scan.smoothed.harmonics} harmonics)"] = (scan.lifts,
+                                                                     *series_derivatives(scan.angles, scan.lifts))
+    names = (("lift", unit), ("velocity", f"{unit}/deg"), ("acceleration", f"{unit}/deg^2"))
+    panels = tuple(Panel(tuple(curve(label, scan.angles, values[i]) for label, values in curves.items()),
+                         with_unit(name, u)) for i, (name, u) in enumerate(names))
+    return [Chart("measured scan: raw against smoothed (per cam degree)", CAM_ANGLE, panels, subject)]
+
+
 def cam_shape_charts(spec: Any, points: int = 720) -> list[Chart]:
     """``vtool cam show --plot`` with a follower: the ground profile (cam frame), its radius of curvature
     against the law angle, and the pressure angle (and a finger's ratio) against cam angle."""
@@ -221,6 +240,36 @@ def cam_shape_charts(spec: Any, points: int = 720) -> list[Chart]:
         charts.append(Chart("finger ratio dV/du (-)", CAM_ANGLE,
                             (Panel((curve("ratio", c.cam_angle_deg, c.ratio),), "ratio (-)"),), spec.title))
     return charts
+
+
+# ----------------------------------------------------------------------------
+# cam orders
+
+
+def order_chart(spectrum: Any, frequencies: list[tuple[str, float]], highest: float | None = None,
+                subject: str = "") -> Chart:
+    """``vtool solve --orders Q --plot``: amplitude per cam order as a staircase up to ``highest`` (default:
+    past the highest natural frequency in orders, at most the Nyquist order); the natural frequencies of
+    the visited configurations marked at their orders (omega_n / omega)."""
+    cam_hz = spectrum.rpm / 60.0
+    orders = [hz / cam_hz for _, hz in frequencies if hz / cam_hz <= spectrum.nyquist]
+    top = highest or min(spectrum.nyquist, max([20.0] + [1.2 * m for m in orders]))
+    keep = (spectrum.orders > 0) & (spectrum.orders <= top)
+    marks = (Mark("natural frequency", np.array([o for o in orders if o <= top])),)
+    panel = Panel((curve(with_unit(spectrum.quantity, spectrum.unit), spectrum.orders[keep],
+                         spectrum.amplitude[keep], step=True),), with_unit("amplitude", spectrum.unit))
+    return Chart(f"{spectrum.quantity}: amplitude per cam order at {spectrum.rpm:g} rev/min", "cam order (-)",
+                 (panel,), subject, marks, xlim=(0.0, float(top)))
+
+
+def campbell_chart(data: Any, subject: str = "") -> HeatMap:
+    """``vtool sweep --campbell Q``: log10 of the order amplitudes over cam speed and cam order."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        values = np.where(data.amplitude > 0, np.log10(data.amplitude), np.nan)
+    orders = np.arange(1, len(data.amplitude) + 1, dtype=float)
+    return HeatMap(f"{data.quantity}: amplitude per cam order and speed (log10)", "cam speed (rev/min)",
+                   "cam order (-)", f"log10 amplitude ({data.unit})", np.asarray(data.rpm, dtype=float), orders,
+                   values, subject)
 
 
 # ----------------------------------------------------------------------------

@@ -27,7 +27,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal, overload
 
 from vtool.errors import InputError
 
@@ -176,7 +176,7 @@ class Table:
         self._note(key, "number", unit, expected, default, required)
         value = self._get(key, default, required)
         if value is None:
-            return None  # type: ignore[return-value]
+            return None  # type: ignore[return-value]  # required=False: None for a missing key, callers check
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise InputError(self.field(key), value, f"a number {expected}".strip(), unit)
         given, value = value, as_float(value)
@@ -239,6 +239,13 @@ class Table:
             raise InputError(self.field(key), value, "true or false")
         return value
 
+    @overload
+    def table(self, key: str, *, required: Literal[True] = True, pattern: str | None = None,
+              kind: str = "table") -> Table: ...
+
+    @overload
+    def table(self, key: str, *, required: bool, pattern: str | None = None, kind: str = "table") -> Table | None: ...
+
     def table(self, key: str, *, required: bool = True, pattern: str | None = None,
               kind: str = "table") -> Table | None:
         pattern = self._pattern(key) if pattern is None else pattern
@@ -254,7 +261,7 @@ class Table:
         if outer is None:
             return iter(())
         inner = f"{outer.pattern}.*"
-        return ((name, outer.table(name, pattern=inner)) for name in list(outer.data))  # type: ignore[misc]
+        return ((name, outer.table(name, pattern=inner)) for name in list(outer.data))
 
     def array_of_tables(self, key: str, *, required: bool = True) -> list[Table]:
         """Entries of an array of tables, e.g. ``[[clearances]]``."""

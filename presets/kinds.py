@@ -23,14 +23,16 @@ plate       vtool.presets.plate:PlateSpec                     vtool.presets.plat
 A loader module has ``load(doc, folder=None) -> spec`` (``folder``: the
 preset's folder, against which a file it names is found: a cam lift table,
 a boom pulse CSV) and ``dump(spec) -> doc``. A solve function has
-``solve(spec, csv_path, plot, as_json, **flags)``, where ``flags`` are the
-kind's :attr:`Kind.run_options` that are not preset fields, as keyword
-arguments (``--every-step`` is ``every_step``); those that are preset fields
-(:attr:`Kind.overrides`: ``--rpm`` is ``run.rpm``) are set into the document
-and checked by the loader (the loader module then has ``with_overrides(doc,
-{path: value}) -> doc``). ``vtool solve`` refuses any other flag for the kind. A TUI screen module
-has ``SCREEN``, its :class:`~vtool.app.tui.base.DomainScreen` class; one
-screen may show several kinds (the boom screen: walls and floors).
+``solve(spec, csv_path, plot, as_json, figure=None, **flags)``, where
+``flags`` are the kind's :attr:`Kind.run_options` that are not preset
+fields, as keyword arguments (``--every-step`` is ``every_step``); those
+that are preset fields (:attr:`Kind.overrides`: ``--rpm`` is ``run.rpm``)
+are set into the document and checked by the loader (the loader module then
+has ``with_overrides(doc, {path: value}) -> doc``). ``vtool solve`` refuses
+any other flag for the kind. A TUI screen module has ``SCREEN``, its
+:class:`~vtool.app.tui.base.DomainScreen` class; one screen may show
+several kinds (the boom screen: walls and floors). The table above is the
+data below (``tests/test_dispatch.py`` compares them).
 """
 
 from __future__ import annotations
@@ -64,7 +66,7 @@ KINDS: dict[str, Kind] = {
                        "vtool.solvers.model.spec:MechanismSpec", "vtool.presets.valvetrain",
                        "vtool.app.cli.solve:run_valvetrain", "vtool.app.tui.valvetrain",
                        ("--backend", "--dt", "--rpm", "--degrees", "--every-step", "--events",
-                        "--max-steps", "--impact", "--start", "--orders"),
+                        "--max-steps", "--impact", "--start", "--orders", "--format"),
                        (("--backend", "run.backend"), ("--dt", "run.time_step"), ("--rpm", "run.rpm"),
                         ("--degrees", "run.degrees"), ("--impact", "contact.impact"),
                         ("--start", "initial.velocities"))),

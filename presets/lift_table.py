@@ -32,8 +32,8 @@ def _is_number(cell: str) -> bool:
     return True
 
 
-def read_lift_table(field: str, name: str, folder: Path | None, unit: str) -> tuple[list[float], list[float]]:
-    """(angles_deg, lifts) from the CSV ``name`` (relative to ``folder``)."""
+def read_table_text(field: str, name: str, folder: Path | None) -> str:
+    """The text of the file ``name`` (relative to ``folder``), with the checks of the module doc."""
     path = Path(name) if Path(name).is_absolute() or folder is None else Path(folder) / name
     if not is_file(path):
         raise InputError(field, str(path), "an existing regular file (relative to the preset's folder)")
@@ -49,6 +49,13 @@ def read_lift_table(field: str, name: str, folder: Path | None, unit: str) -> tu
     except UnicodeDecodeError as exc:
         bad = data[: exc.start].count(b"\n") + 1
         raise InputError(field, str(path), f"UTF-8 text (line {bad} is not)") from None
+    return text
+
+
+def read_lift_table(field: str, name: str, folder: Path | None, unit: str) -> tuple[list[float], list[float]]:
+    """(angles_deg, lifts) from the CSV ``name`` (relative to ``folder``)."""
+    text = read_table_text(field, name, folder)
+    path = Path(name) if Path(name).is_absolute() or folder is None else Path(folder) / name
     angles: list[float] = []
     lifts: list[float] = []
     first = True

@@ -215,13 +215,27 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000, *,
     """
     from vtool.presets import find_preset, load_document, read_document
     from vtool.presets.kinds import require_kind
-    from vtool.solvers.studies.sweep import Point, grid
 
     folder = find_preset(preset).parent
     doc = read_document(find_preset(preset))
+    require_kind(load_document(doc, folder), "valvetrain", "a sweep")
+    fields = parse_assignments(sets, max_points)
+    return plan_document(doc, fields, max_points, folder, progress=progress, cancel=cancel)
+
+
+def plan_document(doc: dict[str, Any], fields: list[tuple[str, list[Any]]], max_points: int = 100_000,
+                  folder: Path | None = None, *, progress: Callable[[int, int], None] | None = None,
+                  cancel: Callable[[], bool] | None = None) -> SweepPlan:
+    """:func:`plan_sweep` for a parsed valvetrain document and (path, values) pairs (the Python API's sweep).
+
+    ``folder`` resolves a file the document names (a cam lift table) as :func:`vtool.presets.load_document`.
+    """
+    from vtool.presets import load_document
+    from vtool.presets.kinds import require_kind
+    from vtool.solvers.studies.sweep import Point, grid
+
     spec = load_document(doc, folder)
     require_kind(spec, "valvetrain", "a sweep")
-    fields = parse_assignments(sets, max_points)
     count = math.prod(len(v) for _, v in fields)
     if count > max_points:
         raise InputError("--set", count, f"a grid of at most {max_points} points")

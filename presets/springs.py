@@ -30,12 +30,18 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from vtool.errors import InputError
 from vtool.presets.fields import Table
+from vtool.solvers.model.spring import SHEAR_RATIO, SpringSpec, segment_rates, wire_mass
 from vtool.units import UnitSystem
 
 MAX_ELEMENTS = 64
 SPRING_KEYS = ("rate", "preload", "mass", "length", "free_length", "installed_length", "elements")
+SHEET_KEYS = ("wire_diameter", "coil_diameter", "active_coils", "total_coils", "free_length", "installed_length",
+              "shear_modulus", "density", "tensile_strength", "fatigue_limit", "solid_length", "shear_ratio",
+              "segment_coils", "segment_pitches", "lengths", "forces", "elements", "inner")
 
 
 @dataclass(frozen=True)
@@ -47,6 +53,7 @@ class SpringModel:
     rate: float
     coordinates: list[dict[str, Any]] = field(default_factory=list)
     clearances: list[dict[str, Any]] = field(default_factory=list)
+    sheets: list[dict[str, Any]] = field(default_factory=list)  # data sheets: the explicit form's [[springs]]
 
 
 def spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
@@ -56,7 +63,8 @@ def spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
     ``first_new`` is the number the spring's own coordinates would take (none today);
     ``position`` places the spring's fixed end in drawings.
     """
-    del first_new  # a single bar adds no coordinate
+    if t.has("wire_diameter"):
+        return sheet_spring_model(t, units, end, first_new, position)
     L = units.length
     rate = t.number("rate", unit=units.stiffness, min_exclusive=0.0, max_value=1e13)
     mass = t.number("mass", unit=units.mass, min_exclusive=0.0, max_value=1e9)
@@ -83,3 +91,141 @@ def spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
     if elements > 1:
         member["elements"] = elements
     return SpringModel({"valve_spring": member}, preload, rate)
+
+
+def read_sheet(t: Table, units: UnitSystem, name: str, coordinate: int) -> SpringSpec:
+    """A data sheet's keys (module doc) checked: a :class:`vtool.solvers.model.spring.SpringSpec`."""
+    L, P = units.length, units.pressure
+    d = t.number("wire_diameter", unit=L, min_exclusive=0.0, max_value=1e3)
+    D = t.number("coil_diameter", unit=L, min_exclusive=2.0 * d, max_value=1e4)  # spring index D/d > 2
+    n_t = t.number("total_coils", min_exclusive=0.0, max_value=1e3)
+    n_a = t.number("active_coils", min_exclusive=0.0, max_value=n_t)
+    free = t.number("free_length", unit=L, min_exclusive=0.0, max_value=1e4)
+    installed = t.number("installed_length", unit=L, min_exclusive=0.0, max_value=free)
+    solid = t.number("solid_length", unit=L, required=False, min_exclusive=0.0, max_exclusive=installed)
+    G = t.number("shear_modulus", unit=P, min_exclusive=0.0, max_value=1e16)
+    rho = t.number("density", unit=units.density, min_exclusive=0.0, max_value=1e9)
+    rm = t.number("tensile_strength", unit=P, min_exclusive=0.0, max_value=1e16)
+    fatigue = t.number("fatigue_limit", unit=P, required=False, min_exclusive=0.0, max_value=rm)
+    ratio = t.number("shear_ratio", default=SHEAR_RATIO, min_exclusive=0.0, max_value=1.0)
+    coils: tuple[float, ...] = ()
+    pitches: tuple[float, ...] = ()
+    if t.has("segment_coils") or t.has("segment_pitches"):
+        coils = tuple(t.numbers("segment_coils"))
+        pitches = tuple(t.numbers("segment_pitches", unit=L))
+        if len(coils) != len(pitches) or not 1 <= len(coils) <= MAX_ELEMENTS:
+            raise InputError(t.field("segment_pitches"), len(pitches),
+                             f"as many entries as segment_coils ({len(coils)}), 1 to {MAX_ELEMENTS}")
+        if any(c <= 0.0 for c in coils) or abs(sum(coils) - n_a) > 1e-9 * n_a:
+            raise InputError(t.field("segment_coils"), list(coils), f"positive, summing to active_coils ({n_a:g})")
+        if any(p <= d for p in pitches):
+            raise InputError(t.field("segment_pitches"), list(pitches), f"each > wire_diameter ({d:g})", L)
+    lengths: tuple[float, ...] = ()
+    forces: tuple[float, ...] = ()
+    if t.has("lengths") or t.has("forces"):
+        lengths = tuple(t.numbers("lengths", unit=L))
+        forces = tuple(t.numbers("forces", unit=units.force))
+        if len(lengths) != len(forces) or len(lengths) < 2:
+            raise InputError(t.field("forces"), len(forces), f"as many entries as lengths ({len(lengths)}), >= 2")
+        if np.any(np.diff(lengths) >= 0.0) or np.any(np.diff(forces) <= 0.0):
+            raise InputError(t.field("lengths"), list(lengths), "lengths decreasing and forces increasing")
+        if not lengths[-1] <= installed <= lengths[0]:
+            raise InputError(t.field("installed_length"), installed,
+                             f"within the table's lengths ({lengths[-1]:g} .. {lengths[0]:g})", L)
+        if coils:
+            raise InputError(t.field("lengths"), list(lengths), "a table or a pitch diagram, not both")
+    return SpringSpec(name, d, D, n_a, n_t, free, installed, G, rho, rm, coordinate, fatigue, solid, ratio,
+                      coils, pitches, lengths, forces)
+
+
+def sheet_spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
+                       position: tuple[float, float]) -> SpringModel:
+    """A data-sheet spring (and its ``inner`` nested spring): bars from the head to coordinate ``end``.
+
+    Without a pitch diagram the spring is one bar of rate k and the active coils' mass, split into
+    ``elements``; with one, a chain of one bar per segment (its coils' rate and mass) through new
+    coordinates numbered from ``first_new``. A nested ``[train.spring.inner]`` is a second spring in
+    parallel (same keys; its interference friction with the outer spring is left out).
+    """
+    inner_t = t.table("inner", required=False)
+    springs = [(t, "valve_spring")] + ([(inner_t, "inner_spring")] if inner_t is not None else [])
+    members: dict[str, dict[str, Any]] = {}
+    coordinates: list[dict[str, Any]] = []
+    sheets: list[dict[str, Any]] = []
+    preload = rate = 0.0
+    for table, name in springs:
+        spec = read_sheet(table, units, name, end)
+        elements = table.integer("elements", default=1, min_value=1, max_value=MAX_ELEMENTS)
+        table.finish()
+        x = position[0] + (0.0 if name == "valve_spring" else 0.05 * spec.installed_length)
+        base = (x, position[1] - spec.installed_length)
+        if spec.segment_coils:
+            rates = segment_rates(spec)
+            nodes = [0]
+            for i in range(len(rates) - 1):
+                coordinates.append({"name": f"{name} coil node {i + 1}", "motion": "translation"})
+                nodes.append(first_new + len(coordinates) - 1)
+            nodes.append(end)
+            share = spec.installed_length / spec.active_coils
+            below = 0.0
+            for i, (n_i, k_i) in enumerate(zip(spec.segment_coils, rates, strict=True)):
+                members[f"{name}_{i + 1}"] = {
+                    "element": "bar", "length": n_i * share, "stiffness": float(k_i),
+                    "mass": wire_mass(spec.density, spec.wire_diameter, spec.coil_diameter, n_i),
+                    "coordinates": [nodes[i], nodes[i + 1]], "position": [base[0], base[1] + below],
+                    "direction": 90.0}
+                below += n_i * share
+        else:
+            member: dict[str, Any] = {"element": "bar", "length": spec.installed_length, "stiffness": spec.rate,
+                                      "mass": spec.active_mass, "coordinates": [0, end], "position": list(base),
+                                      "direction": 90.0}
+            if elements > 1:
+                member["elements"] = elements
+            members[name] = member
+        preload += spec.preload
+        rate += spec.rate
+        sheets.append(sheet_document(spec))
+    t.finish()
+    return SpringModel(members, preload, rate, coordinates, [], sheets)
+
+
+def sheet_document(spec: SpringSpec) -> dict[str, Any]:
+    """The explicit form's ``[[springs]]`` entry of a data sheet (read back by :func:`load_sheets`)."""
+    doc: dict[str, Any] = {"name": spec.name, "coordinate": spec.coordinate}
+    for key in ("wire_diameter", "coil_diameter", "active_coils", "total_coils", "free_length", "installed_length",
+                "shear_modulus", "density", "tensile_strength", "fatigue_limit", "shear_ratio"):
+        value = getattr(spec, key)
+        if value is not None:
+            doc[key] = value
+    if spec.solid_length_given is not None:
+        doc["solid_length"] = spec.solid_length_given
+    if spec.segment_coils:
+        doc["segment_coils"], doc["segment_pitches"] = list(spec.segment_coils), list(spec.segment_pitches)
+    if spec.table_lengths:
+        doc["lengths"], doc["forces"] = list(spec.table_lengths), list(spec.table_forces)
+    return doc
+
+
+def load_sheets(top: Table, units: UnitSystem, n: int) -> tuple[SpringSpec, ...]:
+    """The explicit form's ``[[springs]]`` (data sheets for the spring checks; the members carry the model)."""
+    if not top.has("springs"):
+        return ()
+    raw = top.raw("springs")
+    if not isinstance(raw, list) or not all(isinstance(x, dict) for x in raw) or len(raw) > 8:
+        raise InputError(top.field("springs"), raw, "an array of at most 8 tables (data sheets)")
+    result = []
+    for i, item in enumerate(raw):
+        t = Table(item, f"springs[{i}]")
+        name = t.string("name")
+        coordinate = t.integer("coordinate", min_value=1, max_value=n)
+        result.append(read_sheet(t, units, name, coordinate))
+        t.finish()
+    return tuple(result)
+
+
+def describe(spec: SpringSpec, units: UnitSystem) -> str:
+    """One line of what the loader derived from a data sheet (rate, mass, preload, solid length, surge)."""
+    f = spec.surge_frequencies(1)[0]
+    return (f"{spec.name}: rate {spec.rate:.5g} {units.stiffness}, active mass {spec.active_mass:.4g} {units.mass} "
+            f"(whole wire {spec.total_mass:.4g}), installed preload {spec.preload:.5g} {units.force}, "
+            f"solid length {spec.solid_length:.4g} {units.length}, first surge {f:.5g} Hz")

@@ -261,7 +261,7 @@ def ohv_pushrod(train: Table, units: UnitSystem, folder: Path | None) -> dict[st
     return {"coordinates": coordinates, "members": members, "cam": n + 1, "seat": n + 2,
             "clearances": [_clearance("cam", 1, n + 1, "external"), _clearance("rocker", 2, 8, "internal"),
                            _clearance("seat", 7, n + 2, "external")] + spring.clearances,
-            "closed": ["cam", "rocker"], "preload": spring.preload, "ratio": valve_arm / cam_arm,
+            "closed": ["cam", "rocker"], "preload": spring.preload, "springs": spring.sheets, "ratio": valve_arm / cam_arm,
             "follower_kind": None}
 
 
@@ -284,7 +284,7 @@ def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[
         "valve": _member("bar", valve_length, [2, 3], valve, (0.0, -bucket_length), -90.0)}
     return {"coordinates": coordinates, "members": members, "cam": n + 1, "seat": n + 2,
             "clearances": [_clearance("cam", 1, n + 1, "external"), _clearance("seat", 3, n + 2, "external")]
-            + spring.clearances, "closed": ["cam"], "preload": spring.preload, "ratio": 1.0,
+            + spring.clearances, "closed": ["cam"], "preload": spring.preload, "springs": spring.sheets, "ratio": 1.0,
             "follower_kind": "flat"}
 
 
@@ -316,7 +316,7 @@ def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dic
     return {"coordinates": coordinates, "members": members, "cam": n + 1, "seat": n + 2,
             "clearances": [_clearance("cam", 3, n + 1, "external"), _clearance("pad", 7, 5, "internal"),
                            _clearance("seat", 8, n + 2, "external")] + spring.clearances,
-            "closed": ["cam", "pad"], "preload": spring.preload, "ratio": b / a, "follower_kind": "roller",
+            "closed": ["cam", "pad"], "preload": spring.preload, "springs": spring.sheets, "ratio": b / a, "follower_kind": "roller",
             "finger": geometry, "arrangement": "finger"}
 
 
@@ -359,7 +359,7 @@ def centre_pivot_rocker(train: Table, units: UnitSystem, folder: Path | None) ->
     } | spring.members | {"valve": _member("bar", valve_length, [-6, 4], valve, (a + b, -valve_length), 90.0)}
     return {"coordinates": coordinates, "members": members, "cam": n + 1, "seat": n + 2,
             "clearances": [_clearance("cam", 1, n + 1, "external"), _clearance("seat", 6, n + 2, "external")]
-            + spring.clearances, "closed": ["cam"], "preload": spring.preload, "ratio": b / a,
+            + spring.clearances, "closed": ["cam"], "preload": spring.preload, "springs": spring.sheets, "ratio": b / a,
             "follower_kind": "roller", "finger": geometry, "arrangement": "rocker"}
 
 
@@ -398,6 +398,8 @@ def expand(doc: dict[str, Any], folder: Path | None = None) -> dict[str, Any]:
     explicit["cam"] = cam
     explicit["seat"] = seat
     explicit["clearances"] = built["clearances"]
+    if built["springs"]:
+        explicit["springs"] = built["springs"]
     explicit["initial"] = _initial(doc, built["closed"], built["preload"], built["ratio"])
     if follower is not None:
         explicit["follower"] = follower

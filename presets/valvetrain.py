@@ -158,6 +158,9 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         from vtool.presets.follower import load_checks
 
         checks = load_checks(checks_table, units)
+    from vtool.presets.springs import load_sheets
+
+    springs = load_sheets(top, units, n)
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)  # type: ignore[arg-type]
     top.finish()
     spec = MechanismSpec(
@@ -176,6 +179,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         contact=contact,
         follower=follower,
         checks=checks,
+        springs=springs,
         train=train,
     )
     spec = split_members(spec)
@@ -244,7 +248,7 @@ def _contact(t: Table | None) -> ContactSpec:
 
 
 TOP_KEYS = ("kind", "title", "notes", "units", "gravity", "coordinates", "members", "cam", "seat",
-            "clearances", "initial", "contact", "damping", "run", "follower", "checks")
+            "clearances", "initial", "contact", "damping", "run", "follower", "checks", "springs")
 
 
 def _magnitude(t: Table, key: str, unit: str, what: str, *, default: float | None = None,
@@ -329,26 +333,45 @@ def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, An
     from vtool.solvers.model.cam import fit_table, junction_warning, normalize_table
 
     lift_table = t.string("lift_table", default="") or None
-    if lift_table is not None:
+    polyline = t.string("polyline", default="") or None  # a measured scan (presets/cam_scan.py)
+    if lift_table is not None and polyline is not None:
+        raise InputError(t.field("polyline"), polyline, "either lift_table or polyline, not both")
+    if lift_table is not None or polyline is not None:
         if t.has("angles") or t.has("lifts"):
             raise InputError(t.field("angles"), t.raw("angles"), "no inline table beside lift_table")
-        angles, lifts = read_lift_table(t.field("lift_table"), lift_table, folder, units.length)
+        if lift_table is not None:
+            angles, lifts = read_lift_table(t.field("lift_table"), lift_table, folder, units.length)
+        else:
+            from vtool.presets.cam_scan import read_polyline
+
+            angles, lifts = read_polyline(t.field("polyline"), polyline, folder)  # type: ignore[arg-type]
     else:
         angles = t.numbers("angles", unit="deg")
         lifts = t.numbers("lifts", unit=units.length)
+    scan = t.table("scan", required=False)
+    smoothed_harmonics = None
+    if scan is not None:  # units, angle, tappet/valve, smoothing of a measured scan
+        from vtool.presets.cam_scan import from_table
+
+        measured = from_table(scan, angles, lifts, units, t.path)
+        angles, lifts = measured.angles.tolist(), measured.lifts.tolist()
+        smoothed_harmonics = None if measured.smoothed is None else measured.smoothed.harmonics
     theta, lift = normalize_table(angles, lifts, t.path, units.length)
     if lift.min() < 0.0 or lift.max() <= 0.0:
         raise InputError(t.field("lifts"), float(lift.min()), "lifts >= 0 (0 = base circle), not all 0", units.length)
     harmonics = t.integer("harmonics", default=0, min_value=0) or None
     tolerance = t.number("tolerance", unit=units.length, required=False, min_exclusive=0.0)
+    if smoothed_harmonics is not None and harmonics is None and tolerance is None:
+        harmonics = smoothed_harmonics  # a smoothed scan is a series of this many harmonics
     if (harmonics is None) == (tolerance is None):
         raise InputError(t.field("harmonics"), harmonics, "either harmonics (>= 1) or tolerance, not both")
     fit_table(theta, lift, harmonics, tolerance, t.path, units.length)  # refuse a table that cannot be fitted
-    jumps = junction_warning(theta, lift, t.path)
+    # a smoothed scan is a band-limited series (its base circle clipped at 0 by the noise, said in its note)
+    jumps = None if smoothed_harmonics is not None else junction_warning(theta, lift, t.path)
     if jumps is not None:
         warnings.warn(PresetWarning(jumps), stacklevel=3)
     return dict(angles=tuple(theta.tolist()), lifts=tuple(lift.tolist()), harmonics=harmonics,
-                tolerance=tolerance, lift_table=lift_table)
+                tolerance=tolerance, lift_table=lift_table or polyline)
 
 
 def _seat(t: Table, n: int, cam: CamSpec, units: UnitSystem) -> SeatSpec:
@@ -676,6 +699,10 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         doc["follower"] = dump_follower(spec.follower, _law_doc)
     if spec.checks:
         doc["checks"] = {c.name: c.limit for c in spec.checks}
+    if spec.springs:
+        from vtool.presets.springs import sheet_document
+
+        doc["springs"] = [sheet_document(s) for s in spec.springs]
     return train_document(given, doc) or doc
 
 

@@ -89,8 +89,6 @@ class RunStats:
     configurations: tuple[int, ...] | None = None  # masks built (None: the contact problem's built layers)
     settings: dict[str, Any] = field(default_factory=dict)  # the back end's own settings, for the record
     compile_time: float = 0.0  # s spent compiling or loading compiled code, not in the wall time
-    plain_steps: int = 0  # of the steps, those run as plain Python
-    kernel: str = ""  # what ran the last steps, when a back end has several ways
     sort: bool = False  # the rows were added out of time order: the builder sorts them
 
 
@@ -229,7 +227,7 @@ class Backend(ABC, Generic[OptionsT]):
             settings["contact"] = {c.name: c.contact for c in spec.clearances if not c.rigid}
         built = problem.tables.layers if stats.configurations is None else stats.configurations
         statistics = RunStatistics(self.name, stats.steps, len(builder.events), wall, tuple(sorted(built)), settings,
-                                   compile_time=compile_time, plain_steps=stats.plain_steps, kernel=stats.kernel,
+                                   compile_time=compile_time,
                                    remedy=self.remedy)
         return builder.build(stats.peak, statistics, stats.peak_late, sort=stats.sort,
                              peak_overlap=stats.peak_overlap)

@@ -15,8 +15,9 @@ values (coordinates with velocities and accelerations, contact forces, time
 and configuration, the preset's extra quantities), counted as
 :data:`BYTES_PER_VALUE` bytes each (the kernel's buffers, the joined trace,
 the CSV table and its text: measured 3.7 GB peak for 900,000 rows of 47
-values, which this counts as 2.9 GB), plus the ``2^n_c`` configuration tables
-of ``6 n²`` floats.
+values, which this counts as 2.9 GB), plus the configuration tables of
+``6 n²`` floats each, for the configurations a run visits (allocated when first
+visited): counted as ``min(2^n_c, TABLES_PER_CLEARANCE (n_c + 1))``.
 
 A CSV file written as the run goes (``vtool solve --csv``) holds the output
 rows, or with ``--every-step`` one row per step: ``steps + 1`` rows of
@@ -58,6 +59,8 @@ LARGEST_MAX_STEPS = 1e12
 MAX_SCIPY_STEPS = 5e5
 #: Default largest memory of one run's output (bytes).
 MAX_BYTES = 2e9
+#: Configuration tables counted per clearance (a run builds those it visits; 1A: 5 of 8).
+TABLES_PER_CLEARANCE = 4.0
 #: Samples per period of the highest natural frequency (exact, scipy).
 SAMPLES_PER_PERIOD = 16.0
 BYTES_PER_FLOAT = 8
@@ -102,7 +105,7 @@ def estimate(*, backend: str, rpm: float, degrees: float, time_step: float, outp
         steps = t_end * omega_max / (2.0 * math.pi) * SAMPLES_PER_PERIOD
     rows = steps + 1 if every_step else degrees / output_interval + 1
     columns = 3 * (n_coordinates + n_sources) + n_clearances + 2 + n_quantities
-    tables = 2.0**n_clearances * 6 * n_coordinates**2
+    tables = min(2.0**n_clearances, TABLES_PER_CLEARANCE * (n_clearances + 1)) * 6 * n_coordinates**2
     size = rows * columns * BYTES_PER_VALUE + tables * BYTES_PER_FLOAT
     file_rows = (steps + 1 if csv_every_step else degrees / output_interval + 1) if csv else 0.0
     file_bytes = file_rows * (columns + 2) * CSV_BYTES_PER_VALUE  # (+ the configuration's two text cells)

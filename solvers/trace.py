@@ -84,8 +84,6 @@ class RunStatistics:
     settings: dict = field(default_factory=dict)
     error_estimate: float | None = None
     compile_time: float = 0.0  # s spent compiling (or loading) the kernel, not in wall_time
-    plain_steps: int = 0  # of ``steps``, those run as plain Python (before the compiled kernel was ready)
-    kernel: str = ""  # newmark: what ran its last steps, "native", "numba" or "plain" (newmark.kernel_kind)
     remedy: str = ""  # the back end's advice when a result is not to be trusted (Backend.remedy)
 
 
@@ -315,9 +313,7 @@ class Trace:
         already); ``header=False`` leaves out the header row (a block of a streamed run).
         """
         from vtool.csvrows import write_rows
-        from vtool.solvers.newmark.native import csv_writer
 
-        native = csv_writer()  # a native module's formatter: no numba
         names, columns = self.csv_columns(quantities)
         if header:
             handle.write(",".join(names) + "\n")
@@ -327,7 +323,7 @@ class Trace:
             rows = slice(start, min(start + chunk, len(self.time)))
             block = np.column_stack([column(rows) for column in columns])
             write_rows(handle, block, labels, np.searchsorted(masks, self.configuration[rows]),
-                       compiled=compiled if compiled is not None or len(self.time) < chunk else True, native=native)
+                       compiled=compiled if compiled is not None or len(self.time) < chunk else True)
 
     def csv_text(self, quantities: tuple[str, ...] = ()) -> str:
         """CSV with one header row naming each quantity and its unit."""
@@ -453,8 +449,6 @@ class Trace:
             "events": stats.events,
             "wall_time_s": stats.wall_time,
             "compile_time_s": stats.compile_time,
-            "plain_steps": stats.plain_steps,
-            "kernel": stats.kernel,
             "episode_window_deg": EPISODE_WINDOW_DEG,
             "configurations_built": [configuration_label(self.spec, m) for m in stats.configurations_built],
             "events_list": [
@@ -475,6 +469,10 @@ class Trace:
 
             cam = next(c.name for c in self.spec.clearances if c.behind == self.spec.cam.coordinate)
             result["contact_stress"] = stress_summary(self.spec, self.cam_angle, self.force(cam))
+        if self.spec.springs:
+            from vtool.solvers.model.spring import run_report
+
+            result["springs"] = run_report(self.spec.springs, self)
         if self.spec.checks:
             from vtool.solvers.studies.checks import evaluate
 
@@ -487,9 +485,8 @@ class Trace:
         lines = [s["title"], f"back end {s['backend']}: " + ", ".join(f"{k} = {v}" for k, v in s["settings"].items())]
         compiling = (f" (+ {s['compile_time_s']:.1f} s compiling or loading the solver)"
                      if s["compile_time_s"] >= 0.5 else "")
-        plain = plain_note(s["plain_steps"], s["steps"])
         lines.append(
-            f"steps {s['steps']}{plain}, events {s['events']}, wall time {s['wall_time_s']:.3f} s{compiling}, "
+            f"steps {s['steps']}, events {s['events']}, wall time {s['wall_time_s']:.3f} s{compiling}, "
             f"configurations built: {', '.join(s['configurations_built'])}"
         )
         lines.append("")
@@ -525,6 +522,10 @@ class Trace:
             from vtool.solvers.model.camstress import stress_text
 
             lines += stress_text(s["contact_stress"])
+        if "springs" in s:
+            from vtool.solvers.model.spring import report_text
+
+            lines += report_text(s["springs"], units)
         if "checks" in s:
             from vtool.solvers.studies.checks import checks_text
 
@@ -550,24 +551,6 @@ def cam_angle_deg(time: np.ndarray | float, omega: float) -> np.ndarray | float:
     """Cam angle in degrees at time(s) t (s) for a cam speed omega (rad/s): an array for an array,
     a float for a float (with no array made for it: one per event)."""
     return time * omega * 180.0 / math.pi
-
-
-def plain_note(plain_steps: int, steps: int) -> str:
-    """" (all as plain Python)" or " (N of them as plain Python)" after a step count, or "" when every
-    step ran on the compiled kernel."""
-    if not plain_steps:
-        return ""
-    return " (all as plain Python)" if plain_steps == steps else f" ({plain_steps} of them as plain Python)"
-
-
-def csv_compile_notice() -> str | None:
-    """The line to show before an every-step CSV's number formatter compiles
-    (:func:`vtool.csvrows.compile_notice`), or None; None at once, with no numba imported, when a native
-    module carries the formatter (:func:`vtool.solvers.newmark.native.csv_writer`)."""
-    from vtool import csvrows
-    from vtool.solvers.newmark.native import csv_writer
-
-    return None if csv_writer() is not None else csvrows.compile_notice()
 
 
 class CsvStream:
@@ -600,16 +583,20 @@ class CsvStream:
         self.last_time = -math.inf
         self.header_written = False
 
-    def write(self, block: Trace) -> None:
-        """Append a block of rows (a :class:`Trace` of its rows)."""
-        started = wallclock.perf_counter()
+    def check_order(self, block: Trace) -> None:
+        """A block that goes back in time is a RunError (see the class doc)."""
         if len(block.time):
             if block.time[0] < self.last_time or np.any(np.diff(block.time) < 0.0):
                 from vtool.errors import RunError
 
-                raise RunError(f"rows out of time order at t = {block.time[0]:.6g} s: the CSV cannot be "
+                raise RunError(f"rows out of time order at t = {block.time[0]:.6g} s: the file cannot be "
                                "streamed (a back end must hand rows over in time order)")
             self.last_time = float(block.time[-1])
+
+    def write(self, block: Trace) -> None:
+        """Append a block of rows (a :class:`Trace` of its rows)."""
+        started = wallclock.perf_counter()
+        self.check_order(block)
         block.write_csv_to(self.handle, self.quantities, header=not self.header_written,
                            compiled=True if self.thin else None)
         self.header_written = True

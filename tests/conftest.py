@@ -1,16 +1,5 @@
 """Test-session settings.
 
-``VTOOL_KERNEL=compiled``: every run in the tests (and in the processes they
-start) compiles the Newmark kernel in-process, or loads it from numba's cache,
-before its first step, so that each test runs the compiled kernel it means to
-test and no background compile competes with the suite for the CPU. The first
-run's other paths (``auto``, ``plain``) have their own tests, which set the
-variable themselves (tests/test_first_run.py).
-
-``VTOOL_NATIVE=0``: no run builds or uses the kernel's native module
-(:mod:`vtool.solvers.newmark.native`), so that a test in ``auto`` mode starts no
-native build in the background; the native module's own tests set it to 1.
-
 The suite runs on pytest-xdist workers (``-n auto``, at most four: see
 ``pyproject.toml``), each a process of its own that imports this file: the
 workers share numba's cache, so a kernel one of them compiled is loaded by
@@ -19,8 +8,8 @@ from 8 min 21 s to 5 min 34 s (2026-11-26, empty numba cache both times).
 
 Scheduling: ``--dist loadgroup`` (pyproject's addopts) sends the modules marked
 ``xdist_group`` whole to one worker, and first, the larger groups before the
-smaller and before the single tests: the longest tests (the native builds, the
-valve-train tables' studies, mypy, numba_link's compiles) start at once and the
+smaller and before the single tests: the longest tests (the valve-train
+tables' studies, mypy) start at once and the
 short ones fill in at the end, so that neither worker idles at the end of a run
 (mypy last took 16 s of tail, 2026-11-26). tests/test_tables_valvetrain.py
 checks that pytest-xdist still sees the groups.
@@ -48,9 +37,6 @@ import os
 
 import pytest
 
-os.environ["VTOOL_KERNEL"] = "compiled"
-os.environ["VTOOL_NATIVE"] = "0"
-
 
 def pytest_configure(config) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
     """The collector as ``vtool tui`` sets it; pytest's own objects frozen."""
@@ -69,7 +55,7 @@ SHARED_OUT_FROM = 300
 
 
 def _compile_run(backend: str = "newmark", impact: str | None = None, hertz: bool = False) -> None:
-    """A run of one degree (its kernel compiled, or loaded from numba's cache: VTOOL_KERNEL=compiled)."""
+    """A run of one degree (its kernel compiled, or loaded from numba's cache)."""
     from vtool.presets import load_preset
     from vtool.presets.valvetrain import with_run_overrides
     from vtool.solvers.run import simulate

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ast
 from collections.abc import Iterator
+from functools import cache
 from pathlib import Path
 
 from vtool.presets.kinds import KINDS, resolve
@@ -38,10 +39,14 @@ OTHER_MEANINGS = {
 KERNEL_USERS = {"solvers/model/contact.py", "solvers/trace.py"}
 
 
+@cache
+def parsed() -> tuple[tuple[str, ast.Module], ...]:
+    return tuple((path.relative_to(ROOT).as_posix(), ast.parse(path.read_text(encoding="utf-8")))
+                 for folder in FOLDERS for path in sorted((ROOT / folder).rglob("*.py")))
+
+
 def sources() -> Iterator[tuple[str, ast.Module]]:
-    for folder in FOLDERS:
-        for path in sorted((ROOT / folder).rglob("*.py")):
-            yield path.relative_to(ROOT).as_posix(), ast.parse(path.read_text(encoding="utf-8"))
+    yield from parsed()
 
 
 def strings(node: ast.AST) -> Iterator[ast.Constant]:
@@ -73,6 +78,15 @@ def test_only_the_kinds_table_compares_a_preset_kind() -> None:
                 if named:
                     found.append(f"{file}:{node.lineno} compares with {named}")
     assert found == [], "dispatch on a preset kind outside presets/kinds.py:\n" + "\n".join(found)
+
+
+def test_the_kinds_docstring_table_is_the_table() -> None:
+    import vtool.presets.kinds as kinds
+
+    lines = (kinds.__doc__ or "").splitlines()
+    rules = [i for i, line in enumerate(lines) if line.startswith("==========")]
+    rows = [line.split() for line in lines[rules[1] + 1:rules[2]]]
+    assert rows == [[k.name, k.spec_type, k.loader, k.solve, k.screen] for k in KINDS.values()]
 
 
 def test_the_tui_finds_every_screen_through_the_kinds_table() -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
@@ -45,13 +46,17 @@ def commands(tmp_path: Path) -> dict[str, list[str]]:
         "boom daf": ["boom", "daf", "--range", "0:2:0.05"],
         "boom wall": ["boom", "wall", "boom-brick-wall"],
         "plate study": ["plate", "study", str(small)],
+        "solve --orders": ["solve", "gnilka-1a", "--orders", "F7"],
+        "sweep --campbell": ["sweep", "gnilka-1a", "--set", "run.rpm=9000:10000:500", "--campbell", "F7",
+                             "--workers", "1"],
     }
 
 
 # each command in every format would be 21 runs; solve takes all three, the others one each, in turn
 CASES = [("solve", fmt) for fmt in ("png", "svg", "pdf")] + [
     (name, ("svg", "png", "pdf")[i % 3])
-    for i, name in enumerate(["sweep", "cam", "compare", "boom daf", "boom wall", "plate study"])]
+    for i, name in enumerate(["sweep", "cam", "compare", "boom daf", "boom wall", "plate study", "solve --orders",
+                              "sweep --campbell"])]
 
 
 @pytest.mark.parametrize(("name", "fmt"), CASES)
@@ -133,3 +138,41 @@ def test_a_heat_map_names_its_three_axes() -> None:
     assert (ax.get_xlabel(), ax.get_ylabel(), bar.get_ylabel()) == ("speed (rev/min)", "stiffness (N/mm)",
                                                                      "peak (N)")
     assert "blank: no value" in ax.get_title()
+
+
+def test_docs_figures_are_embedded_and_regenerate() -> None:
+    """benchmarks/docs_figures.py --check: every PNG docs/figures.md embeds exists; one redrawn is a small PNG."""
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    sys.path.insert(0, str(root / "benchmarks"))
+    try:
+        import docs_figures
+    finally:
+        sys.path.pop(0)
+    assert set(docs_figures.FIGURES) == {p.stem for p in (root / "docs" / "figures").glob("*.png")}
+    assert docs_figures.main(["--check", "--only", "boom-daf"]) == 0
+
+
+def test_order_spectrum_and_campbell_figures_name_their_axes() -> None:
+    """The --orders spectrum (natural frequencies marked at their orders) and the --campbell map."""
+    from vtool.app.figures import build_figure
+    from vtool.presets import load_preset
+    from vtool.presets.charts import campbell_chart, order_chart
+    from vtool.solvers.run import simulate
+    from vtool.solvers.studies.orders import Campbell, natural_frequencies, spectrum
+
+    trace = simulate(load_preset("gnilka-1a"))
+    frequencies = natural_frequencies(trace)
+    chart = order_chart(spectrum(trace, "F7"), frequencies)
+    assert chart.labels() == ["cam order (-)", "amplitude (lbf)"]
+    cam_hz = trace.spec.run.rpm / 60.0
+    shown = [hz / cam_hz for _, hz in frequencies if hz / cam_hz <= chart.panels[0].curves[0].x[-1]]
+    assert np.allclose(np.sort(chart.marks[0].x), np.sort(shown))
+    data = Campbell("F7", "lbf", np.array([9000.0, 9500.0]), np.array([[1.0, 10.0], [0.0, 100.0]]), [])
+    heat = campbell_chart(data)
+    assert heat.labels() == ["cam speed (rev/min)", "cam order (-)", "log10 amplitude (lbf)"]
+    assert np.allclose(heat.values, [[0.0, 1.0], [np.nan, 2.0]], equal_nan=True)
+    figure = build_figure([chart, heat])
+    assert {ax.get_xlabel() for ax in figure.get_axes()} >= {"cam order (-)", "cam speed (rev/min)"}

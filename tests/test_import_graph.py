@@ -19,11 +19,8 @@ from tests import typing_tree
 pytestmark = pytest.mark.xdist_group("typing")
 
 #: Circles being removed elsewhere, each named by the edge that closes it; the test also fails once one
-#: of them is gone, so that its line is deleted here. The Newmark build/native pair is issue 35's.
-KNOWN: set[tuple[str, str]] = {
-    ("vtool.solvers.newmark.build", "vtool.solvers.newmark.native"),
-    ("vtool.solvers.newmark.native", "vtool.solvers.newmark.build"),
-}
+#: of them is gone, so that its line is deleted here.
+KNOWN: set[tuple[str, str]] = set()
 
 SCRIPT = """
 import json, sys

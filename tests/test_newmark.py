@@ -136,24 +136,32 @@ def test_numba_kernel_equals_numpy_reference_on_example_1a(tmp_path) -> None:
     np.testing.assert_allclose(compiled.contact_force, reference["F"], rtol=0, atol=1e-6 * compiled.peak_force.max())
 
 
-def test_quiet_steps_cam_angle_by_rotation_equals_libm_every_step(monkeypatch) -> None:  # noqa: ANN001
+def test_quiet_steps_cam_angle_by_rotation_equals_libm_every_step() -> None:
     """The quiet steps carry cos and sin of the cam angle by rotation, taken afresh every
-    ANCHOR_STEPS steps (kernel.advance); with ANCHOR_STEPS = 0 they take libm's at every step. Over
-    1A (59 events, refined steps after each) the two runs agree to the reference test's tolerances
-    (measured: 2e-10 of the displacements, 2.5e-12 s on the event times)."""
-    from vtool.solvers.newmark import build as kernel_build
-
-    monkeypatch.setenv("VTOOL_KERNEL", "plain")
-    plain = kernel_build.plain_kernel()
-    rotated = simulate(load_preset("gnilka-1a"))
-    monkeypatch.setattr(plain, "ANCHOR_STEPS", 0)
-    exact = simulate(load_preset("gnilka-1a"))
-    assert rotated.statistics.kernel == exact.statistics.kernel == "plain"
-    assert [(e.clearance, e.kind) for e in rotated.events] == [(e.clearance, e.kind) for e in exact.events]
-    np.testing.assert_allclose([e.time for e in rotated.events], [e.time for e in exact.events], rtol=0, atol=1e-11)
-    np.testing.assert_allclose(rotated.q, exact.q, rtol=0, atol=1e-9)
-    np.testing.assert_allclose(rotated.contact_force, exact.contact_force, rtol=0, atol=1e-6 * exact.peak_force.max())
-    assert not np.array_equal(rotated.q, exact.q)  # (the switch did change the arithmetic)
+    ANCHOR_STEPS steps (kernel.quiet.advance); with ANCHOR_STEPS = 0 they take libm's at every step.
+    Over 1A (59 events, refined steps after each) the two runs (the plain-Python kernel, whose
+    module constant can be changed) agree to the reference test's tolerances."""
+    code = (
+        "import json, sys\n"
+        "from vtool.presets import load_preset\n"
+        "from vtool.solvers.newmark.kernel import quiet\n"
+        "from vtool.solvers.run import simulate\n"
+        "def run():\n"
+        "    t = simulate(load_preset('gnilka-1a'))\n"
+        "    return {'q': t.q.tolist(), 'F': t.contact_force.tolist(), 'peak': float(t.peak_force.max()),"
+        " 'events': [[e.time, e.clearance, e.kind] for e in t.events]}\n"
+        "rotated = run()\n"
+        "quiet.ANCHOR_STEPS = 0\n"
+        "json.dump([rotated, run()], sys.stdout)\n"
+    )
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    rotated, exact = json.loads(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                                               text=True, check=True).stdout)
+    assert [e[1:] for e in rotated["events"]] == [e[1:] for e in exact["events"]]
+    np.testing.assert_allclose([e[0] for e in rotated["events"]], [e[0] for e in exact["events"]], rtol=0, atol=1e-11)
+    np.testing.assert_allclose(rotated["q"], exact["q"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(rotated["F"], exact["F"], rtol=0, atol=1e-6 * exact["peak"])
+    assert rotated["q"] != exact["q"]  # (the switch did change the arithmetic)
 
 
 @pytest.mark.parametrize("preset", ["gnilka-1a", "gnilka-2", "gnilka-3", "gnilka-1d"])
@@ -161,45 +169,67 @@ def test_a_quiet_steps_force_rows_give_the_contact_force_at_the_steps_end(preset
     """A quiet step reads each closed rigid contact's force off its own product (the step operators'
     force rows, ``ConfigurationTables._force_rows``); that number is the force row of the step's end
     state (``contact_force``, term by term), in every configuration, standard and refined step, from
-    random states, to round-off."""
-    from vtool.solvers.newmark import build as kernel_build
+    random states, to round-off. (The kernel's functions as plain Python: ``py_func``.)"""
     from vtool.solvers.newmark import layout
+    from vtool.solvers.newmark.kernel import algebra, forces, step
+    from vtool.solvers.newmark.records import Config, Motion
 
-    kernel = kernel_build.plain_kernel()
+    def plain(function):  # noqa: ANN001, ANN202
+        return getattr(function, "py_func", function)
+
     problem = ContactProblem(assemble(load_preset(preset)))
     tables = problem.tables
     dt, beta, gamma, fine = 1e-6, 0.25, 0.5, 1e-7
     tables.use_step(dt, beta, gamma, fine)
     n, ns, ncl = problem.n, problem.ns, problem.ncl
+    record = problem.record()
     rng = np.random.default_rng(7)
     checked = 0
     for c in range(2**ncl):
         tables.build(c)
-        nf, m = tables.ci[c, layout.CI_NF], tables.ci[c, layout.CI_M]
+        C = Config(c, *tables.of(c))
+        nf = C.ci[layout.CI_NF]
         for plane, h in ((layout.CP_STD, dt), (layout.CP_FINE, fine)):
             for _ in range(10):
                 z, zd, zdd = rng.normal(size=n) * 1e-2, rng.normal(size=n) * 10, rng.normal(size=n) * 1e4
                 src = rng.normal(size=3 * ns) * np.tile([1e-2, 10, 1e4], ns)
-                z1, zd1 = z + h * zd + h * h * (0.5 - beta) * zdd, zd + h * (1 - gamma) * zdd
-                zdd1 = zdd.copy()
-                kernel.set_prescribed(tables.ci, c, n, src, z1, zd1, zdd1)
+                end = Motion(z + h * zd + h * h * (0.5 - beta) * zdd, zd + h * (1 - gamma) * zdd, zdd.copy())
+                plain(step.prescribed)(C.ci, n, src, end.z, end.zd, end.zdd)
                 out = np.zeros(n + ncl)
-                kernel.apply_operator(tables.cp, c, plane, nf, tables.ci[c, layout.CI_ROWS], m,
-                                      tables.ci[c, layout.CI_SRCSTEP], src, z1, zd1, zdd1, out)
-                zdd1[:nf] = out[:nf]
-                z1[:nf] += beta * h * h * out[:nf]
-                zd1[:nf] += gamma * h * out[:nf]
+                plain(algebra.apply_operator)(C.cp, C.ci, plane, C.ci[layout.CI_ROWS], C.ci[layout.CI_SRCSTEP], src,
+                                              end.z, end.zd, end.zdd, out)
+                end.zdd[:nf] = out[:nf]
+                end.z[:nf] += beta * h * h * out[:nf]
+                end.zd[:nf] += gamma * h * out[:nf]
                 for k in range(ncl):
-                    if tables.mk[c, k, layout.MK_KIND] != layout.MK_FORCE:
+                    if C.mk[k, layout.MK_KIND] != layout.MK_FORCE:
                         continue
-                    expected = kernel.contact_force(tables.mk, tables.mon, c, k, n, ns, z1, zd1, zdd1, src)
-                    row = tables.mk[c, k, layout.MK_ROW]
-                    assert nf <= row < tables.ci[c, layout.CI_ROWS]
-                    scale = np.abs(tables.mon[c, k, :3 * n + 3 * ns]).max() * 1e4
-                    assert tables.mon[c, k, 3 * n + 3 * ns] + out[row] == pytest.approx(expected, rel=1e-11,
-                                                                                          abs=1e-13 * scale)
+                    expected = plain(forces.contact_force)(record, C, k, end, src)
+                    row = C.mk[k, layout.MK_ROW]
+                    assert nf <= row < C.ci[layout.CI_ROWS]
+                    scale = np.abs(C.mon[k, :3 * n + 3 * ns]).max() * 1e4
+                    assert C.mon[k, 3 * n + 3 * ns] + out[row] == pytest.approx(expected, rel=1e-11, abs=1e-13 * scale)
                     checked += 1
     assert checked > 0
+
+
+def chain_doc(masses: int) -> dict:
+    """A chain of ``masses`` masses on springs, each a gap of 0.002 in behind the next (masses - 1
+    internal clearances) and the first riding the cam (one more): a clearance per link."""
+    doc = sdof_doc(amplitude=0.05, rpm=3000.0, degrees=40.0, time_step=1e-6, restitution=0.3)
+    doc["coordinates"] = [{"name": f"m{i}", "motion": "translation"} for i in range(1, masses + 1)]
+    members = {"ground": {"element": "bar", "length": 1.0, "stiffness": 50.0, "mass": 0.001, "area": 1.0,
+                          "coordinates": [masses, 0]}}
+    for i in range(1, masses):
+        members[f"link{i}"] = {"element": "bar", "length": 1.0, "stiffness": 2000.0, "mass": 0.001, "area": 1.0,
+                               "coordinates": [i, i + 1]}
+    doc["members"] = members
+    doc["cam"] = {"coordinate": masses + 1, "amplitude": 0.05}
+    doc["clearances"] = [{"name": "cam", "ahead": 1, "behind": masses + 1, "kind": "external"}]
+    doc["clearances"] += [{"name": f"gap{i}", "ahead": i, "behind": i + 1, "kind": "internal"}
+                          for i in range(1, masses)]
+    doc["initial"]["closed"] = ["cam"]
+    return doc
 
 
 def test_the_row_buffer_holds_a_run_at_its_output_interval_or_4096_rows() -> None:
@@ -369,3 +399,34 @@ def test_a_non_finite_value_anywhere_in_a_trace_is_a_run_error_naming_it(name: s
         with pytest.raises(RunError, match=rf"^the run diverged: non-finite {name} at t = "
                                            rf"{trace.time[7]:.6g} s \(cam angle {trace.cam_angle[7]:.4g} deg\)"):
             run._check_finite(dataclasses.replace(trace, **{name: values}))
+
+
+def twenty_clearance_spec():  # noqa: ANN201
+    """:func:`chain_doc` with 21 masses: 21 clearances (2^21 configurations; the preset loader's limit
+    of 8 is passed by setting the clearances on the loaded spec)."""
+    import dataclasses
+
+    doc = chain_doc(21)
+    doc["cam"]["amplitude"], doc["run"]["degrees"] = 0.2, 60.0
+    every = doc["clearances"]
+    doc["clearances"] = every[:8]
+    spec = spec_from(doc)
+    template = spec.clearances[1]
+    return dataclasses.replace(spec, clearances=spec.clearances[:1] + tuple(
+        dataclasses.replace(template, name=c["name"], ahead=c["ahead"], behind=c["behind"]) for c in every[1:]))
+
+
+def test_twenty_clearances_allocate_only_the_configurations_a_run_visits() -> None:
+    """The configuration tables grow with the configurations a run visits (a mask -> slot map), not
+    with the 2^21 it could reach (dense tables: 2^21 rows of the step operators, some 100 GB)."""
+    spec = twenty_clearance_spec()
+    mechanism = assemble(spec)
+    backend = NewmarkBackend()
+    trace = backend.simulate(mechanism, backend.options_from_run(spec.run))
+    tables = ContactProblem.for_run(mechanism).tables  # (the mechanism's shared tables)
+    built = len(trace.statistics.configurations_built)
+    assert len(spec.clearances) == 21 and trace.events and built >= 3
+    assert set(tables.slots) == set(tables.layers) == set(trace.statistics.configurations_built)
+    assert tables.ci.shape[0] == tables.cp.shape[0] <= 2 * max(built, 4)  # doubled when full
+    index = tables.index  # every built configuration found by the kernel's probe, no other
+    assert sorted(int(m) for m in index[index[:, 0] >= 0, 0]) == sorted(tables.slots)

@@ -207,3 +207,22 @@ async def test_a_speed_sweep_shows_the_intervals_and_a_two_field_sweep_the_map()
         assert pane.table.text.startswith(metric_map(results, axes, "cam_separations", units["cam_separations"]))
         assert str(pane.intervals.content) == ""  # two fields: no speed intervals
 
+async def test_export_while_the_next_sweep_is_checked_writes_the_last_finished_sweep(tmp_path: Path) -> None:
+    """TUI monkey, seeds 108 and 160: Export CSV pressed while a new sweep was being checked met the new
+    (empty) plan beside the last sweep's results (AttributeError)."""
+    app = PaneApp(values="10000,11000", fixed="run.degrees=100", metric="peak_F1")
+    async with app.run_test(size=(140, 50)) as pilot:
+        pane = app.query_one(SweepPane)
+        await _run(pilot, pane)
+        pane.query_one("#sweep-values", Input).value = "1000:100999:1"
+        pane.run_sweep()
+        await pilot.pause()
+        pane.export_csv(tmp_path / "last.csv")
+        await pilot.pause()
+        pane.cancel()
+        while pane.running:
+            await pilot.pause(0.05)
+        await pilot.pause()
+    assert app._exception is None
+    rows = (tmp_path / "last.csv").read_text().splitlines()
+    assert len(rows) == 3 and rows[1].startswith("10000,") and rows[2].startswith("11000,")

@@ -23,3 +23,18 @@ async def run_degrees(pilot, app, degrees: str):  # type: ignore[no-untyped-def]
     await put(pilot, screen, "run.degrees", degrees)
     await run_and_wait(pilot, app)
     return screen
+
+
+async def answer_path_dialog(pilot, app, key: str, path: str) -> None:  # type: ignore[no-untyped-def]
+    """Press ``key`` (save, export, report), check a path dialog opened, give it ``path``, and return to the
+    screen."""
+    from vtool.app.tui.dialogs import PathDialog
+
+    screen = app.screen
+    await pilot.press(key)
+    await pilot.pause()
+    assert isinstance(app.screen, PathDialog)
+    app.screen.query_one("#path-input").value = path
+    await pilot.press("enter")
+    await pilot.pause()
+    assert app.screen is screen

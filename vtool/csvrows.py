@@ -24,10 +24,9 @@ So the text is identical to Python's for every value (a test compares them
 on random and edge values). ``NUMBA_DISABLE_JIT=1`` runs the same source as
 plain Python (the reference).
 
-The kernel itself is :mod:`vtool.csvrows_kernel` (numba). This module imports
-no numba: a caller may hand in the same kernel from a native module (the
-valve-train kernel's, :mod:`vtool.solvers.newmark.native`), and otherwise numba
-is imported only when its kernel is worth it (:func:`choose`).
+The kernel itself is :mod:`vtool.csvrows_kernel` (numba, ``@jit`` of
+:mod:`vtool.jit`). This module imports no numba: numba is imported only when
+its kernel is worth it (:func:`choose`).
 """
 
 from __future__ import annotations
@@ -35,6 +34,7 @@ from __future__ import annotations
 import csv
 import io
 import sys
+import time
 from collections.abc import Callable, Iterable, Sequence
 from types import ModuleType
 from typing import Any
@@ -79,7 +79,7 @@ def repeated_columns(values: np.ndarray) -> np.ndarray:
     return same
 
 
-#: A compiled ``put_rows`` (:mod:`vtool.csvrows_kernel`'s signature; numba's or a native module's).
+#: A compiled ``put_rows`` (:mod:`vtool.csvrows_kernel`'s signature).
 Formatter = Callable[..., int]
 
 
@@ -91,18 +91,17 @@ def kernel() -> ModuleType:
 
 
 def ready() -> bool:
-    """True when numba's kernel needs no compiling: loaded in this process, or in numba's cache."""
-    put_rows = kernel().put_rows
-    if not hasattr(put_rows, "signatures") or put_rows.signatures:
-        return True  # NUMBA_DISABLE_JIT (plain Python), or compiled or loaded already
-    return compile_notice() is None
+    """True when numba's kernel needs no compiling: plain Python, loaded in this process, or compiled into
+    numba's cache before (:func:`vtool.jit.is_compiled`)."""
+    from vtool import jit
+
+    return jit.is_compiled(kernel().put_rows, "put_rows", "csv")
 
 
-def choose(rows: int, compiled: bool | None, native: Formatter | None = None) -> Formatter | None:
+def choose(rows: int, compiled: bool | None) -> Formatter | None:
     """The formatter for ``rows`` rows, or None for Python's formatting.
 
-    ``compiled`` False: Python's; otherwise a ``native`` formatter when one is
-    given (a native module's, no numba); else numba's kernel when ``compiled``
+    ``compiled`` False: Python's; otherwise numba's kernel when ``compiled``
     is True, when the output is large enough to pay for the kernel's compile
     (a few seconds, once; a per-degree CSV does not wait for it), or when
     numba is loaded in this process already and the kernel is cached (not
@@ -110,8 +109,6 @@ def choose(rows: int, compiled: bool | None, native: Formatter | None = None) ->
     """
     if compiled is False:
         return None
-    if native is not None:
-        return native
     if compiled or rows >= WORTH_COMPILING_ROWS or ("numba" in sys.modules and ready()):
         return kernel().put_rows  # type: ignore[no-any-return]
     return None
@@ -136,7 +133,7 @@ def arguments(values: np.ndarray, labels: list[str], label_of_row: np.ndarray) -
 
 
 def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
-            compiled: bool | None = None, native: Formatter | None = None) -> list:  # type: ignore[type-arg]
+            compiled: bool | None = None) -> list:  # type: ignore[type-arg]
     """The rows' UTF-8 text as a list of byte buffers (the kernel's, and Python's rows where it gave up)."""
     values = np.ascontiguousarray(values, dtype=np.float64)
     if values.ndim != 2:
@@ -144,12 +141,19 @@ def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
     rows = values.shape[0]
     if rows == 0:
         return []
-    put_rows = choose(rows, compiled, native)
+    put_rows = choose(rows, compiled)
     if put_rows is None:
         text = "".join(python_row(values[r], labels[int(label_of_row[r])]) for r in range(rows))
         return [text.encode("utf-8")]
     args = arguments(values, labels, label_of_row)
-    end = put_rows(*args)
+    if ready():
+        end = put_rows(*args)
+    else:  # numba compiles it first: timed, and marked compiled (vtool.jit)
+        from vtool import jit
+
+        started = time.perf_counter()
+        end = put_rows(*args)
+        jit.compiled("put_rows", "csv", time.perf_counter() - started)
     label_of_row, out, offsets, fallback = args[6:]
     pieces, done = [], 0
     for r in np.flatnonzero(fallback).tolist():
@@ -161,53 +165,36 @@ def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
 
 
 def format_rows(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
-                compiled: bool | None = None, native: Formatter | None = None) -> str:
+                compiled: bool | None = None) -> str:
     """CSV text of the rows of ``values`` (2-D), each ending with ``labels[label_of_row[r]]``.
 
     ``compiled``: True for a compiled kernel, False for Python's formatting (the same text), None to
-    choose; ``native``: a native module's kernel, used unless ``compiled`` is False (:func:`choose`)."""
-    pieces = _encode(values, labels, label_of_row, compiled, native)
+    choose (:func:`choose`)."""
+    pieces = _encode(values, labels, label_of_row, compiled)
     return b"".join(bytes(piece) for piece in pieces).decode("utf-8")
 
 
 def write_rows(handle, values: np.ndarray, labels: list[str], label_of_row: np.ndarray,  # type: ignore[no-untyped-def]
-               compiled: bool | None = None, native: Formatter | None = None) -> None:
+               compiled: bool | None = None) -> None:
     """Write :func:`format_rows`'s text to a text handle; to a UTF-8 file's binary buffer directly
     (no text copy) when it has one."""
     binary = getattr(handle, "buffer", None)
     if binary is None or (getattr(handle, "encoding", "") or "").lower().replace("-", "") != "utf8":
-        handle.write(format_rows(values, labels, label_of_row, compiled, native))
+        handle.write(format_rows(values, labels, label_of_row, compiled))
         return
     handle.flush()  # what was written as text goes first
-    for piece in _encode(values, labels, label_of_row, compiled, native):
+    for piece in _encode(values, labels, label_of_row, compiled):
         binary.write(piece)
-
-
-#: First compile of the formatter on the reference machine of :mod:`vtool.compile_estimate` (s; one
-#: process), scaled to the machine at hand for the notice; later processes load it from numba's cache.
-COMPILE_REFERENCE_S = 2.6
-
-
-_cached: list[bool] = []  # the cache's answer, read once per process
 
 
 def compile_notice() -> str | None:
     """The line to show before the first large CSV output compiles the formatter, or None when it is
-    cached (or compiled in this process). Imports numba: ask only when no native module is there."""
-    put_rows = kernel().put_rows
-    if not hasattr(put_rows, "signatures") or put_rows.signatures:
+    compiled (in numba's cache, or in this process). Imports numba."""
+    if ready():
         return None
-    if not _cached:
-        try:
-            _cached.append(bool(put_rows._cache._cache_file._load_index()))
-        except Exception:  # noqa: BLE001 (numba internals: a missing or unreadable index means "compile")
-            _cached.append(False)
-    if _cached[0]:
-        return None
-    from vtool import compile_estimate
+    from vtool import jit
 
-    return (f"compiling the CSV writer, once (about {compile_estimate.about(COMPILE_REFERENCE_S)} s); "
-            "later runs load it from the cache")
+    return jit.compile_notice("the CSV writer", "put_rows")
 
 
 def csv_text(rows: Iterable[Sequence[object]]) -> str:

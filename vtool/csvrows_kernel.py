@@ -1,14 +1,10 @@
 """The compiled CSV number formatter (numba): ``'%.10g' % x`` for every value of a table's rows.
 
 The method, and why the text is Python's to the last character, are in
-:mod:`vtool.csvrows`, which chooses between this kernel (numba's, or the same
-source compiled into the valve-train kernel's native module, see
-:mod:`vtool.solvers.newmark.native`) and Python's own formatting.
-``NUMBA_DISABLE_JIT=1`` runs the same source as plain Python (the reference).
-
-Everything the kernel uses is in this file (numba's cache is stamped by it
-alone); the decimal shifts come in as ``powers`` (10^k for k = -S..S, S from
-its length).
+:mod:`vtool.csvrows`, which chooses between this kernel and Python's own
+formatting. ``NUMBA_DISABLE_JIT=1`` runs the same source as plain Python (the
+reference). The decimal shifts come in as ``powers`` (10^k for k = -S..S, S
+from its length).
 """
 
 from __future__ import annotations
@@ -17,17 +13,7 @@ import math
 
 import numpy as np
 
-from vtool import numba_cache
-
-numba_cache.configure()
-
-from numba import njit  # noqa: E402 (after the cache folder is chosen)
-
-from vtool import numba_typing  # noqa: E402
-
-numba_typing.install()  # each call's typing resolved once (see there)
-
-jit = njit(cache=numba_cache.CACHE_ENABLED, nogil=True, error_model="numpy")
+from vtool.jit import jit
 
 #: Fractions of s this close to one half are left to Python's correctly rounded formatting.
 TIE_MARGIN = 1e-5

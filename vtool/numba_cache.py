@@ -1,48 +1,55 @@
-"""Where numba caches compiled kernels, so a read-only install still runs.
+"""Where numba caches vtool's compiled kernels: a private per-user folder, named by the kernels' source.
 
-numba writes its cache beside the module (``__pycache__``) or, when that
-folder is read-only, in the user cache folder. When neither is writable every
-``@njit(cache=True)`` function fails at import with ``RuntimeError: cannot
-cache function ... no locator available``. :func:`configure` runs before numba
-is imported (the kernel module calls it first) and:
+:func:`configure` runs before numba is imported (the kernel modules call it
+first) and sets ``NUMBA_CACHE_DIR`` (numba's documented setting) to
+``BASE/kernels-DIGEST``, where BASE is the first folder of
 
-1. keeps ``NUMBA_CACHE_DIR`` when the user set it;
-2. otherwise keeps numba's default when the package folder is writable;
-3. otherwise points ``NUMBA_CACHE_DIR`` at the first writable folder of
-   ``$XDG_CACHE_HOME/vtool/numba``, ``~/.cache/vtool/numba`` and
-   ``<tempdir>/vtool-numba-<uid>``;
-4. and when none is writable, disables caching (``NUMBA_DISABLE_CACHE``-like:
-   :data:`CACHE_ENABLED` is False, the kernel module passes it as ``cache=``)
-   with a one-line warning on stderr: every run then compiles again.
+1. ``NUMBA_CACHE_DIR`` when the user set it (then only that one);
+2. ``$XDG_CACHE_HOME/vtool/numba``, ``~/.cache/vtool/numba``,
+   ``<tempdir>/vtool-numba-<uid>``
 
-It also answers numba's start-up BLAS probe (:func:`decline_blas_probe`).
+that can be created, and DIGEST is the SHA-256 of the kernels' source files
+(content, size and modification time), numba's version and Python's. numba
+stamps a cached function by its own file only, while the machine code of a
+kernel function holds every compiled callee it calls, from other files: a
+new digest (an edit of any kernel file, another numba) is a new, empty
+folder, so stale machine code is never loaded.
+
+Safety: numba's index files are pickles, loaded as code. A folder is used
+only when it is a real directory owned by the user and not writable by group
+or others (new ones are made 0700); otherwise, or when no folder can be made,
+nothing is cached (every process compiles again) and one warning says why.
+No lock files: numba writes each cache file whole and renames it into place.
+
+Beside the cache (in BASE) ``compile-seconds.json`` keeps the last measured
+compile time of each kernel (:func:`last_compile`), for the notice before
+the next compile.
 """
 
 from __future__ import annotations
 
-import importlib.abc
+import hashlib
+import json
 import os
+import stat
 import sys
 import tempfile
+from collections.abc import Iterable
 from pathlib import Path
 
-#: False when no writable cache folder was found (compile on every start).
+#: False when no safe cache folder was found: kernels are compiled in every process.
 CACHE_ENABLED = True
-_configured: str | None = None
-
-
-def _writable(folder: Path) -> bool:
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        probe = tempfile.NamedTemporaryFile(dir=folder, prefix=".probe.", delete=True)
-        probe.close()
-    except OSError:
-        return False
-    return True
+#: The folder numba caches in (``NUMBA_CACHE_DIR``), or None before :func:`configure` or without a cache.
+FOLDER: Path | None = None
+BASE: Path | None = None
+TIMES = "compile-seconds.json"
+_configured: list[str] = []
 
 
 def candidates() -> list[Path]:
-    """Cache folders tried in order when the package folder is read-only."""
+    """Base folders tried in order (the user's ``NUMBA_CACHE_DIR`` alone when set)."""
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return [Path(os.environ["NUMBA_CACHE_DIR"])]
     xdg = os.environ.get("XDG_CACHE_HOME")
     folders = [Path(xdg) / "vtool" / "numba"] if xdg else []
     folders.append(Path.home() / ".cache" / "vtool" / "numba")
@@ -51,70 +58,117 @@ def candidates() -> list[Path]:
     return folders
 
 
-def configure(package_dir: str | os.PathLike[str] | None = None) -> str:
-    """Choose the numba cache folder (see module doc); returns what was chosen, in words.
+def unsafe(folder: Path) -> str | None:
+    """Why ``folder`` may not hold a cache (None when it may): not a directory of the user's own, or
+    writable by group or others."""
+    try:
+        info = os.lstat(folder)
+    except OSError as exc:
+        return f"{folder}: {exc.strerror}"
+    if not stat.S_ISDIR(info.st_mode):
+        return f"{folder} is not a directory"
+    if hasattr(os, "getuid") and info.st_uid != os.getuid():
+        return f"{folder} is owned by another user (uid {info.st_uid})"
+    if info.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        return f"{folder} is writable by others (mode {stat.S_IMODE(info.st_mode):o})"
+    return None
 
-    ``package_dir`` is the folder of the kernel module (default: ``vtool/solvers``).
-    Idempotent: a second call returns the first answer.
-    """
-    global CACHE_ENABLED, _configured
-    if _configured is not None:
-        return _configured
-    decline_blas_probe()
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        _configured = f"NUMBA_CACHE_DIR={os.environ['NUMBA_CACHE_DIR']} (set by the user)"
-        return _configured
-    here = Path(package_dir) if package_dir else Path(__file__).resolve().parent.parent / "solvers" / "newmark"
-    if os.access(here, os.W_OK) and _writable(here / "__pycache__"):
-        _configured = f"numba default (beside the package, {here / '__pycache__'})"
-        return _configured
-    for folder in candidates():
-        if _writable(folder):
-            os.environ["NUMBA_CACHE_DIR"] = str(folder)
-            _reload_numba_config()
-            _configured = f"NUMBA_CACHE_DIR={folder}"
-            return _configured
+
+def _made(folder: Path) -> bool:
+    """Create ``folder`` (0700, parents as the umask says) unless it exists; False when it cannot be."""
+    try:
+        folder.parent.mkdir(parents=True, exist_ok=True)
+        folder.mkdir(mode=0o700)
+    except FileExistsError:
+        pass
+    except OSError:
+        return False
+    return True
+
+
+def digest(sources: Iterable[Path]) -> str:
+    """The first 16 hex digits of the SHA-256 of the kernels' files, numba's version and Python's."""
+    from importlib.metadata import version
+
+    hashed = hashlib.sha256(f"{version('numba')}|{sys.version}".encode())
+    for path in sorted(sources):
+        info = path.stat()
+        hashed.update(f"{path.name}|{info.st_size}|{info.st_mtime_ns}|".encode())
+        hashed.update(path.read_bytes())
+    return hashed.hexdigest()[:16]
+
+
+def kernel_sources() -> list[Path]:
+    """The files of vtool's compiled kernels: the decorator (``jit.py``), the CSV formatter
+    (``csvrows_kernel.py``) and the Newmark kernel (``solvers/newmark/kernel/*.py`` with the layout
+    and records it reads; beside vtool/ in the source tree, under it once installed)."""
+    here = Path(__file__).resolve().parent
+    newmark = here / "solvers" / "newmark"
+    if not newmark.is_dir():
+        newmark = here.parent / "solvers" / "newmark"
+    return [here / "jit.py", here / "csvrows_kernel.py", newmark / "layout.py", newmark / "records.py",
+            *sorted((newmark / "kernel").glob("*.py"))]
+
+
+def configure(sources: Iterable[Path] | None = None) -> str:
+    """Choose and set numba's cache folder for kernels compiled from ``sources`` (default
+    :func:`kernel_sources`; see the module doc); returns the choice in words. Idempotent: later calls
+    return the first answer."""
+    global CACHE_ENABLED, FOLDER, BASE
+    if _configured:
+        return _configured[0]
+    sources = kernel_sources() if sources is None else list(sources)
+    problem = "no folder could be created"
+    for base in candidates():
+        if not _made(base):
+            continue
+        problem = unsafe(base) or ""
+        folder = base / f"kernels-{digest(sources)}"
+        if not problem and _made(folder):
+            problem = unsafe(folder) or ""
+        if problem:
+            break
+        FOLDER, BASE = folder, base
+        os.environ["NUMBA_CACHE_DIR"] = str(folder)
+        if "numba" in sys.modules:  # imported before: numba.config holds the setting it read then
+            import numba
+
+            numba.config.CACHE_DIR = str(folder)
+        _configured.append(f"NUMBA_CACHE_DIR={folder}")
+        return _configured[0]
     CACHE_ENABLED = False
-    os.environ["NUMBA_CACHE_DIR"] = str(Path(tempfile.gettempdir()))  # never written: cache=False
-    _configured = "caching disabled (no writable folder)"
-    print("warning: no writable folder for numba's cache; kernels are compiled on every start "
-          "(set NUMBA_CACHE_DIR to a writable folder)", file=sys.stderr)
-    return _configured
+    _configured.append(f"no cache ({problem})")
+    print(f"warning: numba's cache is off ({problem}); the solver is compiled in every process "
+          "(set NUMBA_CACHE_DIR to a folder of your own, not writable by others)", file=sys.stderr)
+    return _configured[0]
 
 
-def _reload_numba_config() -> None:
-    """numba reads its environment at import: re-read it when numba came first."""
-    if "numba" in sys.modules:
-        from numba.core import config
-
-        config.reload_config()
-
-
-class _BlasProbe(importlib.abc.MetaPathFinder):
-    """Refuses ``scipy.linalg`` to numba's start-up probe ``numba.np.arraymath._check_blas`` only."""
-
-    def find_spec(self, name, path=None, target=None):  # type: ignore[no-untyped-def]  # noqa: ANN001, ANN201
-        if name != "scipy.linalg":
-            return None
-        frame = sys._getframe(1)
-        while frame is not None:
-            if frame.f_code.co_name == "_check_blas" and frame.f_globals.get("__name__") == "numba.np.arraymath":
-                raise ImportError("vtool: numba's BLAS probe declined (vtool's kernels use no BLAS)")
-            frame = frame.f_back
+def last_compile(name: str) -> float | None:
+    """Seconds the last compile of kernel ``name`` took on this machine (any kernel source), or None."""
+    if BASE is None:
         return None
+    try:
+        value = json.loads((BASE / TIMES).read_text()).get(name)
+    except (OSError, ValueError, AttributeError):
+        return None
+    return float(value) if isinstance(value, int | float) and value > 0 else None
 
 
-def decline_blas_probe() -> None:
-    """Keep numba's start-up from importing ``scipy.linalg`` (0.15-0.25 s of every process).
-
-    When numba first loads a compiled function it imports ``numba.np.arraymath``,
-    whose module code probes for BLAS by importing ``scipy.linalg.cython_blas``
-    and keeps the answer only to choose between BLAS and a plain loop in
-    ``np.correlate``/``np.convolve``, which vtool's kernels do not call. This
-    finder makes that one probe fail, so a ``vtool solve`` that needs no scipy
-    loads none of ``scipy.linalg``. Every other import of ``scipy.linalg`` (the
-    exact and scipy back ends, numba typing ``np.linalg`` or ``np.dot``, which
-    call ``ensure_blas`` themselves) goes through unchanged. Idempotent.
-    """
-    if not any(isinstance(finder, _BlasProbe) for finder in sys.meta_path):
-        sys.meta_path.insert(0, _BlasProbe())
+def record_compile(name: str, seconds: float) -> None:
+    """Keep ``seconds`` as the last compile time of kernel ``name`` (written whole, then renamed)."""
+    if BASE is None:
+        return
+    path = BASE / TIMES
+    try:
+        times = json.loads(path.read_text())
+        if not isinstance(times, dict):
+            times = {}
+    except (OSError, ValueError):
+        times = {}
+    times[name] = round(seconds, 2)
+    try:
+        partial = path.with_name(f"{TIMES}.{os.getpid()}")
+        partial.write_text(json.dumps(times))
+        partial.replace(path)
+    except OSError:
+        pass

@@ -72,6 +72,13 @@ def show(preset: str, plot: bool, as_json: bool, csv_path: Path | None, figure_p
         from vtool.presets.charts import cam_charts, cam_shape_charts
 
         charts = cam_charts(spec) + (cam_shape_charts(spec) if spec.follower is not None else [])
+        from vtool.presets.cam_scan import preset_scan
+
+        scan = preset_scan(preset, spec.unit_system)
+        if scan is not None:  # a measured scan: raw against smoothed derivatives
+            from vtool.presets.charts import scan_charts
+
+            charts = scan_charts(scan, spec.unit_system.length, spec.title) + charts
         if plot:
             click.echo("\n".join(chart_text(chart, height=14) for chart in charts))
         write_figure(charts, figure_path)

@@ -7,7 +7,8 @@ table :data:`COMMANDS` maps its name to ``module:attribute`` so that
 User mistakes (:class:`vtool.errors.InputError`, click usage errors) end with a
 one-line message on stderr and exit code 2; a failed run
 (:class:`vtool.errors.RunError`) ends with its message and exit code 1. No
-traceback is shown for either. Warnings (:class:`vtool.errors.PresetWarning`)
+traceback is shown for either. Notes (:class:`vtool.errors.PresetNote`: what a loader assumed or
+converted) are one ``note: ...`` line each, once. Warnings (:class:`vtool.errors.PresetWarning`)
 are one ``warning: ...`` line each on stderr.
 
 Start-up: a ``vtool solve`` process creates about 120,000 long-lived objects
@@ -39,7 +40,7 @@ from typing import Any
 import click
 
 from vtool import __version__
-from vtool.errors import InputError, PresetWarning, RunError, one_line
+from vtool.errors import InputError, PresetNote, PresetWarning, RunError, one_line
 
 #: Collector thresholds for a command-line process (see the module doc); Python's default is (700, 10, 10).
 GC_THRESHOLDS = (100_000, 50, 100)
@@ -55,6 +56,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "compare": ("vtool.app.cli.compare", "compare"),
     "cam": ("vtool.app.cli.cam", "cam"),
     "size": ("vtool.app.cli.size", "size"),
+    "report": ("vtool.app.cli.report", "report"),
     "tui": ("vtool.app.cli.tui", "tui"),
 }
 
@@ -96,6 +98,7 @@ class LazyGroup(click.Group):
             warnings.simplefilter("ignore", DeprecationWarning)
             warnings.simplefilter("ignore", PendingDeprecationWarning)
             warnings.simplefilter("always", PresetWarning)
+            warnings.simplefilter("default", PresetNote)  # once per text: a sweep loads the preset per point
             warnings.showwarning = _show_warning
             try:
                 return super().invoke(ctx)
@@ -132,8 +135,9 @@ class LazyGroup(click.Group):
 
 
 def _show_warning(message: Warning | str, category: type[Warning], *args: Any, **kwargs: Any) -> None:
-    """Every warning as one line on stderr: ``warning: ...``."""
-    click.echo(f"warning: {one_line(str(message), 400)}", err=True)
+    """Every warning as one line on stderr: ``warning: ...`` (a :class:`PresetNote`: ``note: ...``)."""
+    word = "note" if issubclass(category, PresetNote) else "warning"
+    click.echo(f"{word}: {one_line(str(message), 400)}", err=True)
 
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})

@@ -35,9 +35,9 @@ start_option = click.option(
 def _figure_path(ctx: click.Context, param: click.Parameter, value: str | None):  # type: ignore[no-untyped-def]
     if value is None:
         return None
-    from vtool.app.figures import check_figure_path
+    from vtool.app.figures import check_output
 
-    return check_figure_path(value, "--figure")
+    return check_output(value, "--figure")
 
 
 figure_option = click.option(

@@ -1,8 +1,10 @@
-"""A progress bar for runs longer than a second (stderr, nothing for short runs or a non-terminal)."""
+"""A progress bar for runs longer than a second (stderr, nothing for short runs or a non-terminal), and
+the elapsed seconds of a compile before it."""
 
 from __future__ import annotations
 
 import sys
+import threading
 import time
 
 import click
@@ -19,8 +21,35 @@ class DelayedProgress:
         self.shown = 0
         # a bar on a file or pipe is one label with no newline, which would run into an error line
         self.interactive = sys.stderr.isatty()
+        self.ticker: tuple[threading.Event, threading.Thread] | None = None
+
+    def tick(self) -> None:
+        """Show the seconds elapsed on stderr, once a second, until the first progress (a compile before
+        the run's first chunk); on a terminal only, nothing on a pipe or file."""
+        if not self.interactive or self.ticker is not None:
+            return
+        stop = threading.Event()
+        started = time.perf_counter()
+
+        def show() -> None:
+            while not stop.wait(1.0):
+                sys.stderr.write(f"\r  compiling... {time.perf_counter() - started:.0f} s")
+                sys.stderr.flush()
+
+        self.ticker = (stop, threading.Thread(target=show, daemon=True))
+        self.ticker[1].start()
+
+    def _stop_ticking(self) -> None:
+        if self.ticker is not None:
+            stop, thread = self.ticker
+            stop.set()
+            thread.join()
+            sys.stderr.write("\r\033[K")  # the line cleared
+            sys.stderr.flush()
+            self.ticker = None
 
     def __call__(self, fraction: float) -> None:
+        self._stop_ticking()
         if self.bar is None:
             if time.perf_counter() - self.started < self.delay or not self.interactive:
                 return
@@ -31,5 +60,6 @@ class DelayedProgress:
         self.shown = done
 
     def close(self) -> None:
+        self._stop_ticking()
         if self.bar is not None:
             self.bar.__exit__(None, None, None)

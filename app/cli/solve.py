@@ -40,8 +40,11 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
               help="Degrees of cam rotation to run (1e-6 to 3.6e6); default: the preset's run.degrees.")
 @click.option("--max-steps", type=float, callback=_max_steps,
               help=f"Refuse runs estimated above this many steps (default {MAX_STEPS:.0e}; scipy {MAX_SCIPY_STEPS:.0e}).")
-@click.option("--csv", "csv_path", type=OUTPUT,
+@click.option("--csv", "--out", "csv_path", type=OUTPUT,
               help="Write the response as CSV (per output interval, or per step with --every-step).")
+@click.option("--format", "file_format", type=click.Choice(["csv", "parquet"]),
+              help="Format of the --csv/--out file (default: parquet for a .parquet file, else csv); Parquet "
+                   "needs pyarrow (pip install 'vtool[parquet]'), written in row groups as the run goes.")
 @click.option("--every-step", is_flag=True, help="CSV rows at every time step (and event) instead of per degree.")
 @click.option("--plot", is_flag=True, help="Draw force, displacement and configuration charts (not with --json).")
 @figure_option
@@ -58,7 +61,7 @@ def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) 
 def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None, degrees: float | None,
           max_steps: float | None, csv_path: Path | None, every_step: bool, plot: bool, as_json: bool,
           show_events: bool, orders: str | None, impact: str | None, start: str | None,
-          figure_path: Path | None, sets: tuple[str, ...] = ()) -> None:
+          figure_path: Path | None, file_format: str | None, sets: tuple[str, ...] = ()) -> None:
     """Run a preset: a valve-train simulation, a sonic-boom assessment or a plate study.
 
     Valve train: prints the summary (separations and impacts per clearance,
@@ -70,6 +73,10 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
 
     json_alone(as_json, plot=plot)
     csv_file = csv_path  # checked when the command line was read (options.OUTPUT)
+    if file_format is not None and csv_file is None:
+        raise InputError("--format", file_format, "an output file to write (--out PATH)")
+    if csv_file is not None and file_format is None and str(csv_file).lower().endswith((".parquet", ".pq")):
+        file_format = "parquet"
     path = find_preset(preset)
     doc = read_document(path)
     if sets:
@@ -79,7 +86,8 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
     kind = KINDS[kind_of(doc)]
     given = {"--backend": backend, "--dt": dt, "--rpm": rpm, "--degrees": degrees,
              "--max-steps": max_steps, "--every-step": every_step or None,
-             "--events": show_events or None, "--impact": impact, "--start": start, "--orders": orders}
+             "--events": show_events or None, "--impact": impact, "--start": start, "--orders": orders,
+             "--format": None if file_format == "csv" else file_format}
     for flag, value in given.items():
         if value is not None and flag not in kind.run_options:
             raise InputError(flag, value, f"no {flag} for {preset}: it is a {kind.name} preset "
@@ -96,7 +104,7 @@ def solve(preset: str, backend: str | None, dt: float | None, rpm: float | None,
 #: ``vtool solve``'s run flags and the keyword that carries each to a kind's solve function
 FLAG_ARGUMENTS = {"--backend": "backend", "--dt": "dt", "--rpm": "rpm", "--degrees": "degrees",
                   "--max-steps": "max_steps", "--every-step": "every_step", "--events": "show_events",
-                  "--impact": "impact", "--start": "start", "--orders": "orders"}
+                  "--impact": "impact", "--start": "start", "--orders": "orders", "--format": "file_format"}
 
 
 def applies_to(flag: str) -> list[str]:
@@ -108,22 +116,39 @@ def applies_to(flag: str) -> list[str]:
 
 def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *, every_step: bool = False,
                    show_events: bool = False, max_steps: float | None = None, figure: Path | None = None,
-                   orders: str | None = None) -> None:
+                   orders: str | None = None, file_format: str | None = None) -> None:
     """``vtool solve`` for a valvetrain preset (its flags that are preset fields already in ``spec``): the
     run and its summary."""
     from vtool.app.cli.progress import DelayedProgress
     from vtool.files import json_text
     from vtool.solvers.run import simulate
 
+    parquet = False
+    if csv_path is not None:
+        from vtool.solvers.parquet import output_format
+
+        parquet = output_format(csv_path, file_format) == "parquet"  # pyarrow checked before the run
     progress = DelayedProgress(f"{spec.run.backend} {spec.run.degrees:g} deg")
 
     def before_run() -> None:  # the input is checked: announce a compile, if one is to come
-        announce_compile(spec, csv=csv_path is not None and every_step)
+        if announce_compile(spec, csv=csv_path is not None and every_step):
+            progress.tick()  # elapsed seconds on a terminal until the run's first progress
 
     try:
         if csv_path is None:
             trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps,
                              before_run=before_run)
+        elif parquet:  # row groups to the temporary file as the run makes them; renamed at the end
+            from vtool.files import open_atomic_binary
+            from vtool.solvers.parquet import ParquetStream
+
+            with open_atomic_binary(csv_path, "--out") as binary:
+                stream = ParquetStream(binary, spec.run.quantities, thin=every_step, title=spec.title)
+                try:
+                    trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps,
+                                     stream=stream, before_run=before_run)
+                finally:  # the writer's footer goes to the temporary file before it is renamed (or removed)
+                    stream.close()
         else:  # rows go to the temporary file as the run makes them; renamed over the target at the end
             from vtool.files import open_atomic
             from vtool.solvers.trace import CsvStream
@@ -172,23 +197,29 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
 
             click.echo(order_chart(spectrum, natural_frequencies(trace)))
     if figure is not None:
-        from vtool.presets.charts import trace_charts
+        from vtool.presets.charts import order_chart, trace_charts
 
-        write_figure(trace_charts(trace), figure)
+        charts = trace_charts(trace)
+        if spectrum is not None:  # the --orders spectrum, natural frequencies marked
+            from vtool.solvers.studies.orders import natural_frequencies
+
+            charts.append(order_chart(spectrum, natural_frequencies(trace), subject=trace.spec.title))
+        write_figure(charts, figure)
 
 
-def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()) -> None:
+def announce_compile(spec: Any, csv: bool = False, impacts: tuple[str, ...] = ()) -> bool:
     """One line on stderr before a run that must first compile the solver (a new install's first run, or
     the first with Hertz contacts or momentum-law impacts), and one before the first every-step CSV
-    compiles its number formatter (a few seconds, once). ``impacts``: further impact laws to be run."""
+    compiles its number formatter (a few seconds, once). ``impacts``: further impact laws to be run.
+    True when a line was shown."""
     from vtool.solvers.backends import get
 
-    notice = get(spec.run.backend).compile_notice(spec, impacts)
-    if notice:
-        click.echo(notice, err=True)
+    notices = [get(spec.run.backend).compile_notice(spec, impacts)]
     if csv:
-        from vtool.solvers.trace import csv_compile_notice
+        from vtool.csvrows import compile_notice as csv_notice
 
-        notice = csv_compile_notice()
+        notices.append(csv_notice())
+    for notice in notices:
         if notice:
             click.echo(notice, err=True)
+    return any(notices)

@@ -64,9 +64,14 @@ def _scheduler(ctx: click.Context, param: click.Parameter, value: str | None) ->
               help="Local worker processes (default: chosen from the measured cost of a point; 1 = in this process).")
 @click.option("--scheduler", callback=_scheduler, help="Dask: tcp://HOST:PORT of a running scheduler, local:N (a LocalCluster of N "
                                   "processes) or local-threads:N.")
-@click.option("--csv", "csv_path", type=OUTPUT,
+@click.option("--csv", "--out", "csv_path", type=OUTPUT,
               help="Write one row per point (swept fields, status, metrics; units in the header), appended as "
                    "points finish.")
+@click.option("--format", "file_format", type=click.Choice(["csv", "parquet"]),
+              help="Format of the --csv/--out file (default: parquet for a .parquet file, else csv). Parquet "
+                   "(needs pyarrow: pip install 'vtool[parquet]') is written in row groups, memory bounded; "
+                   "the table is then not printed unless --json, --plot, --map or --figure needs it, and an "
+                   "interrupted sweep keeps nothing (no --resume).")
 @click.option("--resume", is_flag=True, help="Continue the sweep in the --csv file, skipping finished points.")
 @click.option("--timing", is_flag=True, help="Also write each point's wall time to the CSV (not reproducible).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON instead of a table.")
@@ -86,7 +91,7 @@ def _scheduler(ctx: click.Context, param: click.Parameter, value: str | None) ->
 def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | None, scheduler: str | None,
           csv_path: Path | None, resume: bool, timing: bool, as_json: bool, plot: bool, as_map: bool,
           metric: str, every_step: bool, figure_path: Path | None, steady: bool, orders: tuple[str, ...],
-          campbell: str | None) -> None:
+          campbell: str | None, file_format: str | None) -> None:
     """Run a valve-train preset over a grid of field values and report per-point metrics.
 
     \b
@@ -112,6 +117,16 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     json_alone(as_json, plot=plot, map=as_map)
     if resume and csv_path is None:
         raise InputError("--resume", True, "a --csv file to resume")
+    if file_format is not None and csv_path is None:
+        raise InputError("--format", file_format, "an output file to write (--out PATH)")
+    parquet = False
+    if csv_path is not None:
+        from vtool.solvers.parquet import output_format
+
+        parquet = output_format(csv_path, file_format) == "parquet"
+        if parquet and (resume or find is not None):
+            raise InputError("--format", "parquet", "csv for --resume and --find (a Parquet sweep is written "
+                             "whole at the end)")
     if find is not None:
         if not any(s.partition("=")[0].strip() == "run.rpm" for s in sets):
             sets = (f"run.rpm={DEFAULT_SCAN}",) + sets
@@ -145,13 +160,20 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         if find is not None:
             _find(find, plan, runner, csv_path, as_json, every_step)
             return
-        sink = SweepFile(csv_path, plan.fields, plan.spec, resume=resume, timing=timing) if csv_path else None
+        sink = SweepFile(csv_path, plan.fields, plan.spec, resume=resume, timing=timing) if (
+            csv_path and not parquet) else None
         progress = CountProgress(f"{len(plan.points)} points")
+        keep = not parquet or as_json or plot or as_map or bool(campbell) or figure_path is not None
         try:
-            outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress)
+            if parquet:
+                outcome = _run_to_parquet(plan, runner, csv_path, every_step, timing, keep, progress)
+            else:
+                outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress)
         except KeyboardInterrupt:
             progress.close()
-            if sink is not None and (sink.written or resume):
+            if parquet:
+                where = "nothing was kept (an interrupted Parquet sweep is not written; --csv keeps points)"
+            elif sink is not None and (sink.written or resume):
                 where = f"the finished points are in {csv_path}; run again with --resume to finish"
             elif sink is not None:
                 where = f"no point had finished: nothing was written ({csv_path} is as it was)"
@@ -174,11 +196,11 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
                               | {"evaluation": steady_text(plan.spec),
                                  "criteria": Criteria.of(plan.spec).as_dict(length)}, indent=2))
     else:
-        if results:
+        if results and not parquet:
             click.echo(results_table(results, plan.fields, plan.spec))
         click.echo(steady_text(plan.spec))  # which cycles the metrics cover, and by which criteria
         click.echo(Criteria.of(plan.spec).text(length))
-        n = len(results)
+        n = outcome.total - outcome.skipped
         wall = startup + outcome.wall_time
         begun = f", {startup:.2f} s of it starting the cluster" if startup >= 0.005 else ""
         click.echo(f"{n} points in {wall:.2f} s ({1000 * wall / max(n, 1):.1f} ms per "
@@ -197,14 +219,29 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         from vtool.solvers.studies.orders import campbell as campbell_data
 
         rows = [(float(dict(r.values)["run.rpm"]), r.metrics) for r in results if r.ok]
-        click.echo(campbell_map(campbell_data(rows, plan.spec, campbell)))
-    if results and figure_path is not None:  # the --plot chart, and the --map as a grey map
-        from vtool.presets.charts import sweep_chart, sweep_map
+        waterfall = campbell_data(rows, plan.spec, campbell)
+        click.echo(campbell_map(waterfall))
+    if results and figure_path is not None:  # the --plot chart, the --map and the --campbell as grey maps
+        from vtool.presets.charts import campbell_chart, sweep_chart, sweep_map
 
         items: list = [sweep_chart(results, axes, metric, names[metric], plan.spec.title)]
         if as_map:
             items.append(sweep_map(results, axes, metric, names[metric], plan.spec.title))
+        if campbell:
+            items.append(campbell_chart(waterfall, plan.spec.title))
         write_figure(items, figure_path)
+
+
+def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):  # type: ignore[no-untyped-def]
+    """The sweep with its points written to a Parquet file as they finish (renamed into place at the end)."""
+    from vtool.files import open_atomic_binary
+    from vtool.solvers.parquet import SweepParquet
+    from vtool.solvers.studies.sweep import run_points
+
+    with open_atomic_binary(path, "--out") as handle:
+        sink = SweepParquet(handle, plan.fields, plan.spec, timing=timing)
+        return run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress, keep=keep)
+        # (run_points finishes the sink, footer included, also when interrupted: the file is then removed)
 
 
 def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # type: ignore[no-untyped-def]

@@ -152,6 +152,7 @@ Valve-train dynamics, sonic-boom and plate checks.
 - `ctrl+o` open a shipped or recent preset, or a path
 - `ctrl+s` save the form as a preset (the file's comments kept, changes noted `# was ...`)
 - `ctrl+e` export the current results as CSV (same as `vtool solve --csv`)
+- `ctrl+g` valve train: save the last run's report, .pdf or .html (same as `vtool report`)
 - `ctrl+f` hide / show the form (a run hides it below 120 columns)
 - `ctrl+t` next result tab
 - `tab` / `shift+tab` next / previous field

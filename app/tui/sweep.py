@@ -231,8 +231,10 @@ class SweepPane(Widget):
         return sets + [s.strip() for s in self._input("fixed").value.split(";") if s.strip()]
 
     def run_sweep(self) -> None:
-        """Start the worker: it checks every point (errors on the status line), then runs them."""
-        self.plan = None
+        """Start the worker: it checks every point (errors on the status line), then runs them.
+
+        ``plan`` and ``outcome`` stay the last finished sweep's (a pair: what the chart, the table and
+        *Export CSV* show) until this one finishes."""
         self.query_one("#sweep-progress", ProgressBar).update(total=None, progress=0)
         self.set_status("checking the points ... (Cancel stops)")
         self.worker = self._work(self.preset, self.assignments())

@@ -6,10 +6,11 @@ tab (e.g. a sweep) is one more ``TabPane`` appended there.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from textual import work
 from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
 from textual.containers import Horizontal
 from textual.widgets import SelectionList, TabbedContent, TabPane
 from textual.widgets.selection_list import Selection
@@ -141,6 +142,8 @@ class ValveTrainScreen(DomainScreen):
     MODE = "valvetrain"
     DEFAULT_PRESET = "gnilka-1a"
     TITLE_TEXT = "VALVE TRAIN"
+    # hidden from the footer (its keys are full at 80 columns); listed in the help and docs/tui.md
+    BINDINGS: ClassVar[list[BindingType]] = [Binding("ctrl+g", "save_report", "Report", show=False)]
     # a table cam's file is written inline (docs/cams.md): a saved copy must not depend on its folder
     FILE_REFERENCES = ((("cam",), "lift_table", ("angles", "lifts")),)
 
@@ -209,6 +212,7 @@ class ValveTrainScreen(DomainScreen):
         return valvetrain_fields(spec, doc)
 
     def after_load(self) -> None:
+        self.compile_solver(self.spec)
         quantities = displacement_quantities(self.spec)
         selection = self.quantity_list
         selection.clear_options()
@@ -227,6 +231,15 @@ class ValveTrainScreen(DomainScreen):
         self.query_one("#summary", TextPanel).set_text("no run yet")
         self.query_one("#side-panel", TextPanel).set_text("")
         self.animation.clear()
+
+    @work(thread=True, exclusive=True, exit_on_error=False, group="compile")
+    def compile_solver(self, spec: Any) -> None:
+        """Compile the solver for this preset's contact laws (or load it from numba's cache) while the
+        screen is read, so that the first Run need not wait for it (a Run meanwhile waits for the same
+        compile, its status line saying so)."""
+        from vtool.solvers.newmark.backend import compile_solver
+
+        compile_solver(spec)
 
     # ----- run -----
     def start_run(self, spec: Any, run_id: int) -> Worker[Any]:
@@ -267,10 +280,7 @@ class ValveTrainScreen(DomainScreen):
         self.results = trace
         self.show_trace(trace)
         stats = trace.statistics
-        from vtool.solvers.trace import plain_note
-
-        self.set_status(f"done: {stats.steps} steps{plain_note(stats.plain_steps, stats.steps)}, {stats.events} "
-                        f"events, {stats.wall_time:.2f} s ({stats.backend})")
+        self.set_status(f"done: {stats.steps} steps, {stats.events} events, {stats.wall_time:.2f} s ({stats.backend})")
 
     def show_trace(self, trace: Any) -> None:
         from vtool.app import valvetrain_charts as charts
@@ -331,6 +341,32 @@ class ValveTrainScreen(DomainScreen):
     def write_csv(self, path: str) -> None:
         self.results.write_csv(path)
 
+    def action_save_report(self) -> None:
+        """ctrl+g: the last run's report (what `vtool report` writes), as .pdf or .html."""
+        if self.results is None or self.running:
+            self.notify("run first (ctrl+r): a report needs a finished run", severity="warning")
+            return
+        from pathlib import Path
+
+        from vtool.app.tui.base import path_problem
+        from vtool.app.tui.dialogs import PathDialog
+
+        def save(path: str | None) -> None:
+            if not path:
+                return
+            from vtool.app.report import write_report
+            from vtool.presets.report import report_of_trace
+
+            try:
+                write_report(report_of_trace(self.results), path, "report")
+            except (OSError, ValueError) as exc:  # ValueError: InputError (suffix, folder), a NUL in the path
+                self.app.report_error("Report failed", path_problem(exc, path))  # type: ignore[attr-defined]
+                return
+            self.set_status(f"wrote {path}")
+            self.notify(f"wrote {path}")
+
+        self.app.push_screen(PathDialog("Save report (.pdf or .html) to", f"{Path(self.source).stem}-report.pdf"),
+                             save)
 
 #: this module's screen, named by the kinds table (vtool.presets.kinds.KINDS)
 SCREEN = ValveTrainScreen

@@ -24,6 +24,7 @@ contact problem's (:mod:`vtool.solvers.model.contact`, the kernel's ``impact`` a
 from __future__ import annotations
 
 import math
+import time
 import weakref
 from abc import ABC, abstractmethod
 from typing import Any
@@ -33,12 +34,12 @@ import numpy as np
 from vtool.errors import InputError, RunError
 from vtool.solvers.backends import Backend, Cancel, OptionsT, Progress, RunStats
 from vtool.solvers.exact.statespace import StateSpace, from_layer
-from vtool.solvers.model.contact import ContactProblem, OrderedLayer
+from vtool.solvers.model.contact import ContactProblem, OrderedLayer, event_buffers
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.sources import SourceSeries
 from vtool.solvers.model.spec import HERTZ, MechanismSpec
-from vtool.solvers.newmark import build as kernel_build
 from vtool.solvers.newmark import layout
+from vtool.solvers.newmark.records import Motion, Output, State
 from vtool.solvers.trace import OPENED, TraceBuilder
 
 #: The state spaces of a mechanism's configurations, kept as long as its configuration tables: a
@@ -67,6 +68,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
     n, ncl, ns, K = problem.n, problem.ncl, problem.ns, series.n_harmonics
     nb = 1 + 2 * K
     m, nf, mask = layer.m, layer.nf, layer.mask
+    _, _, _, mk, mon = tables.of(mask)
     ss = from_layer(problem, layer)
     A, B = ss.A, ss.B
     n2 = 2 * nf
@@ -90,7 +92,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
     G, H = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # monitors (kernel.monitor_value)
     GF, HF = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # contact forces (kernel.contact_force)
     for k in range(ncl):
-        kind, ahead, behind = (int(v) for v in tables.mk[mask, k, :layout.MK_M])
+        kind, ahead, behind = (int(v) for v in mk[k, :layout.MK_M])
         if kind in (layout.MK_GAP, layout.MK_OVERLAP):
             sign = 1.0 if kind == layout.MK_GAP else -1.0
             G[k] += sign * Zy[0, ahead]
@@ -102,7 +104,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
                 H[k] -= sign * src[3 * (-1 - behind)]
             H[k, 0] += problem.gap_noise
         if kind in (layout.MK_FORCE, layout.MK_OVERLAP):
-            row = tables.mon[mask, k]
+            row = mon[k]
             for i in range(3):
                 coefficients = row[i * n:i * n + m]
                 GF[k] += coefficients @ Zy[i]
@@ -111,15 +113,15 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
             HF[k, 0] += row[3 * n + 3 * ns]
         if kind == layout.MK_FORCE:
             G[k], H[k] = GF[k], HF[k]
-    ss.compliant = tables.mk[mask, :, layout.MK_KIND] == layout.MK_OVERLAP
+    ss.compliant = mk[:, layout.MK_KIND] == layout.MK_OVERLAP
     hertz = np.flatnonzero(ss.compliant & (problem.cl[:, layout.CL_SOFT] == layout.SOFT_HERTZ))
     ss.hertz = hertz
     if hertz.size:  # F_j acts as F_j w_j: on ÿ through M_FF⁻¹ w_F, on the rigid forces through their rows
         GF[hertz], HF[hertz] = 0.0, 0.0
-        w = -tables.mon[mask][hertz][:, :nf].T  # (nf, nh): the Hertz rows hold -w
+        w = -mon[hertz][:, :nf].T  # (nf, nh): the Hertz rows hold -w
         ss.hertz_rate = np.vstack([np.zeros((nf, hertz.size)), np.linalg.solve(layer.M[:nf, :nf], w)])
         head = 3 * n + 3 * ns + 1
-        ss.hertz_force = tables.mon[mask][:, head + hertz].copy()
+        ss.hertz_force = mon[:, head + hertz].copy()
         ss.hertz_force[hertz, np.arange(hertz.size)] = 1.0
     ss.P, ss.Q, ss.G, ss.H, ss.GF, ss.HF = P, Q, G, H, GF, HF
     return ss
@@ -147,7 +149,7 @@ class PiecewiseRun(ABC):
         self.t_end = spec.run.degrees * math.pi / 180.0 / problem.omega
         self.out_dt = output_interval * math.pi / 180.0 / problem.omega
         self.every_step = every_step
-        self.ip, self.fp = problem.parameters(t_end=self.t_end)
+        self.record = problem.record(*problem.parameters(t_end=self.t_end))
         self.spaces: dict[int, StateSpace] = {}
         # output rows not yet handed to the builder: blocks (t, q3, F, cfg), flushed in time order
         self.rows: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
@@ -161,10 +163,12 @@ class PiecewiseRun(ABC):
         self.last_event = -1.0
         self.monitored = problem.cl[:, layout.CL_MON].astype(bool)
         self.closed_bit = problem.cl[:, layout.CL_BIT]
-        self.ev_f = np.zeros((4 * self.ncl + 4, 2))
-        self.ev_i = np.zeros((4 * self.ncl + 4, 4), dtype=np.int64)
+        self.events = Output(*event_buffers(4 * self.ncl + 4))
         self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
-        self.rules = kernel_build.rules(problem.hertz, problem.momentum)  # compiled, or plain until cached
+        self.fst = np.zeros(layout.F_SIZE)
+        from vtool.solvers.newmark import kernel  # numba: imported by the back ends that call it
+
+        self.rules = kernel
 
     # ----- configuration data -----
     def space(self, mask: int) -> StateSpace:
@@ -213,7 +217,7 @@ class PiecewiseRun(ABC):
         for i, k in enumerate(rows):
             for index in np.ndindex(np.shape(delta)[1:]):
                 at = (i, *index)
-                out[at] = self.rules.hertz_law(self.problem.clf, int(k), float(delta[at]), float(rate[at]))[0]
+                out[at] = self.rules.hertz_force(self.problem.clf, int(k), float(delta[at]), float(rate[at]))[0]
         return out
 
     def track_overlap(self, ss: StateSpace, values: np.ndarray) -> None:
@@ -230,9 +234,7 @@ class PiecewiseRun(ABC):
 
     def sources(self, t: float) -> np.ndarray:
         src = np.zeros(3 * self.problem.ns)
-        series = self.problem.series
-        self.rules.fill_sources(self.problem.ns, self.problem.nh, series.omega, series.const, series.cos,
-                                series.sin, t, src)
+        self.rules.sources(self.record, t, src)
         return src
 
     # ----- output -----
@@ -292,6 +294,18 @@ class PiecewiseRun(ABC):
         """Integrate to the first event or t_stop; return (t, y, the clearances whose monitor crossed zero)."""
 
     def execute(self, progress: Progress | None, cancel: Cancel | None) -> None:
+        """The run; the first one that compiles the event rules marks them compiled, with its time
+        (compile-bound: :func:`vtool.solvers.newmark.backend.compile_notice` quotes it)."""
+        from vtool import jit
+
+        key = jit.law_key(self.problem.hertz, self.problem.momentum)
+        compiled = jit.is_compiled(self.rules.release_pulling, "rules", key)
+        started = time.perf_counter()
+        self.integrate(progress, cancel)
+        if not compiled:
+            jit.compiled("rules", key, time.perf_counter() - started)
+
+    def integrate(self, progress: Progress | None, cancel: Cancel | None) -> None:
         start = self.mechanism.start
         x, v, a = start.q.copy(), start.qd.copy(), start.qdd.copy()
         mask = self.settle(self.problem.start_mask, 0.0, x, v, a)
@@ -311,7 +325,6 @@ class PiecewiseRun(ABC):
                 progress(min(t / self.t_end, 1.0))
             if cancel is not None and cancel():
                 raise RunError(f"cancelled at t = {t:.6g} s")
-        kernel_build.compile_recorded(self.rules)
 
     def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
         """The kernel's settle (release of pulling contacts), building configurations as it asks."""
@@ -319,10 +332,9 @@ class PiecewiseRun(ABC):
         m = problem.n
         while True:
             self.ist[layout.I_NEV] = 0
-            result = int(self.rules.settle(self.ip, self.fp, problem.cl, problem.clf, tables.ci, tables.cm,
-                                           tables.cp, tables.mk, tables.mon, mask, t, x, v, a, self.sources(t),
-                                           self.ev_f, self.ev_i, self.ist, np.zeros(m), np.zeros(m), np.zeros(m),
-                                           np.zeros(m), problem.hertz))
+            result = int(self.rules.release_pulling(
+                self.record, tables.record(), mask, t, State(x, v, a, self.ist, self.fst), self.sources(t),
+                self.events, Motion(np.zeros(m), np.zeros(m), np.zeros(m)), np.zeros(m), problem.hertz))
             self._take_events()
             if result >= 0:
                 return result
@@ -332,7 +344,7 @@ class PiecewiseRun(ABC):
 
     def _take_events(self) -> None:
         nev = int(self.ist[layout.I_NEV])
-        self.builder.add_events(self.ev_f[:nev], self.ev_i[:nev])
+        self.builder.add_events(self.events.ev_f[:nev], self.events.ev_i[:nev])
         self.ist[layout.I_NEV] = 0
 
     def apply_events(self, ss: StateSpace, t: float, y: np.ndarray,
@@ -356,16 +368,16 @@ class PiecewiseRun(ABC):
             if (c & self.closed_bit[k]) and not (new_c & self.closed_bit[k]):
                 u = 0.0
                 if self.problem.cl[k, layout.CL_SOFT]:  # the parts leave with their relative velocity
-                    self.rules.snap_shut(self.problem.cl, k, x, src)
-                    u = float(self.rules.relative_velocity(self.problem.cl, k, v, src))
+                    self.rules.shut_gap(self.problem.cl, k, x, src)
+                    u = float(self.rules.gap_velocity(self.problem.cl, k, v, src))
                 self.builder.add_event(t, k, OPENED, u, c, new_c)
         if closing.any():
             stick = self.rapid >= self.problem.rules.zeno_stick
             problem = self.problem
             self.ist[layout.I_NEV] = 0
-            new_c = int(self.rules.impact(self.ip, self.fp, problem.cl, problem.clf, problem.mass, new_c, closing,
-                                          self.sources(t), x, v, stick, self.ev_f, self.ev_i, self.ist, t,
-                                          problem.momentum))
+            new_c = int(self.rules.apply_impacts(self.record, new_c, closing, self.sources(t),
+                                                 State(x, v, a, self.ist, self.fst), stick, self.events, t,
+                                                 problem.momentum))
             self._take_events()
         new_c = self.settle(new_c, t, x, v, a)
         return new_c, x, v, a
@@ -391,7 +403,7 @@ class PiecewiseBackend(Backend[OptionsT]):
 
     @classmethod
     def compile_notice(cls, spec: MechanismSpec, impacts: tuple[str, ...] = ()) -> str | None:
-        """The event rules' compile (``impact``, ``settle``, ``fill_sources``), called from Python."""
+        """The event rules' compile (``apply_impacts``, ``release_pulling``, ``sources``, ...), called from Python."""
         from vtool.solvers.newmark.backend import compile_notice, kernel_laws
 
         return compile_notice(cls.name, kernel_laws(spec, impacts))

@@ -16,7 +16,7 @@ reads:
   standard and refined steps.
 
 The event rules (located sign changes, earliest first; impact laws;
-:func:`~vtool.solvers.newmark.kernel.settle` after every transition; sticking
+:func:`~vtool.solvers.newmark.kernel.release_pulling` after every transition; sticking
 and stopping of chattering contacts) are the kernel's functions, called by
 every back end: a back end only integrates between events.
 
@@ -59,6 +59,7 @@ from vtool.solvers.model.spec import (
     THESIS,
 )
 from vtool.solvers.newmark import layout
+from vtool.solvers.newmark.records import Motion, Output, Problem, State, Tables, mask_hash
 from vtool.solvers.trace import EVENT_KINDS, OPENED, TraceBuilder
 
 LAW_CODES = {MOMENTUM: layout.LAW_MOMENTUM, LOCAL: layout.LAW_LOCAL, THESIS: layout.LAW_THESIS}
@@ -111,21 +112,78 @@ class OrderedLayer:
 
 
 class ConfigurationTables:
-    """Per-configuration arrays for the kernel, filled lazily by :meth:`build` (speed-independent)."""
+    """Per-configuration arrays for the kernel, filled lazily by :meth:`build` (speed-independent).
+
+    Storage grows with the configurations a run visits, not with the 2^ncl a
+    mechanism could reach: each built configuration has a slot (row) of the
+    arrays ``ci``, ``cm``, ``cp``, ``mk``, ``mon``, given by :attr:`slots` (mask ->
+    slot) and, for the kernel, by the open-addressing map ``index``
+    (:class:`vtool.solvers.newmark.records.Tables`). Both double when full; the
+    kernel's record is then made again (:meth:`record`).
+    """
 
     def __init__(self, mechanism: Mechanism) -> None:
         spec = mechanism.spec
         self.mechanism = mechanism
         n, ncl, ns = spec.n_coordinates, len(spec.clearances), len(sources(spec))
         self.n, self.ncl, self.ns = n, ncl, ns
-        count = 2**ncl
-        self.ci = np.zeros((count, layout.CI_HEAD + 3 * n), dtype=np.int64)
-        self.cm = np.zeros((count, layout.CM_SIZE, n, n))
-        self.cp = np.zeros((count, layout.CP_SIZE, layout.PART_SIZE, 3 * max(n, ns), n + ncl))  # layout.CP_RAW
-        self.mk = np.zeros((count, ncl, layout.MK_SIZE), dtype=np.int64)
-        self.mon = np.zeros((count, ncl, 3 * n + 3 * ns + 1 + ncl))
+        self.slots: dict[int, int] = {}
+        self.index = np.full((8, 2), -1, dtype=np.int64)
+        self._allocate(4)
         self.layers: dict[int, OrderedLayer] = {}
         self.step: tuple[float, float, float, float] | None = None  # (dt, beta, gamma, fine) of the inverses
+        self._record: Tables | None = None
+
+    def _allocate(self, count: int) -> None:
+        """Room for ``count`` configurations; the built ones are kept."""
+        n, ncl, ns = self.n, self.ncl, self.ns
+        shapes = {"ci": ((layout.CI_HEAD + 3 * n,), np.int64), "cm": ((layout.CM_SIZE, n, n), float),
+                  "cp": ((layout.CP_SIZE, layout.PART_SIZE, 3 * max(n, ns), n + ncl), float),  # layout.CP_RAW
+                  "mk": ((ncl, layout.MK_SIZE), np.int64), "mon": ((ncl, 3 * n + 3 * ns + 1 + ncl), float)}
+        for name, (shape, dtype) in shapes.items():
+            grown = np.zeros((count, *shape), dtype=dtype)
+            if hasattr(self, name):
+                old = getattr(self, name)
+                grown[:old.shape[0]] = old
+            setattr(self, name, grown)
+        self._record = None
+
+    def _slot(self, mask: int) -> int:
+        """A new slot for configuration ``mask`` (the arrays grown as needed); the kernel finds it once
+        it is filled (:meth:`_publish`)."""
+        slot = len(self.slots)
+        if slot >= self.ci.shape[0]:
+            self._allocate(2 * self.ci.shape[0])
+        self.slots[mask] = slot
+        return slot
+
+    def _publish(self, mask: int) -> None:
+        """Configuration ``mask`` into the kernel's index (grown to stay at most half full)."""
+        if 2 * len(self.layers) > self.index.shape[0]:
+            self.index = np.full((2 * self.index.shape[0], 2), -1, dtype=np.int64)
+            for known in self.layers:
+                self._insert(known, self.slots[known])
+        else:
+            self._insert(mask, self.slots[mask])
+        self._record = None
+
+    def _insert(self, mask: int, slot: int) -> None:
+        capacity = self.index.shape[0]
+        h = mask_hash(mask, capacity)
+        while self.index[h, 0] >= 0:
+            h = (h + 1) & (capacity - 1)
+        self.index[h] = (mask, slot)
+
+    def record(self) -> Tables:
+        """The kernel's record of these tables (the arrays as they are now)."""
+        if self._record is None:
+            self._record = Tables(self.index, self.ci, self.cm, self.cp, self.mk, self.mon)
+        return self._record
+
+    def of(self, mask: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Built configuration ``mask``'s rows (ci, cm, cp, mk, mon)."""
+        slot = self.slots[mask]
+        return self.ci[slot], self.cm[slot], self.cp[slot], self.mk[slot], self.mon[slot]
 
     def use_step(self, dt: float, beta: float, gamma: float, fine: float) -> None:
         """Make the stored effective inverses those of this step (rebuilt for every built configuration)."""
@@ -140,9 +198,8 @@ class ConfigurationTables:
         if self.step is None:
             return
         dt, beta, gamma, fine = self.step
-        nf = int(self.ci[mask, layout.CI_NF])
-        cm = self.cm[mask]
-        cp = self.cp[mask]  # G = S⁻¹R, part by part, stored transposed as R is (see layout.CP_RAW)
+        ci, cm, cp, _, _ = self.of(mask)
+        nf = int(ci[layout.CI_NF])  # G = S⁻¹R, part by part, stored transposed as R is (see layout.CP_RAW)
         if nf:
             M, C, K = cm[layout.CM_MFF, :nf, :nf], cm[layout.CM_CFF, :nf, :nf], cm[layout.CM_KFF, :nf, :nf]
             cm[layout.CM_SINV, :nf, :nf] = np.linalg.inv(M + gamma * dt * C + beta * dt * dt * K)
@@ -170,17 +227,17 @@ class ConfigurationTables:
         :func:`vtool.solvers.newmark.kernel.contact_force` of the step's end, up to round-off.
         """
         n, ns = self.n, self.ns
-        ci, cp = self.ci[mask], self.cp[mask]
+        ci, _, cp, mk, mon = self.of(mask)
         nf, m = int(ci[layout.CI_NF]), int(ci[layout.CI_M])
         np_ = m - nf
         reads_sources = bool(ci[layout.CI_SRC])
         for plane, h in planes:
             bx, gv = beta * h * h, gamma * h
             for k in range(self.ncl):
-                row = int(self.mk[mask, k, layout.MK_ROW])
-                if self.mk[mask, k, layout.MK_KIND] != layout.MK_FORCE or row < 0:
+                row = int(mk[k, layout.MK_ROW])
+                if mk[k, layout.MK_KIND] != layout.MK_FORCE or row < 0:
                     continue
-                w = self.mon[mask, k]
+                w = mon[k]
                 wz, wzd, wzdd, ws = w[:n], w[n:2 * n], w[2 * n:3 * n], w[3 * n:3 * n + 3 * ns]
                 u = bx * wz[:nf] + gv * wzd[:nf] + wzdd[:nf]
                 d = np.zeros(cp.shape[1:3])
@@ -199,6 +256,11 @@ class ConfigurationTables:
                         cp[plane, layout.PART_S, 3 * s + q, row] = 0.0
                 reads_sources = reads_sources or bool(np.any(cp[plane, layout.PART_S, :, row]))
         ci[layout.CI_SRCSTEP] = int(reads_sources)
+
+    def of_new(self, mask: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """A new slot's rows for configuration ``mask`` (see :meth:`of`)."""
+        self._slot(mask)
+        return self.of(mask)
 
     def build(self, mask: int) -> OrderedLayer:
         """Partition configuration ``mask`` and fill its rows (see the module doc)."""
@@ -220,20 +282,19 @@ class ConfigurationTables:
         C_o = (part.C + springs.layer_C(layer.T))[ix]
         K_o = (layer.K + springs.layer_K(layer.T))[ix]
         S_o = (layer.T.T @ springs.S)[order]
-        ci = self.ci[mask]
+        ci, cm, raw, _, _ = self.of(mask) if mask in self.slots else self.of_new(mask)
+        raw = raw[layout.CP_RAW]  # Rᵀ: see layout.CP_RAW
         ci[layout.CI_M], ci[layout.CI_NF] = m, nf
         ci[layout.CI_ROWS] = nf  # and one more per closed rigid clearance (_monitors)
         head = layout.CI_HEAD
         ci[head:head + m] = kept
         ci[head + n:head + 2 * n] = group
         ci[head + 2 * n + nf:head + 2 * n + m] = source
-        cm = self.cm[mask]
         cm[layout.CM_MFF, :nf, :nf] = M_o[:nf, :nf]
         cm[layout.CM_CFF, :nf, :nf] = C_o[:nf, :nf]
         cm[layout.CM_KFF, :nf, :nf] = K_o[:nf, :nf]
         if nf:
             cm[layout.CM_MINVFF, :nf, :nf] = np.linalg.inv(M_o[:nf, :nf])
-        raw = self.cp[mask, layout.CP_RAW]  # Rᵀ: see layout.CP_RAW
         raw[layout.PART_C, :nf, :nf] = C_o[:nf, :nf].T
         raw[layout.PART_K, :nf, :nf] = K_o[:nf, :nf].T
         raw[layout.PART_P, 0:3 * (m - nf):3, :nf] = M_o[:nf, nf:].T
@@ -247,7 +308,7 @@ class ConfigurationTables:
         ordered = OrderedLayer(mask, M_o, C_o, K_o, nf, kept, group, source, S_o)
         self.layers[mask] = ordered
         self._inverses(mask)
-        ci[layout.CI_BUILT] = 1
+        self._publish(mask)
         return ordered
 
     def _monitors(self, mask: int, part, group: np.ndarray, m: int, springs) -> None:  # type: ignore[no-untyped-def]
@@ -263,8 +324,9 @@ class ConfigurationTables:
         MT = mechanism.M @ layer.T
         row_x, row_v, row_a = mechanism.K @ layer.T, MT @ np.linalg.solve(layer.M, part.C), MT
         source_of = {number: s for s, (number, _, _) in enumerate(sources(spec))}
+        ci, _, _, mk_all, mon_all = self.of(mask)
         for index, c in enumerate(spec.clearances):
-            mk, mon = self.mk[mask, index], self.mon[mask, index]
+            mk, mon = mk_all[index], mon_all[index]
             behind = int(group[c.behind - 1]) if c.kind == INTERNAL else -1 - source_of[c.behind]
             if mask & clearance_bit(spec, index):
                 frow = np.zeros(3 * n + 3 * ns)
@@ -296,11 +358,17 @@ class ConfigurationTables:
                 kind = layout.MK_FORCE if c.rigid else layout.MK_OVERLAP
                 row = -1
                 if c.rigid:  # its row in the step operators (see layout.CP_RAW), after the free rows
-                    row = int(self.ci[mask, layout.CI_ROWS])
-                    self.ci[mask, layout.CI_ROWS] = row + 1
+                    row = int(ci[layout.CI_ROWS])
+                    ci[layout.CI_ROWS] = row + 1
                 mk[:] = (kind, int(group[c.ahead - 1]), behind, m, row)
             elif c.state == ENABLED:
                 mk[:] = (layout.MK_GAP, int(group[c.ahead - 1]), behind, m, -1)
+
+
+def event_buffers(rows: int) -> tuple[np.ndarray, ...]:
+    """Output buffers for events only (a kernel Output record's fields; no rows, no peaks)."""
+    return (np.zeros(0), np.zeros((3, 0, 0)), np.zeros((0, 0)), np.zeros(0, dtype=np.int64),
+            np.zeros((rows, 2)), np.zeros((rows, 4), dtype=np.int64), np.zeros((3, 0)))
 
 
 @dataclass(frozen=True)
@@ -415,15 +483,20 @@ class ContactProblem:
     def build(self, mask: int) -> OrderedLayer:
         return self.tables.build(mask)
 
+    def record(self, ip: np.ndarray | None = None, fp: np.ndarray | None = None) -> Problem:
+        """The kernel's record of this problem with parameter vectors ``ip``, ``fp`` (default
+        :meth:`parameters`' defaults)."""
+        if ip is None or fp is None:
+            ip, fp = self.parameters()
+        s = self.series
+        return Problem(ip, fp, self.cl, self.clf, s.const, s.cos, s.sin, self.mass)
+
     def sources_at(self, t: float) -> np.ndarray:
         """(x, v, a) of every source at t, as the kernel's src vector."""
-        src = np.zeros(3 * self.ns)
-        from vtool.solvers.newmark import (
-            kernel,  # numba: only the back ends that call it load it (lazy)
-        )
+        from vtool.solvers.newmark import kernel  # numba: only the back ends that call it load it
 
-        s = self.series
-        kernel.fill_sources(self.ns, self.nh, s.omega, s.const, s.cos, s.sin, t, src)
+        src = np.zeros(3 * self.ns)
+        kernel.sources(self.record(), t, src)
         return src
 
     def impact(self, mask: int, closing: list[int], t: float, x: np.ndarray, v: np.ndarray,
@@ -435,18 +508,17 @@ class ContactProblem:
         back ends call.
         """
         from vtool.solvers.newmark import kernel
+        from vtool.solvers.newmark.records import Output
 
         flags = np.zeros(self.ncl, dtype=np.int64)
         flags[list(closing)] = 1  # the indices of the closing clearances
-        ip, fp = self.parameters()
-        ev_f = np.zeros((4 * self.ncl + 4, 2))
-        ev_i = np.zeros((4 * self.ncl + 4, 4), dtype=np.int64)
-        ist = np.zeros(layout.I_SIZE, dtype=np.int64)
-        new = int(kernel.impact(ip, fp, self.cl, self.clf, self.mass, mask, flags, self.sources_at(t), x, v,
-                                stick, ev_f, ev_i, ist, t, self.momentum))
-        events = [(int(ev_i[r, 0]), EVENT_KINDS[int(ev_i[r, 1])], float(ev_f[r, 1]), int(ev_i[r, 2]),
-                   int(ev_i[r, 3])) for r in range(int(ist[layout.I_NEV]))]
-        return new, events
+        events = Output(*event_buffers(4 * self.ncl + 4))
+        state = State(x, v, np.zeros_like(x), np.zeros(layout.I_SIZE, dtype=np.int64), np.zeros(layout.F_SIZE))
+        new = int(kernel.apply_impacts(self.record(), mask, flags, self.sources_at(t), state, stick, events, t,
+                                       self.momentum))
+        ev_f, ev_i = events.ev_f, events.ev_i
+        return new, [(int(ev_i[r, 0]), EVENT_KINDS[int(ev_i[r, 1])], float(ev_f[r, 1]), int(ev_i[r, 2]),
+                      int(ev_i[r, 3])) for r in range(int(state.ist[layout.I_NEV]))]
 
     # ----- the Python-level contract a back end integrates against (vtool.solvers.backends, point 4) -----
     # Rigid and linear contacts: a Hertz contact's force is the kernel's hertz_law (the Newmark and
@@ -492,7 +564,7 @@ class ContactProblem:
         z, zd, zdd, src = self.layer_vectors(mask, t, x, v, a)
         values = np.full(self.ncl, np.nan)
         forces = self.contact_forces(mask, t, x, v, a)
-        for k, (kind, ahead, behind) in enumerate(self.tables.mk[mask, :, :layout.MK_M]):
+        for k, (kind, ahead, behind) in enumerate(self.tables.of(mask)[3][:, :layout.MK_M]):
             if kind in (layout.MK_GAP, layout.MK_OVERLAP):
                 other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
                 values[k] = (1.0 if kind == layout.MK_GAP else -1.0) * (z[ahead] - other) + self.gap_noise
@@ -505,9 +577,10 @@ class ContactProblem:
         z, zd, zdd, src = self.layer_vectors(mask, t, x, v, a)
         n, ns, m = self.n, self.ns, len(z)
         forces = np.zeros(self.ncl)
-        for k, kind in enumerate(self.tables.mk[mask, :, layout.MK_KIND]):
+        _, _, _, mk, mon = self.tables.of(mask)
+        for k, kind in enumerate(mk[:, layout.MK_KIND]):
             if kind in (layout.MK_FORCE, layout.MK_OVERLAP):
-                row = self.tables.mon[mask, k]
+                row = mon[k]
                 forces[k] = (row[:m] @ z + row[n:n + m] @ zd + row[2 * n:2 * n + m] @ zdd
                              + row[3 * n:3 * n + 3 * ns] @ src + row[3 * n + 3 * ns])
         return forces
@@ -545,15 +618,16 @@ class Transitions:
 
     def __init__(self, problem: ContactProblem, builder: TraceBuilder) -> None:
         from vtool.solvers.newmark import (
-            build as kernel_build,  # the compiled rules, or plain until cached
+            kernel,  # the compiled rules (numba: imported by those who call them)
         )
 
         self.problem, self.builder = problem, builder
-        self.rules = kernel_build.rules(problem.hertz, problem.momentum)
-        self.ip, self.fp = problem.parameters()
-        ncl = problem.ncl
-        self.ev_f, self.ev_i = np.zeros((4 * ncl + 4, 2)), np.zeros((4 * ncl + 4, 4), dtype=np.int64)
+        self.rules = kernel
+        self.record = problem.record()
+        self.events = Output(*event_buffers(4 * problem.ncl + 4))
+        self.ev_f, self.ev_i = self.events.ev_f, self.events.ev_i
         self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
+        self.fst = np.zeros(layout.F_SIZE)
         self.rapid, self.last_event = 0, -math.inf
 
     def start(self) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
@@ -568,10 +642,9 @@ class Transitions:
         problem, tables, m = self.problem, self.problem.tables, self.problem.n
         while True:
             self.ist[layout.I_NEV] = 0
-            result = int(self.rules.settle(self.ip, self.fp, problem.cl, problem.clf, tables.ci, tables.cm,
-                                           tables.cp, tables.mk, tables.mon, mask, t, x, v, a,
-                                           problem.sources_at(t), self.ev_f, self.ev_i, self.ist, np.zeros(m),
-                                           np.zeros(m), np.zeros(m), np.zeros(m), problem.hertz))
+            result = int(self.rules.release_pulling(
+                self.record, tables.record(), mask, t, State(x, v, a, self.ist, self.fst), problem.sources_at(t),
+                self.events, Motion(np.zeros(m), np.zeros(m), np.zeros(m)), np.zeros(m), problem.hertz))
             self.take_events()
             if result >= 0:
                 return result
@@ -605,14 +678,15 @@ class Transitions:
             if (mask & bits[k]) and not (new & bits[k]):
                 u = 0.0
                 if problem.cl[k, layout.CL_SOFT]:  # a linear contact's parts leave with their relative velocity
-                    self.rules.snap_shut(problem.cl, k, x, src)
-                    u = float(self.rules.relative_velocity(problem.cl, k, v, src))
+                    self.rules.shut_gap(problem.cl, k, x, src)
+                    u = float(self.rules.gap_velocity(problem.cl, k, v, src))
                 self.builder.add_event(t, k, OPENED, u, mask, new)
         if closing.any():
             self.ist[layout.I_NEV] = 0
-            new = int(self.rules.impact(self.ip, self.fp, problem.cl, problem.clf, problem.mass, new, closing, src,
-                                        x, v, self.rapid >= problem.rules.zeno_stick, self.ev_f, self.ev_i, self.ist,
-                                        t, problem.momentum))
+            state = State(x, v, np.zeros_like(x), self.ist, self.fst)
+            new = int(self.rules.apply_impacts(self.record, new, closing, src, state,
+                                               self.rapid >= problem.rules.zeno_stick, self.events, t,
+                                               problem.momentum))
             self.take_events()
         a = problem.accelerations(new, t, x, v)
         new = self.settle(new, t, x, v, a)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from vtool.solvers.model.spring import SpringSpec
 from vtool.solvers.model.units import UNIT_SYSTEMS, UnitSystem
 from vtool.units import cam_speed
 
@@ -393,6 +394,8 @@ class MechanismSpec:
     contact: ContactSpec = field(default_factory=ContactSpec)
     follower: FollowerSpec | None = None  # cam shape and contact stress (presets' [follower] table)
     checks: tuple[CheckLimit, ...] = ()  # limits signed off (presets' [checks] table)
+    #: valve springs' data sheets (presets' [[springs]]; a train's data-sheet spring): stress, fatigue, coil bind
+    springs: tuple[SpringSpec, ...] = ()
     #: JSON text of the preset's [train] table when it was entered by train type (provenance: a saved copy
     #: keeps the type's parameters while the model is still what they expand to; see presets/trains.py)
     train: str = field(default="", compare=False)
@@ -422,12 +425,3 @@ class MechanismSpec:
             if c.name == name:
                 return c
         raise KeyError(name)
-
-    def coordinate_name(self, number: int) -> str:
-        if 1 <= number <= self.n_coordinates:
-            return self.coordinates[number - 1].name
-        if number == self.cam.coordinate:
-            return self.cam.name
-        if self.seat is not None and number == self.seat.coordinate:
-            return self.seat.name
-        raise KeyError(number)

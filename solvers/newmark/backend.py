@@ -22,10 +22,10 @@ Method (see the kernel's docstring for the equations):
   starts at zero (a contact just released) has a round-off sign, so a gap
   closes when it falls below -1e-13 of the mechanism's size.
 * Impacts: the clearance's impact law (``local``, ``thesis``, ``momentum``;
-  see :func:`vtool.solvers.newmark.kernel.impact`) with Newton's restitution
+  see :func:`vtool.solvers.newmark.kernel.apply_impacts`) with Newton's restitution
   coefficient. After every transition the contact forces of the new
   configuration are evaluated and any contact that would pull is released
-  at once (:func:`vtool.solvers.newmark.kernel.settle`). Separations and
+  at once (:func:`vtool.solvers.newmark.kernel.release_pulling`). Separations and
   bounces slower than ``rest_velocity`` (default 1e-5 of the cam amplitude
   times the larger of the cam speed and the lowest natural frequency) are
   resting contacts that stay closed until their contact force says
@@ -44,23 +44,10 @@ Method (see the kernel's docstring for the equations):
   after the impact) came out as an extra separation; with four, all six
   thesis presets give the exact back end's event sequence (the accuracy
   tables give the figures). ``refine = 1`` is the plain thesis scheme.
-* First run: when numba's cache has no compiled kernel for this mechanism's
-  contact laws (a new install, or the first Hertz or momentum-law run), the
-  run does not wait for the compile. A child process compiles the kernel
-  into the cache (:mod:`vtool.solvers.newmark.build`) while the run starts at
-  once in the kernel's own source run as plain Python
-  (:func:`~vtool.solvers.newmark.build.plain_kernel`); between chunks the
-  run looks in the cache and, once the kernel is there,
-  loads it and goes on compiled (should the child end without it, the run
-  compiles the kernel itself). Both execute the same source, and their
-  results agree to the last bit on every thesis preset (a test compares
-  them to the reference tolerances). ``VTOOL_KERNEL`` chooses otherwise:
-  ``compiled`` compiles first, in this process (benchmarks, and the tests,
-  which need the compiled kernel), ``plain`` never compiles.
-* Native module: after that compile the child also builds ``run_chunk`` as
-  a native extension module (:mod:`vtool.solvers.newmark.native`); a later
-  ``auto`` run that finds the module for its argument types calls it and
-  imports no numba (one that finds only numba's cache starts the build).
+* First run: the kernel is compiled by numba on the first call and kept in
+  numba's cache (:mod:`vtool.numba_cache`); :func:`compile_notice` gives the
+  line to show before it, and :class:`KernelRun` times it and marks it done
+  (:mod:`vtool.jit`).
 * Stability: for gamma = 1/2 and beta < 1/4 the step must satisfy
   omega_max dt <= 1 / sqrt(gamma/2 - beta) (2 sqrt 3 for linear acceleration:
   dt <= sqrt(3)/pi T_min), with omega_max the highest natural frequency of
@@ -73,13 +60,10 @@ import dataclasses
 import math
 import time as wallclock
 from dataclasses import dataclass
-from functools import cached_property
-from types import ModuleType
 from typing import Any
 
 import numpy as np
 
-from vtool import compile_estimate, numba_cache
 from vtool.errors import InputError, RunError
 from vtool.solvers.backends import (
     AccuracyKnobs,
@@ -100,20 +84,10 @@ from vtool.solvers.model.spec import (
     MechanismSpec,
     RunSpec,
 )
-from vtool.solvers.newmark import build as kernel_build
 from vtool.solvers.newmark import layout
-from vtool.solvers.newmark import native as kernel_native
+from vtool.solvers.newmark.records import Output, State, scratch
 from vtool.solvers.trace import TraceBuilder
 
-#: first compiles on the reference machine of :mod:`vtool.compile_estimate` (s), which scales them to the
-#: machine at hand for the notice (``python3 benchmarks/bench_compile_estimate.py`` measures them): the kernel
-#: in the run's own process (two processes compile: n = 2) ...
-COMPILE_REFERENCE_S = 2.8
-#: ... in a child beside a first run in plain Python, until it is in numba's cache (the run is a third
-#: process while it lasts: n = 3; the child's own start-up is in it) ...
-BACKGROUND_REFERENCE_S = 2.7
-#: ... and the event rules alone (impact, settle, fill_sources: the piecewise back ends; n = 1)
-RULES_REFERENCE_S = 1.6
 ROW_BUFFER = 4096  # output rows between flushes at most: memory stays bounded for any run length
 EVENT_BUFFER = 1024  # events between flushes
 
@@ -163,33 +137,39 @@ def kernel_laws(spec: Any, impacts: tuple[str, ...] = ()) -> tuple[bool | None, 
 
 
 def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | None] = (None, None)) -> str | None:
-    """The line to show before a run that must first compile the kernel, or None when it is cached.
+    """The line to show before a run that must first compile the solver, or None when it is compiled.
 
     The newmark back end runs ``run_chunk``; the piecewise back ends call the
-    event rules (``impact``, ``settle``, ``fill_sources``) from Python. ``laws``:
-    see :func:`kernel_laws` (a kernel is compiled and cached per switch pair).
-    In the default ``auto`` mode no run waits for the compile: a newmark run
-    says so; a piecewise run calls the event rules as plain Python, a few
-    milliseconds more, and says nothing (:mod:`vtool.solvers.newmark.build`).
+    event rules (:data:`RULES`) from Python. ``laws``: see :func:`kernel_laws`
+    (a kernel is compiled and cached per switch pair). Imports numba.
     """
-    names = ("run_chunk",) if backend == "newmark" else ("impact", "settle", "fill_sources")
-    mode = kernel_build.kernel_mode()
-    if mode == "auto" and backend == "newmark" and kernel_native.exists(laws):
-        return None  # (asked before numba is imported: a run on the native module imports none)
-    if not kernel_build.jit_enabled() or kernel_build.kernel().is_cached(names, *laws):
+    from vtool import jit
+    from vtool.solvers.newmark import kernel
+
+    name = "run_chunk" if backend == "newmark" else "rules"
+    if jit.is_compiled(kernel.run_chunk if backend == "newmark" else kernel.release_pulling, name,
+                       jit.law_key(*laws)):
         return None
-    if mode == "plain":
-        return None
-    if mode == "auto" and numba_cache.CACHE_ENABLED:
-        if backend != "newmark":
-            return None
-        return (f"compiling the solver for these contact laws in the background, once (about "
-                f"{compile_estimate.about(BACKGROUND_REFERENCE_S, 3)} s); this run starts now in plain Python "
-                "and moves to the compiled solver when it is ready")
-    estimate = (compile_estimate.about(COMPILE_REFERENCE_S, 2) if backend == "newmark"
-                else compile_estimate.about(RULES_REFERENCE_S, 1))
-    return (f"compiling the solver for these contact laws, once (about {estimate} s); "
-            "later runs load it from the cache")
+    return jit.compile_notice("the solver" if backend == "newmark" else "the event rules", name)
+
+
+def compile_solver(spec: Any) -> None:
+    """Compile the kernel for valve-train ``spec``'s contact laws, or load it from numba's cache: a run
+    of ten time steps (the TUI starts it when a preset opens). Nothing when its back end is not newmark
+    or its settings are refused (the real run says why)."""
+    import dataclasses
+
+    from vtool.solvers.model.mechanism import assemble
+
+    if spec.run.backend != "newmark":
+        return
+    run = spec.run
+    short = dataclasses.replace(spec, run=dataclasses.replace(run, degrees=10.0 * run.time_step * 6.0 * run.rpm))
+    backend = NewmarkBackend()
+    try:
+        backend.simulate(assemble(short), backend.options_from_run(short.run))
+    except (InputError, RunError):
+        return
 
 
 def stability_limit(beta: float, gamma: float, omega_max: float) -> float:
@@ -273,30 +253,13 @@ class NewmarkBackend(Backend[NewmarkOptions]):
         o = options
         return RunStats(int(run.ist[layout.I_STEPS]), run.peak[layout.PEAK_ALL].copy(),
                         run.peak[layout.PEAK_LATE].copy(), run.peak[layout.PEAK_OVERLAP].copy(),
-                        compile_time=run.compile_time, plain_steps=run.plain_steps, kernel=run.kernel,
+                        compile_time=run.compile_time,
                         settings={"time_step_s": o.time_step, "beta": o.beta, "gamma": o.gamma,
                                   "refine_after_events": o.refine})
 
 
-def kernel_kind(module: ModuleType) -> str:
-    """What a kernel module is: "native" (:mod:`vtool.solvers.newmark.native`'s extension module), "numba"
-    (numba's compiled kernel) or "plain" (the source as plain Python: a first run before the compile, or
-    ``VTOOL_KERNEL=plain``, or ``NUMBA_DISABLE_JIT``)."""
-    if module.__name__.startswith(kernel_native.PREFIX):
-        return "native"
-    return "numba" if hasattr(module.run_chunk, "py_func") else "plain"
-
-
-#: Native modules whose build this process found failed, or could not start: each warm run on numba's
-#: kernel asked again (the build's lock file named and its failure note looked for: 0.25 ms a run).
-_no_native_build: set[str] = set()
-#: The argument types ``run_chunk`` is compiled or loaded for in this process, by their objects' ids: a
-#: warm run's check without hashing them (numba hashes its 32 types in about 25 µs, a hundredth of a run).
-_compiled_for: dict[tuple[int, ...], tuple[Any, ...]] = {}
-
-
 class KernelRun:
-    """The kernel's buffers and state for one run, and its chunked calls."""
+    """The kernel's records for one run, and its chunked calls."""
 
     def __init__(self, problem: ContactProblem, options: NewmarkOptions, builder: TraceBuilder) -> None:
         self.problem = problem
@@ -309,145 +272,65 @@ class KernelRun:
         fine = dt / options.refine
         problem.tables.use_step(dt, options.beta, options.gamma, fine)
         out_dt = options.output_interval * math.pi / 180.0 / problem.omega
-        self.ip, self.fp = problem.parameters(
+        ip, fp = problem.parameters(
             dt=dt, beta=options.beta, gamma=options.gamma, t_end=self.t_end,
             out_dt=out_dt, every_step=options.every_step,
             time_tol=options.time_tolerance or 1e-6 * dt, refine=float(options.refine),
             refine_window=options.refine_periods * 2 * math.pi / problem.omega_max)
+        self.record = problem.record(ip, fp)
         n, ncl, ns = problem.n, problem.ncl, problem.ns
         rows = row_buffer(self.t_end, out_dt, options.every_step)
-        # uninitialised: the kernel fills a row (an event) whole before flush reads it, and reads no other
-        self.out_t = np.empty(rows)
+        # uninitialised: the kernel fills a row (an event) whole before flush reads it, and reads no other.
         # (x, v, a) planes, each rows x (n + ns): a plane's filled rows are the trace's q, q̇ or q̈ as they
         # are (contiguous), with no copy at the end of a run (see flush)
-        self.out_q = np.empty((3, rows, n + ns))
-        self.out_F = np.empty((rows, ncl))
-        self.out_c = np.empty(rows, dtype=np.int64)
-        self.ev_f = np.empty((EVENT_BUFFER, 2))
-        self.ev_i = np.empty((EVENT_BUFFER, 4), dtype=np.int64)
-        self.peak = np.zeros((3, ncl))
+        self.out = Output(np.empty(rows), np.empty((3, rows, n + ns)), np.empty((rows, ncl)),
+                          np.empty(rows, dtype=np.int64), np.empty((EVENT_BUFFER, 2)),
+                          np.empty((EVENT_BUFFER, 4), dtype=np.int64), np.zeros((3, ncl)))
         start = mechanism.start
-        self.x, self.v, self.a = start.q.copy(), start.qd.copy(), start.qdd.copy()
-        self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
+        self.state = State(start.q.copy(), start.qd.copy(), start.qdd.copy(), np.zeros(layout.I_SIZE, dtype=np.int64),
+                           np.zeros(layout.F_SIZE))
+        self.ist, self.fst, self.peak = self.state.ist, self.state.fst, self.out.peak
         self.ist[layout.I_CFG] = problem.start_mask
         self.ist[layout.I_NEED_SETTLE] = 1
-        self.fst = np.zeros(layout.F_SIZE)
         self.fst[layout.F_LAST_EVENT] = -1.0
-        # run_chunk's scratch (it zeroes them at each call)
-        self.work = np.zeros(layout.WORK_PER_N * n + layout.WORK_PER_SOURCE * ns + layout.WORK_PER_CLEARANCE * ncl)
-        self.L = np.zeros((n, n))
-        self.closing = np.zeros(ncl, dtype=np.int64)
+        self.scratch = scratch(n, ns, ncl)  # (zeroed by the kernel at each call)
         self.compile_time = 0.0
-        self.plain_steps = 0  # steps taken by the plain-Python kernel (before the compiled one was ready)
-        self.kernel = ""  # what took the last chunk: "native" (module), "numba" or "plain" (see kernel_kind)
 
     def flush(self, final: bool = False) -> None:
         """Move the filled rows and events out of the kernel's buffers. ``final``: the run is over and
-        the kernel writes no more rows, so the trace may keep the buffers themselves rather than copies
-        (in a process on the native module each copy took fresh memory, which the machine faulted in
-        page by page: 68 page faults a warm 1A run, none now; ``benchmarks/bench_page_faults.py``)."""
+        the kernel writes no more rows, so the trace may keep the buffers themselves rather than copies."""
+        out = self.out
         nout = int(self.ist[layout.I_NOUT])
-        nev = int(min(self.ist[layout.I_NEV], self.ev_f.shape[0]))
-        self.builder.add_rows(self.out_t[:nout], self.out_q[:, :nout].transpose(1, 0, 2), self.out_F[:nout],
-                              self.out_c[:nout], copy=not final)
-        self.builder.add_events(self.ev_f[:nev], self.ev_i[:nev])
+        nev = int(min(self.ist[layout.I_NEV], out.ev_f.shape[0]))
+        self.builder.add_rows(out.t[:nout], out.q[:, :nout].transpose(1, 0, 2), out.F[:nout], out.c[:nout],
+                              copy=not final)
+        self.builder.add_events(out.ev_f[:nev], out.ev_i[:nev])
         self.ist[layout.I_NOUT] = 0
         self.ist[layout.I_NEV] = 0
 
-    @cached_property
-    def _arguments(self) -> tuple:
-        problem, tables = self.problem, self.problem.tables
-        return (self.ip, self.fp, problem.cl, problem.clf, problem.series.const, problem.series.cos,
-                problem.series.sin, problem.mass, tables.ci, tables.cm, tables.cp, tables.mk, tables.mon,
-                self.out_t, self.out_q, self.out_F, self.out_c, self.ev_f, self.ev_i, self.peak,
-                self.x, self.v, self.a, self.ist, self.fst, self.work, self.L, self.closing, problem.hertz,
+    def chunk(self) -> int:
+        """One call of the kernel (the first one timed as the compile when the kernel was not compiled)."""
+        from vtool import jit
+        from vtool.solvers.newmark import kernel
+
+        problem = self.problem
+        args = (self.record, problem.tables.record(), self.scratch, self.state, self.out, problem.hertz,
                 problem.momentum)
-
-    def arguments(self) -> tuple:
-        """``run_chunk``'s arguments: arrays made once for the run (the kernel writes into them), so the
-        tuple is made once too."""
-        return self._arguments
-
-    @cached_property
-    def signature(self) -> tuple[Any, ...]:
-        """numba's types of :meth:`arguments` (what ``run_chunk`` is compiled for; fixed for the run)."""
-        return kernel_build.numba_types(self.arguments())
-
-    @cached_property
-    def signature_key(self) -> tuple[int, ...]:
-        """:attr:`signature` by its types' ids (numba interns its types: equal types are one object), the key
-        of ``_compiled_for``."""
-        return tuple(map(id, self.signature))
-
-    def compile(self) -> None:
-        """Compile (or load from the cache) the kernel for these argument types; timed apart from the run."""
-        if not kernel_build.jit_enabled():
-            return  # NUMBA_DISABLE_JIT (the plain reference)
-        signature = self.signature
-        if self.signature_key in _compiled_for:
-            return
-        kernel = kernel_build.kernel()
-        if signature not in kernel.run_chunk.signatures:  # (compiled or loaded in this process already)
-            started = wallclock.perf_counter()
-            if self.ready():
-                kernel.run_chunk.compile(signature)  # a load from the cache
-            else:  # on two processes; once, should another process be compiling the same kernel
-                kernel_build.compile_once(signature, self.ready)
-            self.compile_time += wallclock.perf_counter() - started
-        _compiled_for[self.signature_key] = signature  # (the types kept alive: their ids stay theirs)
-
-    def ready(self) -> bool:
-        """True when ``run_chunk`` for these argument types is loaded in this process, or in numba's cache."""
-        if self.signature_key in _compiled_for:
-            return True
-        kernel = kernel_build.kernel()
-        return (self.signature in kernel.run_chunk.signatures
-                or kernel.is_cached(("run_chunk",), self.problem.hertz, self.problem.momentum))
-
-    def first_kernel(self) -> tuple[ModuleType, bool]:
-        """The kernel module that takes the first chunk, and whether a compile is under way meanwhile
-        (see "First run" in the module doc)."""
-        mode = kernel_build.kernel_mode()
-        if mode == "auto":
-            native = kernel_native.load(self.arguments())
-            if native is not None:
-                return native, False  # numba is not imported
-        if not kernel_build.jit_enabled():
-            return kernel_build.kernel(), False
-        if mode == "plain":
-            return kernel_build.plain_kernel(), False
-        if (mode == "compiled" or not numba_cache.CACHE_ENABLED or self.ready()
-                or not kernel_build.start(self.jobs)):
-            self.compile()
-            if mode == "auto" and kernel_native.enabled():  # the kernel was cached but has no native module yet
-                name = kernel_native.module_name(self.arguments())
-                if name not in _no_native_build and not kernel_build.start(self.jobs[1:]):
-                    _no_native_build.add(name)  # its build failed (no C compiler?): not asked again in this process
-            return kernel_build.kernel(), False
-        return kernel_build.plain_kernel(), True
-
-    @cached_property
-    def jobs(self) -> list[kernel_build.Job]:
-        """What the background child builds for this run: ``run_chunk`` into numba's cache, then (unless
-        ``VTOOL_NATIVE=0``) its native module (:mod:`vtool.solvers.newmark.native`). Fixed for the run."""
-        jobs: list[kernel_build.Job] = [("run_chunk", self.signature)]
-        if kernel_native.enabled():
-            jobs.append(("native", (kernel_native.module_name(self.arguments()), self.signature)))
-        return jobs
+        key = jit.law_key(problem.hertz, problem.momentum)
+        if jit.is_compiled(kernel.run_chunk, "run_chunk", key):
+            return int(kernel.run_chunk(*args))
+        started = wallclock.perf_counter()
+        status = int(kernel.run_chunk(*args))  # numba compiles it (or loads it from its cache) first
+        self.compile_time = wallclock.perf_counter() - started
+        jit.compiled("run_chunk", key, self.compile_time)
+        return status
 
     def execute(self, progress: Progress | None, cancel: Cancel | None) -> None:
         problem = self.problem
         chunk = self.options.chunk_steps * self.options.time_step
-        module, building = self.first_kernel()
-        args = self.arguments()
         self.fst[layout.F_CHUNK_END] = self.fst[layout.F_T] + chunk
         while True:
-            # the child's compile is in the cache (or the child is gone without it: compile here): go on compiled
-            if building and (self.ready() or not kernel_build.compiling(self.jobs)):
-                self.plain_steps = int(self.ist[layout.I_STEPS])
-                self.compile()
-                module, building = kernel_build.kernel(), False
-            status = module.run_chunk(*args)
+            status = self.chunk()
             t = float(self.fst[layout.F_T])
             if status == layout.NEED_CONFIG:
                 problem.build(int(self.ist[layout.I_WANT_CFG]))
@@ -466,9 +349,6 @@ class KernelRun:
                 progress(min(t / self.t_end, 1.0))
             if status == layout.FINISHED:
                 self.flush(final=True)
-                self.kernel = kernel_kind(module)
-                if getattr(module, "PLAIN", False):  # the whole run in plain Python
-                    self.plain_steps = int(self.ist[layout.I_STEPS])
                 return
             if cancel is not None and cancel():
                 raise RunError(f"cancelled at t = {t:.6g} s")

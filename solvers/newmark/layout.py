@@ -2,21 +2,14 @@
 
 :mod:`vtool.solvers.model.contact` builds the tables in this layout,
 :mod:`vtool.solvers.newmark.backend` reads the kernel's state and status codes in
-it, and :mod:`vtool.solvers.newmark.kernel` computes on them. They live
-here, apart from the kernel, so that a run whose compiled kernel is a native
-module (:mod:`vtool.solvers.newmark.native`) imports no numba at all.
-
-numba freezes these values into the compiled code, and its cache is stamped
-by ``newmark_kernel.py`` alone: a change here must change that file too.
-``newmark_kernel.LAYOUT_FINGERPRINT`` holds this file's digest
-(:func:`fingerprint`), and a test fails until it is updated, so that the
-edit that changes a slot also invalidates every cached kernel.
+it, and the kernel (:mod:`vtool.solvers.newmark.kernel`) computes on them; the
+arrays travel in the records of :mod:`vtool.solvers.newmark.records`. numba
+freezes these values into the compiled code: this file is one of the sources
+whose digest names the cache folder (:func:`vtool.numba_cache.kernel_sources`),
+so an edit here starts an empty cache.
 """
 
 from __future__ import annotations
-
-import hashlib
-from pathlib import Path
 
 import numpy as np
 
@@ -37,11 +30,11 @@ CLF_SIZE = 5
 LAW_MOMENTUM, LAW_LOCAL, LAW_THESIS = range(3)
 # event kinds
 EV_OPENED, EV_CLOSED, EV_RELEASED = np.int64(0), np.int64(1), np.int64(2)  # np.int64: add_event compiles once
-# configuration integer table: built, m, nf, source coupling, closed Hertz contacts, the rows of the
+# configuration integer table: m, nf, source coupling, closed Hertz contacts, the rows of the
 # standard and refined step operators (nf free rows, then the force rows: see CP_RAW), whether those
 # rows read the sources, then kept[n], group[n], source of each z index[n]
-CI_BUILT, CI_M, CI_NF, CI_SRC, CI_HERTZ, CI_ROWS, CI_SRCSTEP = range(7)
-CI_HEAD = 7
+CI_M, CI_NF, CI_SRC, CI_HERTZ, CI_ROWS, CI_SRCSTEP = range(6)
+CI_HEAD = 6
 # configuration matrices
 CM_MFF, CM_CFF, CM_KFF, CM_SINV, CM_SINVF, CM_MINVFF = range(6)
 CM_SIZE = 6
@@ -75,8 +68,6 @@ I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_SETTLE, I_WAN
 I_SIZE = 11  # I_SUB: refined steps taken since the grid point I_GRID (the refined steps' own grid)
 F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
 F_SIZE = 4
-# run_chunk's float scratch ``work``: this many values per coordinate, per source and per clearance
-WORK_PER_N, WORK_PER_SOURCE, WORK_PER_CLEARANCE = 11, 9, 4
 
 
 def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:
@@ -93,7 +84,3 @@ def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:
     momentum = bool(np.any((cl[:, CL_LAW] == LAW_MOMENTUM) & (cl[:, CL_SOFT] == 0)))
     return (True if hertz else None), (True if momentum else None)
 
-
-def fingerprint() -> str:
-    """The first 16 hex digits of this file's SHA-256 (see the module doc)."""
-    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:16]

@@ -73,7 +73,7 @@ class CheckKind:
 
     name: str
     sense: str
-    unit_kind: str  # "pressure", "length", "velocity", "force", "deg"
+    unit_kind: str  # "pressure", "length", "velocity", "force", "deg", "ratio" (no unit)
     description: str
     evaluate: Callable[[MechanismSpec, Any], float | None]
     needs_run: bool = True
@@ -90,7 +90,7 @@ def register(kind: CheckKind) -> None:
 def unit_of(spec: MechanismSpec, unit_kind: str) -> str:
     units = spec.unit_system
     return {"pressure": units.pressure, "length": units.length, "velocity": units.velocity,
-            "force": units.force, "deg": "deg"}[unit_kind]
+            "force": units.force, "deg": "deg", "ratio": ""}[unit_kind]
 
 
 def evaluate(spec: MechanismSpec, trace: Any = None) -> list[Check]:
@@ -180,6 +180,40 @@ for _kind in (
     CheckKind("contact_travel_max", MAX, "length", "contact travel on the flat face (largest |offset|)",
               _travel, needs_run=False),
     CheckKind("seating_velocity_max", MAX, "velocity", "valve seating velocity (largest)", _seating),
+):
+    register(_kind)
+
+
+# ----- the valve spring's checks (issue 40; data-sheet springs, vtool.solvers.model.spring) -----------
+
+def _springs(spec: MechanismSpec, trace: Any) -> list[dict]:
+    from vtool.solvers.model.spring import run_report
+
+    return run_report(spec.springs, trace) if spec.springs else []
+
+
+def _spring_stress(spec: MechanismSpec, trace: Any) -> float | None:
+    report = _springs(spec, trace)
+    return max(r["max_stress"] for r in report) if report else None
+
+
+def _spring_fatigue(spec: MechanismSpec, trace: Any) -> float | None:
+    factors = [r["fatigue_factor"] for r in _springs(spec, trace) if r["fatigue_factor"] is not None]
+    return min(factors) if factors else None
+
+
+def _coil_bind(spec: MechanismSpec, trace: Any) -> float | None:
+    report = _springs(spec, trace)
+    return min(r["coil_bind_margin"] for r in report) if report else None
+
+
+for _kind in (
+    CheckKind("spring_stress_max", MAX, "pressure", "valve spring shear stress (Bergstraesser, largest)",
+              _spring_stress),
+    CheckKind("spring_fatigue_min", MIN, "ratio", "valve spring fatigue safety factor (Goodman, last cycle)",
+              _spring_fatigue),
+    CheckKind("coil_bind_margin_min", MIN, "length", "valve spring coil-bind margin (shortest - solid length)",
+              _coil_bind),
 ):
     register(_kind)
 

@@ -200,9 +200,7 @@ def concatenate(traces: list[Trace], spec: Any, omega: float, cycles: Cycles) ->
                           sum(t.statistics.wall_time for t in traces),
                           tuple(sorted({c for t in traces for c in t.statistics.configurations_built})),
                           dict(first.settings, degrees=REVOLUTION * len(traces), cycles=len(traces)),
-                          compile_time=sum(t.statistics.compile_time for t in traces),
-                          plain_steps=sum(t.statistics.plain_steps for t in traces),
-                          kernel=traces[-1].statistics.kernel)
+                          compile_time=sum(t.statistics.compile_time for t in traces))
     peak = np.max([t.peak_force for t in traces], axis=0)
     late = np.max([t.peak_force for t in traces[1:]], axis=0) if len(traces) > 1 else None
     overlaps = [t.peak_overlap for t in traces if t.peak_overlap is not None]

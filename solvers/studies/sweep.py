@@ -530,12 +530,15 @@ class SweepOutcome:
 
 
 def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False,
-               sink: SweepFile | None = None, progress: Callable[[int, int], None] | None = None,
-               cancel: Callable[[], bool] | None = None) -> SweepOutcome:
-    """Evaluate ``points`` with ``runner``; results go to ``sink`` as they arrive.
+               sink: Any = None, progress: Callable[[int, int], None] | None = None,
+               cancel: Callable[[], bool] | None = None, keep: bool = True) -> SweepOutcome:
+    """Evaluate ``points`` with ``runner``; results go to ``sink`` (a :class:`SweepFile`, or
+    :class:`vtool.solvers.parquet.SweepParquet`) as they arrive.
 
     Points already in ``sink`` (a resumed sweep) are skipped. KeyboardInterrupt
     stops the workers, leaves the sink in point order and propagates.
+    ``keep=False`` (with a sink) keeps no result in memory: the outcome's
+    ``results`` is empty and the file has them (a large sweep's memory stays bounded).
     """
     cancel = cancel or (lambda: False)
     started = time.perf_counter()
@@ -549,7 +552,8 @@ def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False
     def collect(batch: list[PointResult]) -> None:
         nonlocal done
         for result in batch:
-            results[result.index] = result
+            if keep or sink is None:
+                results[result.index] = result
             if sink is not None:
                 sink.append(result)
         done += len(batch)
@@ -564,7 +568,7 @@ def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False
     finally:
         if sink is not None:
             sink.finish()
-    if sink is not None:
+    if sink is not None and keep:
         results = sink.finished_results(points) | results
     ordered = [results[i] for i in sorted(results)]
     return SweepOutcome(ordered, complete, time.perf_counter() - started, len(points) - len(todo), len(points))

@@ -1,0 +1,261 @@
+"""A helical compression valve spring from its data sheet: rate, mass, solid length, surge, stress, fatigue.
+
+A :class:`SpringSpec` is what a spring's maker prints: round wire diameter
+``d``, mean coil diameter ``D``, active and total coils, free, installed and
+solid length, the material's shear modulus ``G``, density, tensile strength
+``R_m`` and the shear fatigue limit, and optionally a pitch diagram (active
+coils and free pitch per segment) or a measured force-length table. Every
+quantity an engineer checks follows from it in closed form (lengths, forces,
+stresses in the preset's units; one consistent unit system):
+
+* rate ``k = G d^4 / (8 D^3 n_a)`` (a segment of ``n_i`` active coils:
+  ``G d^4 / (8 D^3 n_i)``; segments in series give ``k``);
+* mass of the active coils ``m_a = rho (pi d^2 / 4) pi D n_a`` (the whole wire
+  with ``n_t``); the model's bar carries ``m_a`` (the dead end coils sit on
+  the head and under the retainer: their mass is left out, a choice);
+* solid length ``L_c = n_t d`` unless given (ground ends: the maker's figure);
+* installed preload ``F_1 = k (L_0 - L_1)`` (or the table's force at ``L_1``);
+* surge (fixed-fixed, the wave equation of the active coils):
+  ``f_j = (j/2) sqrt(k / m_a)`` Hz, j = 1, 2, ...;
+* shear stress ``tau = K 8 F D / (pi d^3)`` with the Bergstraesser factor
+  ``K_B = (w + 0.5)/(w - 0.75)`` or Wahl's ``K_W = (4w - 1)/(4w - 4) + 0.615/w``,
+  ``w = D/d`` (DIN EN 13906-1 uses Bergstraesser);
+* fatigue safety factor, Goodman (our stated rule): with ``tau_m``, ``tau_a``
+  the mean and amplitude of the corrected stress over a cycle, the fatigue
+  limit ``tau_D`` (alternating shear at zero mean) and the ultimate shear
+  strength ``tau_u = shear_ratio R_m`` (default 0.67, Shigley's ratio),
+  ``S = 1 / (tau_a / tau_D + tau_m / tau_u)``;
+* coil-bind margin: the smallest length reached minus ``L_c``.
+
+A pitch diagram gives the progressive force-length curve of the static
+spring (:func:`pitch_force_length`): segment i closes (its coils touch) when
+the force reaches ``k_i n_i (p_i - d) = G d^4 (p_i - d) / (8 D^3)``, so the
+smallest pitch closes first; after that the spring is the remaining segments
+in series (:func:`closing_forces` gives the order).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+SHEAR_RATIO = 0.67  # ultimate shear / tensile strength (Shigley); DIN EN 13906 gives 0.5 R_m as the static limit
+
+
+@dataclass(frozen=True)
+class SpringSpec:
+    """One valve spring's data sheet (module doc); ``coordinate``: the model's coordinate of its moving end."""
+
+    name: str
+    wire_diameter: float
+    coil_diameter: float  # mean
+    active_coils: float
+    total_coils: float
+    free_length: float
+    installed_length: float
+    shear_modulus: float
+    density: float
+    tensile_strength: float
+    coordinate: int
+    fatigue_limit: float | None = None
+    solid_length_given: float | None = None
+    shear_ratio: float = SHEAR_RATIO
+    segment_coils: tuple[float, ...] = ()  # pitch diagram: active coils per segment (fixed end first)
+    segment_pitches: tuple[float, ...] = ()  # free pitch of each segment (length per coil)
+    table_lengths: tuple[float, ...] = ()  # measured force-length table (decreasing lengths)
+    table_forces: tuple[float, ...] = ()
+
+    # ----- closed forms -----
+    @property
+    def index(self) -> float:
+        """Spring index w = D / d."""
+        return self.coil_diameter / self.wire_diameter
+
+    @property
+    def rate(self) -> float:
+        """G d^4 / (8 D^3 n_a); with a table, its slope at the installed length."""
+        if self.table_lengths:
+            return table_rate(self.table_lengths, self.table_forces, self.installed_length)
+        return coil_rate(self.shear_modulus, self.wire_diameter, self.coil_diameter, self.active_coils)
+
+    @property
+    def active_mass(self) -> float:
+        return wire_mass(self.density, self.wire_diameter, self.coil_diameter, self.active_coils)
+
+    @property
+    def total_mass(self) -> float:
+        return wire_mass(self.density, self.wire_diameter, self.coil_diameter, self.total_coils)
+
+    @property
+    def solid_length(self) -> float:
+        return self.solid_length_given if self.solid_length_given is not None else self.total_coils * \
+            self.wire_diameter
+
+    @property
+    def preload(self) -> float:
+        return self.force_at(self.installed_length)
+
+    @property
+    def rest_length(self) -> float:
+        """The length at q = 0 of the model (the unloaded mechanism: the preload enters through the cam
+        offset, so the installed spring sits at q = preload / rate): installed + preload / rate."""
+        return self.installed_length + self.preload / self.model_rate
+
+    @property
+    def model_rate(self) -> float:
+        """The model's (linear) rate: the bars' stiffness, segments in series."""
+        if self.segment_coils:
+            return 1.0 / float(np.sum(1.0 / segment_rates(self)))
+        return self.rate
+
+    def force_at(self, length: float | np.ndarray) -> float | np.ndarray:
+        """The static force at a length: the table's (interpolated), else the pitch diagram's, else linear."""
+        if self.table_lengths:
+            lengths = np.asarray(self.table_lengths)[::-1]
+            return np.interp(length, lengths, np.asarray(self.table_forces)[::-1])
+        if self.segment_coils:
+            return pitch_force_length(self, length)
+        return self.rate * (self.free_length - np.asarray(length)) if isinstance(length, np.ndarray) else \
+            self.rate * (self.free_length - length)
+
+    def surge_frequencies(self, count: int = 3) -> list[float]:
+        """Fixed-fixed surge frequencies f_j = (j/2) sqrt(k / m_a), Hz (time unit: s)."""
+        return [0.5 * j * math.sqrt(self.rate / self.active_mass) for j in range(1, count + 1)]
+
+    def stress(self, force: float | np.ndarray, factor: str = "bergstrasser") -> float | np.ndarray:
+        """Corrected shear stress K 8 F D / (pi d^3)."""
+        return stress_factor(self.index, factor) * 8.0 * force * self.coil_diameter / (math.pi * self.wire_diameter ** 3)
+
+    def fatigue_factor(self, force_min: float, force_max: float) -> float | None:
+        """Goodman safety factor of a cycle between two forces (module doc); None without a fatigue limit."""
+        if self.fatigue_limit is None:
+            return None
+        return goodman(self.stress(force_min), self.stress(force_max), self.fatigue_limit,
+                       self.shear_ratio * self.tensile_strength)
+
+
+def coil_rate(G: float, d: float, D: float, n: float) -> float:
+    return G * d ** 4 / (8.0 * D ** 3 * n)
+
+
+def wire_mass(density: float, d: float, D: float, n: float) -> float:
+    return density * 0.25 * math.pi * d * d * math.pi * D * n
+
+
+def stress_factor(w: float, factor: str) -> float:
+    """Bergstraesser (w + 0.5)/(w - 0.75) or Wahl (4w - 1)/(4w - 4) + 0.615/w."""
+    if factor == "wahl":
+        return (4.0 * w - 1.0) / (4.0 * w - 4.0) + 0.615 / w
+    return (w + 0.5) / (w - 0.75)
+
+
+def goodman(tau_min: float, tau_max: float, fatigue_limit: float, ultimate: float) -> float:
+    """1 / (tau_a / tau_D + tau_m / tau_u)."""
+    mean, amplitude = 0.5 * (tau_max + tau_min), 0.5 * (tau_max - tau_min)
+    return 1.0 / (amplitude / fatigue_limit + mean / ultimate)
+
+
+def table_rate(lengths: tuple[float, ...], forces: tuple[float, ...], at: float) -> float:
+    """Slope -dF/dL of a force-length table at a length (the interval holding it; the nearest end one outside)."""
+    L, F = np.asarray(lengths), np.asarray(forces)
+    i = int(np.clip(np.searchsorted(-L, -at) - 1, 0, len(L) - 2))
+    return float((F[i + 1] - F[i]) / (L[i] - L[i + 1]))
+
+
+def segment_rates(s: SpringSpec) -> np.ndarray:
+    return np.array([coil_rate(s.shear_modulus, s.wire_diameter, s.coil_diameter, n) for n in s.segment_coils])
+
+
+def closing_forces(s: SpringSpec) -> np.ndarray:
+    """Force at which each pitch segment closes: G d^4 (p_i - d) / (8 D^3) (its coils touch)."""
+    k = segment_rates(s)
+    return k * np.asarray(s.segment_coils) * (np.asarray(s.segment_pitches) - s.wire_diameter)
+
+
+def pitch_force_length(s: SpringSpec, length: float | np.ndarray) -> float | np.ndarray:
+    """Static force at a length of a spring with a pitch diagram (module doc): piecewise linear, progressive."""
+    k = segment_rates(s)
+    close = closing_forces(s)
+    travel = np.asarray(s.free_length - np.asarray(length, dtype=float))
+    # deflection at which each segment's force level is reached: sum over segments of min(F, close_i)/k_i
+    levels = np.sort(close)
+    deflections = np.array([np.sum(np.minimum(f, close) / k) for f in levels])
+    force = np.empty_like(travel, dtype=float)
+    flat = travel.ravel()
+    out = force.ravel()
+    for j, x in enumerate(flat):
+        below = np.searchsorted(deflections, x)
+        if below >= len(levels):  # every segment solid: the spring is a block
+            out[j] = math.inf
+            continue
+        f0, x0 = (0.0, 0.0) if below == 0 else (levels[below - 1], deflections[below - 1])
+        open_rate = 1.0 / np.sum(1.0 / k[close > f0]) if np.any(close > f0) else math.inf
+        out[j] = f0 + open_rate * (x - x0)
+    return float(force) if np.ndim(length) == 0 else force
+
+
+
+
+# ----- a run's spring: lengths, forces, stresses (trace: vtool.solvers.trace.Trace, duck-typed) -----
+
+def compression_sign(trace: object, coordinate: int) -> float:
+    """+1 when the end coordinate's positive direction compresses the spring (it moves with the valve's
+    lift), else -1: the sign of the correlation of q_end with the valve lift (-1 without a seat: the bar's
+    own sense, ground at its first end)."""
+    q = trace.coordinate(coordinate)  # type: ignore[attr-defined]
+    try:
+        lift = trace.valve_lift()  # type: ignore[attr-defined]
+    except KeyError:
+        return -1.0
+    return 1.0 if float(np.dot(q, lift)) >= 0.0 else -1.0
+
+
+def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
+    """Per spring: smallest length reached, coil-bind margin, forces and Bergstraesser stresses at installed,
+    largest over the run and over the last cycle (min, max), the Goodman factor of the last cycle, surge."""
+    angle = np.asarray(trace.cam_angle)  # type: ignore[attr-defined]
+    last = angle >= angle[-1] - 360.0 if angle.size else angle.astype(bool)
+    result = []
+    for s in springs:
+        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]
+        length = s.rest_length - compression_sign(trace, s.coordinate) * q
+        force = np.asarray(s.force_at(length), dtype=float)
+        shortest = float(length.min())
+        f_lo, f_hi = float(force[last].min()), float(force[last].max())
+        result.append({
+            "name": s.name, "rate": s.rate, "active_mass": s.active_mass, "preload": s.preload,
+            "solid_length": s.solid_length, "min_length": shortest, "min_length_angle_deg": float(angle[np.argmin(length)]),
+            "coil_bind_margin": shortest - s.solid_length,
+            "coil_bind": bool(shortest <= s.solid_length),
+            "installed_stress": float(s.stress(s.preload)),
+            "installed_stress_wahl": float(s.stress(s.preload, "wahl")),
+            "max_force": float(force.max()), "max_stress": float(s.stress(float(force.max()))),
+            "max_stress_wahl": float(s.stress(float(force.max()), "wahl")),
+            "last_cycle_force": [f_lo, f_hi],
+            "last_cycle_stress": [float(s.stress(f_lo)), float(s.stress(f_hi))],
+            "fatigue_factor": s.fatigue_factor(f_lo, f_hi) if np.isfinite(f_hi) else 0.0,
+            "surge_hz": s.surge_frequencies(3),
+        })
+    return result
+
+
+def report_text(report: list[dict], units: object) -> list[str]:
+    """Summary lines of :func:`run_report` (``units``: the preset's UnitSystem)."""
+    L, F, P = units.length, units.force, units.pressure  # type: ignore[attr-defined]
+    lines = ["", "valve springs (data sheet; tau = K 8 F D/(pi d^3), Bergstraesser K, Wahl in brackets):"]
+    for r in report:
+        fatigue = "n/a (no fatigue_limit)" if r["fatigue_factor"] is None else f"{r['fatigue_factor']:.3f}"
+        lines += [
+            f"  {r['name']}: rate {r['rate']:.5g} {units.stiffness}, preload {r['preload']:.5g} {F}, "  # type: ignore[attr-defined]
+            f"surge {', '.join(f'{f:.1f}' for f in r['surge_hz'])} Hz",
+            f"    stress installed {r['installed_stress']:.5g} ({r['installed_stress_wahl']:.5g}) {P}, largest "
+            f"{r['max_stress']:.5g} ({r['max_stress_wahl']:.5g}) {P} at force {r['max_force']:.5g} {F}",
+            f"    last cycle force {r['last_cycle_force'][0]:.5g} .. {r['last_cycle_force'][1]:.5g} {F}, "
+            f"Goodman fatigue factor {fatigue}",
+            f"    shortest length {r['min_length']:.5g} {L} at {r['min_length_angle_deg']:.1f} deg, solid "
+            f"{r['solid_length']:.5g} {L}: coil-bind margin {r['coil_bind_margin']:.4g} {L}"
+            + ("  COIL BIND" if r["coil_bind"] else ""),
+        ]
+    return lines

@@ -1,0 +1,227 @@
+"""Contact forces and monitors: the linear force rows, the Hertz law and its Newton iteration in a step."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vtool.jit import jit, jit_inline
+from vtool.solvers.newmark.kernel.algebra import effective_solve, solve_dense
+from vtool.solvers.newmark.layout import (
+    CI_NF,
+    CL_SOFT,
+    CLF_E,
+    CLF_HK,
+    CLF_HN,
+    CLF_HV,
+    FP_BETA,
+    FP_GAMMA,
+    IP_N,
+    IP_NS,
+    MK_AHEAD,
+    MK_BEHIND,
+    MK_FORCE,
+    MK_GAP,
+    MK_KIND,
+    MK_M,
+    MK_OVERLAP,
+    SOFT_HERTZ,
+)
+
+
+@jit
+def hertz_force(clf, k, delta, rate):
+    """(F, dF/dδ, dF/dδ̇) of Hertz contact k: F = K δⁿ (1 + 3(1 - e)/2 · δ̇/v⁻), never pulling.
+
+    v⁻ is the approach velocity of the contact's closing (Hunt and Crossley
+    1975: the damping that gives restitution e at an impact at v⁻)."""
+    if delta <= 0.0:
+        return 0.0, 0.0, 0.0
+    stiffness = clf[k, CLF_HK]
+    exponent = clf[k, CLF_HN]
+    lam = 1.5 * (1.0 - clf[k, CLF_E]) / clf[k, CLF_HV]
+    power = stiffness * delta**exponent
+    force = power * (1.0 + lam * rate)
+    if force <= 0.0:
+        return 0.0, 0.0, 0.0
+    return force, exponent * power / delta * (1.0 + lam * rate), power * lam
+
+
+@jit
+def overlap_and_rate(prob, C, k, y, src):
+    """(δ, δ̇) of a closed Hertz contact: its monitor row holds -w on z and on ż, +1 on its source."""
+    n, ns = prob.ip[IP_N], prob.ip[IP_NS]
+    row = C.mon[k]
+    delta = 0.0
+    rate = 0.0
+    for j in range(n):
+        delta += row[j] * y.z[j]
+        rate += row[n + j] * y.zd[j]
+    for s in range(ns):
+        delta += row[3 * n + 3 * s] * src[3 * s]
+        rate += row[3 * n + 3 * s + 1] * src[3 * s + 1]
+    return delta, rate
+
+
+@jit_inline
+def linear_force(mon, k, n, ns, count, z, zd, zdd, src):
+    """Contact force of closed clearance k from its monitor row mon[k] on (z, ż, z̈, sources, 1) (the
+    first ``count`` z indices), summed term by term in the order z_0, ż_0, z̈_0, z_1, …, then the
+    sources. (A quiet step takes the same force, up to round-off, from its force row in the step's
+    product: see ``layout.CP_RAW``.)"""
+    f = mon[k, 3 * n + 3 * ns]
+    for j in range(count):
+        f += mon[k, j] * z[j]
+        f += mon[k, n + j] * zd[j]
+        f += mon[k, 2 * n + j] * zdd[j]
+    for j in range(3 * ns):
+        f += mon[k, 3 * n + j] * src[j]
+    return f
+
+
+@jit
+def contact_force(prob, C, k, y, src):
+    """:func:`linear_force` of closed clearance k in configuration C, layer state y."""
+    return linear_force(C.mon, k, prob.ip[IP_N], prob.ip[IP_NS], C.mk[k, MK_M], y.z, y.zd, y.zdd, src)
+
+
+@jit
+def rigid_force(prob, C, k, y, src, hertz):
+    """Contact force of closed rigid clearance k: its linear row, plus the closed Hertz contacts' pull
+    on it (``mon[k, 3n + 3ns + 1 + j]`` per unit Hertz force F_j)."""
+    f = contact_force(prob, C, k, y, src)
+    if hertz is not None:
+        head = 3 * prob.ip[IP_N] + 3 * prob.ip[IP_NS] + 1
+        for j in range(prob.cl.shape[0]):
+            if C.mon[k, head + j] != 0.0:
+                delta, rate = overlap_and_rate(prob, C, j, y, src)
+                f += C.mon[k, head + j] * hertz_force(prob.clf, j, delta, rate)[0]
+    return f
+
+
+@jit
+def compliant_force(prob, C, k, y, src, hertz):
+    """Contact force of closed compliant clearance k: the Hertz law, or its linear row."""
+    if hertz is not None:
+        if prob.cl[k, CL_SOFT] == SOFT_HERTZ:
+            delta, rate = overlap_and_rate(prob, C, k, y, src)
+            return hertz_force(prob.clf, k, delta, rate)[0]
+    return contact_force(prob, C, k, y, src)
+
+
+@jit_inline
+def signed_gap(kind, gap, gap_noise):
+    """The monitor of an open clearance (its gap) or a closed compliant one (its overlap, -gap), plus
+    the round-off allowance: negative past the event. Scalars only: an inline helper handed arrays
+    takes and drops a reference count of each at every call, and this one runs per clearance and step."""
+    return (gap if kind == MK_GAP else -gap) + gap_noise
+
+
+@jit
+def monitor_value(prob, C, k, y, src, gap_noise, hertz):
+    """What changes sign at clearance k's next event; 0 when not monitored.
+
+    Open: gap + allowance. Closed rigid: the contact force. Closed compliant:
+    the overlap δ = -gap + allowance (the contact ends when the parts part).
+    """
+    kind = C.mk[k, MK_KIND]
+    if kind == MK_GAP or kind == MK_OVERLAP:
+        behind = C.mk[k, MK_BEHIND]
+        other = y.z[behind] if behind >= 0 else src[3 * (-1 - behind)]
+        return signed_gap(kind, y.z[C.mk[k, MK_AHEAD]] - other, gap_noise)
+    if kind == MK_FORCE:
+        if hertz is None:  # the linear row alone
+            return contact_force(prob, C, k, y, src)
+        return rigid_force(prob, C, k, y, src, hertz)
+    return 0.0
+
+
+@jit
+def monitors(prob, C, y, src, gap_noise, phi, hertz):
+    """phi[k] = :func:`monitor_value` of every clearance k: one call for all of them (gaps and linear
+    forces on arrays taken out of the records once; see step_rows)."""
+    n, ns = prob.ip[IP_N], prob.ip[IP_NS]
+    mk, mon, z, zd, zdd = C.mk, C.mon, y.z, y.zd, y.zdd
+    for k in range(prob.cl.shape[0]):
+        kind = mk[k, MK_KIND]
+        if kind == MK_GAP or kind == MK_OVERLAP:
+            behind = mk[k, MK_BEHIND]
+            other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
+            phi[k] = signed_gap(kind, z[mk[k, MK_AHEAD]] - other, gap_noise)
+        elif kind == MK_FORCE and hertz is None:
+            phi[k] = linear_force(mon, k, n, ns, mk[k, MK_M], z, zd, zdd, src)
+        else:
+            phi[k] = monitor_value(prob, C, k, y, src, gap_noise, hertz)
+
+
+@jit
+def hertz_correction(prob, C, W, h, which):
+    """Add the closed Hertz contacts' forces to the Newmark step into W.end whose linear part is done.
+
+    With the linear accelerations u (in z̈1) and V_j = S⁻¹ w_j (w_j: contact
+    j's direction on the free rows), z̈_F = u + Σ V_j F_j, and each overlap is
+    affine in the forces: δ_k = δ_k⁰ - βh² Σ w_kᵀV_j F_j, δ̇_k = δ̇_k⁰ - γh
+    Σ w_kᵀV_j F_j. Newton on F_k = H_k(δ_k(F), δ̇_k(F)) (a system of the
+    closed Hertz contacts' size); then the state takes the forces.
+    """
+    beta, gamma = prob.fp[FP_BETA], prob.fp[FP_GAMMA]
+    end = W.end
+    nf = C.ci[CI_NF]
+    ncl = prob.cl.shape[0]
+    idx = np.empty(ncl, dtype=np.int64)
+    nc = 0
+    for k in range(ncl):
+        if C.mk[k, MK_KIND] == MK_OVERLAP and prob.cl[k, CL_SOFT] == SOFT_HERTZ:
+            idx[nc] = k
+            nc += 1
+    if nc == 0:
+        return
+    V = np.zeros((nf, nc))
+    w = np.zeros(nf)
+    col = np.zeros(nf)
+    for j in range(nc):
+        for f in range(nf):
+            w[f] = -C.mon[idx[j], f]
+        effective_solve(C, which, W.L, w, col)
+        for f in range(nf):
+            V[f, j] = col[f]
+    A = np.zeros((nc, nc))  # δ_k per unit F_j, before the βh² and γh factors: -w_kᵀ V_j
+    d0 = np.zeros(nc)
+    r0 = np.zeros(nc)
+    for i in range(nc):
+        d0[i], r0[i] = overlap_and_rate(prob, C, idx[i], end, W.src1)
+        for j in range(nc):
+            acc = 0.0
+            for f in range(nf):
+                acc += C.mon[idx[i], f] * V[f, j]
+            A[i, j] = acc
+    F = np.zeros(nc)
+    R = np.zeros(nc)
+    J = np.zeros((nc, nc))
+    dF = np.zeros(nc)
+    scale = 0.0
+    for _ in range(60):
+        for i in range(nc):
+            delta = d0[i]
+            rate = r0[i]
+            for j in range(nc):
+                delta += beta * h * h * A[i, j] * F[j]
+                rate += gamma * h * A[i, j] * F[j]
+            value, d_delta, d_rate = hertz_force(prob.clf, idx[i], delta, rate)
+            R[i] = value - F[i]
+            for j in range(nc):
+                J[i, j] = (d_delta * beta * h * h + d_rate * gamma * h) * A[i, j] - (1.0 if i == j else 0.0)
+            scale = max(scale, abs(value))
+        solve_dense(J, R, dF, nc)
+        change = 0.0
+        for i in range(nc):
+            F[i] = max(F[i] - dF[i], 0.0)
+            change = max(change, abs(dF[i]))
+        if change <= 1e-12 * scale + 1e-300:
+            break
+    for f in range(nf):
+        acc = 0.0
+        for j in range(nc):
+            acc += V[f, j] * F[j]
+        end.zdd[f] += acc
+        end.z[f] += beta * h * h * acc
+        end.zd[f] += gamma * h * acc

@@ -1,0 +1,399 @@
+"""The run loop: steps in a configuration until an event, event location, and the chunked entry point."""
+
+from __future__ import annotations
+
+import math
+
+from vtool.jit import jit, jit_inline
+from vtool.solvers.newmark.kernel.algebra import apply_operator, cholesky_solve, factor_effective
+from vtool.solvers.newmark.kernel.forces import (
+    hertz_correction,
+    linear_force,
+    monitor_value,
+    monitors,
+    signed_gap,
+)
+from vtool.solvers.newmark.kernel.impacts import release_pulling, take_events
+from vtool.solvers.newmark.kernel.output import record_row, step_rows, track_peaks
+from vtool.solvers.newmark.kernel.quiet import advance
+from vtool.solvers.newmark.kernel.step import (
+    CHOLESKY,
+    REFINED,
+    STANDARD,
+    configuration,
+    correct,
+    find_slot,
+    gather,
+    harmonics,
+    layer_step,
+    predict,
+    prescribed,
+    scatter,
+    sources,
+)
+from vtool.solvers.newmark.layout import (
+    CHATTER,
+    CHUNK_END,
+    CI_HERTZ,
+    CI_M,
+    CI_NF,
+    CI_SRC,
+    CL_MON,
+    CP_RAW,
+    DIVERGED,
+    F_CHUNK_END,
+    F_FINE_UNTIL,
+    F_T,
+    FINISHED,
+    FP_BETA,
+    FP_DT,
+    FP_GAMMA,
+    FP_GAPNOISE,
+    FP_OMEGA,
+    FP_OUTDT,
+    FP_REFINE,
+    FP_REFWIN,
+    FP_TEND,
+    FP_TREV,
+    FP_TTOL,
+    FP_XLIM,
+    I_CFG,
+    I_GRID,
+    I_NEED_SETTLE,
+    I_NEV,
+    I_NEXT_OUT,
+    I_NOUT,
+    I_STARTED,
+    I_STEPS,
+    I_SUB,
+    I_WANT_CFG,
+    IP_EVERY,
+    IP_N,
+    IP_NS,
+    MK_AHEAD,
+    MK_BEHIND,
+    MK_FORCE,
+    MK_GAP,
+    MK_KIND,
+    MK_M,
+    MK_OVERLAP,
+    NEED_CONFIG,
+    OUTPUT_FULL,
+    PEAK_ALL,
+)
+
+
+@jit
+def locate_event(prob, C, W, k, t, h, hertz):
+    """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from W.now at t.
+
+    Illinois (modified regula falsi) on phi(tau) = monitor after a Newmark
+    step of length tau, bracketed by phi(0) = W.phi_start[k] >= 0 > phi(h) =
+    W.phi[k], with a bisection whenever two iterations have not halved the
+    bracket; returns the left end of the final bracket (the monitor still
+    non-negative), within the time tolerance of the crossing. Each trial
+    factors S(tau) by Cholesky. The trials are :func:`step_to`'s step written
+    with the shared inline helpers on arrays taken out of the records once (a
+    call handed records takes and drops a reference count of each of their
+    arrays: in this loop, most of an event's cost).
+    """
+    fp, ip = prob.fp, prob.ip
+    beta, gamma, omega, tol, gap_noise = fp[FP_BETA], fp[FP_GAMMA], fp[FP_OMEGA], fp[FP_TTOL], fp[FP_GAPNOISE]
+    n, ns = ip[IP_N], ip[IP_NS]
+    sc, sa, sb = prob.sc, prob.sa, prob.sb
+    ci, cm, cp, mk, mon = C.ci, C.cm, C.cp, C.mk, C.mon
+    z, zd, zdd, z1, zd1, zdd1 = W.now.z, W.now.zd, W.now.zdd, W.end.z, W.end.zd, W.end.zdd
+    src1, rhs, sol, L = W.src1, W.rhs, W.sol, W.L
+    m, nf, coupled, closed_hertz = ci[CI_M], ci[CI_NF], ci[CI_SRC], ci[CI_HERTZ]
+    kind = mk[k, MK_KIND]
+    lo, hi = 0.0, h
+    flo, fhi = W.phi_start[k], W.phi[k]
+    side = 0
+    width_before = 2.0 * h
+    for iteration in range(200):
+        width = hi - lo
+        if width <= tol:
+            break
+        if iteration % 2 == 0:
+            if width > 0.5 * width_before:
+                tau = 0.5 * (lo + hi)
+            else:
+                tau = (lo * fhi - hi * flo) / (fhi - flo)
+            width_before = width
+        else:
+            tau = (lo * fhi - hi * flo) / (fhi - flo)
+        tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
+        # step_to(prob, C, W, t, tau, hertz), on the arrays
+        harmonics(sc, sa, sb, omega, math.cos(omega * (t + tau)), math.sin(omega * (t + tau)), src1)
+        factor_effective(cm, nf, beta, gamma, tau, L)
+        predict(m, tau, beta, gamma, z, zd, zdd, z1, zd1)
+        prescribed(ci, n, src1, z1, zd1, zdd1)
+        apply_operator(cp, ci, CP_RAW, nf, coupled, src1, z1, zd1, zdd1, rhs)
+        cholesky_solve(nf, L, rhs, sol)
+        correct(nf, tau, beta, gamma, sol, z1, zd1, zdd1)
+        if hertz is not None:
+            if closed_hertz:
+                hertz_correction(prob, C, W, tau, CHOLESKY)
+        # monitor_value(prob, C, k, W.end, src1, gap_noise, hertz), on the arrays
+        if kind == MK_GAP or kind == MK_OVERLAP:
+            behind = mk[k, MK_BEHIND]
+            other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
+            f = signed_gap(kind, z1[mk[k, MK_AHEAD]] - other, gap_noise)
+        elif kind == MK_FORCE and hertz is None:
+            f = linear_force(mon, k, n, ns, mk[k, MK_M], z1, zd1, zdd1, src1)
+        else:
+            f = monitor_value(prob, C, k, W.end, src1, gap_noise, hertz)
+        if f < 0.0:
+            hi, fhi = tau, f
+            if side == -1:
+                flo *= 0.5
+            side = -1
+        else:
+            lo, flo = tau, f
+            if side == 1:
+                fhi *= 0.5
+            side = 1
+    return lo
+
+
+@jit_inline
+def step_to(prob, C, W, t, h, hertz):
+    """A step of any length h from W.now at t into W.end: sources at t + h, S(h) factored by Cholesky."""
+    sources(prob, t + h, W.src1)
+    factor_effective(C.cm, C.ci[CI_NF], prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
+    layer_step(prob, C, W, h, CHOLESKY, hertz)
+
+
+@jit_inline
+def copy_state(m, y, src, y_to, src_to):
+    """The first m entries of y, and the sources, into y_to and src_to."""
+    for j in range(m):
+        y_to.z[j] = y.z[j]
+        y_to.zd[j] = y.zd[j]
+        y_to.zdd[j] = y.zdd[j]
+    for j in range(src.shape[0]):
+        src_to[j] = src[j]
+
+
+@jit_inline
+def arrive(S, target, grid_next, k_grid, j_target):
+    """Now at ``target``: the next standard grid point, or point ``j_target`` of the refined grid."""
+    if target == grid_next:
+        S.ist[I_GRID] = k_grid + 1
+        S.ist[I_SUB] = 0
+    else:
+        S.ist[I_SUB] = j_target
+    S.fst[F_T] = target
+    return target
+
+
+@jit_inline
+def clear(W):
+    """The scratch zeroed, as fresh arrays would be (each call of :func:`run_chunk` starts so)."""
+    for y in (W.now, W.end, W.out):
+        y.z[:] = 0.0
+        y.zd[:] = 0.0
+        y.zdd[:] = 0.0
+    for vector in (W.src0, W.src1, W.srco, W.rhs, W.sol, W.phi, W.phi_start, W.tau):
+        vector[:] = 0.0
+    W.L[:, :] = 0.0
+    W.closing[:] = 0
+
+
+@jit_inline
+def start(prob, C, W, S, O, hertz):
+    """The run's first row (the start is an output row and counts for the peaks); False when the
+    output buffer is full."""
+    ist = S.ist
+    if ist[I_NOUT] >= O.t.shape[0]:
+        return False
+    gather(C, prob.ip[IP_N], S, W.now)
+    record_row(prob, C, S.fst[F_T], W.now, W.src0, O, ist[I_NOUT], hertz)
+    for k in range(prob.cl.shape[0]):
+        O.peak[PEAK_ALL, k] = max(O.peak[PEAK_ALL, k], O.F[ist[I_NOUT], k])
+    ist[I_NOUT] += 1
+    ist[I_NEXT_OUT] = 1
+    ist[I_STARTED] = 1
+    return True
+
+
+@jit_inline
+def step_length(prob, S, t, c_hertz):
+    """The next step from t: (h, target, grid_next, j_target, quiet), quiet when the quiet loop may take it
+    (on a point of the step grid, not every-step mode, no closed Hertz contact)."""
+    fp, ist = prob.fp, S.ist
+    dt, t_end = fp[FP_DT], fp[FP_TEND]
+    refine = int(fp[FP_REFINE] + 0.5)
+    fine = dt / refine
+    k_grid = ist[I_GRID]
+    sub = ist[I_SUB]
+    refined = sub > 0 or t < S.fst[F_FINE_UNTIL]
+    quiet = t == (k_grid * dt + sub * fine if refined else k_grid * dt) and not (prob.ip[IP_EVERY] or c_hertz)
+    grid_next = (k_grid + 1) * dt
+    j_target = -1  # refined steps: the index of the refined grid point this step reaches
+    target = grid_next
+    if refined:
+        if t == k_grid * dt + sub * fine:
+            j_target = sub + 1
+        else:  # after an event, between the refined grid's points: on to the next one
+            j_target = int((t - k_grid * dt) / fine) + 1
+        target = grid_next if j_target >= refine else k_grid * dt + j_target * fine
+        h = min(target, t_end) - t
+        if t == k_grid * dt + sub * fine and target <= t_end:
+            h = fine
+    elif t == k_grid * dt:
+        h = min(dt, t_end - t)
+    else:
+        h = min(grid_next, t_end) - t
+    return h, target, grid_next, j_target, quiet
+
+
+@jit_inline
+def event_step(prob, C, W, t, h, hertz):
+    """After a step of length h whose monitors W.phi changed sign: locate every sign change, take the
+    earliest (tau in W.tau) and redo the step to it. Returns the step taken."""
+    ncl = prob.cl.shape[0]
+    monitors(prob, C, W.now, W.src0, prob.fp[FP_GAPNOISE], W.phi_start, hertz)
+    tau_min = 2.0 * h
+    for k in range(ncl):
+        W.tau[k] = 2.0 * h
+        if prob.cl[k, CL_MON] and W.phi[k] < 0.0:
+            W.tau[k] = 0.0 if W.phi_start[k] < 0.0 else locate_event(prob, C, W, k, t, h, hertz)
+            tau_min = min(tau_min, W.tau[k])
+    h = tau_min
+    if h > 0.0:
+        step_to(prob, C, W, t, h, hertz)
+        # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
+        monitors(prob, C, W.end, W.src1, prob.fp[FP_GAPNOISE], W.phi, hertz)
+    else:
+        copy_state(prob.ip[IP_N], W.now, W.src0, W.end, W.src1)
+    return h
+
+
+@jit
+def steps(prob, C, W, S, O, hertz):
+    """Steps in configuration C from S.fst[F_T] until an event, the chunk end, the run's end or a full
+    buffer. Returns (status, event, h): status FINISHED, CHUNK_END, OUTPUT_FULL or DIVERGED (0 after an
+    event), h the event's located step."""
+    fp, ist, fst = prob.fp, S.ist, S.fst
+    dt, t_end, out_dt, x_limit, t_rev = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_XLIM], fp[FP_TREV]
+    omega, sc, sa, sb, src0, src1 = fp[FP_OMEGA], prob.sc, prob.sa, prob.sb, W.src0, W.src1
+    n = prob.ip[IP_N]
+    t = fst[F_T]
+    h = 0.0
+    while True:
+        if t >= t_end - 1e-9 * dt:
+            return FINISHED, False, h
+        if t >= fst[F_CHUNK_END]:
+            return CHUNK_END, False, h
+        h, target, grid_next, j_target, quiet = step_length(prob, S, t, C.ci[CI_HERTZ])
+        if quiet:  # quiet steps may follow; off the grid, after an event, the call would return at once
+            t_quiet = advance(prob, C, W, S, O, hertz)
+            if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
+                t = t_quiet
+                harmonics(sc, sa, sb, omega, math.cos(omega * t), math.sin(omega * t), src0)
+                continue
+        if h <= 1e-9 * dt:  # at a grid point but for round-off
+            t = arrive(S, target, grid_next, ist[I_GRID], j_target)
+            continue
+        harmonics(sc, sa, sb, omega, math.cos(omega * (t + h)), math.sin(omega * (t + h)), src1)
+        which = STANDARD
+        if h != dt:
+            if h == dt / int(fp[FP_REFINE] + 0.5):
+                which = REFINED
+            else:
+                which = CHOLESKY
+                factor_effective(C.cm, C.ci[CI_NF], fp[FP_BETA], fp[FP_GAMMA], h, W.L)
+        layer_step(prob, C, W, h, which, hertz)
+        monitors(prob, C, W.end, W.src1, fp[FP_GAPNOISE], W.phi, hertz)
+        fired = False
+        for k in range(prob.cl.shape[0]):
+            if prob.cl[k, CL_MON] and W.phi[k] < 0.0:
+                fired = True
+        if fired:  # locate every sign change; the earliest is taken
+            h = event_step(prob, C, W, t, h, hertz)
+        if h > 0.0:
+            for j in range(C.ci[CI_NF]):
+                if not (abs(W.end.z[j]) <= x_limit):
+                    scatter(C, n, W.end, S)
+                    fst[F_T] = t + h
+                    return DIVERGED, False, h
+            # outputs inside (t, t + h]
+            if prob.ip[IP_EVERY]:
+                if ist[I_NOUT] >= O.t.shape[0]:
+                    return OUTPUT_FULL, False, h
+                record_row(prob, C, t + h, W.end, W.src1, O, ist[I_NOUT], hertz)
+                ist[I_NOUT] += 1
+            else:
+                t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant: a call only when one is due
+                if (t_out <= t + h + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
+                        and not step_rows(prob, C, t, h, W.now, W.end.zdd, W, O, S, hertz)):
+                    return OUTPUT_FULL, False, h
+            track_peaks(prob, C, t + h >= t_rev, W.phi, W.end, W.src1, O.peak, hertz)
+            ist[I_STEPS] += 1
+            copy_state(n, W.end, W.src1, W.now, W.src0)
+            t = t + h
+            fst[F_T] = t
+            if abs(t - target) <= 1e-9 * dt:
+                t = arrive(S, target, grid_next, ist[I_GRID], j_target)
+        if fired:
+            return 0, True, h
+
+
+@jit
+def run_chunk(prob, T, W, S, O, hertz, momentum):
+    """Integrate from S.fst[F_T] until t_end, the chunk end, or something Python must do.
+
+    Returns a status (FINISHED, CHUNK_END, NEED_CONFIG, OUTPUT_FULL, DIVERGED,
+    CHATTER). (S.x, S.v, S.a) is the full state at S.fst[F_T] in configuration
+    S.ist[I_CFG]; everything needed to resume is in the arguments, so Python
+    may build a configuration (NEED_CONFIG: its mask in S.ist[I_WANT_CFG]) or
+    empty a buffer and call again. Output rows at the output instants are
+    interpolated inside the step; ``O.peak[PEAK_ALL]`` holds the peak contact
+    forces over every step, ``[PEAK_LATE]`` those after the first cam
+    revolution, ``[PEAK_OVERLAP]`` the largest overlap of each compliant
+    contact. The scratch W is zeroed at each call, as fresh arrays would be.
+    Only the momentum law's impacts and the Hertz iteration allocate their
+    small systems.
+    """
+    ist, fst = S.ist, S.fst
+    n, ncl = prob.ip[IP_N], prob.cl.shape[0]
+    clear(W)
+    while True:
+        t = fst[F_T]
+        c = ist[I_CFG]
+        slot = find_slot(T.index, c)
+        if slot < 0:
+            ist[I_WANT_CFG] = c
+            return NEED_CONFIG
+        if ist[I_NEV] + 3 * ncl + 2 >= O.ev_f.shape[0]:
+            return OUTPUT_FULL
+        sources(prob, t, W.src0)
+        if ist[I_NEED_SETTLE]:
+            settled = release_pulling(prob, T, c, t, S, W.src0, O, W.now, W.rhs, hertz)
+            if settled < 0:
+                ist[I_CFG] = -1 - settled
+                ist[I_WANT_CFG] = -1 - settled
+                return NEED_CONFIG
+            c = settled
+            ist[I_CFG] = c
+            ist[I_NEED_SETTLE] = 0
+            slot = find_slot(T.index, c)
+            if not ist[I_STARTED] and not start(prob, configuration(T, c, slot), W, S, O, hertz):
+                return OUTPUT_FULL
+        C = configuration(T, c, slot)
+        gather(C, n, S, W.now)
+        status, event, h = steps(prob, C, W, S, O, hertz)
+        if status == DIVERGED:  # (the state at the divergence is in S already)
+            return status
+        scatter(C, n, W.now, S)
+        if not event:
+            return status
+        # ---- the events at t (within the tolerance) ----
+        t = fst[F_T]
+        new_c = take_events(prob, c, t, h, W, S, O, momentum)
+        if new_c < 0:
+            return CHATTER
+        ist[I_CFG] = new_c
+        ist[I_NEED_SETTLE] = 1
+        fst[F_FINE_UNTIL] = t + prob.fp[FP_REFWIN]

@@ -1,0 +1,127 @@
+"""The run's output: rows at the output instants (interpolated inside a step), and the peak forces."""
+
+from __future__ import annotations
+
+import math
+
+from vtool.jit import jit, jit_inline
+from vtool.solvers.newmark.kernel.forces import compliant_force, linear_force, rigid_force
+from vtool.solvers.newmark.kernel.step import harmonics, interpolate, prescribed
+from vtool.solvers.newmark.layout import (
+    CI_HEAD,
+    CI_NF,
+    FP_DT,
+    FP_GAPNOISE,
+    FP_OMEGA,
+    FP_OUTDT,
+    FP_TEND,
+    I_NEXT_OUT,
+    I_NOUT,
+    IP_N,
+    IP_NS,
+    MK_FORCE,
+    MK_KIND,
+    MK_M,
+    MK_OVERLAP,
+    PEAK_ALL,
+    PEAK_LATE,
+    PEAK_OVERLAP,
+)
+
+
+@jit_inline
+def put_state(ci, n, ns, row, z, zd, zdd, src, q):
+    """Row ``row`` of the output planes q (x, v, a): the full coordinates of the layer state
+    (z, ż, z̈) in the configuration whose integer row is ci, then the sources."""
+    for i in range(n):
+        j = ci[CI_HEAD + n + i]
+        q[0, row, i] = z[j]
+        q[1, row, i] = zd[j]
+        q[2, row, i] = zdd[j]
+    for s in range(ns):
+        q[0, row, n + s] = src[3 * s]
+        q[1, row, n + s] = src[3 * s + 1]
+        q[2, row, n + s] = src[3 * s + 2]
+
+
+@jit
+def record_row(prob, C, t, y, src, O, row, hertz):
+    """Output row ``row``: time, configuration, the full coordinates (x, v, a planes) and the sources,
+    and every clearance's contact force (0 when open)."""
+    n, ns = prob.ip[IP_N], prob.ip[IP_NS]
+    O.t[row] = t
+    O.c[row] = C.mask
+    put_state(C.ci, n, ns, row, y.z, y.zd, y.zdd, src, O.q)
+    for k in range(prob.cl.shape[0]):
+        if C.mk[k, MK_KIND] == MK_FORCE:
+            O.F[row, k] = rigid_force(prob, C, k, y, src, hertz)
+        elif C.mk[k, MK_KIND] == MK_OVERLAP:
+            O.F[row, k] = compliant_force(prob, C, k, y, src, hertz)
+        else:
+            O.F[row, k] = 0.0
+
+
+@jit
+def step_rows(prob, C, t, h, y, zdd1, W, O, S, hertz):
+    """The output rows inside (t, t + h] of a step from y whose end acceleration is z̈1, by the
+    linear-acceleration interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); False when the buffer
+    filled first (the rows before are written). :func:`record_row`'s row, on arrays taken out of the
+    records once (a call handed records takes and drops a reference count of each of their arrays)."""
+    dt, t_end, out_dt, omega = prob.fp[FP_DT], prob.fp[FP_TEND], prob.fp[FP_OUTDT], prob.fp[FP_OMEGA]
+    n, ns, ncl = prob.ip[IP_N], prob.ip[IP_NS], prob.cl.shape[0]
+    sc, sa, sb = prob.sc, prob.sa, prob.sb
+    ci, mk, mon = C.ci, C.mk, C.mon
+    z, zd, zdd = y.z, y.zd, y.zdd
+    zo, zdo, zddo, srco = W.out.z, W.out.zd, W.out.zdd, W.srco
+    out_t, out_q, out_F, out_c = O.t, O.q, O.F, O.c
+    ist = S.ist
+    nf = ci[CI_NF]
+    while True:
+        j_out = ist[I_NEXT_OUT]
+        t_out = j_out * out_dt
+        if t_out > t + h + 1e-9 * dt or t_out > t_end + 1e-9 * dt:
+            return True
+        row = ist[I_NOUT]
+        if row >= out_t.shape[0]:
+            return False
+        interpolate(nf, t_out - t, h, z, zd, zdd, zdd1, W.out)
+        harmonics(sc, sa, sb, omega, math.cos(omega * t_out), math.sin(omega * t_out), srco)
+        prescribed(ci, n, srco, zo, zdo, zddo)
+        out_t[row] = t_out
+        out_c[row] = C.mask
+        put_state(ci, n, ns, row, zo, zdo, zddo, srco, out_q)
+        for k in range(ncl):
+            kind = mk[k, MK_KIND]
+            force = 0.0
+            if (kind == MK_FORCE or kind == MK_OVERLAP) and hertz is None:
+                force = linear_force(mon, k, n, ns, mk[k, MK_M], zo, zdo, zddo, srco)
+            elif kind == MK_FORCE:
+                force = rigid_force(prob, C, k, W.out, srco, hertz)
+            elif kind == MK_OVERLAP:
+                force = compliant_force(prob, C, k, W.out, srco, hertz)
+            out_F[row, k] = force
+        ist[I_NOUT] = row + 1
+        ist[I_NEXT_OUT] = j_out + 1
+
+
+@jit
+def track_peaks(prob, C, after, phi, y, src, peak, hertz):
+    """Raise the peak contact forces (and compliant overlaps) with the monitors ``phi`` at a step's end
+    (state y, sources src); ``after``: the step ends after the first cam revolution."""
+    gap_noise = prob.fp[FP_GAPNOISE]
+    n, ns = prob.ip[IP_N], prob.ip[IP_NS]
+    mk, mon = C.mk, C.mon
+    for k in range(prob.cl.shape[0]):
+        kind = mk[k, MK_KIND]
+        force = phi[k]
+        if kind == MK_OVERLAP:
+            if hertz is None:
+                force = linear_force(mon, k, n, ns, mk[k, MK_M], y.z, y.zd, y.zdd, src)
+            else:
+                force = compliant_force(prob, C, k, y, src, hertz)
+            peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
+        elif kind != MK_FORCE:
+            continue
+        peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], force)
+        if after:
+            peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], force)

@@ -1,0 +1,197 @@
+"""The quiet loop: standard and refined steps in one configuration while nothing happens.
+
+Most of a run's steps are taken here (:func:`advance`), so each is the least
+work a step can be: the sources by rotation of the cam angle, the predictor,
+one product with the stored step operator (which also gives the closed rigid
+contacts' forces: ``layout.CP_RAW``), the corrector, the gap and force
+checks and the peaks. The predictor, corrector, harmonics and gap checks are
+the inline helpers every step shares (:mod:`~vtool.solvers.newmark.kernel.step`,
+:mod:`~vtool.solvers.newmark.kernel.forces`); output rows are written by
+:func:`~vtool.solvers.newmark.kernel.output.step_rows` when one is due.
+"""
+
+from __future__ import annotations
+
+import math
+
+from vtool.jit import jit
+from vtool.solvers.newmark.kernel.algebra import apply_operator
+from vtool.solvers.newmark.kernel.forces import contact_force, signed_gap
+from vtool.solvers.newmark.kernel.output import step_rows
+from vtool.solvers.newmark.kernel.step import correct, harmonics, predict, prescribed
+from vtool.solvers.newmark.layout import (
+    CI_M,
+    CI_NF,
+    CI_ROWS,
+    CI_SRCSTEP,
+    CL_MON,
+    CP_FINE,
+    CP_STD,
+    F_CHUNK_END,
+    F_FINE_UNTIL,
+    F_T,
+    FP_BETA,
+    FP_DT,
+    FP_GAMMA,
+    FP_GAPNOISE,
+    FP_OMEGA,
+    FP_OUTDT,
+    FP_REFINE,
+    FP_TEND,
+    FP_TREV,
+    FP_XLIM,
+    I_GRID,
+    I_NEXT_OUT,
+    I_STEPS,
+    I_SUB,
+    IP_N,
+    IP_NS,
+    MK_AHEAD,
+    MK_BEHIND,
+    MK_FORCE,
+    MK_GAP,
+    MK_KIND,
+    MK_OVERLAP,
+    MK_ROW,
+    PEAK_ALL,
+    PEAK_LATE,
+    PEAK_OVERLAP,
+)
+
+#: Quiet steps between fresh evaluations of cos and sin of the cam angle (see :func:`advance`).
+ANCHOR_STEPS = 64
+
+
+@jit
+def advance(prob, C, W, S, O, hertz):
+    """Standard and refined steps in configuration C from W.now while nothing happens; returns the time
+    reached (the state there in W.now).
+
+    It stops, without taking it, at the first step that is neither a
+    standard step on the grid nor a refined one, that would end past the
+    chunk or the run, change a monitor's sign, leave the divergence limit or
+    overflow the output buffer; :func:`~vtool.solvers.newmark.kernel.loop.run_chunk`
+    takes that step with full handling. Not called in every-step mode, nor in
+    a configuration with closed Hertz contacts (each of their steps goes
+    through layer_step's iteration).
+
+    Every array is taken out of its record once, before the loop: numba counts references, and a
+    record's field read inside the loop would take and drop one at every step. The step's end is
+    computed into W.end and copied back into W.now (m values), cheaper than swapping the two.
+    """
+    ip, fp, ist, fst = prob.ip, prob.fp, S.ist, S.fst
+    sc, sa, sb, cl = prob.sc, prob.sa, prob.sb, prob.cl
+    ci, cp, mk, mon = C.ci, C.cp, C.mk, C.mon
+    z, zd, zdd = W.now.z, W.now.zd, W.now.zdd
+    z1, zd1, zdd1 = W.end.z, W.end.zd, W.end.zdd
+    rhs, phi, src1, peak = W.rhs, W.phi, W.src1, O.peak
+    n, ns, ncl = ip[IP_N], ip[IP_NS], cl.shape[0]
+    beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
+    omega, gap_noise, x_limit, t_rev = fp[FP_OMEGA], fp[FP_GAPNOISE], fp[FP_XLIM], fp[FP_TREV]
+    refine = int(fp[FP_REFINE] + 0.5)
+    fine = dt / refine
+    m, nf, nrows, coupled = ci[CI_M], ci[CI_NF], ci[CI_ROWS], ci[CI_SRCSTEP]
+    constant = 3 * n + 3 * ns  # a force row's constant term, in its monitor row
+    t = fst[F_T]
+    # cos, sin of omega t, carried from step to step by the rotation through one step's angle (libm's
+    # sincos took a seventh of a quiet step), and taken afresh every ANCHOR_STEPS steps: the rotation's
+    # round-off grows by an ulp or two a step, so they stay within about 1e-13 of libm's, the round-off
+    # of the angle omega t itself at a few hundred rad
+    c0 = math.cos(omega * t)
+    s0 = math.sin(omega * t)
+    c_dt = math.cos(omega * dt)
+    s_dt = math.sin(omega * dt)
+    c_fine = math.cos(omega * fine)
+    s_fine = math.sin(omega * fine)
+    rotated = 0
+    while True:
+        k_grid = ist[I_GRID]
+        sub = ist[I_SUB]
+        if sub > 0 or t < fst[F_FINE_UNTIL]:  # refined steps on their grid, on to the next grid point
+            if t != k_grid * dt + sub * fine:
+                break
+            h = fine
+            plane = CP_FINE
+            t1 = (k_grid + 1) * dt if sub + 1 == refine else k_grid * dt + (sub + 1) * fine
+        elif t == k_grid * dt:
+            h = dt
+            plane = CP_STD
+            t1 = (k_grid + 1) * dt
+        else:
+            break
+        if t1 > t_end or t >= fst[F_CHUNK_END]:
+            break
+        if rotated == ANCHOR_STEPS:
+            c1 = math.cos(omega * t1)
+            s1 = math.sin(omega * t1)
+        elif plane == CP_STD:
+            c1 = c0 * c_dt - s0 * s_dt
+            s1 = s0 * c_dt + c0 * s_dt
+        else:
+            c1 = c0 * c_fine - s0 * s_fine
+            s1 = s0 * c_fine + c0 * s_fine
+        # the step (layer_step's, with the stored operator: its force rows give the contact forces too)
+        harmonics(sc, sa, sb, omega, c1, s1, src1)
+        predict(m, h, beta, gamma, z, zd, zdd, z1, zd1)
+        prescribed(ci, n, src1, z1, zd1, zdd1)
+        apply_operator(cp, ci, plane, nrows, coupled, src1, z1, zd1, zdd1, rhs)
+        correct(nf, h, beta, gamma, rhs, z1, zd1, zdd1)
+        stop = False
+        for f in range(nf):
+            if not (abs(z1[f]) <= x_limit):  # the divergence limit
+                stop = True
+        if stop:
+            break
+        # monitors (see forces.monitor_value): stop before a sign change
+        for k in range(ncl):
+            kind = mk[k, MK_KIND]
+            value = 0.0
+            if kind == MK_GAP or kind == MK_OVERLAP:
+                behind = mk[k, MK_BEHIND]
+                other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
+                value = signed_gap(kind, z1[mk[k, MK_AHEAD]] - other, gap_noise)
+                if value < 0.0:
+                    stop = True
+                    break
+            elif kind == MK_FORCE:  # its force row of the step's product, and the row's constant
+                value = mon[k, constant] + rhs[mk[k, MK_ROW]]
+                if value < 0.0 and cl[k, CL_MON]:
+                    stop = True
+                    break
+            phi[k] = value
+        if stop:
+            break
+        t_out = ist[I_NEXT_OUT] * out_dt  # output rows inside (t, t1]: a call only when one is due
+        if (t_out <= t1 + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
+                and not step_rows(prob, C, t, h, W.now, zdd1, W, O, S, hertz)):
+            break
+        # accept: peaks (output.track_peaks, the forces from the step's product), state, time
+        after = t1 >= t_rev
+        for k in range(ncl):
+            kind = mk[k, MK_KIND]
+            if kind == MK_FORCE:
+                peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], phi[k])
+                if after:
+                    peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], phi[k])
+            elif kind == MK_OVERLAP:
+                force = contact_force(prob, C, k, W.end, src1)
+                peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
+                peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], force)
+                if after:
+                    peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], force)
+        for j in range(m):
+            z[j] = z1[j]
+            zd[j] = zd1[j]
+            zdd[j] = zdd1[j]
+        ist[I_STEPS] += 1
+        if plane == CP_STD or sub + 1 == refine:
+            ist[I_GRID] = k_grid + 1
+            ist[I_SUB] = 0
+        else:
+            ist[I_SUB] = sub + 1
+        t = t1
+        fst[F_T] = t
+        c0 = c1
+        s0 = s1
+        rotated = 0 if rotated == ANCHOR_STEPS else rotated + 1
+    return t

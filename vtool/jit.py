@@ -1,0 +1,76 @@
+"""The one decorator of vtool's compiled kernels, their cache folder, and what a first run says.
+
+Every compiled function (the Newmark kernel's files under ``solvers/newmark/``,
+the CSV formatter :mod:`vtool.csvrows_kernel`) is ``@jit``: numba's ``njit`` with
+``cache=True`` (when :mod:`vtool.numba_cache` found a safe folder),
+``nogil=True`` (threads of a sweep run in parallel) and numpy's error model
+(a division by zero gives inf, as the plain-NumPy reference does). The few
+small helpers of the quiet step are ``@jit_inline``: the same, copied into
+their callers as numba IR (``inline="always"``) so that LLVM vectorizes them
+in place. ``NUMBA_DISABLE_JIT=1`` runs the same source as plain Python, the
+reference the tests compare the compiled kernel with.
+
+The cache folder's name carries a digest of all of the kernels' files
+(:func:`vtool.numba_cache.kernel_sources`): an edit of any of them starts an empty cache.
+
+First run: :func:`compile_notice` says whether an entry point still has to be
+compiled for a law pair (a ``.done`` mark in the cache folder, written by
+:func:`compiled`, or a compile in this process already) and how long it took
+last time on this machine.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from vtool import numba_cache
+
+numba_cache.configure()
+
+from numba import njit  # noqa: E402 (after the cache folder is chosen)
+
+_OPTIONS: dict[str, Any] = {"cache": numba_cache.CACHE_ENABLED, "nogil": True, "error_model": "numpy"}
+jit = njit(**_OPTIONS)
+jit_inline = njit(**_OPTIONS, inline="always")
+
+#: A first compile's length when none was measured yet on this machine (s; the 2-core development
+#: machine took 9-14 s for 1A's kernel with other work running).
+FIRST_GUESS = "5-20"
+
+
+def law_key(hertz: bool | None, momentum: bool | None) -> str:
+    return f"{'hertz' if hertz else 'rigid'}-{'momentum' if momentum else 'local'}"
+
+
+def _mark(name: str, key: str) -> Path | None:
+    folder = numba_cache.FOLDER
+    return None if folder is None else folder / f"{name}-{key}.done"
+
+
+def is_compiled(dispatcher: Any, name: str, key: str) -> bool:
+    """True when ``dispatcher`` needs no compile: plain Python, compiled in this process, or marked done
+    in the cache folder for ``key``."""
+    if not hasattr(dispatcher, "signatures") or dispatcher.signatures:
+        return True
+    mark = _mark(name, key)
+    return mark is not None and mark.exists()
+
+
+def compiled(name: str, key: str, seconds: float) -> None:
+    """Mark ``name`` compiled into the cache for ``key``, and keep how long it took."""
+    numba_cache.record_compile(name, seconds)
+    mark = _mark(name, key)
+    if mark is not None:
+        try:
+            mark.touch()
+        except OSError:
+            pass
+
+
+def compile_notice(what: str, name: str) -> str:
+    """The line before a compile: "compiling WHAT once, about N s on this machine"."""
+    last = numba_cache.last_compile(name)
+    about = f"{last:.0f}" if last is not None else FIRST_GUESS
+    later = "later runs load it from the cache" if numba_cache.CACHE_ENABLED else "no cache: every process compiles it"
+    return f"compiling {what} once, about {about} s on this machine; {later}"
