@@ -213,9 +213,9 @@ def compression_sign(trace: object, coordinate: int) -> float:
     """+1 when the end coordinate's positive direction compresses the spring (it moves with the valve's
     lift), else -1: the sign of the correlation of q_end with the valve lift (-1 without a seat: the bar's
     own sense, ground at its first end)."""
-    q = trace.coordinate(coordinate)  # type: ignore[attr-defined]
+    q = trace.coordinate(coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     try:
-        lift = trace.valve_lift()  # type: ignore[attr-defined]
+        lift = trace.valve_lift()  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     except KeyError:
         return -1.0
     return 1.0 if float(np.dot(q, lift)) >= 0.0 else -1.0
@@ -224,11 +224,11 @@ def compression_sign(trace: object, coordinate: int) -> float:
 def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
     """Per spring: smallest length reached, coil-bind margin, forces and Bergstraesser stresses at installed,
     largest over the run and over the last cycle (min, max), the Goodman factor of the last cycle, surge."""
-    angle = np.asarray(trace.cam_angle)  # type: ignore[attr-defined]
+    angle = np.asarray(trace.cam_angle)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     last = angle >= angle[-1] - 360.0 if angle.size else angle.astype(bool)
     result = []
     for s in springs:
-        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]
+        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
         length = s.rest_length - compression_sign(trace, s.coordinate) * q
         force = np.asarray(s.force_at(length), dtype=float)
         shortest = float(length.min())
@@ -252,12 +252,12 @@ def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
 
 def report_text(report: list[dict], units: object) -> list[str]:
     """Summary lines of :func:`run_report` (``units``: the preset's UnitSystem)."""
-    L, F, P = units.length, units.force, units.pressure  # type: ignore[attr-defined]
+    L, F, P = units.length, units.force, units.pressure  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
     lines = ["", "valve springs (data sheet; tau = K 8 F D/(pi d^3), Bergstraesser K, Wahl in brackets):"]
     for r in report:
         fatigue = "n/a (no fatigue_limit)" if r["fatigue_factor"] is None else f"{r['fatigue_factor']:.3f}"
         lines += [
-            f"  {r['name']}: rate {r['rate']:.5g} {units.stiffness}, preload {r['preload']:.5g} {F}, "  # type: ignore[attr-defined]
+            f"  {r['name']}: rate {r['rate']:.5g} {units.stiffness}, preload {r['preload']:.5g} {F}, "  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
             f"surge {', '.join(f'{f:.1f}' for f in r['surge_hz'])} Hz",
             f"    stress installed {r['installed_stress']:.5g} ({r['installed_stress_wahl']:.5g}) {P}, largest "
             f"{r['max_stress']:.5g} ({r['max_stress_wahl']:.5g}) {P} at force {r['max_force']:.5g} {F}",
