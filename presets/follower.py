@@ -106,8 +106,10 @@ def load_follower(t: Table, units: UnitSystem, read_law: Callable[[Table], CamSp
         alpha = oil_table.number("pressure_viscosity", unit="1/GPa", min_value=0.0, max_value=100.0)
         oil_table.finish()
         oil = OilSpec(viscosity * MPA_S, alpha * PER_GPA)
+    friction = t.number("friction", default=0.0, min_value=0.0, max_value=1.0)
     t.finish()
-    return FollowerSpec(kind, arrangement, base, width, roller, face, finger=finger, lift=lift, oil=oil, **moduli)
+    return FollowerSpec(kind, arrangement, base, width, roller, face, finger=finger, lift=lift, oil=oil,
+                        friction=friction, **moduli)
 
 
 def dump_follower(f: FollowerSpec, dump_law: Callable[[CamSpec], dict[str, Any]]) -> dict[str, Any]:
@@ -120,6 +122,8 @@ def dump_follower(f: FollowerSpec, dump_law: Callable[[CamSpec], dict[str, Any]]
         doc["face_diameter"] = f.face_diameter
     doc |= {"cam_modulus": f.cam_modulus, "cam_poisson": f.cam_poisson, "follower_modulus": f.follower_modulus,
             "follower_poisson": f.follower_poisson}
+    if f.friction:
+        doc["friction"] = f.friction
     if f.finger is not None:
         doc |= {key: getattr(f.finger, key) for key in FINGER_KEYS}
     if f.lift is not None:

@@ -203,6 +203,10 @@ class Trace:
     def coordinate(self, number: int, rows: slice = slice(None)) -> np.ndarray:
         return self.q[rows, self.coordinate_numbers.index(number)]
 
+    def cam_clearance_index(self) -> int:
+        """The index of the clearance at the cam (the cam coordinate behind it)."""
+        return next(i for i, c in enumerate(self.spec.clearances) if c.behind == self.spec.cam.coordinate)
+
     def force_label(self, index: int) -> str:
         return f"F{self.spec.clearances[index].ahead}"
 
@@ -294,6 +298,14 @@ class Trace:
                 header.append(f"cam_{name} ({row_unit(self.spec, name)})")
                 columns.append(lambda rows, name=name: stress_rows(
                     self.spec, self.cam_angle[rows], self.contact_force[rows, cam])[name])
+        if self.spec.follower is not None:  # drive torque and friction (solvers/studies/torque.py)
+            from vtool.solvers.studies import torque
+
+            cam = self.cam_clearance_index()
+            for name in torque.ROW_UNITS:
+                header.append(f"cam_{name} ({torque.row_unit(self.spec, name)})")
+                columns.append(lambda rows, name=name: getattr(torque.torque_rows(
+                    self.spec, self.cam_angle[rows], self.contact_force[rows, cam]), name))
         return header + ["configuration", "closed"], columns
 
     def configuration_csv(self, mask: int) -> str:
@@ -469,6 +481,13 @@ class Trace:
 
             cam = next(c.name for c in self.spec.clearances if c.behind == self.spec.cam.coordinate)
             result["contact_stress"] = stress_summary(self.spec, self.cam_angle, self.force(cam))
+        if self.spec.follower is not None:  # drive torque over the last whole revolution
+            from vtool.solvers.studies import torque
+
+            window = torque.last_revolution(self.cam_angle)
+            if window is not None:
+                rows = torque.torque_rows(self.spec, self.cam_angle, self.contact_force[:, self.cam_clearance_index()])
+                result["cam_torque"] = torque.torque_summary(self.spec, rows, *window)
         if self.spec.springs:
             from vtool.solvers.model.spring import run_report
 
@@ -522,6 +541,10 @@ class Trace:
             from vtool.solvers.model.camstress import stress_text
 
             lines += stress_text(s["contact_stress"])
+        if "cam_torque" in s:
+            from vtool.solvers.studies.torque import torque_text
+
+            lines += torque_text(s["cam_torque"])
         if "springs" in s:
             from vtool.solvers.model.spring import report_text
 

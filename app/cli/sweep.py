@@ -56,9 +56,10 @@ def _scheduler(ctx: click.Context, param: click.Parameter, value: str | None) ->
               help="Swept field (dotted preset path, e.g. run.rpm, members.valve_spring.stiffness, "
                    "clearances[2].restitution) and its values: start:stop:step (stop included) or a,b,c. "
                    "Several --set make a grid.")
-@click.option("--find", "find", type=click.Choice(["jump-speed", "bounce-speed"]),
+@click.option("--find", "find", type=click.Choice(["jump-speed", "bounce-speed", "coil-bind-speed"]),
               help="Bracket and bisect (to 1 rev/min) every cam-speed interval where the follower leaves the "
-                   "cam during lift (jump-speed) or the valve bounces on its seat (bounce-speed), each run to "
+                   "cam during lift (jump-speed), the valve bounces on its seat (bounce-speed) or a data-sheet "
+                   "valve spring's coils touch (coil-bind-speed), each run to "
                    f"steady state; --set run.rpm gives the scan (default {DEFAULT_SCAN}), other --set fields a "
                    "grid of searches.")
 @click.option("--workers", type=int, callback=_workers,
@@ -143,6 +144,8 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         raise InputError("--campbell", campbell, "a sweep over run.rpm")
     if find == "bounce-speed" and seat_index(plan.spec) is None:
         raise InputError("--find", find, "a preset with a valve seat (this one has none)")
+    if find == "coil-bind-speed" and not getattr(plan.spec, "springs", ()):
+        raise InputError("--find", find, "a preset with a data-sheet valve spring ([train.spring] wire_diameter ...)")
     names = {name: unit for name, unit in metric_columns(plan.spec)}
     if metric not in names:
         raise InputError("--metric", metric, f"one of: {', '.join(names)}")

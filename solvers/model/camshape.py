@@ -284,6 +284,12 @@ class Contact:
     valve_lift: np.ndarray  # finger: the geometric valve lift; translating: the lift
     ratio: np.ndarray  # finger: dV/du (module doc); translating: 1
     model_lift: np.ndarray  # what the model's cam coordinate does (finger: V a/b; else the lift)
+    #: the normal force's moment arm about the camshaft axis, signed: drive torque per unit normal force
+    #: ((x - C) × n for a point x on the normal line, n the cam's outward normal; flat face: L')
+    torque_arm: np.ndarray
+    #: the tangent line's distance from the camshaft axis ((x - C)·n at the contact point x; flat face:
+    #: r_b + L): drive torque per unit friction force at the contact
+    tangent_arm: np.ndarray
 
 
 def contact(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> Contact:
@@ -316,10 +322,11 @@ def contact(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> Contact:
         rho = p.pitch_radius - r_r
         V = g.valve_lift(phi)
         ratio_model = finger.roller_arm / finger.valve_arm
+        arm = d[0] * n[1] - d[1] * n[0]
         return Contact(np.degrees(theta), np.degrees(psi), p.R - g.R0, np.degrees(alpha), rho,
                        1.0 / rho + 1.0 / r_r, ratio_model * dV / n_dQ,
                        np.abs(p.speed * rho / p.pitch_radius * dpsi), 0.0 * ones, np.full_like(theta, np.nan),
-                       V, dV / du, V * ratio_model)
+                       V, dV / du, V * ratio_model, arm, d[0] * n[0] + d[1] * n[1] - r_r)
     L, dL, ddL, dddL = law_derivatives(law, theta)
     if follower.kind == FLAT:
         f = np.array([dL, follower.base_radius + L])
@@ -328,13 +335,14 @@ def contact(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> Contact:
         with np.errstate(divide="ignore"):
             curvature = 1.0 / rho
         return Contact(np.degrees(theta), np.degrees(theta), L, 0.0 * ones, rho, curvature, ones,
-                       0.5 * np.abs(rho + ddL), np.abs(follower.base_radius + L), dL, L, ones, L)
+                       0.5 * np.abs(rho + ddL), np.abs(follower.base_radius + L), dL, L, ones, L, dL,
+                       follower.base_radius + L)
     p = pitch(law, follower.base_radius, r_r, theta)
     alpha = np.arctan2(p.dL, p.R)
     rho = p.pitch_radius - r_r
     return Contact(np.degrees(theta), np.degrees(theta), L, np.degrees(alpha), rho, 1.0 / rho + 1.0 / r_r,
                    1.0 / np.cos(alpha), np.abs(p.speed * rho / p.pitch_radius), 0.0 * ones,
-                   np.full_like(theta, np.nan), L, ones, L)
+                   np.full_like(theta, np.nan), L, ones, L, p.R * np.sin(alpha), p.R * np.cos(alpha) - r_r)
 
 
 def model_lift(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> np.ndarray:

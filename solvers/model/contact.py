@@ -144,15 +144,19 @@ class ConfigurationTables:
     def _allocate(self, count: int) -> None:
         """Room for ``count`` configurations; the built ones are kept."""
         n, ncl, ns = self.n, self.ncl, self.ns
-        shapes = {"ci": ((layout.CI_HEAD + 3 * n,), np.int64), "cm": ((layout.CM_SIZE, n, n), float),
-                  "cp": ((layout.CP_SIZE, layout.PART_SIZE, 3 * max(n, ns), n + ncl), float),  # layout.CP_RAW
-                  "mk": ((ncl, layout.MK_SIZE), np.int64), "mon": ((ncl, 3 * n + 3 * ns + 1 + ncl), float)}
-        for name, (shape, dtype) in shapes.items():
-            grown = np.zeros((count, *shape), dtype=dtype)
-            if hasattr(self, name):
-                old = getattr(self, name)
-                grown[:old.shape[0]] = old
-            setattr(self, name, grown)
+
+        def grown(old: np.ndarray | None, shape: tuple[int, ...], dtype: type) -> np.ndarray:
+            new: np.ndarray = np.zeros((count, *shape), dtype=dtype)
+            if old is not None:
+                new[:old.shape[0]] = old
+            return new
+
+        self.ci: np.ndarray = grown(getattr(self, "ci", None), (layout.CI_HEAD + 3 * n,), np.int64)
+        self.cm: np.ndarray = grown(getattr(self, "cm", None), (layout.CM_SIZE, n, n), float)
+        self.cp: np.ndarray = grown(getattr(self, "cp", None),  # layout.CP_RAW
+                                    (layout.CP_SIZE, layout.PART_SIZE, 3 * max(n, ns), n + ncl), float)
+        self.mk: np.ndarray = grown(getattr(self, "mk", None), (ncl, layout.MK_SIZE), np.int64)
+        self.mon: np.ndarray = grown(getattr(self, "mon", None), (ncl, 3 * n + 3 * ns + 1 + ncl), float)
         self._record = None
 
     def _slot(self, mask: int) -> int:

@@ -368,6 +368,9 @@ class FollowerSpec:
     finger: FingerSpec | None = None
     lift: CamSpec | None = None
     oil: OilSpec | None = None
+    #: cam-follower friction coefficient (flat face: Coulomb sliding; roller: rolling traction, the bearing's
+    #: drag referred to the rim), see :mod:`vtool.solvers.studies.torque`
+    friction: float = 0.0
 
 
 @dataclass(frozen=True)

@@ -152,12 +152,19 @@ def spectrum(trace: Trace, quantity: str) -> Spectrum:
         raise InputError("--orders", quantity, "a quantity of this preset: qN (a coordinate), qN-qM or FN (the "
                          "contact force at the clearance ahead of qN)") from None
     start, cycles = whole_cycles(trace)
-    step = trace.spec.run.output_interval
+    return series_spectrum(quantity, unit, trace.cam_angle, values, start, cycles, trace.spec.run.output_interval,
+                           trace.spec.run.rpm)
+
+
+def series_spectrum(quantity: str, unit: str, cam_angle: np.ndarray, values: np.ndarray, start: float, cycles: int,
+                    step: float, rpm: float) -> Spectrum:
+    """The cam-order spectrum of rows ``values`` at ``cam_angle`` (deg) over ``cycles`` whole cycles from
+    ``start``, resampled every ``step`` deg (module doc); any series, e.g. a camshaft's summed torque."""
     per_cycle = max(int(round(REVOLUTION / step)), 4)
     n = per_cycle * cycles
     theta = start + np.arange(n) * (REVOLUTION * cycles / n)
-    angle, first = np.unique(trace.cam_angle, return_index=True)  # rows in angle order, one per angle
-    y = np.interp(theta, angle, values[first])
+    angle, first = np.unique(cam_angle, return_index=True)  # rows in angle order, one per angle
+    y = np.interp(theta, angle, np.asarray(values, dtype=float)[first])
     Y = np.fft.rfft(y)
     amplitude = np.abs(Y) * 2.0 / n
     amplitude[0] = abs(Y[0].real) / n
@@ -166,7 +173,7 @@ def spectrum(trace: Trace, quantity: str) -> Spectrum:
     phase = np.angle(Y)
     phase[0] = 0.0 if Y[0].real >= 0 else math.pi
     orders = np.arange(len(Y)) / cycles
-    return Spectrum(quantity, unit, orders, amplitude, phase, start, cycles, trace.spec.run.rpm)
+    return Spectrum(quantity, unit, orders, amplitude, phase, start, cycles, rpm)
 
 
 def natural_frequencies(trace: Trace) -> list[tuple[str, float]]:

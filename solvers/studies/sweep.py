@@ -749,6 +749,7 @@ class SweepFile:
 CRITERIA: dict[str, tuple[str, Callable[[float], bool], str]] = {
     "jump-speed": ("cam_separations", lambda v: v >= 1, "the follower leaves the cam during lift"),
     "bounce-speed": ("seat_bounces", lambda v: v >= 1, "the valve bounces on its seat"),
+    "coil-bind-speed": ("coil_bind_margin", lambda v: v <= 0.0, "a valve spring's coils touch (data-sheet spring)"),
 }
 
 
