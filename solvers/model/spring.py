@@ -229,7 +229,7 @@ def segment_gaps(s: SpringSpec, trace: object) -> np.ndarray:
     (the model's segment bars are unloaded at q = 0); <= 0: that segment's coils touch (coil bind)."""
     sign = compression_sign(trace, s.coordinate)
     ends = (0, *s.nodes, s.coordinate)
-    q = [np.zeros_like(trace.cam_angle, dtype=float) if k == 0 else trace.coordinate(k)  # type: ignore[attr-defined]
+    q = [np.zeros_like(trace.cam_angle, dtype=np.float64) if k == 0 else trace.coordinate(k)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
          for k in ends]
     free_gap = np.asarray(s.segment_coils) * (np.asarray(s.segment_pitches) - s.wire_diameter)
     return np.column_stack([free_gap[i] - sign * (q[i + 1] - q[i]) for i in range(len(free_gap))])
@@ -240,7 +240,7 @@ def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
     largest over the run and over the last cycle (min, max), the Goodman factor of the last cycle, surge."""
     angle = np.asarray(trace.cam_angle)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     last = angle >= angle[-1] - 360.0 if angle.size else angle.astype(bool)
-    u = trace.spec.unit_system  # type: ignore[attr-defined]
+    u = trace.spec.unit_system  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     units = {"length_unit": u.length, "force_unit": u.force, "stress_unit": u.pressure,
              "stiffness_unit": u.stiffness, "mass_unit": u.mass, "frequency_unit": "Hz", "angle_unit": "deg"}
     result = []
@@ -315,7 +315,7 @@ def coil_bind_margin(springs: tuple[SpringSpec, ...], trace: object, rows: np.nd
     minus the solid length, or a pitch segment's smallest coil gap when smaller (<= 0: coils touch)."""
     margins = []
     for s in springs:
-        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]
+        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
         length = s.rest_length - compression_sign(trace, s.coordinate) * q
         chosen = slice(None) if rows is None else rows
         if np.size(length[chosen]) == 0:
@@ -340,8 +340,8 @@ def surge_text(table: list[dict], units: object) -> list[str]:
         return []
     lines = ["", f"valve spring surge (fixed-fixed, (j/2) sqrt(k/m_a)), cam frequency {table[0]['cam_hz']:.4g} Hz:"]
     for row in table:
-        lines.append(f"  {row['spring']}: rate {row['rate']:.5g} {units.stiffness}, active mass "  # type: ignore[attr-defined]
-                     f"{row['active_mass']:.4g} {units.mass}: "  # type: ignore[attr-defined]
+        lines.append(f"  {row['spring']}: rate {row['rate']:.5g} {units.stiffness}, active mass "  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
+                     f"{row['active_mass']:.4g} {units.mass}: "  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
                      + ", ".join(f"{f:.1f} Hz (order {o:.1f})" for f, o in zip(row["surge_hz"], row["surge_order"],
                                                                               strict=True)))
     return lines
