@@ -176,6 +176,10 @@ class Backend(ABC, Generic[OptionsT]):
         return None
 
     @classmethod
+    def warm_up(cls, spec: MechanismSpec) -> None:  # noqa: B027 (optional hook)
+        """Compile (or load) what a run of ``spec`` will need, ahead of it (default: nothing)."""
+
+    @classmethod
     def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:
         """The settings an accuracy study runs this back end at (default: none; see
         :mod:`vtool.solvers.studies.accuracy`)."""

@@ -234,9 +234,9 @@ class ValveTrainScreen(DomainScreen):
         """Compile the solver for this preset's contact laws (or load it from numba's cache) while the
         screen is read, so that the first Run need not wait for it (a Run meanwhile waits for the same
         compile, its status line saying so)."""
-        from vtool.solvers.newmark.backend import compile_solver
+        from vtool.solvers.backends import get
 
-        compile_solver(spec)
+        get(spec.run.backend).warm_up(spec)
 
     # ----- run -----
     def start_run(self, spec: Any, run_id: int) -> Worker[Any]:
