@@ -176,9 +176,8 @@ class Backend(ABC, Generic[OptionsT]):
         return None
 
     @classmethod
-    def warm_up(cls, spec: MechanismSpec) -> None:
-        """Compile (or load from the cache) what a run of ``spec`` needs, ahead of the run (the TUI calls
-        it when a preset opens); default: nothing to compile."""
+    def warm_up(cls, spec: MechanismSpec) -> None:  # noqa: B027 (optional hook)
+        """Compile (or load) what a run of ``spec`` will need, ahead of it (default: nothing)."""
 
     @classmethod
     def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:

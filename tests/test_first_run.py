@@ -57,7 +57,7 @@ def test_the_private_name_check_finds_what_it_looks_for() -> None:
 
 def test_no_lock_files_and_no_switches_of_the_removed_machinery() -> None:
     text = "\n".join(path.read_text() for path in product_files())
-    for name in ("VTOOL_NATIVE", "VTOOL_LINK_ONLY", "VTOOL_TYPING_MEMO", "VTOOL_KERNEL", ".lock", "O_EXCL"):
+    for name in ("VTOOL_NATIVE", "VTOOL_LINK_ONLY", "VTOOL_TYPING_MEMO", "VTOOL_KERNEL", ".lock"):
         assert name not in text, name
 
 
