@@ -108,7 +108,7 @@ async def test_descriptor_stderr_changes_nothing_when_stderr_has_a_descriptor() 
     import os
     import sys
 
-    from vtool.app.tui.sweep import descriptor_stderr
+    from vtool.solvers.studies.sweep import descriptor_stderr
 
     class NoDescriptor:
         def fileno(self) -> int:

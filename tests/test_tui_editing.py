@@ -157,3 +157,19 @@ async def test_a_table_cam_preset_saved_from_the_tui_has_its_table_inline(tmp_pa
     expected = valvetrain.dump(load_preset("ramped-cam"))
     expected["run"]["rpm"] = 5000
     assert valvetrain.dump(saved) == expected
+
+
+async def test_focusing_the_first_field_while_the_rows_are_refilled_is_harmless() -> None:
+    """TUI monkey, seed 274: a preset opened while another screen mounted set the form's fields before
+    their rows existed, and focusing the first field raised KeyError from on_mount."""
+    from vtool.app.tui.form import Field
+
+    app = make_app("boom-brick-wall")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        screen.form.fields = [Field(("not", "mounted"), "no row yet"), *screen.form.fields]
+        screen.focus_first_field()
+        await pilot.pause()
+        assert app.focused is screen.form.row(screen.form.fields[1].path).editor
+    assert app._exception is None

@@ -226,8 +226,13 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):  # type: ignore
         self.focus_first_field()
 
     def focus_first_field(self) -> None:
-        if self.form.fields:
-            self.form.row(self.form.fields[0].path).editor.focus()
+        """Focus the first row the form shows, if any (a preset opened meanwhile may be refilling it:
+        its fields are set before its rows are mounted)."""
+        from vtool.app.tui.form import FieldRow
+
+        rows = self.form.query(FieldRow)
+        if rows:
+            rows.first().editor.focus()
 
     def on_source_changed(self, source: str) -> None:
         """Hook: a screen that keeps the preset's name elsewhere (the valve train's sweep tab) updates it."""

@@ -11,22 +11,18 @@ and :class:`SweepFinished`. *Cancel* stops between points, while checking or
 running, and keeps what finished; *Export CSV* writes the results atomically
 (same bytes as ``vtool sweep --csv``).
 
-With several workers the points run on a process pool. Textual replaces
-``sys.stderr`` with a stream that has no file descriptor, and multiprocessing
-hands ``sys.stderr``'s descriptor to the helper process it starts with a
-process's first pool ("bad value(s) in fds_to_keep"): the pool is made with
-an explicit stream (:func:`descriptor_stderr`), and its workers write their
-standard error to os.devnull, not over Textual's screen.
+With several workers the points run on a process pool whose workers write
+their standard error to os.devnull, not over Textual's screen. Textual
+replaces ``sys.stderr`` with a stream that has no file descriptor, which
+multiprocessing hands to the helper process it starts with a process's first
+pool ("bad value(s) in fds_to_keep"): the pool is made with an explicit
+stream (:func:`vtool.solvers.studies.sweep.descriptor_stderr`).
 """
 
 from __future__ import annotations
 
 import math
 import os
-import sys
-import threading
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -43,33 +39,6 @@ from vtool.app.tui.widgets import ChartView, ChoiceSelect, TextPanel
 DEFAULT_METRICS = ("spring_margin", "cam_separation_duration", "cam_separations", "lift_loss",
                    "seating_velocity_max", "seat_bounces", "bounce_height", "peak_F1", "peak_F2", "peak_F7",
                    "events", "wall_time")
-
-
-_STDERR_LOCK = threading.Lock()
-
-
-@contextmanager
-def descriptor_stderr() -> Iterator[None]:
-    """``sys.stderr`` a stream with a file descriptor (os.devnull) inside the block, when it has none.
-
-    For making a process pool under Textual (see the module doc). Outside an app
-    (a real ``sys.stderr``) nothing changes. Afterwards the replaced stream is put
-    back unless something else replaced ``sys.stderr`` meanwhile (the app ending).
-    """
-    try:
-        usable = sys.stderr is not None and sys.stderr.fileno() >= 0
-    except (AttributeError, OSError, ValueError):
-        usable = False
-    if usable:
-        yield
-        return
-    with _STDERR_LOCK, open(os.devnull, "w") as devnull:
-        replaced, sys.stderr = sys.stderr, devnull
-        try:
-            yield
-        finally:
-            if sys.stderr is devnull:
-                sys.stderr = replaced
 
 
 def failure_text(error: BaseException | None) -> str:
@@ -261,8 +230,7 @@ class SweepPane(Widget):
             self.post_message(SweepFinished(None, None, checked=checked[0]))
             return
         self.post_message(SweepProgressed(0, len(plan.points)))
-        with descriptor_stderr():  # the pool's helper processes start here
-            runner = make_runner(self.sweep_workers, stderr=os.devnull)
+        runner = make_runner(self.sweep_workers, stderr=os.devnull)  # its workers' stderr: not Textual's screen
         try:
             outcome = run_points(plan.points, runner, progress=lambda d, t: self.post_message(SweepProgressed(d, t)),
                                  cancel=lambda: worker.is_cancelled)
@@ -355,7 +323,9 @@ class SweepPane(Widget):
             return ""
         parts = []
         for criterion in CRITERIA:
-            words = CRITERIA[criterion][2]
+            metric, _, words = CRITERIA[criterion]
+            if not results or metric not in results[0].metrics:
+                continue  # a criterion on a metric this preset has not (coil bind without a coil spring)
             found = scan_intervals(results, "run.rpm", criterion)
             spans = ", ".join(f"{a:g}-{b:g}" if a != b else f"{a:g}" for a, b in found) or "at no scanned speed"
             parts.append(f"{words}: {spans}" + (" rev/min" if found else ""))

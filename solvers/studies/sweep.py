@@ -38,6 +38,7 @@ import math
 import os
 import signal
 import stat
+import threading
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
@@ -308,6 +309,38 @@ def _pool_start() -> Iterator[None]:
             signal.raise_signal(signum)
 
 
+_STDERR_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def descriptor_stderr() -> Iterator[None]:
+    """``sys.stderr`` a stream with a file descriptor (os.devnull) inside the block, when it has none.
+
+    multiprocessing hands ``sys.stderr.fileno()`` to the resource-tracker process it
+    starts with a process's first pool; a host that replaced ``sys.stderr`` with a stream
+    without a descriptor (Textual's TUI: ``fileno()`` is -1) got "bad value(s) in
+    fds_to_keep" from every pool. :class:`ProcessRunner` makes and starts its pool inside
+    this block. With a real ``sys.stderr`` nothing changes; afterwards the replaced stream
+    is put back unless something else replaced ``sys.stderr`` meanwhile.
+    """
+    import sys
+
+    try:
+        usable = sys.stderr is not None and sys.stderr.fileno() >= 0
+    except (AttributeError, OSError, ValueError):
+        usable = False
+    if usable:
+        yield
+        return
+    with _STDERR_LOCK, open(os.devnull, "w") as devnull:
+        replaced, sys.stderr = sys.stderr, devnull
+        try:
+            yield
+        finally:
+            if sys.stderr is devnull:
+                sys.stderr = replaced
+
+
 class ProcessRunner:
     """A forkserver process pool of ``workers`` processes that ignore Ctrl+C (the parent stops them);
     its helper processes import the installed ``vtool`` whatever the current folder holds
@@ -324,10 +357,11 @@ class ProcessRunner:
         context = multiprocessing.get_context("forkserver")
         context.set_forkserver_preload(["vtool.solvers.studies.sweep", backends.module_of(backends.DEFAULT)])
         self.workers = workers
-        self.ready = context.Semaphore(0)
         self.started = False
-        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt,
-                                        initargs=(self.ready, stderr))
+        with descriptor_stderr():  # the pool's first semaphore starts multiprocessing's resource tracker
+            self.ready = context.Semaphore(0)
+            self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt,
+                                            initargs=(self.ready, stderr))
 
     def start(self, timeout: float = 300.0) -> None:
         """Start every worker and wait until each runs (inside :func:`_pool_start`).
@@ -338,7 +372,7 @@ class ProcessRunner:
         """
         if self.started:
             return
-        with _pool_start():
+        with _pool_start(), descriptor_stderr():
             # each submission to a pool without an idle worker starts one
             futures = [self.pool.submit(os.getpid) for _ in range(self.workers)]
             deadline = time.perf_counter() + timeout
