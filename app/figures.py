@@ -134,7 +134,10 @@ def build_figure(items: Sequence[Drawable], caption: str = "") -> Any:
     FigureCanvasAgg(figure)
     subfigures = figure.subfigures(len(items), 1, height_ratios=heights, squeeze=False)[:, 0]
     for subfigure, item in zip(subfigures, items, strict=True):
-        (_draw_map if isinstance(item, HeatMap) else _draw_chart)(subfigure, item)
+        if isinstance(item, HeatMap):
+            _draw_map(subfigure, item)
+        else:
+            _draw_chart(subfigure, item)
     subject = next((i.subject for i in items if i.subject), "")
     if subject:
         figure.suptitle(subject, fontsize="large")

@@ -34,7 +34,7 @@ class Panel:
     yticks: Ticks | None = None  # positions and names (e.g. one lane per clearance)
 
 
-def _reset(plt) -> None:  # type: ignore[no-untyped-def]
+def _reset(plt) -> None:
     """Empty plotext's one global figure, subplots included (``clf`` clears only the active one)."""
     plt.main().clear_figure()  # the master figure: its __init__ forgets every subplot
 

@@ -60,7 +60,7 @@ def _html_checks(checks: tuple[Check, ...]) -> str:
             f"<th>outcome</th><th>margin / note</th></tr>{rows}</table>")
 
 
-def _inline_svg(charts) -> str:  # type: ignore[no-untyped-def]
+def _inline_svg(charts) -> str:
     from vtool.app.figures import svg_text
 
     text = svg_text(charts)

@@ -5,7 +5,7 @@ Run: ``python3 benchmarks/bench_suite_ab.py REF [--pairs N] [-k EXPRESSION]`` (N
 
 Each run is the suite of one commit (REF, then HEAD, alternating, so that a drift of the machine's
 speed slows both alike) in a fresh ``git archive`` of it, laid out as ``bench_compile_ab.py`` does
-and first on ``PYTHONPATH``: numba's cache, the native modules' folder and mypy's cache start
+and first on ``PYTHONPATH``: numba's cache and mypy's cache start
 empty, as in CI's fresh clone. Both run under the pytest and the libraries installed here (CI's
 fresh install may pick other versions: pyproject pins pytest below 9.2 for that reason). ``-k``
 passes a selection to pytest (to try the script on a few tests).

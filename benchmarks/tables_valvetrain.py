@@ -138,7 +138,7 @@ def warm_time(spec: MechanismSpec, repeat: int = 5) -> tuple[float, Trace]:
     return best, trace
 
 
-def speed_block(results: list[PresetStudy], second_process: tuple[float, float, int, int, bool] | None) -> str:
+def speed_block(results: list[PresetStudy], second_process: tuple[float, float] | None) -> str:
     """Default run (Newmark, the preset's step) of every preset, slowest first, and the exact back end."""
     body = []
     for r in results:
@@ -149,11 +149,10 @@ def speed_block(results: list[PresetStudy], second_process: tuple[float, float, 
     body.sort(key=lambda item: -item[0])
     rows = [cells for _, cells in body]
     if second_process is not None:
-        total, solve_time, misses, hits, native = second_process
-        how = ("on the kernel's native module, numba not imported" if native else
-               f"numba cache: {hits} hit(s), {misses} miss(es); a miss is a recompilation")
-        rows.append([f"`vtool solve gnilka-1a` in a second process, median of five ({how})",
-                     f"{solve_time * 1e3:.0f} in-process, {total * 1e3:.0f} with interpreter start-up", "", "", "", ""])
+        total, ratio = second_process
+        rows.append(["`vtool solve gnilka-1a` in a second process (numba's cache), median of seven",
+                     f"{total * 1e3:.0f} with interpreter start-up, {ratio:.2f} x `python3 -c \"import numpy, numba\"`",
+                     "", "", "", ""])
     head = ["preset (Newmark, the preset's dt, with refinement after events)", "warm wall time (ms)", "steps",
             "events", "exact back end, warm (ms)", "exact events"]
     return table(head, rows)
@@ -219,7 +218,7 @@ def deterministic(block: str) -> list[list[str]]:
             and "second process" not in row[0]]
 
 
-def blocks(results: list[PresetStudy], second_process: tuple[float, float, int, int, bool] | None) -> dict:
+def blocks(results: list[PresetStudy], second_process: tuple[float, float] | None) -> dict:
     """{(path, block name): Markdown}."""
     out = {(DOC, f"accuracy-{r.name.removeprefix('gnilka-')}"): accuracy_block(r) for r in results}
     out[(README, "accuracy-worst")] = worst_block(results)
@@ -242,7 +241,9 @@ def warm_up() -> None:
 
 def main(argv: list[str]) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from bench_newmark import ensure_native, second_process
+    import statistics
+
+    from bench_newmark import second_process
 
     warm_up()
     results = []
@@ -250,9 +251,8 @@ def main(argv: list[str]) -> None:
         started = time.perf_counter()
         results.append(study(name))
         print(f"{name}: {time.perf_counter() - started:.1f} s", file=sys.stderr)
-    ensure_native()  # a user's second run: numba's cache and the native module built (kernel_native)
-    second_process()  # and the bytecode written
-    generated = blocks(results, sorted(second_process() for _ in range(5))[2])  # the median of five
+    pairs = second_process()  # (solve, import numpy and numba) seconds, alternating
+    generated = blocks(results, (statistics.median(a for a, _ in pairs), statistics.median(a / b for a, b in pairs)))
     for (path, name), text in generated.items():
         if "--no-write" in argv:
             print(f"{path.name} {name}:\n{text}")

@@ -12,11 +12,10 @@ own speed and its [checks] (:mod:`vtool.solvers.model.camstress`,
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
-from vtool.markdown import read_block, replace_block, table
+from vtool.markdown import table, write_or_check
 from vtool.presets import load_preset
 from vtool.presets.valvetrain import with_run_overrides
 
@@ -93,27 +92,16 @@ def figure_bytes() -> bytes:
     return figure_bytes(build_figure(charts), "svg")
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    mode = parser.add_mutually_exclusive_group(required=True)
-    mode.add_argument("--write", action="store_true", help="rewrite the blocks and the figure")
-    mode.add_argument("--check", action="store_true", help="exit 1 if a block is not current")
-    args = parser.parse_args()
-    fresh = blocks()
-    if args.write:
-        from vtool.files import write_atomic_bytes
+def write_figure() -> None:
+    from vtool.files import write_atomic_bytes
 
-        for name, text in fresh.items():
-            changed = replace_block(DOC, name, text)
-            print(f"{name}: {'updated' if changed else 'unchanged'}", file=sys.stderr)
-        FIGURE.parent.mkdir(exist_ok=True)
-        write_atomic_bytes(FIGURE, figure_bytes(), "figure")
-        print(f"wrote {FIGURE.relative_to(ROOT)}", file=sys.stderr)
-        return 0
-    stale = [name for name, text in fresh.items() if read_block(DOC, name) != text]
-    for name in stale:
-        print(f"{name} is not current: run python benchmarks/trains_docs.py --write", file=sys.stderr)
-    return 1 if stale else 0
+    FIGURE.parent.mkdir(exist_ok=True)
+    write_atomic_bytes(FIGURE, figure_bytes(), "figure")
+    print(f"wrote {FIGURE.relative_to(ROOT)}", file=sys.stderr)
+
+
+def main() -> int:
+    return write_or_check(DOC, blocks, "benchmarks/trains_docs.py", __doc__.splitlines()[0], write_figure)
 
 
 if __name__ == "__main__":

@@ -142,7 +142,7 @@ def _load(doc: dict[str, Any], base: str | Path | None) -> BoomWallSpec | BoomFl
         if name not in known:
             raise InputError("criteria", name, f"one of: {', '.join(known)}")
         criteria.append(known[name])
-    boom = _boom(top.table("boom"), base)  # type: ignore[arg-type]
+    boom = _boom(top.table("boom"), base)
     design_table = top.table("design", required=False)
     design = _design(design_table) if design_table is not None else DesignRange()
     if kind == "boom_wall":

@@ -158,4 +158,4 @@ def check_units(units: UnitSystem) -> dict[str, str]:
     class _Spec:  # unit_of reads only .unit_system
         unit_system = units
 
-    return {name: unit_of(_Spec, kind.unit_kind) for name, kind in CHECKS.items()}  # type: ignore[arg-type]
+    return {name: unit_of(_Spec, kind.unit_kind) for name, kind in CHECKS.items()}  # type: ignore[arg-type]  # unit_of reads only .unit_system, which _Spec has

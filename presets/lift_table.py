@@ -74,7 +74,7 @@ def read_lift_table(field: str, name: str, folder: Path | None, unit: str) -> tu
             bad = sum(1 for c in cells if not _is_number(c))
             what = (f"{len(cells)} cell{'s' if len(cells) != 1 else ''}"
                     + (f", {bad} not a number" if bad else ""))
-            raise InputError(f"{field} line {number}", str(path),
+            raise InputError(f"{field} ({path.name}) line {number}", str(path),
                              f"two numbers per line, angle (deg) and lift ({unit}); this line has {what} "
                              "(its text is not shown)")
         angles.append(values[0])

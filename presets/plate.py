@@ -195,7 +195,7 @@ def _load(doc: dict[str, Any]) -> PlateSpec:
     notes = top.string("notes", default="", multiline=True)
     units_name = top.string("units", choices=tuple(UNIT_SYSTEMS))
     units = UNIT_SYSTEMS[units_name]
-    plate = _plate(top.table("plate"), units)  # type: ignore[arg-type]
+    plate = _plate(top.table("plate"), units)
     s = top.table("study")
     assert s is not None
     element = s.string("element", choices=tuple(ELEMENTS))

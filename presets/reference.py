@@ -131,6 +131,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         # [follower] and [checks] (presets/follower.py): the cam's shape and contact stress, limits
         "follower": "The cam's follower: its geometry gives the cam's shape and the contact stress.",
         "follower.kind": "A flat face or a roller.",
+        "follower.friction": "Friction coefficient of the cam-follower contact (its share of the drive torque).",
         "follower.arrangement": "Translating (bucket, tappet, roller lifter) or an end-pivot finger.",
         "follower.base_radius": "The cam's base-circle radius (profile).",
         "follower.width": "Length of the line contact (roller or lobe width).",
@@ -207,6 +208,28 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.spring.free_length": "Free length (with installed_length: the preload).",
         "train.spring.length": "The spring member's length (drawings; default the installed length).",
         "train.spring.elements": "Equal bar elements of the spring (surge modes).",
+        "train.spring.wire_diameter": "Data sheet: the round wire's diameter d (instead of rate and mass).",
+        "train.spring.coil_diameter": "Data sheet: mean coil diameter D (> 2 d).",
+        "train.spring.active_coils": "Data sheet: active coils n_a (rate G d^4/(8 D^3 n_a)).",
+        "train.spring.total_coils": "Data sheet: total coils (the wire's mass; solid length n_t d).",
+        "train.spring.solid_length": "Data sheet: solid length (default total_coils x wire_diameter).",
+        "train.spring.shear_modulus": "Data sheet: the wire's shear modulus G.",
+        "train.spring.density": "Data sheet: the wire's density (the spring's mass).",
+        "train.spring.tensile_strength": "Data sheet: the wire's tensile strength R_m at its diameter.",
+        "train.spring.fatigue_limit": "Data sheet: shear fatigue limit at zero mean (Goodman factor).",
+        "train.spring.shear_ratio": "Data sheet: ultimate shear over tensile strength (Goodman line's end).",
+        "train.spring.segment_coils": "Pitch diagram: active coils per segment, fixed end first (one bar each).",
+        "train.spring.segment_pitches": "Pitch diagram: each segment's free pitch (coil spacing).",
+        "train.spring.lengths": "Force-length table: lengths, decreasing (progressive spring).",
+        "train.spring.forces": "Force-length table: the force at each length.",
+        "train.spring.inner": "A nested inner spring in parallel: the same data-sheet keys.",
+        "checks.spring_stress_max": "Largest corrected shear stress of a data-sheet spring (Bergstraesser).",
+        "checks.spring_fatigue_min": "Smallest Goodman fatigue safety factor of a spring over the last cycle.",
+        "checks.coil_bind_margin_min": "Smallest length reached minus the solid length.",
+        "springs": "Data sheets of the valve springs (a train's data-sheet spring writes them).",
+        "springs[].name": "The spring's member name.",
+        "springs[].coordinate": "The coordinate of the spring's moving end (retainer).",
+        "springs[].nodes": "A pitch diagram's coordinates between its segments (fixed end first).",
         "train.cam": "The lift law at the cam (a finger's: the roller's radial lift).",
         "train.cam.law": "Harmonic (the thesis' cam), a lift table or the ramped polydyne.",
         "train.cam.angle_basis": "Angles in cam or crank degrees (crank: halved).",
@@ -222,6 +245,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.seat.position": "The seat's position on the valve coordinate.",
         "train.follower": "The follower's geometry ([follower]'s keys; the type sets its arrangement).",
         "train.follower.kind": "A flat face or a roller.",
+        "train.follower.friction": "Friction coefficient of the cam-follower contact (its share of the drive torque).",
         "train.follower.arrangement": "Set by the type (not given here).",
         "train.follower.base_radius": "The cam's base-circle radius (profile).",
         "train.follower.width": "Length of the line contact.",
@@ -362,6 +386,15 @@ MEANINGS: dict[str, dict[str, str]] = {
         "transient.truncation_check": "Check the exact superposition's truncation by doubling its modes.",
     },
 }
+# the explicit form's [[springs]] (a data sheet as a train writes it): the same keys as [train.spring]
+# and a nested [train.spring.inner]
+MEANINGS["valvetrain"] |= {
+    f"{table}.{key}": MEANINGS["valvetrain"][f"train.spring.{key}"]
+    for table in ("springs[]", "train.spring.inner")
+    for key in ("wire_diameter", "coil_diameter", "active_coils", "total_coils", "free_length", "installed_length",
+                "solid_length", "shear_modulus", "density", "tensile_strength", "fatigue_limit", "shear_ratio",
+                "lengths", "forces") + (("segment_coils", "segment_pitches") if table == "springs[]" else ())} | {
+    "train.spring.inner.elements": "Equal bar elements of the inner spring (surge modes)."}
 
 
 def _merge(into: dict[str, FieldRead], reads: dict[str, FieldRead]) -> None:

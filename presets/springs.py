@@ -27,14 +27,20 @@ retainer sees m/3 of it), split into ``elements`` equal elements.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from vtool.errors import InputError
 from vtool.presets.fields import Table
-from vtool.solvers.model.spring import SHEAR_RATIO, SpringSpec, segment_rates, wire_mass
+from vtool.solvers.model.spring import (
+    SHEAR_RATIO,
+    SpringSpec,
+    closing_forces,
+    segment_rates,
+    wire_mass,
+)
 from vtool.units import UnitSystem
 
 MAX_ELEMENTS = 64
@@ -97,16 +103,26 @@ def read_sheet(t: Table, units: UnitSystem, name: str, coordinate: int) -> Sprin
     """A data sheet's keys (module doc) checked: a :class:`vtool.solvers.model.spring.SpringSpec`."""
     L, P = units.length, units.pressure
     d = t.number("wire_diameter", unit=L, min_exclusive=0.0, max_value=1e3)
-    D = t.number("coil_diameter", unit=L, min_exclusive=2.0 * d, max_value=1e4)  # spring index D/d > 2
+    D = t.number("coil_diameter", unit=L, min_exclusive=0.0, max_value=1e4)
+    if D <= 2.0 * d:
+        raise InputError(t.field("coil_diameter"), D, f"> 2 wire_diameter ({2.0 * d:g}) (spring index D/d > 2)", L)
     n_t = t.number("total_coils", min_exclusive=0.0, max_value=1e3)
-    n_a = t.number("active_coils", min_exclusive=0.0, max_value=n_t)
+    n_a = t.number("active_coils", min_exclusive=0.0, max_value=1e3)
+    if n_a > n_t:
+        raise InputError(t.field("active_coils"), n_a, f"<= total_coils ({n_t:g})")
     free = t.number("free_length", unit=L, min_exclusive=0.0, max_value=1e4)
-    installed = t.number("installed_length", unit=L, min_exclusive=0.0, max_value=free)
-    solid = t.number("solid_length", unit=L, required=False, min_exclusive=0.0, max_exclusive=installed)
+    installed = t.number("installed_length", unit=L, min_exclusive=0.0, max_value=1e4)
+    if installed > free:
+        raise InputError(t.field("installed_length"), installed, f"<= free_length ({free:g})", L)
+    solid = t.number("solid_length", unit=L, required=False, min_exclusive=0.0, max_value=1e4)
+    if solid is not None and solid >= installed:
+        raise InputError(t.field("solid_length"), solid, f"< installed_length ({installed:g})", L)
     G = t.number("shear_modulus", unit=P, min_exclusive=0.0, max_value=1e16)
     rho = t.number("density", unit=units.density, min_exclusive=0.0, max_value=1e9)
     rm = t.number("tensile_strength", unit=P, min_exclusive=0.0, max_value=1e16)
-    fatigue = t.number("fatigue_limit", unit=P, required=False, min_exclusive=0.0, max_value=rm)
+    fatigue = t.number("fatigue_limit", unit=P, required=False, min_exclusive=0.0, max_value=1e16)
+    if fatigue is not None and fatigue > rm:
+        raise InputError(t.field("fatigue_limit"), fatigue, f"<= tensile_strength ({rm:g})", P)
     ratio = t.number("shear_ratio", default=SHEAR_RATIO, min_exclusive=0.0, max_value=1.0)
     coils: tuple[float, ...] = ()
     pitches: tuple[float, ...] = ()
@@ -155,6 +171,10 @@ def sheet_spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
     preload = rate = 0.0
     for table, name in springs:
         spec = read_sheet(table, units, name, end)
+        if spec.segment_coils and float(closing_forces(spec).min()) < spec.preload * (1.0 - 1e-12):
+            raise InputError(table.field("installed_length"), spec.installed_length,
+                             "a length at which no pitch segment is closed yet (the model's segments are linear "
+                             "bars)", units.length)
         elements = table.integer("elements", default=1, min_value=1, max_value=MAX_ELEMENTS)
         table.finish()
         x = position[0] + (0.0 if name == "valve_spring" else 0.05 * spec.installed_length)
@@ -166,6 +186,7 @@ def sheet_spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
                 coordinates.append({"name": f"{name} coil node {i + 1}", "motion": "translation"})
                 nodes.append(first_new + len(coordinates) - 1)
             nodes.append(end)
+            spec = replace(spec, nodes=tuple(nodes[1:-1]))
             share = spec.installed_length / spec.active_coils
             below = 0.0
             for i, (n_i, k_i) in enumerate(zip(spec.segment_coils, rates, strict=True)):
@@ -201,6 +222,7 @@ def sheet_document(spec: SpringSpec) -> dict[str, Any]:
         doc["solid_length"] = spec.solid_length_given
     if spec.segment_coils:
         doc["segment_coils"], doc["segment_pitches"] = list(spec.segment_coils), list(spec.segment_pitches)
+        doc["nodes"] = list(spec.nodes)
     if spec.table_lengths:
         doc["lengths"], doc["forces"] = list(spec.table_lengths), list(spec.table_forces)
     return doc
@@ -217,8 +239,16 @@ def load_sheets(top: Table, units: UnitSystem, n: int) -> tuple[SpringSpec, ...]
     for i, item in enumerate(raw):
         t = Table(item, f"springs[{i}]")
         name = t.string("name")
-        coordinate = t.integer("coordinate", min_value=1, max_value=n)
-        result.append(read_sheet(t, units, name, coordinate))
+        coordinate = t.integer("coordinate", min_value=1, max_value=10_000)
+        if coordinate > n:
+            raise InputError(t.field("coordinate"), coordinate, f"an elastic coordinate (1 .. {n})")
+        sheet = read_sheet(t, units, name, coordinate)
+        if sheet.segment_coils:
+            nodes = t.numbers("nodes")
+            if len(nodes) != len(sheet.segment_coils) - 1 or any(k != int(k) or not 1 <= k <= n for k in nodes):
+                raise InputError(t.field("nodes"), nodes, f"{len(sheet.segment_coils) - 1} coordinates in 1 .. {n}")
+            sheet = replace(sheet, nodes=tuple(int(k) for k in nodes))
+        result.append(sheet)
         t.finish()
     return tuple(result)
 
@@ -229,3 +259,12 @@ def describe(spec: SpringSpec, units: UnitSystem) -> str:
     return (f"{spec.name}: rate {spec.rate:.5g} {units.stiffness}, active mass {spec.active_mass:.4g} {units.mass} "
             f"(whole wire {spec.total_mass:.4g}), installed preload {spec.preload:.5g} {units.force}, "
             f"solid length {spec.solid_length:.4g} {units.length}, first surge {f:.5g} Hz")
+
+
+def describe_document(explicit: dict[str, Any]) -> list[str]:
+    """:func:`describe` of each data sheet of an expanded document (``vtool presets expand`` prints them)."""
+    from vtool.units import UNIT_SYSTEMS
+
+    units = UNIT_SYSTEMS[explicit["units"]]
+    n = len(explicit["coordinates"])
+    return [describe(s, units) for s in load_sheets(Table(explicit, ""), units, n)]

@@ -124,7 +124,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
 
     coordinates = _coordinates(top)
     n = len(coordinates)
-    cam = _cam(top.table("cam"), n, units, folder)  # type: ignore[arg-type]
+    cam = _cam(top.table("cam"), n, units, folder)
     seat_table = top.table("seat", required=False)
     seat = _seat(seat_table, n, cam, units) if seat_table is not None else None
     prescribed = {cam.coordinate} | ({seat.coordinate} if seat else set())
@@ -132,7 +132,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     clearances = _clearances(top, n, prescribed, cam.coordinate, units)
     names = {c.name: c for c in clearances}
     cam_name = next(c.name for c in clearances if c.behind == cam.coordinate)
-    initial = _initial(top.table("initial"), names, cam_name, units)  # type: ignore[arg-type]
+    initial = _initial(top.table("initial"), names, cam_name, units)
     damping_table = top.table("damping", required=False)
     if damping_table is None:
         warnings.warn(PresetWarning(
@@ -161,7 +161,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     from vtool.presets.springs import load_sheets
 
     springs = load_sheets(top, units, n)
-    run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)  # type: ignore[arg-type]
+    run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)
     top.finish()
     spec = MechanismSpec(
         title=title,
@@ -186,7 +186,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     if seat is not None and seat.lash is not None:
         from vtool.solvers.model.lash import seat_position
 
-        spec = replace(spec, seat=replace(spec.seat, position=float(seat_position(spec, seat.lash))))
+        spec = replace(spec, seat=replace(seat, position=float(seat_position(spec, seat.lash))))
     return spec
 
 
@@ -344,7 +344,7 @@ def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, An
         else:
             from vtool.presets.cam_scan import read_polyline
 
-            angles, lifts = read_polyline(t.field("polyline"), polyline, folder)  # type: ignore[arg-type]
+            angles, lifts = read_polyline(t.field("polyline"), polyline, folder)  # type: ignore[arg-type]  # a polyline here: lift_table and polyline are exclusive (checked above)
     else:
         angles = t.numbers("angles", unit="deg")
         lifts = t.numbers("lifts", unit=units.length)
@@ -546,7 +546,7 @@ def _damping(t: Table | None, names: dict[str, ClearanceSpec]) -> DampingSpec:
     return DampingSpec(factor, default_ratio, tuple(layers))
 
 
-def _quantity_names(coordinates, cam, seat, clearances) -> tuple[set[int], set[int]]:  # type: ignore[no-untyped-def]
+def _quantity_names(coordinates, cam, seat, clearances) -> tuple[set[int], set[int]]:
     numbers = {c.number for c in coordinates} | {cam.coordinate} | ({seat.coordinate} if seat else set())
     return numbers, {c.ahead for c in clearances}
 

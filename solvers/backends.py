@@ -147,7 +147,7 @@ def get(name: str) -> type[Backend[Any]]:
     ep = _entry_points().get(name)
     if ep is None:
         raise InputError("run.backend", name, f"one of the installed back ends: {', '.join(available())}")
-    return ep.load()  # type: ignore[no-any-return]
+    return ep.load()
 
 
 class Backend(ABC, Generic[OptionsT]):
@@ -174,6 +174,11 @@ class Backend(ABC, Generic[OptionsT]):
         """The line to show before a run of ``spec`` (and of it under the impact laws ``impacts``) that
         must first compile code, or None (default: nothing to compile)."""
         return None
+
+    @classmethod
+    def warm_up(cls, spec: MechanismSpec) -> None:
+        """Compile (or load from the cache) what a run of ``spec`` needs, ahead of the run (the TUI calls
+        it when a preset opens); default: nothing to compile."""
 
     @classmethod
     def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:

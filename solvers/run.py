@@ -124,7 +124,7 @@ def simulate(
     max_steps: float | None = None,
     max_bytes: float | None = None,
     stream: CsvStream | None = None,
-    before_run: Callable[[], None] | None = None,
+    before_run: Callable[[], object] | None = None,
 ) -> Trace:
     """Run the preset's back end (``spec.run.backend``) on the assembled mechanism.
 

@@ -14,6 +14,7 @@ import math
 import re
 import time as wallclock
 from dataclasses import dataclass, field
+from typing import Any, overload
 
 import numpy as np
 
@@ -259,7 +260,7 @@ class Trace:
             return self.coordinate(valve, rows) - self.coordinate(seat, rows)
         return self.coordinate(valve, rows) - self.spec.seat.position
 
-    def csv_columns(self, quantities: tuple[str, ...] = ()) -> tuple[list[str], list]:  # type: ignore[type-arg]
+    def csv_columns(self, quantities: tuple[str, ...] = ()) -> tuple[list[str], list]:
         """The CSV header (quantity names with units) and one function per numeric column that gives
         the column's values on a slice of rows (so a long run is written block by block).
 
@@ -293,8 +294,7 @@ class Trace:
             from vtool.solvers.model.camstress import row_unit, stress_rows
 
             cam = next(i for i, c in enumerate(self.spec.clearances) if c.behind == self.spec.cam.coordinate)
-            names = list(stress_rows(self.spec, self.cam_angle[:1], self.contact_force[:1, cam]))
-            for name in names:
+            for name in list(stress_rows(self.spec, self.cam_angle[:1], self.contact_force[:1, cam])):
                 header.append(f"cam_{name} ({row_unit(self.spec, name)})")
                 columns.append(lambda rows, name=name: stress_rows(
                     self.spec, self.cam_angle[rows], self.contact_force[rows, cam])[name])
@@ -322,7 +322,7 @@ class Trace:
         return csv_text([["" if number is None else number,
                           "+".join(closed_names(self.spec, mask)) or "none"]]).removesuffix("\n")
 
-    def write_csv_to(self, handle, quantities: tuple[str, ...] = (), chunk: int = 20_000,  # type: ignore[no-untyped-def]
+    def write_csv_to(self, handle, quantities: tuple[str, ...] = (), chunk: int = 20_000,
                      header: bool = True, compiled: bool | None = None) -> None:
         """Write the CSV in blocks of ``chunk`` rows (memory stays bounded by the block, not the run).
 
@@ -423,7 +423,7 @@ class Trace:
         for i, c in enumerate(self.spec.clearances):
             impacts = self.events_at(c.name, (CLOSED,))
             episodes = self.episodes(c.name)
-            entry = {
+            entry: dict[str, Any] = {
                 "clearance": c.name,
                 "force": self.force_label(i),
                 "state": c.state,
@@ -582,6 +582,10 @@ class Trace:
         return "\n".join(lines)
 
 
+@overload
+def cam_angle_deg(time: np.ndarray, omega: float) -> np.ndarray: ...
+@overload
+def cam_angle_deg(time: float, omega: float) -> float: ...
 def cam_angle_deg(time: np.ndarray | float, omega: float) -> np.ndarray | float:
     """Cam angle in degrees at time(s) t (s) for a cam speed omega (rad/s): an array for an array,
     a float for a float (with no array made for it: one per event)."""
@@ -609,7 +613,7 @@ class CsvStream:
     of every step. The file has every row; :attr:`rows` counts them.
     """
 
-    def __init__(self, handle, quantities: tuple[str, ...] = (), thin: bool = False) -> None:  # type: ignore[no-untyped-def]
+    def __init__(self, handle, quantities: tuple[str, ...] = (), thin: bool = False) -> None:
         self.handle = handle
         self.quantities = tuple(quantities)
         self.thin = thin

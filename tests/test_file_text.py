@@ -117,7 +117,7 @@ def test_a_lift_table_error_names_the_line_but_never_shows_it(tmp_path: Path, co
     table.write_text(content)
     result = run("solve", str(ramped_with_table(tmp_path, table)))
     line = one_line(result)
-    assert result.exit_code == 2 and words in line and str(table) in line
+    assert result.exit_code == 2 and words in line and f"({table.name})" in line
     assert SECRET not in result.output and "MATERIAL" not in result.stderr
 
 

@@ -36,3 +36,29 @@ def test_py_typed_is_shipped() -> None:
     assert (typing_tree.ROOT / "vtool" / "py.typed").exists()
     text = (typing_tree.ROOT / "pyproject.toml").read_text(encoding="utf-8")
     assert '"vtool" = ["py.typed"]' in text
+
+
+def test_no_error_code_is_switched_off_for_a_module() -> None:
+    """The gate is the whole package: no [[tool.mypy.overrides]] block disables error codes."""
+    import tomllib
+
+    config = tomllib.loads((typing_tree.ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    blocks = config["tool"]["mypy"].get("overrides", [])
+    assert [block["module"] for block in blocks if "disable_error_code" in block] == []
+    assert "-p vtool" in " ".join(typing_tree.MYPY_TARGETS) and len(typing_tree.MYPY_TARGETS) == 2
+
+
+def test_every_type_ignore_names_its_code_and_a_reason() -> None:
+    """``# type: ignore[code]  # why`` (or ``... [code] (why)``): never a bare ignore, never one without a word
+    on why."""
+    import re
+
+    bare = re.compile(r"#\s*type:\s*ignore(?!\[)")
+    no_reason = re.compile(r"#\s*type:\s*ignore\[[^\]]*\]\s*$")
+    found = []
+    for folder in ("vtool", *typing_tree.FOLDERS):
+        for path in sorted((typing_tree.ROOT / folder).rglob("*.py")):
+            for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+                if bare.search(line) or no_reason.search(line):
+                    found.append(f"{path.relative_to(typing_tree.ROOT)}:{number}: {line.strip()}")
+    assert found == [], "type: ignore without a code and a reason:\n" + "\n".join(found)

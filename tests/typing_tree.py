@@ -42,11 +42,15 @@ def tool_env(tree: Path = TREE) -> dict[str, str]:
     return env
 
 
+#: what mypy checks: the whole installed package
+MYPY_TARGETS = ("-p", "vtool")
+
+
 def run_mypy(tree: Path = TREE) -> subprocess.CompletedProcess[str]:
-    """mypy on vtool.solvers and vtool.presets with pyproject's configuration."""
+    """mypy on the whole vtool package with pyproject's configuration."""
     return subprocess.run(
         [sys.executable, "-m", "mypy", "--config-file", str(ROOT / "pyproject.toml"),
-         "--cache-dir", str(ROOT / ".mypy_cache"), "-p", "vtool.solvers", "-p", "vtool.presets"],
+         "--cache-dir", str(ROOT / ".mypy_cache"), *MYPY_TARGETS],
         cwd=tree, env=tool_env(tree), capture_output=True, text=True, check=False)
 
 

@@ -249,14 +249,14 @@ class Result:
         from vtool.app.figures import save_figure
         from vtool.presets.charts import trace_charts
 
-        return save_figure(trace_charts(self.trace), path, "path")
+        return save_figure(trace_charts(self.trace), Path(path), "path")
 
     def save_report(self, path: str | os.PathLike[str]) -> Path:
         """The run's report, .pdf or .html (``vtool report`` without a sweep)."""
         from vtool.app.report import write_report
         from vtool.presets.report import report_of_trace
 
-        return write_report(report_of_trace(self.trace), path, "path")
+        return write_report(report_of_trace(self.trace), Path(path), "path")
 
 
 @dataclass(frozen=True)

@@ -110,7 +110,7 @@ def choose(rows: int, compiled: bool | None) -> Formatter | None:
     if compiled is False:
         return None
     if compiled or rows >= WORTH_COMPILING_ROWS or ("numba" in sys.modules and ready()):
-        return kernel().put_rows  # type: ignore[no-any-return]
+        return kernel().put_rows
     return None
 
 
@@ -133,7 +133,7 @@ def arguments(values: np.ndarray, labels: list[str], label_of_row: np.ndarray) -
 
 
 def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
-            compiled: bool | None = None) -> list:  # type: ignore[type-arg]
+            compiled: bool | None = None) -> list:
     """The rows' UTF-8 text as a list of byte buffers (the kernel's, and Python's rows where it gave up)."""
     values = np.ascontiguousarray(values, dtype=np.float64)
     if values.ndim != 2:
@@ -174,7 +174,7 @@ def format_rows(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
     return b"".join(bytes(piece) for piece in pieces).decode("utf-8")
 
 
-def write_rows(handle, values: np.ndarray, labels: list[str], label_of_row: np.ndarray,  # type: ignore[no-untyped-def]
+def write_rows(handle, values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
                compiled: bool | None = None) -> None:
     """Write :func:`format_rows`'s text to a text handle; to a UTF-8 file's binary buffer directly
     (no text copy) when it has one."""

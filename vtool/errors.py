@@ -21,14 +21,18 @@ MAX_SHOWN = 80
 
 
 def shown(value: Any, limit: int = MAX_SHOWN) -> str:
-    """``repr(value)`` cut to ``limit`` characters, saying how long it was."""
+    """``repr(value)`` cut to ``limit`` characters, saying how long it was.
+
+    The middle is cut, not the end: a long file path keeps its file name.
+    """
     try:
         text = repr(value)
     except (ValueError, RecursionError):  # e.g. an int with more digits than repr allows
         text = f"<{type(value).__name__}>"
     if len(text) <= limit:
         return text
-    return f"{text[: limit - 3]}... ({len(text):,} characters)"
+    head = (limit - 3) // 2
+    return f"{text[:head]}...{text[len(text) - (limit - 3 - head):]} ({len(text):,} characters)"
 
 
 def one_line(text: str, limit: int = 300) -> str:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from vtool.files import write_atomic
@@ -103,3 +103,30 @@ def table_differences(committed: str, fresh: str, rel: float, decades: int = 0) 
                 continue
             out.append(f"line {r + 1}, column {col + 1}: committed {a}, generated {b}")
     return out
+
+
+def write_or_check(path: Path, blocks: Callable[[], dict[str, str]], script: str, description: str,
+                   after_write: Callable[[], None] | None = None) -> int:
+    """A docs script's command line: ``--write`` replaces each generated block of ``path`` with what
+    ``blocks()`` gives (then calls ``after_write``: figures), ``--check`` returns 1 (naming ``script``)
+    when one is not current."""
+    import argparse
+    import sys
+
+    parser = argparse.ArgumentParser(description=description)
+    mode = parser.add_mutually_exclusive_group(required=True)
+    mode.add_argument("--write", action="store_true", help="rewrite the blocks")
+    mode.add_argument("--check", action="store_true", help="exit 1 if a block is not current")
+    args = parser.parse_args()
+    fresh = blocks()
+    if args.write:
+        for name, text in fresh.items():
+            changed = replace_block(path, name, text)
+            print(f"{name}: {'updated' if changed else 'unchanged'}", file=sys.stderr)
+        if after_write is not None:
+            after_write()
+        return 0
+    stale = [name for name, text in fresh.items() if read_block(path, name) != text]
+    for name in stale:
+        print(f"{name} is not current: run python {script} --write", file=sys.stderr)
+    return 1 if stale else 0

@@ -77,7 +77,7 @@ def limited(threads: int | None = None) -> Iterator[None]:
 _CONTROLLERS: list = []
 
 
-def _controller():  # type: ignore[no-untyped-def]
+def _controller():
     """One ThreadpoolController per process: inspecting the loaded libraries costs about 30 ms,
     limiting with it afterwards about 0.1 ms."""
     if not _CONTROLLERS:

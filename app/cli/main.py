@@ -93,7 +93,7 @@ class LazyGroup(click.Group):
         module, attribute = COMMANDS[cmd_name]
         return getattr(importlib.import_module(module), attribute)
 
-    def invoke(self, ctx: click.Context):  # type: ignore[no-untyped-def]
+    def invoke(self, ctx: click.Context):
         with warnings.catch_warnings():
             # a library's deprecation notice is not the user's business: only our warnings are shown
             warnings.simplefilter("ignore", DeprecationWarning)
@@ -118,7 +118,7 @@ class LazyGroup(click.Group):
         """click's main, with usage errors on one line (``error: ...``, exit 2) instead of four."""
         standalone = kwargs.pop("standalone_mode", True)
         try:
-            result = super().main(*args, standalone_mode=False, **kwargs)
+            result = super().main(*args, standalone_mode=False, **kwargs)  # type: ignore[call-overload]  # click's overloads take no *args
             code = result if isinstance(result, int) else 0
         except click.exceptions.UsageError as exc:
             where = f" (see `{exc.ctx.command_path} --help`)" if exc.ctx is not None else ""
@@ -160,4 +160,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -53,6 +53,10 @@ def modes(preset: str, as_json: bool) -> None:
                 "surge": surge_labels(spec, layer.T @ layer.modes.shapes),
             }
         )
+    if spec.springs:
+        from vtool.solvers.model.spring import surge_table
+
+        report["spring_surge"] = surge_table(spec.springs, spec.run.rpm)
     if spec.seat is not None:
         from vtool.solvers.model.lash import lash_of
 
@@ -67,6 +71,11 @@ def modes(preset: str, as_json: bool) -> None:
     if spec.seat is not None:
         click.echo(f"seat position      = {spec.seat.position:.8g} {units.length}, "
                    f"lash {report['lash']['value']:.6g} {units.length} (follower clearance on the base circle)")
+    if spec.springs:
+        from vtool.solvers.model.spring import surge_text
+
+        for line in surge_text(report["spring_surge"], units):
+            click.echo(line)
     for layer, entry in zip(mechanism.all_layers(), report["layers"], strict=True):
         click.echo("")
         click.echo(f"Layer {layer.label()}  ({layer.size} coordinates)")

@@ -9,7 +9,7 @@ import click
 from vtool.solvers.model.spec import IMPACT_LAWS, START_VELOCITIES
 
 
-def _choices(field: str, allowed: tuple[str, ...]):  # type: ignore[no-untyped-def]
+def _choices(field: str, allowed: tuple[str, ...]):
     def convert(ctx: click.Context, param: click.Parameter, value: str | None) -> tuple[str, ...] | None:
         if value is None:
             return None
@@ -32,7 +32,7 @@ start_option = click.option(
     help=f"Start velocities to compare (comma-separated from {', '.join(START_VELOCITIES)}); default: the preset's.")
 
 
-def _figure_path(ctx: click.Context, param: click.Parameter, value: str | None):  # type: ignore[no-untyped-def]
+def _figure_path(ctx: click.Context, param: click.Parameter, value: str | None):
     if value is None:
         return None
     from vtool.app.figures import check_output
@@ -46,7 +46,7 @@ figure_option = click.option(
          "events marked, black-and-white readable).")
 
 
-def write_figure(items, path) -> None:  # type: ignore[no-untyped-def]
+def write_figure(items, path) -> None:
     """Draw chart data to ``path`` (checked by the option) and say so on stderr."""
     if path is None:
         return

@@ -67,4 +67,9 @@ def expand_command(name: str) -> None:
         return
     explicit = expand(doc, path.parent)
     click.echo(f"# {path.stem}: the explicit model of its [train] (vtool presets expand; presets/trains.py)")
+    if explicit.get("springs"):
+        from vtool.presets.springs import describe_document
+
+        for line in describe_document(explicit):
+            click.echo(f"# {line}")
     click.echo(tomli_w.dumps(explicit), nl=False)

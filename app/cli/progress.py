@@ -6,6 +6,7 @@ from __future__ import annotations
 import sys
 import threading
 import time
+from typing import Any
 
 import click
 
@@ -17,7 +18,7 @@ class DelayedProgress:
         self.label = label
         self.delay = delay
         self.started = time.perf_counter()
-        self.bar = None
+        self.bar: Any = None  # click's progress bar, once shown
         self.shown = 0
         # a bar on a file or pipe is one label with no newline, which would run into an error line
         self.interactive = sys.stderr.isatty()

@@ -14,7 +14,7 @@ estimated and refused above ``--max-steps`` before the back end starts
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -23,6 +23,9 @@ from vtool.errors import InputError
 from vtool.solvers.backends import available
 from vtool.solvers.cost import MAX_SCIPY_STEPS, MAX_STEPS
 from vtool.solvers.model.spec import IMPACT_LAWS, START_VELOCITIES
+
+if TYPE_CHECKING:
+    from vtool.solvers.trace import CsvStream
 
 
 def _max_steps(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
@@ -143,12 +146,13 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
             from vtool.solvers.parquet import ParquetStream
 
             with open_atomic_binary(csv_path, "--out") as binary:
-                stream = ParquetStream(binary, spec.run.quantities, thin=every_step, title=spec.title)
+                parquet_stream = ParquetStream(binary, spec.run.quantities, thin=every_step, title=spec.title)
+                stream: CsvStream = parquet_stream
                 try:
                     trace = simulate(spec, every_step=every_step, progress=progress, max_steps=max_steps,
                                      stream=stream, before_run=before_run)
                 finally:  # the writer's footer goes to the temporary file before it is renamed (or removed)
-                    stream.close()
+                    parquet_stream.close()
         else:  # rows go to the temporary file as the run makes them; renamed over the target at the end
             from vtool.files import open_atomic
             from vtool.solvers.trace import CsvStream
@@ -197,13 +201,14 @@ def run_valvetrain(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, 
 
             click.echo(order_chart(spectrum, natural_frequencies(trace)))
     if figure is not None:
-        from vtool.presets.charts import order_chart, trace_charts
+        from vtool.presets.charts import order_chart as order_chart_data
+        from vtool.presets.charts import trace_charts
 
         charts = trace_charts(trace)
         if spectrum is not None:  # the --orders spectrum, natural frequencies marked
             from vtool.solvers.studies.orders import natural_frequencies
 
-            charts.append(order_chart(spectrum, natural_frequencies(trace), subject=trace.spec.title))
+            charts.append(order_chart_data(spectrum, natural_frequencies(trace), subject=trace.spec.title))
         write_figure(charts, figure)
 
 

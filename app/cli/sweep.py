@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -18,7 +19,7 @@ class CountProgress:
 
     def __init__(self, label: str) -> None:
         self.label = label
-        self.bar = None
+        self.bar: Any = None  # click's progress bar, once shown
         self.shown = 0
 
     def __call__(self, done: int, total: int) -> None:
@@ -55,9 +56,10 @@ def _scheduler(ctx: click.Context, param: click.Parameter, value: str | None) ->
               help="Swept field (dotted preset path, e.g. run.rpm, members.valve_spring.stiffness, "
                    "clearances[2].restitution) and its values: start:stop:step (stop included) or a,b,c. "
                    "Several --set make a grid.")
-@click.option("--find", "find", type=click.Choice(["jump-speed", "bounce-speed"]),
+@click.option("--find", "find", type=click.Choice(["jump-speed", "bounce-speed", "coil-bind-speed"]),
               help="Bracket and bisect (to 1 rev/min) every cam-speed interval where the follower leaves the "
-                   "cam during lift (jump-speed) or the valve bounces on its seat (bounce-speed), each run to "
+                   "cam during lift (jump-speed), the valve bounces on its seat (bounce-speed) or a data-sheet "
+                   "valve spring's coils touch (coil-bind-speed), each run to "
                    f"steady state; --set run.rpm gives the scan (default {DEFAULT_SCAN}), other --set fields a "
                    "grid of searches.")
 @click.option("--workers", type=int, callback=_workers,
@@ -142,6 +144,8 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         raise InputError("--campbell", campbell, "a sweep over run.rpm")
     if find == "bounce-speed" and seat_index(plan.spec) is None:
         raise InputError("--find", find, "a preset with a valve seat (this one has none)")
+    if find == "coil-bind-speed" and not getattr(plan.spec, "springs", ()):
+        raise InputError("--find", find, "a preset with a data-sheet valve spring ([train.spring] wire_diameter ...)")
     names = {name: unit for name, unit in metric_columns(plan.spec)}
     if metric not in names:
         raise InputError("--metric", metric, f"one of: {', '.join(names)}")
@@ -232,7 +236,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         write_figure(items, figure_path)
 
 
-def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):  # type: ignore[no-untyped-def]
+def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):
     """The sweep with its points written to a Parquet file as they finish (renamed into place at the end)."""
     from vtool.files import open_atomic_binary
     from vtool.solvers.parquet import SweepParquet
@@ -244,7 +248,7 @@ def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):  # 
         # (run_points finishes the sink, footer included, also when interrupted: the file is then removed)
 
 
-def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # type: ignore[no-untyped-def]
+def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:
     """One speed search per grid point of the fields other than run.rpm."""
     from vtool.files import write_atomic
     from vtool.presets.valvetrain import with_run_overrides
@@ -268,13 +272,15 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
         if key and not as_json:
             click.echo(", ".join(f"{k} = {format_value(v)}" for k, v in key))
 
-        def report(b):  # type: ignore[no-untyped-def]
+        def report(b):
             if not as_json:
                 click.echo(f"  {b.stage:<6} {b.rpm:>9g} rev/min  {'holds' if b.holds else 'no':<5}  "
                            f"({format_value(b.value)})")
 
-        result = find_speed(criterion, lambda rpm, spec=spec: with_steady(with_run_overrides(spec, rpm=rpm)),
-                            scan, runner, every_step=every_step, report=report)
+        def at_speed(rpm: float, spec: Any = spec) -> Any:
+            return with_steady(with_run_overrides(spec, rpm=rpm))
+
+        result = find_speed(criterion, at_speed, scan, runner, every_step=every_step, report=report)
         if not as_json:
             for interval in result.intervals:
                 click.echo(f"  interval: {interval.text()}")
@@ -303,14 +309,14 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:  # ty
         write_atomic(csv_path, buffer.getvalue())
 
 
-def _with_settings(plan, steady: bool, orders: tuple[str, ...]):  # type: ignore[no-untyped-def]
+def _with_settings(plan, steady: bool, orders: tuple[str, ...]):
     """The plan with every point (and its base spec) run to steady state and reporting these order amplitudes."""
     import dataclasses
 
     from vtool.solvers.studies.orders import with_orders
     from vtool.solvers.studies.steady import with_steady
 
-    def change(spec):  # type: ignore[no-untyped-def]
+    def change(spec):
         spec = with_orders(spec, orders) if orders else spec
         return with_steady(spec) if steady else spec
 

@@ -7,12 +7,13 @@ Textual mode (f2 / f3 / f4): switching keeps each screen's form and results.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, ClassVar
 
 from textual.app import App
 from textual.binding import Binding, BindingType
-from textual.screen import ModalScreen
+from textual.screen import ModalScreen, Screen
 
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.dialogs import ErrorDialog, HelpScreen, OpenDialog
@@ -24,7 +25,7 @@ from vtool.presets.kinds import KINDS, kind_named, resolve
 
 def screen_for_kind(kind: str) -> type[DomainScreen]:
     """The screen that shows presets of ``kind`` (the kinds table's screen module)."""
-    return resolve(kind_named(kind).screen).SCREEN  # type: ignore[no-any-return]  # a module's SCREEN class
+    return resolve(kind_named(kind).screen).SCREEN
 
 
 #: the app's modes (one per screen, several kinds may share one), in the kinds table's order
@@ -41,8 +42,8 @@ class VtoolApp(App[None]):
     CSS_PATH = "vtool.tcss"
     TITLE = "vtool"
     ENABLE_COMMAND_PALETTE = False
-    HORIZONTAL_BREAKPOINTS: ClassVar[list[tuple[int, str]] | None] = [(0, "-narrow"), (120, "-wide"), (170, "-huge")]
-    MODES: ClassVar[dict[str, Any]] = dict(SCREENS_BY_MODE)
+    HORIZONTAL_BREAKPOINTS: list[tuple[int, str]] | None = [(0, "-narrow"), (120, "-wide"), (170, "-huge")]
+    MODES: ClassVar[dict[str, str | Callable[[], Screen[Any]]]] = dict(SCREENS_BY_MODE)
     BINDINGS: ClassVar[list[BindingType]] = [
         Binding("ctrl+o", "open", "Open", priority=True),
         Binding("f1", "help", "Help"),

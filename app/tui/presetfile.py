@@ -74,7 +74,8 @@ FileReference = tuple[tuple[str, ...], str, tuple[str, ...]]
 def _inline(doc: Any, edited: dict[str, Any], references: Sequence[FileReference]) -> None:
     """Replace each file reference of ``doc`` (tomlkit) by the inline values of ``edited``."""
     for table, key, inline_keys in references:
-        node, values = doc, edited
+        node: Any = doc
+        values: Any = edited
         for name in table:
             node = node.get(name) if isinstance(node, dict) else None
             values = values.get(name) if isinstance(values, dict) else None

@@ -346,7 +346,7 @@ class SweepPane(Widget):
         return self.query_one("#sweep-intervals", Static)
 
     @staticmethod
-    def _intervals_text(results: Any, axes: list) -> str:  # type: ignore[type-arg]
+    def _intervals_text(results: Any, axes: list) -> str:
         """The speed intervals of a one-field sweep over run.rpm where the follower leaves the cam or the valve
         bounces, on the scanned speeds (``vtool sweep --find`` bisects their edges)."""
         from vtool.solvers.studies.sweep import CRITERIA, scan_intervals

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Literal
 
 from rich.text import Text
 from textual.app import ComposeResult
@@ -73,7 +74,7 @@ class TextPanel(ScrollableContainer):
         self._initial = text
         self.text = text
 
-    def compose(self):  # type: ignore[no-untyped-def]
+    def compose(self):
         yield Static(Text(self._initial, no_wrap=True), markup=False)
 
     def set_text(self, text: str) -> None:
@@ -112,7 +113,7 @@ class _PagingOverlay(SelectOverlay):
     nothing here.
     """
 
-    def _move_page(self, direction: int) -> None:
+    def _move_page(self, direction: Literal[-1, 1]) -> None:
         if (self.highlighted or 0) not in self._index_to_line:
             return
         super()._move_page(direction)

@@ -89,7 +89,7 @@ class Mesh:
     def element_dofs(self, ex: int, ey: int) -> np.ndarray:
         """Global DOF numbers of element (ex, ey) in the element's corner-major order."""
         ndof = self.element.dofs_per_node
-        out = []
+        out: list[int] = []
         for cx, cy in CORNERS:
             base = self.node(ex + cx, ey + cy) * ndof
             out.extend(range(base, base + ndof))

@@ -149,7 +149,7 @@ def _histories(t: np.ndarray, shapes: np.ndarray, qs: np.ndarray, omega: np.ndar
 def step_histories(
     plate: Plate, load: str, n_modes: int = 200, *,
     at: tuple[float, float] | None = None, point: tuple[float, float] | None = None,
-) -> Callable[[np.ndarray], tuple[np.ndarray, ...]]:
+) -> Callable[[np.ndarray | float], tuple[np.ndarray, ...]]:
     """``t -> (displacement, velocity, acceleration)`` per unit load of :func:`step_response`'s full
     series, its modes computed once: for evaluating the exact response at chosen instants (a peak
     refined between samples)."""
@@ -182,7 +182,7 @@ def step_response(
 
     changes = [change(f, c) for f, c in zip(full, coarse, strict=True)]
     return ExactResponse(
-        t, *full, n_modes=n_modes, change_displacement=changes[0],
+        t, full[0], full[1], full[2], n_modes=n_modes, change_displacement=changes[0],
         change_velocity=changes[1], change_acceleration=changes[2],
         acceleration_converged=(load == "uniform" and changes[2] <= CONVERGED_CHANGE),
     )

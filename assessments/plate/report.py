@@ -81,7 +81,7 @@ def cost_table(result: StudyResult) -> str:
     ref = max(free, key=lambda f: f.size)
     lines = ["Table 4  computing time against KS (this machine; ratios against the largest case)",
              f"{'case':<5} {'KS':>4} {'eigen ms':>10} {'ratio':>8}   {'RK4 at wmax*h':<14} {'steps':>7} {'loop ms':>9} {'(2KS)^2 x steps':>16}"]
-    rk = {}
+    rk: dict[str, list[Any]] = {}
     for r in result.transient:
         if r.load == result.study.transient.loads[0] and not math.isnan(r.omega_max_h):
             rk.setdefault(r.case, []).append(r)
@@ -278,16 +278,16 @@ def study_csv(result: StudyResult) -> str:
     for r in result.convergence:
         rows.append(["convergence", f"{r.element}-{r.n}x{r.n}", r.size, "", "", "fundamental_error", "1-1",
                      f"{r.fundamental_error_pct:.6g}", "%"])
-    for r in result.transient:
-        wh = "modal" if math.isnan(r.omega_max_h) else f"{r.omega_max_h:g}"
-        for suffix, errors in (("_peak_error", r.errors_pct), ("_peak_error_4n_modes", r.errors_4n_pct),
-                               ("_peak_error", r.signed_pct)):
+    for t in result.transient:
+        wh = "modal" if math.isnan(t.omega_max_h) else f"{t.omega_max_h:g}"
+        for suffix, errors in (("_peak_error", t.errors_pct), ("_peak_error_4n_modes", t.errors_4n_pct),
+                               ("_peak_error", t.signed_pct)):
             for q, v in errors.items():
                 value = "" if math.isnan(v) else f"{v:.6g}"
                 name = q.replace("+", "_positive").replace("-", "_negative")
-                rows.append(["transient", r.case, r.size, r.load, wh, f"{name}{suffix}", "", value, "%"])
-        rows.append(["cost", r.case, r.size, r.load, wh, "time_loop", "", f"{r.seconds:.6g}", "s"])
-        rows.append(["cost", r.case, r.size, r.load, wh, "steps", "", r.steps, "1"])
+                rows.append(["transient", t.case, t.size, t.load, wh, f"{name}{suffix}", "", value, "%"])
+        rows.append(["cost", t.case, t.size, t.load, wh, "time_loop", "", f"{t.seconds:.6g}", "s"])
+        rows.append(["cost", t.case, t.size, t.load, wh, "steps", "", t.steps, "1"])
     return csv_text(rows)
 
 

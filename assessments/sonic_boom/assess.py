@@ -235,7 +235,7 @@ def assess(spec: BoomWallSpec | BoomFloorSpec, cancel: Cancel | None = None) -> 
             for crit in spec.criteria:
                 daf = _lookup(table, crit.response, tau * freqs)
                 S = _static_per_pressure(st, freqs)
-                p = allowable_pressure(crit, daf, freqs, S, units.metres_per_length)
-                curves.append(DesignCurve(st.name, crit.name, tau, freqs, p))
+                pressures = allowable_pressure(crit, daf, freqs, S, units.metres_per_length)
+                curves.append(DesignCurve(st.name, crit.name, tau, freqs, pressures))
     return Assessment(spec.kind, spec.title, units, statement, structures, tuple(rows),
                       tuple(curves), spec.criteria)

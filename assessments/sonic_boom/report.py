@@ -77,7 +77,7 @@ def limits_text(a: Assessment, answer_first: bool = False) -> str:
     details += [structure_line(s, u) for s in a.structures]
     header = (*ROW_HEADER, f"limit/DAF [{u.length}/s | {u.length}]", f"p+ [{u.pressure}]",
               f"p+ [{u.alt_pressure}]", "note")
-    table = [header]
+    table: list[tuple[str, ...]] = [header]
     for r in a.rows:
         note = ", ".join(n for n, on in (("tentative", r.tentative),
                                          ("f outside criterion range", not r.in_range)) if on)

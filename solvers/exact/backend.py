@@ -301,18 +301,18 @@ class _ExactRun(PiecewiseRun):
             slope_rate = float((GAV[k, prop.drift_x] @ drift).real) if drift.size else 0.0
             forcing = self.forced_part(ss, forced, t)
 
-            def both(tau: float) -> tuple[float, float]:
+            def drifting_both(tau: float) -> tuple[float, float]:
                 value, rate = (coefficients @ np.exp(lam * tau)).real
                 at, rate_at = forcing(tau)
                 return float(value) + slope * tau + at, float(rate) + slope_rate * tau + rate_at
 
-            def value(tau: float) -> float:
-                return both(tau)[0]
+            def drifting_value(tau: float) -> float:
+                return drifting_both(tau)[0]
 
-            def rate(tau: float) -> float:
-                return both(tau)[1]
+            def drifting_rate(tau: float) -> float:
+                return drifting_both(tau)[1]
 
-            return value, rate, both
+            return drifting_value, drifting_rate, drifting_both
 
         def value(tau: float) -> float:
             return float((GV[k] @ prop.at(h, tau)).real + forced @ ss.basis(t + tau))
@@ -384,6 +384,7 @@ class _ExactRun(PiecewiseRun):
         self.track_overlap(ss, np.concatenate([base_v[:, None], values], axis=1))
         taus = np.concatenate([[0.0], taus])
         values = np.concatenate([base_v[:, None], values], axis=1) - self.problem.gap_noise
+        assert ss.compliant is not None  # (a configuration with compliant contacts: set by state_space)
         for k, first, last in peak_brackets(values, ss.compliant, self.peak_overlap):
             value, rate, _ = self.monitor(ss, cfg, t, h, k)
             low, high = float(taus[first]), float(taus[last])
@@ -393,8 +394,8 @@ class _ExactRun(PiecewiseRun):
 
     def outputs(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, times: list[float]) -> None:
         if times:
-            times = np.array(times)
-            self.emit_rows(ss, cfg, times, cfg.prop(h, times - t))
+            at = np.array(times)
+            self.emit_rows(ss, cfg, at, cfg.prop(h, at - t))
 
     def emit_rows(self, ss: StateSpace, cfg: _Config, times: np.ndarray, hs: np.ndarray) -> None:
         """Output rows at ``times`` (ascending) from the homogeneous states ``hs`` (columns): the rows'

@@ -186,12 +186,14 @@ class PiecewiseRun(ABC):
         return self.spaces[mask]
 
     def full_state(self, ss: StateSpace, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        assert ss.P is not None and ss.Q is not None  # (set by state_space)
         z = ss.P @ y + ss.harmonic(ss.Q, t)
         return z[:self.n], z[self.n:2 * self.n], z[2 * self.n:]
 
     def monitors(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
         """Monitor values (rigid contact force or compliant overlap if closed, gap if open) at t;
         columns for arrays of t."""
+        assert ss.G is not None and ss.H is not None  # (set by state_space)
         linear = ss.G @ y + ss.harmonic(ss.H, t)
         if ss.hertz is None or not ss.hertz.size or ss.hertz_force is None:
             return linear
@@ -201,6 +203,7 @@ class PiecewiseRun(ABC):
 
     def forces(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
         """Contact forces (0 for an open clearance) at t; columns for arrays of t."""
+        assert ss.GF is not None and ss.HF is not None  # (set by state_space)
         linear = ss.GF @ y + ss.harmonic(ss.HF, t)
         if ss.hertz is None or not ss.hertz.size or ss.hertz_force is None:
             return linear
@@ -209,7 +212,7 @@ class PiecewiseRun(ABC):
     def hertz_forces(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
         """Forces of the closed Hertz contacts (the kernel's ``hertz_law``) at t; columns for arrays of t."""
         rows = ss.hertz
-        assert ss.G is not None and ss.H is not None
+        assert ss.G is not None and ss.H is not None and rows is not None
         nf = ss.size // 2
         delta = ss.G[rows] @ y + ss.harmonic(ss.H[rows], t) - self.problem.gap_noise
         rate = ss.G[rows, :nf] @ y[nf:] + ss.H[rows] @ ss.basis_rate(t)
@@ -280,7 +283,7 @@ class PiecewiseRun(ABC):
 
     def output_times(self, t0: float, t1: float) -> list[float]:
         """Requested output instants in (t0, t1] not yet written (and t = 0 at the start)."""
-        times = []
+        times: list[float] = []
         while True:
             t = self.next_out * self.out_dt
             if t > t1 * (1 + 1e-12) or t > self.t_end * (1 + 1e-12):
@@ -410,7 +413,7 @@ class PiecewiseBackend(Backend[OptionsT]):
 
     def integrate(self, problem: ContactProblem, options: OptionsT, builder: TraceBuilder,
                   progress: Progress | None, cancel: Cancel | None) -> RunStats:
-        run = self.run_class(problem, options, builder)  # type: ignore[call-arg]
+        run = self.run_class(problem, options, builder)  # type: ignore[call-arg, arg-type]  # a subclass: (problem, options, builder)
         run.execute(progress, cancel)
         return run.statistics(self.settings(options))
 

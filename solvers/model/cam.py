@@ -175,9 +175,10 @@ def fit_table(angles_deg: np.ndarray, lifts: np.ndarray, harmonics: int | None =
                 fitted += a[K - 1] * np.cos(K * theta) + b[K - 1] * np.sin(K * theta)
                 error = np.abs(lift - fitted).max()
             else:
+                assert projection is not None  # (made above when the angles are not uniform)
                 x = np.linalg.solve(R[: 2 * K + 1, : 2 * K + 1], projection[: 2 * K + 1])
                 error = np.abs(lift - Q[:, : 2 * K + 1] @ projection[: 2 * K + 1]).max()
-            if error <= tolerance:  # type: ignore[operator]
+            if error <= tolerance:
                 if uniform:
                     a, b = a[:K].copy(), b[:K].copy()
                 else:
@@ -329,7 +330,7 @@ def junction_warning(angles_deg: np.ndarray, lifts: np.ndarray, field: str = "ca
 MATTERS = 0.01  # a harmonic matters when its acceleration amplitude is >= 1 % of the largest
 
 
-def cam_report(spec, points: int = 3600, top: int = 8) -> dict:  # type: ignore[no-untyped-def]
+def cam_report(spec, points: int = 3600, top: int = 8) -> dict:
     """What ``vtool cam show`` prints: fit, extremes at the preset's speed, spectrum, junctions.
 
     Derivatives are of the fitted series (what the solver sees); at the run's
@@ -398,7 +399,7 @@ def report_text(report: dict) -> str:
     return "\n".join(lines)
 
 
-def table_start(spec, harmonic, omega: float):  # type: ignore[no-untyped-def]
+def table_start(spec, harmonic, omega: float):
     """The static start of a table cam, from the harmonic rule's start ``harmonic``.
 
     :func:`vtool.solvers.model.initial.static_start` places the harmonic cam at

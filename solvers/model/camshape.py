@@ -251,7 +251,7 @@ def finger_angle(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> np.
         F = dist - g.R0 - L
         slope = du + dL * ddelta
         if np.any(slope <= 0.0):
-            raise InputError("follower.roller_arm", follower.finger.roller_arm,  # type: ignore[union-attr]
+            raise InputError("follower.roller_arm", follower.finger.roller_arm,  # type: ignore[union-attr]  # a finger follower here (checked by the caller)
                              "a finger geometry whose roller moves away from the cam as it turns "
                              "(the contact condition has no unique root)")
         step = F / slope
@@ -352,7 +352,7 @@ def model_lift(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> np.nd
 
 # ----- reports (``vtool cam show``) ------------------------------------------------------------------
 
-def shape_report(spec, points: int = 3600) -> dict:  # type: ignore[no-untyped-def]
+def shape_report(spec, points: int = 3600) -> dict:
     """The cam's shape for ``vtool cam show``: base radius, curvature, undercut, pressure angle, ratio."""
     follower = spec.follower
     law = spec.lift_law
@@ -407,7 +407,7 @@ def shape_text(report: dict) -> str:
     return "\n".join(lines)
 
 
-def profile_csv_text(spec, step_deg: float = 0.5) -> str:  # type: ignore[no-untyped-def]
+def profile_csv_text(spec, step_deg: float = 0.5) -> str:
     """The ground profile for grinding: per law angle, lift, Cartesian and polar point, radius of curvature
     (cam frame: y along the follower at law angle 0, angles in degrees)."""
     follower, law = spec.follower, spec.lift_law

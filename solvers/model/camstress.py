@@ -160,7 +160,7 @@ def stress_summary(spec: MechanismSpec, cam_angle_deg: np.ndarray, model_force: 
             j = int(np.argmin(h))
             result.update(min_film_thickness=float(h[j]) if np.isfinite(h[j]) else None,
                           min_film_thickness_angle_deg=float(cam_angle_deg[j]))
-    c = revolution(spec.follower, spec.lift_law)  # type: ignore[arg-type]
+    c = revolution(spec.follower, spec.lift_law)
     result.update(min_cam_curvature_radius=float(np.min(c.curvature_radius)),
                   max_pressure_angle_deg=float(np.max(np.abs(c.pressure_angle_deg))))
     return result

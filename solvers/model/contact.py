@@ -122,6 +122,13 @@ class ConfigurationTables:
     kernel's record is then made again (:meth:`record`).
     """
 
+    # the slot arrays, (re)made by _allocate
+    ci: np.ndarray
+    cm: np.ndarray
+    cp: np.ndarray
+    mk: np.ndarray
+    mon: np.ndarray
+
     def __init__(self, mechanism: Mechanism) -> None:
         spec = mechanism.spec
         self.mechanism = mechanism
@@ -137,15 +144,19 @@ class ConfigurationTables:
     def _allocate(self, count: int) -> None:
         """Room for ``count`` configurations; the built ones are kept."""
         n, ncl, ns = self.n, self.ncl, self.ns
-        shapes = {"ci": ((layout.CI_HEAD + 3 * n,), np.int64), "cm": ((layout.CM_SIZE, n, n), float),
-                  "cp": ((layout.CP_SIZE, layout.PART_SIZE, 3 * max(n, ns), n + ncl), float),  # layout.CP_RAW
-                  "mk": ((ncl, layout.MK_SIZE), np.int64), "mon": ((ncl, 3 * n + 3 * ns + 1 + ncl), float)}
-        for name, (shape, dtype) in shapes.items():
-            grown = np.zeros((count, *shape), dtype=dtype)
-            if hasattr(self, name):
-                old = getattr(self, name)
-                grown[:old.shape[0]] = old
-            setattr(self, name, grown)
+
+        def grown(old: np.ndarray | None, shape: tuple[int, ...], dtype: type) -> np.ndarray:
+            new: np.ndarray = np.zeros((count, *shape), dtype=dtype)
+            if old is not None:
+                new[:old.shape[0]] = old
+            return new
+
+        self.ci: np.ndarray = grown(getattr(self, "ci", None), (layout.CI_HEAD + 3 * n,), np.int64)
+        self.cm: np.ndarray = grown(getattr(self, "cm", None), (layout.CM_SIZE, n, n), float)
+        self.cp: np.ndarray = grown(getattr(self, "cp", None),  # layout.CP_RAW
+                                    (layout.CP_SIZE, layout.PART_SIZE, 3 * max(n, ns), n + ncl), float)
+        self.mk: np.ndarray = grown(getattr(self, "mk", None), (ncl, layout.MK_SIZE), np.int64)
+        self.mon: np.ndarray = grown(getattr(self, "mon", None), (ncl, 3 * n + 3 * ns + 1 + ncl), float)
         self._record = None
 
     def _slot(self, mask: int) -> int:
@@ -311,7 +322,7 @@ class ConfigurationTables:
         self._publish(mask)
         return ordered
 
-    def _monitors(self, mask: int, part, group: np.ndarray, m: int, springs) -> None:  # type: ignore[no-untyped-def]
+    def _monitors(self, mask: int, part, group: np.ndarray, m: int, springs) -> None:
         """Force rows of the closed clearances, gap references of the open monitored ones.
 
         A rigid external contact's force is the row force r at its ahead
@@ -529,7 +540,7 @@ class ContactProblem:
         operators = self.__dict__.setdefault("_operators", {})
         if mask not in operators:
             operators[mask] = LayerOperator.of(self.build(mask), self.n)
-        return operators[mask]  # type: ignore[no-any-return]  # the dict holds LayerOperators only
+        return operators[mask]
 
     def layer_vectors(self, mask: int, t: float, x: np.ndarray, v: np.ndarray,
                       a: np.ndarray | None = None) -> tuple[np.ndarray, ...]:

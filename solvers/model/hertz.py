@@ -51,7 +51,7 @@ def rebound(a: float, n: float) -> float:
     def back_at_zero(_t: float, y: np.ndarray) -> float:
         return float(y[0])
 
-    back_at_zero.terminal, back_at_zero.direction = True, -1  # type: ignore[attr-defined]
+    back_at_zero.terminal, back_at_zero.direction = True, -1  # type: ignore[attr-defined]  # solve_ivp's event attributes
     solution = solve_ivp(rhs, (0.0, 1e4), (0.0, 1.0), method="DOP853", rtol=1e-11, atol=1e-13,
                          events=back_at_zero)
     return float(-solution.y_events[0][0][1])

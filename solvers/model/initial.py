@@ -65,7 +65,7 @@ class StaticStart:
     qdd: np.ndarray
 
 
-def cam_clearance(spec: MechanismSpec):  # type: ignore[no-untyped-def]
+def cam_clearance(spec: MechanismSpec):
     for c in spec.clearances:
         if c.behind == spec.cam.coordinate:
             return c

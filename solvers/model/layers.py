@@ -113,7 +113,7 @@ def build_layer(spec: MechanismSpec, M: np.ndarray, K: np.ndarray, closed: froze
     return Layer(frozenset(closed), kept, T, M_L, K_L, C_L, modes, ratios)
 
 
-def _follow_split_modes(spec: MechanismSpec, closed: frozenset[str], kept: tuple[int, ...], modes,  # type: ignore[no-untyped-def]
+def _follow_split_modes(spec: MechanismSpec, closed: frozenset[str], kept: tuple[int, ...], modes,
                         overrides: tuple[tuple[int, float], ...]) -> tuple[tuple[int, float], ...]:
     """Per-mode damping overrides number the modes of the preset's one-element model.
 

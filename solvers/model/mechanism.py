@@ -61,7 +61,7 @@ class Mechanism:
         keeps one value per key, not one per cam speed."""
         if key not in self._lasting:
             self._lasting[key] = make()
-        return self._lasting[key]  # type: ignore[no-any-return]  # the value make() returned for this key
+        return self._lasting[key]
 
     def with_start(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, mask: int) -> Mechanism:
         """This mechanism started from a given state (full elastic coordinates, cam angle zero) in

@@ -15,10 +15,13 @@ here reads files. All numbers are in the preset's unit system
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-from vtool.solvers.model.spring import SpringSpec
 from vtool.solvers.model.units import UNIT_SYSTEMS, UnitSystem
 from vtool.units import cam_speed
+
+if TYPE_CHECKING:  # (a field's type only: the spring module imports numpy, which `vtool --help` must not)
+    from vtool.solvers.model.spring import SpringSpec
 
 BAR = "bar"
 BEAM = "beam"

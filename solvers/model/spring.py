@@ -25,7 +25,8 @@ stresses in the preset's units; one consistent unit system):
   limit ``tau_D`` (alternating shear at zero mean) and the ultimate shear
   strength ``tau_u = shear_ratio R_m`` (default 0.67, Shigley's ratio),
   ``S = 1 / (tau_a / tau_D + tau_m / tau_u)``;
-* coil-bind margin: the smallest length reached minus ``L_c``.
+* coil-bind margin: the smallest length reached minus ``L_c``, or with a
+  pitch diagram a segment's smallest coil gap when smaller (:func:`coil_bind_margin`).
 
 A pitch diagram gives the progressive force-length curve of the static
 spring (:func:`pitch_force_length`): segment i closes (its coils touch) when
@@ -38,6 +39,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -66,6 +68,7 @@ class SpringSpec:
     segment_pitches: tuple[float, ...] = ()  # free pitch of each segment (length per coil)
     table_lengths: tuple[float, ...] = ()  # measured force-length table (decreasing lengths)
     table_forces: tuple[float, ...] = ()
+    nodes: tuple[int, ...] = ()  # a pitch diagram's coordinates between its segments (fixed end first)
 
     # ----- closed forms -----
     @property
@@ -110,6 +113,10 @@ class SpringSpec:
             return 1.0 / float(np.sum(1.0 / segment_rates(self)))
         return self.rate
 
+    @overload
+    def force_at(self, length: float) -> float: ...
+    @overload
+    def force_at(self, length: np.ndarray) -> np.ndarray: ...
     def force_at(self, length: float | np.ndarray) -> float | np.ndarray:
         """The static force at a length: the table's (interpolated), else the pitch diagram's, else linear."""
         if self.table_lengths:
@@ -124,6 +131,10 @@ class SpringSpec:
         """Fixed-fixed surge frequencies f_j = (j/2) sqrt(k / m_a), Hz (time unit: s)."""
         return [0.5 * j * math.sqrt(self.rate / self.active_mass) for j in range(1, count + 1)]
 
+    @overload
+    def stress(self, force: float, factor: str = "bergstrasser") -> float: ...
+    @overload
+    def stress(self, force: np.ndarray, factor: str = "bergstrasser") -> np.ndarray: ...
     def stress(self, force: float | np.ndarray, factor: str = "bergstrasser") -> float | np.ndarray:
         """Corrected shear stress K 8 F D / (pi d^3)."""
         return stress_factor(self.index, factor) * 8.0 * force * self.coil_diameter / (math.pi * self.wire_diameter ** 3)
@@ -158,9 +169,10 @@ def goodman(tau_min: float, tau_max: float, fatigue_limit: float, ultimate: floa
 
 
 def table_rate(lengths: tuple[float, ...], forces: tuple[float, ...], at: float) -> float:
-    """Slope -dF/dL of a force-length table at a length (the interval holding it; the nearest end one outside)."""
+    """Slope -dF/dL of a force-length table at a length: the interval below it (the one a lift compresses
+    into; at a table point, the next one down), the nearest end one outside."""
     L, F = np.asarray(lengths), np.asarray(forces)
-    i = int(np.clip(np.searchsorted(-L, -at) - 1, 0, len(L) - 2))
+    i = int(np.clip(np.searchsorted(-L, -at, side="right") - 1, 0, len(L) - 2))
     return float((F[i + 1] - F[i]) / (L[i] - L[i + 1]))
 
 
@@ -204,22 +216,36 @@ def compression_sign(trace: object, coordinate: int) -> float:
     """+1 when the end coordinate's positive direction compresses the spring (it moves with the valve's
     lift), else -1: the sign of the correlation of q_end with the valve lift (-1 without a seat: the bar's
     own sense, ground at its first end)."""
-    q = trace.coordinate(coordinate)  # type: ignore[attr-defined]
+    q = trace.coordinate(coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     try:
-        lift = trace.valve_lift()  # type: ignore[attr-defined]
+        lift = trace.valve_lift()  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     except KeyError:
         return -1.0
     return 1.0 if float(np.dot(q, lift)) >= 0.0 else -1.0
 
 
+def segment_gaps(s: SpringSpec, trace: object) -> np.ndarray:
+    """Rows x segments: each pitch segment's coil gap n_i (p_i - d) minus its compression from the run
+    (the model's segment bars are unloaded at q = 0); <= 0: that segment's coils touch (coil bind)."""
+    sign = compression_sign(trace, s.coordinate)
+    ends = (0, *s.nodes, s.coordinate)
+    q = [np.zeros_like(trace.cam_angle, dtype=np.float64) if k == 0 else trace.coordinate(k)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+         for k in ends]
+    free_gap = np.asarray(s.segment_coils) * (np.asarray(s.segment_pitches) - s.wire_diameter)
+    return np.column_stack([free_gap[i] - sign * (q[i + 1] - q[i]) for i in range(len(free_gap))])
+
+
 def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
     """Per spring: smallest length reached, coil-bind margin, forces and Bergstraesser stresses at installed,
     largest over the run and over the last cycle (min, max), the Goodman factor of the last cycle, surge."""
-    angle = np.asarray(trace.cam_angle)  # type: ignore[attr-defined]
+    angle = np.asarray(trace.cam_angle)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     last = angle >= angle[-1] - 360.0 if angle.size else angle.astype(bool)
+    u = trace.spec.unit_system  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+    units = {"length_unit": u.length, "force_unit": u.force, "stress_unit": u.pressure,
+             "stiffness_unit": u.stiffness, "mass_unit": u.mass, "frequency_unit": "Hz", "angle_unit": "deg"}
     result = []
     for s in springs:
-        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]
+        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
         length = s.rest_length - compression_sign(trace, s.coordinate) * q
         force = np.asarray(s.force_at(length), dtype=float)
         shortest = float(length.min())
@@ -227,8 +253,8 @@ def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
         result.append({
             "name": s.name, "rate": s.rate, "active_mass": s.active_mass, "preload": s.preload,
             "solid_length": s.solid_length, "min_length": shortest, "min_length_angle_deg": float(angle[np.argmin(length)]),
-            "coil_bind_margin": shortest - s.solid_length,
-            "coil_bind": bool(shortest <= s.solid_length),
+            "coil_bind_margin": coil_bind_margin((s,), trace),
+            "coil_bind": bool(coil_bind_margin((s,), trace) <= 0.0),
             "installed_stress": float(s.stress(s.preload)),
             "installed_stress_wahl": float(s.stress(s.preload, "wahl")),
             "max_force": float(force.max()), "max_stress": float(s.stress(float(force.max()))),
@@ -237,25 +263,85 @@ def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
             "last_cycle_stress": [float(s.stress(f_lo)), float(s.stress(f_hi))],
             "fatigue_factor": s.fatigue_factor(f_lo, f_hi) if np.isfinite(f_hi) else 0.0,
             "surge_hz": s.surge_frequencies(3),
-        })
+        } | units | _clash(s, trace, angle))
     return result
 
 
 def report_text(report: list[dict], units: object) -> list[str]:
     """Summary lines of :func:`run_report` (``units``: the preset's UnitSystem)."""
-    L, F, P = units.length, units.force, units.pressure  # type: ignore[attr-defined]
+    L, F, P = units.length, units.force, units.pressure  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
     lines = ["", "valve springs (data sheet; tau = K 8 F D/(pi d^3), Bergstraesser K, Wahl in brackets):"]
     for r in report:
         fatigue = "n/a (no fatigue_limit)" if r["fatigue_factor"] is None else f"{r['fatigue_factor']:.3f}"
         lines += [
-            f"  {r['name']}: rate {r['rate']:.5g} {units.stiffness}, preload {r['preload']:.5g} {F}, "  # type: ignore[attr-defined]
+            f"  {r['name']}: rate {r['rate']:.5g} {units.stiffness}, preload {r['preload']:.5g} {F}, "  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
             f"surge {', '.join(f'{f:.1f}' for f in r['surge_hz'])} Hz",
             f"    stress installed {r['installed_stress']:.5g} ({r['installed_stress_wahl']:.5g}) {P}, largest "
             f"{r['max_stress']:.5g} ({r['max_stress_wahl']:.5g}) {P} at force {r['max_force']:.5g} {F}",
             f"    last cycle force {r['last_cycle_force'][0]:.5g} .. {r['last_cycle_force'][1]:.5g} {F}, "
             f"Goodman fatigue factor {fatigue}",
             f"    shortest length {r['min_length']:.5g} {L} at {r['min_length_angle_deg']:.1f} deg, solid "
-            f"{r['solid_length']:.5g} {L}: coil-bind margin {r['coil_bind_margin']:.4g} {L}"
+            f"{r['solid_length']:.5g} {L}; coil-bind margin {r['coil_bind_margin']:.4g} {L}"
             + ("  COIL BIND" if r["coil_bind"] else ""),
         ]
+        if "segment_first_touch_deg" in r:
+            touches = ", ".join(f"{i + 1}: " + ("-" if a is None else f"{a:.1f} deg")
+                                for i, a in enumerate(r["segment_first_touch_deg"]))
+            lines.append(f"    pitch segments, coils first touching (smallest gap "
+                         f"{', '.join(f'{g:.3g}' for g in r['segment_min_gap'])} {L}): {touches}")
+            if r["first_coil_bind_deg"] is not None:
+                lines.append(f"    first coil clash at {r['first_coil_bind_deg']:.1f} deg: the model's segments do "
+                             "not stop there (no coil-contact force); the response after it is not to be trusted")
+    return lines
+
+
+def _clash(s: SpringSpec, trace: object, angle: np.ndarray) -> dict:
+    """A pitch diagram's segments: the first angle each segment's coils touch (None: never), the first
+    coil-bind angle of the spring, the smallest gap per segment."""
+    if not s.segment_coils or not angle.size:
+        return {}
+    gaps = segment_gaps(s, trace)
+    first: list[float | None] = []
+    for i in range(gaps.shape[1]):
+        touching = np.flatnonzero(gaps[:, i] <= 0.0)
+        first.append(float(angle[touching[0]]) if touching.size else None)
+    seen = [a for a in first if a is not None]
+    return {"segment_first_touch_deg": first, "segment_min_gap": gaps.min(axis=0).tolist(),
+            "first_coil_bind_deg": min(seen) if seen else None}
+
+
+def coil_bind_margin(springs: tuple[SpringSpec, ...], trace: object, rows: np.ndarray | None = None) -> float:
+    """The smallest coil-bind margin over the springs and ``rows`` (default all): the shortest length reached
+    minus the solid length, or a pitch segment's smallest coil gap when smaller (<= 0: coils touch)."""
+    margins = []
+    for s in springs:
+        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+        length = s.rest_length - compression_sign(trace, s.coordinate) * q
+        chosen = slice(None) if rows is None else rows
+        if np.size(length[chosen]) == 0:
+            continue
+        margins.append(float(length[chosen].min()) - s.solid_length)
+        if s.segment_coils:
+            margins.append(float(segment_gaps(s, trace)[chosen].min()))
+    return min(margins) if margins else math.nan
+
+
+def surge_table(springs: tuple[SpringSpec, ...], rpm: float, count: int = 3) -> list[dict]:
+    """Per spring: its fixed-fixed surge frequencies (Hz) and their ratio to the cam frequency rpm/60
+    (the cam order a surge mode sits at: a lift harmonic of that order excites it)."""
+    cam_hz = rpm / 60.0
+    return [{"spring": s.name, "rate": s.rate, "active_mass": s.active_mass, "surge_hz": s.surge_frequencies(count),
+             "cam_hz": cam_hz, "surge_order": [f / cam_hz for f in s.surge_frequencies(count)]} for s in springs]
+
+
+def surge_text(table: list[dict], units: object) -> list[str]:
+    """Lines of :func:`surge_table` (``vtool modes``)."""
+    if not table:
+        return []
+    lines = ["", f"valve spring surge (fixed-fixed, (j/2) sqrt(k/m_a)), cam frequency {table[0]['cam_hz']:.4g} Hz:"]
+    for row in table:
+        lines.append(f"  {row['spring']}: rate {row['rate']:.5g} {units.stiffness}, active mass "  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
+                     f"{row['active_mass']:.4g} {units.mass}: "  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
+                     + ", ".join(f"{f:.1f} Hz (order {o:.1f})" for f, o in zip(row["surge_hz"], row["surge_order"],
+                                                                              strict=True)))
     return lines

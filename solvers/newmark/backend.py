@@ -232,6 +232,10 @@ class NewmarkBackend(Backend[NewmarkOptions]):
         return compile_notice(cls.name, kernel_laws(spec, impacts))
 
     @classmethod
+    def warm_up(cls, spec: MechanismSpec) -> None:
+        compile_solver(spec)
+
+    @classmethod
     def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:
         """Every step at every beta (with the default refinement after events), then the thesis' plain
         scheme at 1 µs."""

@@ -93,7 +93,7 @@ class _ScipyRun(PiecewiseRun):
 
     def advance(self, ss: StateSpace, t0: float, y0: np.ndarray, t_stop: float) -> tuple[float, np.ndarray, list[int]]:
         nf = ss.size // 2
-        atol = self.options.atol
+        atol: float | np.ndarray | None = self.options.atol
         if atol is None:
             atol = np.concatenate([np.full(nf, self.x_scale), np.full(nf, self.v_scale)]) * self.options.rtol
 
@@ -117,8 +117,8 @@ class _ScipyRun(PiecewiseRun):
                     return 1.0
                 return float(self.monitors(ss, t, y)[k])
 
-            event.terminal = True
-            event.direction = -1
+            event.terminal = True  # type: ignore[attr-defined]  # solve_ivp reads an event's function attributes
+            event.direction = -1  # type: ignore[attr-defined]  # (as above)
             events.append(event)
         times = self.output_times(t0, t_stop)
         solution = solve_ivp(rhs, (t0, t_stop), y0, method=self.options.method, rtol=self.options.rtol,

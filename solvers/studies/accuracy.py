@@ -40,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -92,7 +93,7 @@ def library_versions() -> str:
     return ", ".join([f"scipy {scipy.__version__}", f"numpy {np.__version__}", *kernels])
 
 
-def with_run(spec: MechanismSpec, **changes: object) -> MechanismSpec:
+def with_run(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
     """``spec`` with some of its RunSpec fields replaced (``None`` values are ignored)."""
     changes = {key: value for key, value in changes.items() if value is not None}
     return dataclasses.replace(spec, run=dataclasses.replace(spec.run, **changes))

@@ -212,7 +212,8 @@ for _kind in (
               _spring_stress),
     CheckKind("spring_fatigue_min", MIN, "ratio", "valve spring fatigue safety factor (Goodman, last cycle)",
               _spring_fatigue),
-    CheckKind("coil_bind_margin_min", MIN, "length", "valve spring coil-bind margin (shortest - solid length)",
+    CheckKind("coil_bind_margin_min", MIN, "length", "valve spring coil-bind margin (shortest - solid length, or "
+              "a pitch segment's coil gap)",
               _coil_bind),
 ):
     register(_kind)

@@ -102,7 +102,7 @@ class Variant:
 
 
 def compare(spec: MechanismSpec, impacts: tuple[str, ...] = IMPACT_LAWS, starts: tuple[str, ...] | None = None,
-            every_step: bool = False, before_run: Callable[[], None] | None = None) -> list[Variant]:
+            every_step: bool = False, before_run: Callable[[], object] | None = None) -> list[Variant]:
     """Run every (impact law, start) combination with the preset's back end and step; ``before_run()``
     once the first variant's input checks have passed (see :func:`vtool.solvers.run.simulate`)."""
     starts = starts or (spec.initial.velocities,)

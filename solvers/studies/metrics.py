@@ -264,6 +264,8 @@ def metric_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
     columns += [(f"peak_{force_label(spec, i)}", u.force) for i in range(len(spec.clearances))]
     columns += [("spring_margin", u.force), ("startup_peak_force", u.force), ("startup_seating_velocity", u.velocity),
                 ("cycles", ""), ("cycle_change", ""), ("events", ""), ("wall_time", "s")]
+    if spec.springs:  # data-sheet springs (vtool.solvers.model.spring): <= 0 when coils touch
+        columns.append(("coil_bind_margin", u.length))
     return columns + order_columns(spec)
 
 
@@ -436,6 +438,10 @@ def run_metrics(trace: Trace, window: tuple[float, float] | None = None) -> dict
     metrics["cycle_change"] = trace.cycles.change if trace.cycles is not None else NAN
     metrics["events"] = trace.statistics.events
     metrics["wall_time"] = trace.statistics.wall_time
+    if spec.springs:
+        from vtool.solvers.model.spring import coil_bind_margin
+
+        metrics["coil_bind_margin"] = coil_bind_margin(spec.springs, trace, rows)
     for quantity in spec.run.orders:  # over the whole cycles of the evaluated window (NaN: none to analyse)
         try:
             orders = spectrum(trace, quantity)

@@ -101,7 +101,7 @@ def grid(fields: Sequence[tuple[str, Sequence[Any]]]) -> list[tuple[tuple[str, A
 
 def _model_key(spec: MechanismSpec) -> MechanismSpec:
     """The spec without its run settings: points with equal keys share one assembled model."""
-    return replace(spec, run=None)  # type: ignore[arg-type]
+    return replace(spec, run=None)  # type: ignore[arg-type]  # a cache key without run settings, never run
 
 
 def _mechanism(spec: MechanismSpec, previous: Mechanism | None) -> Mechanism:
@@ -530,7 +530,7 @@ class SweepOutcome:
 
 
 def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False,
-               sink: Any = None, progress: Callable[[int, int], None] | None = None,
+               sink: Any = None, progress: Callable[[int, int], object] | None = None,
                cancel: Callable[[], bool] | None = None, keep: bool = True) -> SweepOutcome:
     """Evaluate ``points`` with ``runner``; results go to ``sink`` (a :class:`SweepFile`, or
     :class:`vtool.solvers.parquet.SweepParquet`) as they arrive.
@@ -749,6 +749,7 @@ class SweepFile:
 CRITERIA: dict[str, tuple[str, Callable[[float], bool], str]] = {
     "jump-speed": ("cam_separations", lambda v: v >= 1, "the follower leaves the cam during lift"),
     "bounce-speed": ("seat_bounces", lambda v: v >= 1, "the valve bounces on its seat"),
+    "coil-bind-speed": ("coil_bind_margin", lambda v: v <= 0.0, "a valve spring's coils touch (data-sheet spring)"),
 }
 
 
