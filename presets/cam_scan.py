@@ -188,7 +188,7 @@ def convert(angles: list[float] | np.ndarray, lifts: list[float] | np.ndarray, s
     else:
         notes.append("angles taken as cam degrees")
     if settings.lift_of == "valve":
-        ratio = float(settings.rocker_ratio)  # type: ignore[arg-type]
+        ratio = float(settings.rocker_ratio)  # type: ignore[arg-type]  # given whenever lift_of is valve (the loader checks)
         lift = lift / ratio
         notes.append(f"valve lift divided by the rocker ratio {ratio:g} to tappet lift")
     else:
@@ -274,7 +274,7 @@ def prepare(angles: list[float], lifts: list[float], settings: ScanSettings, len
     scale = LIFT_UNITS[settings.lift_unit or length_unit] / metres_per_length if (
         settings.lift_unit or length_unit) in LIFT_UNITS else 1.0
     if settings.lift_of == "valve":
-        scale /= float(settings.rocker_ratio)  # type: ignore[arg-type]
+        scale /= float(settings.rocker_ratio)  # type: ignore[arg-type]  # given whenever lift_of is valve (the loader checks)
     theta, lift, extended = _uniform_revolution(theta, lift, field)
     if extended:
         notes.append(extended)

@@ -107,9 +107,12 @@ def load_follower(t: Table, units: UnitSystem, read_law: Callable[[Table], CamSp
         oil_table.finish()
         oil = OilSpec(viscosity * MPA_S, alpha * PER_GPA)
     friction = t.number("friction", default=0.0, min_value=0.0, max_value=1.0)
+    guide = t.number("guide_friction", unit=units.force, default=0.0, min_value=0.0, max_value=1e9)
+    guide_velocity = t.number("guide_velocity", unit=f"{L}/s", default=1e-3 / units.metres_per_length,
+                              min_exclusive=0.0, max_value=1e9)
     t.finish()
     return FollowerSpec(kind, arrangement, base, width, roller, face, finger=finger, lift=lift, oil=oil,
-                        friction=friction, **moduli)
+                        friction=friction, guide_friction=guide, guide_velocity=guide_velocity, **moduli)
 
 
 def dump_follower(f: FollowerSpec, dump_law: Callable[[CamSpec], dict[str, Any]]) -> dict[str, Any]:
@@ -124,6 +127,8 @@ def dump_follower(f: FollowerSpec, dump_law: Callable[[CamSpec], dict[str, Any]]
             "follower_poisson": f.follower_poisson}
     if f.friction:
         doc["friction"] = f.friction
+    if f.guide_friction:
+        doc |= {"guide_friction": f.guide_friction, "guide_velocity": f.guide_velocity}
     if f.finger is not None:
         doc |= {key: getattr(f.finger, key) for key in FINGER_KEYS}
     if f.lift is not None:
@@ -153,4 +158,4 @@ def check_units(units: UnitSystem) -> dict[str, str]:
     class _Spec:  # unit_of reads only .unit_system
         unit_system = units
 
-    return {name: unit_of(_Spec, kind.unit_kind) for name, kind in CHECKS.items()}  # type: ignore[arg-type]
+    return {name: unit_of(_Spec, kind.unit_kind) for name, kind in CHECKS.items()}  # type: ignore[arg-type]  # unit_of reads only .unit_system, which _Spec has

@@ -131,6 +131,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         # [follower] and [checks] (presets/follower.py): the cam's shape and contact stress, limits
         "follower": "The cam's follower: its geometry gives the cam's shape and the contact stress.",
         "follower.kind": "A flat face or a roller.",
+        "follower.friction": "Friction coefficient of the cam-follower contact (its share of the drive torque).",
         "follower.arrangement": "Translating (bucket, tappet, roller lifter) or an end-pivot finger.",
         "follower.base_radius": "The cam's base-circle radius (profile).",
         "follower.width": "Length of the line contact (roller or lobe width).",
@@ -244,6 +245,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.seat.position": "The seat's position on the valve coordinate.",
         "train.follower": "The follower's geometry ([follower]'s keys; the type sets its arrangement).",
         "train.follower.kind": "A flat face or a roller.",
+        "train.follower.friction": "Friction coefficient of the cam-follower contact (its share of the drive torque).",
         "train.follower.arrangement": "Set by the type (not given here).",
         "train.follower.base_radius": "The cam's base-circle radius (profile).",
         "train.follower.width": "Length of the line contact.",

@@ -344,7 +344,7 @@ def _cam_table(t: Table, units: UnitSystem, folder: Path | None) -> dict[str, An
         else:
             from vtool.presets.cam_scan import read_polyline
 
-            angles, lifts = read_polyline(t.field("polyline"), polyline, folder)  # type: ignore[arg-type]
+            angles, lifts = read_polyline(t.field("polyline"), polyline, folder)  # type: ignore[arg-type]  # a polyline here: lift_table and polyline are exclusive (checked above)
     else:
         angles = t.numbers("angles", unit="deg")
         lifts = t.numbers("lifts", unit=units.length)

@@ -306,6 +306,12 @@ class Trace:
                 header.append(f"cam_{name} ({torque.row_unit(self.spec, name)})")
                 columns.append(lambda rows, name=name: getattr(torque.torque_rows(
                     self.spec, self.cam_angle[rows], self.contact_force[rows, cam]), name))
+            valve = self.valve_coordinate()
+            if self.spec.follower.guide_friction > 0.0 and valve is not None:
+                j = self.coordinate_numbers.index(valve)
+                for k, name in enumerate(("valve_guide_friction_force", "valve_guide_friction_power")):
+                    header.append(f"{name} ({torque.row_unit(self.spec, name.removeprefix('valve_guide_'))})")
+                    columns.append(lambda rows, k=k: torque.guide_rows(self.spec, self.qd[rows, j])[k])
         return header + ["configuration", "closed"], columns
 
     def configuration_csv(self, mask: int) -> str:
@@ -488,6 +494,12 @@ class Trace:
             if window is not None:
                 rows = torque.torque_rows(self.spec, self.cam_angle, self.contact_force[:, self.cam_clearance_index()])
                 result["cam_torque"] = torque.torque_summary(self.spec, rows, *window)
+                valve = self.valve_coordinate()
+                if self.spec.follower.guide_friction > 0.0 and valve is not None:
+                    keep = self.cam_angle >= window[0] - 1e-9
+                    power = torque.guide_rows(self.spec, self.qd[keep, self.coordinate_numbers.index(valve)])[1]
+                    result["cam_torque"]["mean_guide_friction_power"] = float(
+                        np.trapezoid(power, self.cam_angle[keep]) / 360.0)
         if self.spec.springs:
             from vtool.solvers.model.spring import run_report
 

@@ -105,3 +105,22 @@ def test_follower_friction_field_is_checked():
         load_document(doc)
     doc["train"]["follower"]["friction"] = 0.08
     assert load_document(doc).follower.friction == 0.08
+
+
+def test_guide_friction_dissipates_force_times_valve_travel():
+    """Coulomb guide friction (v_r small): the energy per revolution is F_g times the stem's travel, twice the
+    valve's largest lift (up and back down), so the mean power is F_g 2 h_max / T_rev."""
+    spec = _spec("direct-acting-bucket", guide_friction=20.0, guide_velocity=1.0)
+    trace = simulate(spec)
+    s = trace.summary()["cam_torque"]
+    keep = trace.cam_angle >= 360.0 - 1e-6
+    travel = np.sum(np.abs(np.diff(trace.valve_lift()[keep])))
+    lift = trace.valve_lift()[keep].max() - trace.valve_lift()[keep].min()
+    assert math.isclose(travel, 2.0 * lift, rel_tol=2e-2)  # the valve goes up and back once (little bounce)
+    expected = 20.0 * travel / (2.0 * math.pi / spec.run.omega)
+    assert math.isclose(s["mean_guide_friction_power"], expected, rel_tol=2e-2)
+    assert "valve guide friction: mean power" in trace.summary_text()
+    header, columns = trace.csv_columns(())
+    names = [h.rpartition(" (")[0] for h in header]
+    force = columns[names.index("valve_guide_friction_force")](slice(None))
+    assert np.all(np.abs(force) <= 20.0) and np.max(np.abs(force)) > 19.9

@@ -55,6 +55,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "sweep": ("vtool.app.cli.sweep", "sweep"),
     "compare": ("vtool.app.cli.compare", "compare"),
     "cam": ("vtool.app.cli.cam", "cam"),
+    "camshaft": ("vtool.app.cli.camshaft", "camshaft"),
     "size": ("vtool.app.cli.size", "size"),
     "report": ("vtool.app.cli.report", "report"),
     "tui": ("vtool.app.cli.tui", "tui"),

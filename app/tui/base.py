@@ -214,8 +214,8 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):  # type: ignore
 
     # ----- presets -----
     async def on_mount(self) -> None:
-        self.app.mounted_modes.add(self.MODE)  # type: ignore[attr-defined]
-        pending = self.app.take_pending(self.MODE)  # type: ignore[attr-defined]
+        self.app.mounted_modes.add(self.MODE)  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
+        pending = self.app.take_pending(self.MODE)  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
         if pending is not None:
             spec, source = pending
         else:
@@ -368,8 +368,8 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):  # type: ignore
             if isinstance(error, InputError):
                 self.problem = error
                 self.form.show_error(error)
-            self.set_status(f"failed: {self.app.error_text(error)}")  # type: ignore[attr-defined]
-            self.app.report_error("Run failed", error)  # type: ignore[attr-defined]
+            self.set_status(f"failed: {self.app.error_text(error)}")  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
+            self.app.report_error("Run failed", error)  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
         elif event.state == WorkerState.CANCELLED:
             self.set_status("cancelled")
 
@@ -388,10 +388,10 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):  # type: ignore
             try:
                 kept = self.save_document(document, path)
             except (OSError, ValueError) as exc:  # ValueError: InputError, a NUL in the path
-                self.app.report_error("Save failed", path_problem(exc, path))  # type: ignore[attr-defined]
+                self.app.report_error("Save failed", path_problem(exc, path))  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
                 return
             full = str(Path(path).resolve())
-            self.app.remember(full)  # type: ignore[attr-defined]
+            self.app.remember(full)  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
             self.source = full
             self.loaded_doc = self.loader().dump(spec)
             self.start_doc = self.form.apply(self.base_doc)
@@ -433,7 +433,7 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):  # type: ignore
             try:
                 self.write_csv(path)
             except (OSError, ValueError) as exc:  # ValueError: InputError, a NUL in the path
-                self.app.report_error("Export failed", path_problem(exc, path))  # type: ignore[attr-defined]
+                self.app.report_error("Export failed", path_problem(exc, path))  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
                 return
             self.set_status(f"wrote {path}")
             self.notify(f"wrote {path}")

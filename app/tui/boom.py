@@ -152,7 +152,7 @@ class BoomScreen(DomainScreen):
     TITLE_TEXT = "SONIC BOOM"
 
     def compose_results(self) -> ComposeResult:
-        color = self.app.chart_color  # type: ignore[attr-defined]
+        color = self.app.chart_color  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
         with TabbedContent(id="results-tabs"):
             with TabPane("Limits", id="tab-limits"):
                 yield TextPanel("allowable pressures appear here after a run (ctrl+r)", id="limits")
@@ -247,12 +247,12 @@ class BoomScreen(DomainScreen):
                                                        color=c))
         stack = self.query_one("#design-charts")
         await stack.remove_children()
-        color = self.app.chart_color  # type: ignore[attr-defined]
+        color = self.app.chart_color  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
         charts = []
         u = a.units
         for name, freq, series in report.design_series(a):
             chart = ChartView(id=None, color=color)
-            chart.structure = name  # type: ignore[attr-defined]
+            chart.structure = name  # type: ignore[attr-defined]  # a label this screen puts on its chart widget
             charts.append((chart, name, freq, series))
         await stack.mount_all([c for c, *_ in charts])
         for chart, name, freq, series in charts:

@@ -224,7 +224,7 @@ class FieldRow(Widget):
 
     @property
     def editor(self) -> Input | Select:
-        return self.query_one(f"#{self.field.widget_id}-editor")  # type: ignore[return-value]
+        return self.query_one(f"#{self.field.widget_id}-editor")  # type: ignore[return-value]  # the editor widget by its id: query_one is typed Widget
 
     @property
     def text(self) -> str:

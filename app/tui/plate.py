@@ -147,8 +147,8 @@ def check_options(spec: Any, options: dict[str, Any]) -> dict[str, Any]:
     names = [c.name for c in spec.study.cases]
     if options.get("case") not in names:
         raise InputError(f"{RUN}.case", options.get("case"), f"one of: {', '.join(names)}")
-    check_run_options(options.get("load"), options.get("scheme"), options.get("omega_max_h"),  # type: ignore[arg-type]
-                      options.get("periods"), options.get("exact_modes"), prefix=f"{RUN}.")  # type: ignore[arg-type]
+    check_run_options(options.get("load"), options.get("scheme"), options.get("omega_max_h"),  # type: ignore[arg-type]  # the form's raw options: check_run_options refuses bad ones
+                      options.get("periods"), options.get("exact_modes"), prefix=f"{RUN}.")  # type: ignore[arg-type]  # the form's raw options: check_run_options refuses bad ones
     return {**options, "omega_max_h": float(options["omega_max_h"]), "periods": float(options["periods"])}
 
 
@@ -202,7 +202,7 @@ class PlateScreen(DomainScreen):
         self.options: dict[str, Any] = {}
 
     def compose_results(self) -> ComposeResult:
-        color = self.app.chart_color  # type: ignore[attr-defined]
+        color = self.app.chart_color  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
         with TabbedContent(id="results-tabs"):
             with TabPane("Frequencies", id="tab-frequencies"):
                 yield TextPanel("the frequency table appears here after a run (ctrl+r)", id="frequencies")

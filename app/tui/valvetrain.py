@@ -149,7 +149,7 @@ class ValveTrainScreen(DomainScreen):
 
     def result_panes(self) -> list[TabPane]:
         """The result tabs, in order: a new tab is one more pane in this list."""
-        color = self.app.chart_color  # type: ignore[attr-defined]
+        color = self.app.chart_color  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
         return [
             TabPane("Forces", ChartView("contact forces appear here after a run (ctrl+r)",
                                         id="force-chart", color=color), id="tab-forces"),
@@ -360,7 +360,7 @@ class ValveTrainScreen(DomainScreen):
             try:
                 write_report(report_of_trace(self.results), path, "report")
             except (OSError, ValueError) as exc:  # ValueError: InputError (suffix, folder), a NUL in the path
-                self.app.report_error("Report failed", path_problem(exc, path))  # type: ignore[attr-defined]
+                self.app.report_error("Report failed", path_problem(exc, path))  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
                 return
             self.set_status(f"wrote {path}")
             self.notify(f"wrote {path}")

@@ -99,10 +99,10 @@ def master_positions(mesh: Mesh, selection: MasterSelection, free: np.ndarray,
         return named_set(mesh, selection.named, free)
     if selection.labels:
         return labelled_set(mesh, selection.labels, free)
-    if not 1 <= int(selection.auto) <= free.size:  # type: ignore[arg-type]
+    if not 1 <= int(selection.auto) <= free.size:  # type: ignore[arg-type]  # an automatic selection here: named and labels were not given
         raise MasterSetError(f"automatic selection needs 1..{free.size} masters (got {selection.auto})")
     assert M_c is not None and K_c is not None
-    return henshell_ong_masters(M_c, K_c, int(selection.auto))  # type: ignore[arg-type]
+    return henshell_ong_masters(M_c, K_c, int(selection.auto))  # type: ignore[arg-type]  # an automatic selection here: named and labels were not given
 
 
 @limited()  # small dense matrices: one BLAS thread (vtool.threads)

@@ -225,7 +225,7 @@ def make_pulse(params: PulseParams) -> Pulse:
     if p.kind == "N" or (p.kind == "P" and r1 == 0.0 and p.r2 == 0.0):
         segs.append(Segment(0.0, s, 1.0, -1.0))
     elif p.kind == "P":
-        r2 = float(p.r2)  # type: ignore[arg-type]
+        r2 = float(p.r2)  # type: ignore[arg-type]  # validate() has required this parameter for this pulse kind
         if r1 > 0.0:
             segs.append(Segment(0.0, r1, 0.0, 1.0 / r1))
         fall = -1.0 / (1.0 - r1)
@@ -237,15 +237,15 @@ def make_pulse(params: PulseParams) -> Pulse:
     elif p.kind == "Q":
         segs.append(Segment(0.0, 1.0, sin_amp=1.0, freq=math.pi))
         if s > 1.0:
-            segs.append(Segment(1.0, s, sin_amp=-float(p.alpha), freq=math.pi / (s - 1.0)))  # type: ignore[arg-type]
+            segs.append(Segment(1.0, s, sin_amp=-float(p.alpha), freq=math.pi / (s - 1.0)))  # type: ignore[arg-type]  # validate() has required this parameter for this pulse kind
     elif p.kind == "R":
         segs.append(Segment(0.0, 1.0, cos_amp=1.0, freq=math.pi / 2.0))
         if s > 1.0:
             segs.append(
-                Segment(1.0, s, sin_amp=-float(p.alpha), freq=math.pi / (2.0 * (s - 1.0)))  # type: ignore[arg-type]
+                Segment(1.0, s, sin_amp=-float(p.alpha), freq=math.pi / (2.0 * (s - 1.0)))  # type: ignore[arg-type]  # validate() has required this parameter for this pulse kind
             )
     else:  # T
-        alpha, beta, r2 = float(p.alpha), float(p.beta), float(p.r2)  # type: ignore[arg-type]
+        alpha, beta, r2 = float(p.alpha), float(p.beta), float(p.r2)  # type: ignore[arg-type]  # validate() has required this parameter for this pulse kind
         segs.append(Segment(0.0, r1, 1.0, -(1.0 - alpha * (1.0 - r1)) / r1))
         segs.append(Segment(r1, s, alpha * (1.0 - r1), -alpha))
         if r2 > 0.0:

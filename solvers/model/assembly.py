@@ -51,15 +51,15 @@ def member_properties(member: MemberSpec, gravity: float) -> MemberProperties:
     else:
         density = member.density
         if density is None:
-            density = member.specific_weight / gravity  # type: ignore[operator]
-        mass = density * area * member.length  # type: ignore[operator]
+            density = member.specific_weight / gravity  # type: ignore[operator]  # the loader gives one of each pair (area/diameter, ...)
+        mass = density * area * member.length  # type: ignore[operator]  # the loader gives one of each pair (area/diameter, ...)
     modulus = member.modulus or 0.0
     if member.element == BAR:
-        axial = member.stiffness if member.stiffness is not None else modulus * area / member.length  # type: ignore[operator]
+        axial = member.stiffness if member.stiffness is not None else modulus * area / member.length  # type: ignore[operator]  # the loader gives one of each pair (area/diameter, ...)
         bending = 0.0
     else:
         axial = 0.0
-        bending = modulus * inertia  # type: ignore[operator]
+        bending = modulus * inertia  # type: ignore[operator]  # the loader gives one of each pair (area/diameter, ...)
     return MemberProperties(member.name, member.element, member.length, axial, bending, mass)
 
 

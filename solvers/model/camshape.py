@@ -251,7 +251,7 @@ def finger_angle(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> np.
         F = dist - g.R0 - L
         slope = du + dL * ddelta
         if np.any(slope <= 0.0):
-            raise InputError("follower.roller_arm", follower.finger.roller_arm,  # type: ignore[union-attr]
+            raise InputError("follower.roller_arm", follower.finger.roller_arm,  # type: ignore[union-attr]  # a finger follower here (checked by the caller)
                              "a finger geometry whose roller moves away from the cam as it turns "
                              "(the contact condition has no unique root)")
         step = F / slope

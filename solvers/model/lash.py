@@ -68,4 +68,4 @@ def seat_position(spec: MechanismSpec, lash: float) -> float:
 def lash_of(spec: MechanismSpec) -> float:
     """The lash the spec's seat position gives (length units)."""
     base, r = base_and_ratio(spec)
-    return r * spec.seat.position - base  # type: ignore[union-attr]
+    return r * spec.seat.position - base  # type: ignore[union-attr]  # a lash preset has a seat (the loader checks)

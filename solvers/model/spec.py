@@ -371,6 +371,10 @@ class FollowerSpec:
     #: cam-follower friction coefficient (flat face: Coulomb sliding; roller: rolling traction, the bearing's
     #: drag referred to the rim), see :mod:`vtool.solvers.studies.torque`
     friction: float = 0.0
+    #: valve-guide Coulomb friction force (the stem's side load times its coefficient, taken as constant) and
+    #: its regularisation velocity v_r (F = F_g tanh(v / v_r)); 0: none (:mod:`vtool.solvers.studies.torque`)
+    guide_friction: float = 0.0
+    guide_velocity: float = 1.0
 
 
 @dataclass(frozen=True)

@@ -216,9 +216,9 @@ def compression_sign(trace: object, coordinate: int) -> float:
     """+1 when the end coordinate's positive direction compresses the spring (it moves with the valve's
     lift), else -1: the sign of the correlation of q_end with the valve lift (-1 without a seat: the bar's
     own sense, ground at its first end)."""
-    q = trace.coordinate(coordinate)  # type: ignore[attr-defined]
+    q = trace.coordinate(coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     try:
-        lift = trace.valve_lift()  # type: ignore[attr-defined]
+        lift = trace.valve_lift()  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     except KeyError:
         return -1.0
     return 1.0 if float(np.dot(q, lift)) >= 0.0 else -1.0
@@ -229,7 +229,7 @@ def segment_gaps(s: SpringSpec, trace: object) -> np.ndarray:
     (the model's segment bars are unloaded at q = 0); <= 0: that segment's coils touch (coil bind)."""
     sign = compression_sign(trace, s.coordinate)
     ends = (0, *s.nodes, s.coordinate)
-    q = [np.zeros_like(trace.cam_angle, dtype=float) if k == 0 else trace.coordinate(k)  # type: ignore[attr-defined]
+    q = [np.zeros_like(trace.cam_angle, dtype=np.float64) if k == 0 else trace.coordinate(k)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
          for k in ends]
     free_gap = np.asarray(s.segment_coils) * (np.asarray(s.segment_pitches) - s.wire_diameter)
     return np.column_stack([free_gap[i] - sign * (q[i + 1] - q[i]) for i in range(len(free_gap))])
@@ -238,14 +238,14 @@ def segment_gaps(s: SpringSpec, trace: object) -> np.ndarray:
 def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
     """Per spring: smallest length reached, coil-bind margin, forces and Bergstraesser stresses at installed,
     largest over the run and over the last cycle (min, max), the Goodman factor of the last cycle, surge."""
-    angle = np.asarray(trace.cam_angle)  # type: ignore[attr-defined]
+    angle = np.asarray(trace.cam_angle)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     last = angle >= angle[-1] - 360.0 if angle.size else angle.astype(bool)
-    u = trace.spec.unit_system  # type: ignore[attr-defined]
+    u = trace.spec.unit_system  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
     units = {"length_unit": u.length, "force_unit": u.force, "stress_unit": u.pressure,
              "stiffness_unit": u.stiffness, "mass_unit": u.mass, "frequency_unit": "Hz", "angle_unit": "deg"}
     result = []
     for s in springs:
-        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]
+        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
         length = s.rest_length - compression_sign(trace, s.coordinate) * q
         force = np.asarray(s.force_at(length), dtype=float)
         shortest = float(length.min())
@@ -269,12 +269,12 @@ def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
 
 def report_text(report: list[dict], units: object) -> list[str]:
     """Summary lines of :func:`run_report` (``units``: the preset's UnitSystem)."""
-    L, F, P = units.length, units.force, units.pressure  # type: ignore[attr-defined]
+    L, F, P = units.length, units.force, units.pressure  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
     lines = ["", "valve springs (data sheet; tau = K 8 F D/(pi d^3), Bergstraesser K, Wahl in brackets):"]
     for r in report:
         fatigue = "n/a (no fatigue_limit)" if r["fatigue_factor"] is None else f"{r['fatigue_factor']:.3f}"
         lines += [
-            f"  {r['name']}: rate {r['rate']:.5g} {units.stiffness}, preload {r['preload']:.5g} {F}, "  # type: ignore[attr-defined]
+            f"  {r['name']}: rate {r['rate']:.5g} {units.stiffness}, preload {r['preload']:.5g} {F}, "  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
             f"surge {', '.join(f'{f:.1f}' for f in r['surge_hz'])} Hz",
             f"    stress installed {r['installed_stress']:.5g} ({r['installed_stress_wahl']:.5g}) {P}, largest "
             f"{r['max_stress']:.5g} ({r['max_stress_wahl']:.5g}) {P} at force {r['max_force']:.5g} {F}",
@@ -315,7 +315,7 @@ def coil_bind_margin(springs: tuple[SpringSpec, ...], trace: object, rows: np.nd
     minus the solid length, or a pitch segment's smallest coil gap when smaller (<= 0: coils touch)."""
     margins = []
     for s in springs:
-        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]
+        q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
         length = s.rest_length - compression_sign(trace, s.coordinate) * q
         chosen = slice(None) if rows is None else rows
         if np.size(length[chosen]) == 0:
@@ -340,8 +340,8 @@ def surge_text(table: list[dict], units: object) -> list[str]:
         return []
     lines = ["", f"valve spring surge (fixed-fixed, (j/2) sqrt(k/m_a)), cam frequency {table[0]['cam_hz']:.4g} Hz:"]
     for row in table:
-        lines.append(f"  {row['spring']}: rate {row['rate']:.5g} {units.stiffness}, active mass "  # type: ignore[attr-defined]
-                     f"{row['active_mass']:.4g} {units.mass}: "  # type: ignore[attr-defined]
+        lines.append(f"  {row['spring']}: rate {row['rate']:.5g} {units.stiffness}, active mass "  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
+                     f"{row['active_mass']:.4g} {units.mass}: "  # type: ignore[attr-defined]  # a UnitSystem, duck-typed (module doc)
                      + ", ".join(f"{f:.1f} Hz (order {o:.1f})" for f, o in zip(row["surge_hz"], row["surge_order"],
                                                                               strict=True)))
     return lines

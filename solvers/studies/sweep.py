@@ -101,7 +101,7 @@ def grid(fields: Sequence[tuple[str, Sequence[Any]]]) -> list[tuple[tuple[str, A
 
 def _model_key(spec: MechanismSpec) -> MechanismSpec:
     """The spec without its run settings: points with equal keys share one assembled model."""
-    return replace(spec, run=None)  # type: ignore[arg-type]
+    return replace(spec, run=None)  # type: ignore[arg-type]  # a cache key without run settings, never run
 
 
 def _mechanism(spec: MechanismSpec, previous: Mechanism | None) -> Mechanism:

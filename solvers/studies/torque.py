@@ -25,7 +25,13 @@ Friction at the cam-follower contact (``[follower] friction = μ``, default 0):
   the roller's own inertia neglected): F_t = μ F_n at the rim, power ω F_t
   times the tangent arm, which the roller bearing dissipates.
 
-The friction force is computed from the normal force after the run: it does
+Valve guide (``[follower] guide_friction = F_g``, a force, with
+``guide_velocity = v_r``, default 1 mm/s): Coulomb friction on the stem,
+regularised as F = F_g tanh(v / v_r) (v the valve's velocity; F_g the stem's
+side load times the guide's coefficient, taken as constant over the cycle),
+power F v >= 0. The rocker or finger pivot's friction is not modelled.
+
+The friction forces are computed after the run: it does
 not act back on the model's dynamics (the model's coordinates move along
 the follower's line of action, on which the tangential force does no work
 for a translating follower; a finger's pivot would take a small moment from
@@ -81,6 +87,16 @@ def torque_rows(spec: MechanismSpec, cam_angle_deg: np.ndarray, model_force: np.
     return TorqueRows(angles, normal, torque, friction, power)
 
 
+def guide_rows(spec: MechanismSpec, valve_velocity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The valve guide's friction force and power at rows of valve velocity (module doc)."""
+    follower = spec.follower
+    v = np.asarray(valve_velocity, dtype=float)
+    if follower is None or follower.guide_friction == 0.0:
+        return np.zeros_like(v), np.zeros_like(v)
+    force = follower.guide_friction * np.tanh(v / follower.guide_velocity)
+    return force, force * v
+
+
 def row_unit(spec: MechanismSpec, name: str) -> str:
     units = spec.unit_system
     return {"torque": f"{units.force}*{units.length}", "force": units.force,
@@ -128,4 +144,6 @@ def torque_text(s: dict) -> list[str]:
     if s["friction_coefficient"] > 0.0:
         lines.append(f"cam-follower friction (mu {s['friction_coefficient']:g}): mean power "
                      f"{s['mean_friction_power']:.5g} {s['power_unit']}, max force {s['max_friction_force']:.5g} {s['force_unit']}")
+    if "mean_guide_friction_power" in s:
+        lines.append(f"valve guide friction: mean power {s['mean_guide_friction_power']:.5g} {s['power_unit']}")
     return lines
