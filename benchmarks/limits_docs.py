@@ -1,14 +1,21 @@
 """Regenerate docs/limits.md's measured figures: the nominal 1A runs and the cost guard's example line.
 
-Run: ``python3 benchmarks/limits_docs.py`` (a few seconds; ``--check`` compares
-instead of writing and exits 1 on a difference). It writes the generated
+Run: ``python3 benchmarks/limits_docs.py --write`` (about half a minute; ``--check``
+compares instead of writing and exits 1 on a difference). It writes the generated
 blocks
 
 * ``limits-nominal``: example 1A as shipped (the thesis' start, the local
   impact law) and from the quasi-static start the extremes table's variants
   use (tests/test_extremes.py ``variant()``): throw-off, first seating and its
   bounce, peak forces, largest valve coordinate, events;
-* ``limits-cost-guard``: what ``vtool solve gnilka-1a --rpm 1.5`` prints.
+* ``limits-cost-guard``: what ``vtool solve gnilka-1a --rpm 1.5`` prints;
+* ``limits-extremes``: the extremes table, each row measured by running the
+  case tests/test_extremes.py runs (benchmarks/limits_extremes.py; about 20
+  runs of 850 degrees, a few seconds once the kernel is compiled);
+* ``limits-extremes-long``: the four cases the suite marks slow (100 rpm,
+  20 revolutions of 1A and of example 2 at every step, restitution on every
+  clearance, 3,600 degrees of cam bounces). ``--write`` writes them; ``--check``
+  compares them only with ``--long``, and the regeneration test does not.
 
 Everything here is deterministic (no wall times); tests/test_limits_docs.py
 regenerates the blocks and compares them with the committed page.
@@ -76,13 +83,34 @@ def cost_guard_block() -> str:
     return f"```\n$ vtool solve gnilka-1a --rpm 1.5\n{result.output.rstrip()}\n```\n"
 
 
-BLOCKS = {"limits-nominal": nominal_block, "limits-cost-guard": cost_guard_block}
+def _extremes():  # type: ignore[no-untyped-def]
+    """benchmarks/limits_extremes.py, loaded by path (benchmarks/ is not a package)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("limits_extremes", Path(__file__).resolve().parent / "limits_extremes.py")
+    module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+    spec.loader.exec_module(module)  # type: ignore[union-attr]
+    return module
+
+
+def extremes_block() -> str:
+    return _extremes().extremes_block()
+
+
+def extremes_long_block() -> str:
+    return _extremes().long_block()
+
+
+BLOCKS = {"limits-nominal": nominal_block, "limits-cost-guard": cost_guard_block,
+          "limits-extremes": extremes_block}
+LONG_BLOCKS = {"limits-extremes-long": extremes_long_block}
 
 
 def main(argv: list[str]) -> int:
     check = "--check" in argv
     status = 0
-    for name, make in BLOCKS.items():
+    blocks = BLOCKS | (LONG_BLOCKS if not check or "--long" in argv else {})
+    for name, make in blocks.items():
         text = make()
         if check:
             same = read_block(DOC, name) == text

@@ -500,6 +500,17 @@ def test_the_limit_is_sharp(factor: float) -> None:
 
 # ----- long runs -----
 
+def seatings_per_revolution(trace: Trace, revolutions: int) -> tuple[list[float], list[float]]:
+    """Per revolution: the first seating's angle within it (deg) and the largest seat force."""
+    seatings, peaks = [], []
+    for revolution in range(revolutions):
+        inside = (trace.cam_angle >= 360.0 * revolution) & (trace.cam_angle < 360.0 * (revolution + 1))
+        seatings.append(next(e.cam_angle for e in impacts(trace, "seat") if e.cam_angle >= 360.0 * revolution)
+                        - 360.0 * revolution)
+        peaks.append(float(trace.force("seat")[inside].max()))
+    return seatings, peaks
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["gnilka-1a", "gnilka-2"])
 def test_twenty_revolutions_keep_closed_contacts_shut_and_do_not_drift(name: str) -> None:
@@ -507,12 +518,7 @@ def test_twenty_revolutions_keep_closed_contacts_shut_and_do_not_drift(name: str
     each revolution seats the valve at the same angle with the same force."""
     trace, mechanism = run(variant(name, degrees=7200.0), every_step=True)
     assert_sane(trace, mechanism)
-    seatings, peaks = [], []
-    for revolution in range(20):
-        inside = (trace.cam_angle >= 360.0 * revolution) & (trace.cam_angle < 360.0 * (revolution + 1))
-        seatings.append(next(e.cam_angle for e in impacts(trace, "seat") if e.cam_angle >= 360.0 * revolution)
-                        - 360.0 * revolution)
-        peaks.append(trace.force("seat")[inside].max())
+    seatings, peaks = seatings_per_revolution(trace, 20)
     np.testing.assert_allclose(seatings, seatings[0], rtol=0, atol=0.01)
     np.testing.assert_allclose(peaks, peaks[0], rtol=0.005)
 

@@ -1,5 +1,5 @@
-"""docs/limits.md: the generated nominal runs and cost-guard line match a fresh regeneration
-(benchmarks/limits_docs.py)."""
+"""docs/limits.md: the generated nominal runs, cost-guard line and extremes table match a fresh
+regeneration (benchmarks/limits_docs.py; the extremes table's slow rows are written by --write only)."""
 
 from __future__ import annotations
 
@@ -20,8 +20,9 @@ def _generator():  # type: ignore[no-untyped-def]
     return module
 
 
-@pytest.mark.parametrize("name", ["limits-nominal", "limits-cost-guard"])
+@pytest.mark.parametrize("name", ["limits-nominal", "limits-cost-guard", "limits-extremes"])
 def test_committed_limits_figures_are_regenerated_unchanged(name: str) -> None:
     block = _generator().BLOCKS[name]()
     assert read_block(ROOT / "docs" / "limits.md", name) == block, f"{name}: run python3 benchmarks/limits_docs.py"
     assert "0.0944 s" not in block and "163 events" not in block  # the stale figures it replaced
+    assert "7,028" not in block and "5,871" not in block  # the extremes table's old-law rocker peaks
