@@ -97,7 +97,7 @@ class SpringSpec:
 
     @property
     def preload(self) -> float:
-        return self.force_at(self.installed_length)
+        return float(self.force_at(self.installed_length))
 
     @property
     def rest_length(self) -> float:
@@ -134,7 +134,7 @@ class SpringSpec:
         """Goodman safety factor of a cycle between two forces (module doc); None without a fatigue limit."""
         if self.fatigue_limit is None:
             return None
-        return goodman(self.stress(force_min), self.stress(force_max), self.fatigue_limit,
+        return goodman(float(self.stress(force_min)), float(self.stress(force_max)), self.fatigue_limit,
                        self.shear_ratio * self.tensile_strength)
 
 
@@ -220,8 +220,9 @@ def segment_gaps(s: SpringSpec, trace: object) -> np.ndarray:
     (the model's segment bars are unloaded at q = 0); <= 0: that segment's coils touch (coil bind)."""
     sign = compression_sign(trace, s.coordinate)
     ends = (0, *s.nodes, s.coordinate)
-    q = [np.zeros_like(trace.cam_angle, dtype=float) if k == 0 else trace.coordinate(k)  # type: ignore[attr-defined]
-         for k in ends]
+    rows = len(trace.cam_angle)  # type: ignore[attr-defined]
+    q: list[np.ndarray] = [np.zeros(rows) if k == 0 else np.asarray(trace.coordinate(k), dtype=float)  # type: ignore[attr-defined]
+                           for k in ends]
     free_gap = np.asarray(s.segment_coils) * (np.asarray(s.segment_pitches) - s.wire_diameter)
     return np.column_stack([free_gap[i] - sign * (q[i + 1] - q[i]) for i in range(len(free_gap))])
 
