@@ -98,7 +98,7 @@ class SpringSpec:
 
     @property
     def preload(self) -> float:
-        return self.force_at(self.installed_length)
+        return float(self.force_at(self.installed_length))
 
     @property
     def rest_length(self) -> float:
@@ -143,7 +143,7 @@ class SpringSpec:
         """Goodman safety factor of a cycle between two forces (module doc); None without a fatigue limit."""
         if self.fatigue_limit is None:
             return None
-        return goodman(self.stress(force_min), self.stress(force_max), self.fatigue_limit,
+        return goodman(float(self.stress(force_min)), float(self.stress(force_max)), self.fatigue_limit,
                        self.shear_ratio * self.tensile_strength)
 
 
