@@ -769,7 +769,12 @@ def with_run_overrides(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
     if unknown:
         raise InputError(f"run.{unknown[0]}", given[unknown[0]], f"one of: {', '.join(RUN_KEYS)}")
     names = _quantity_names(spec.coordinates, spec.cam, spec.seat, spec.clearances)
-    run = _run(Table(_dump_run(spec.run) | given, "run"), names, spec.unit_system)
+    table = _dump_run(spec.run) | given
+    if "quantities" not in given:  # (checked at the load against the preset's own numbering, which a train's
+        table.pop("quantities", None)  # expansion and the members' split renumber: kept as loaded)
+    run = _run(Table(table, "run"), names, spec.unit_system)
+    if "quantities" not in given:
+        run = dataclasses.replace(run, quantities=spec.run.quantities)
     title = spec.title
     if "rpm" in given and run.rpm != spec.run.rpm:
         title = rpm_title(title, run.rpm)
