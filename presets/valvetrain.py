@@ -183,10 +183,10 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         train=train,
     )
     spec = split_members(spec)
-    if seat is not None and seat.lash is not None:
+    if spec.seat is not None and spec.seat.lash is not None:  # the split seat: its coordinate may have moved up
         from vtool.solvers.model.lash import seat_position
 
-        spec = replace(spec, seat=replace(seat, position=float(seat_position(spec, seat.lash))))
+        spec = replace(spec, seat=replace(spec.seat, position=float(seat_position(spec, spec.seat.lash))))
     return spec
 
 
