@@ -229,7 +229,11 @@ class Backend(ABC, Generic[OptionsT]):
                         rocker_scale=spec.contact.rocker_scale, start_velocities=spec.initial.velocities)
         if any(not c.rigid for c in spec.clearances):
             settings["contact"] = {c.name: c.contact for c in spec.clearances if not c.rigid}
-        built = problem.tables.layers if stats.configurations is None else stats.configurations
+        if stats.configurations is None:  # the configurations this run held: its start and every event's two
+            # (the tables are shared by every run of the mechanism, so what they have built says nothing of this run)
+            built = {problem.start_mask} | {e.before for e in builder.events} | {e.after for e in builder.events}
+        else:
+            built = set(stats.configurations)
         statistics = RunStatistics(self.name, stats.steps, len(builder.events), wall, tuple(sorted(built)), settings,
                                    compile_time=compile_time,
                                    remedy=self.remedy)

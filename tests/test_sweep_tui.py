@@ -63,7 +63,7 @@ async def test_bad_range_shows_one_line_and_runs_nothing() -> None:
 
 
 async def test_cancel_stops_and_keeps_finished_points() -> None:
-    app = PaneApp(values="9000:12000:20", fixed="run.degrees=2000")
+    app = PaneApp(values="9000:12000:5", fixed="run.degrees=4000")  # ~20 s of work: still running at the cancel
     async with app.run_test(size=(140, 50)) as pilot:
         pane = app.query_one(SweepPane)
         pane.run_sweep()
@@ -77,7 +77,7 @@ async def test_cancel_stops_and_keeps_finished_points() -> None:
         await pilot.pause()
         await pilot.pause()
         assert pane.status_text.startswith("stopped:"), pane.status_text
-        assert len(pane.outcome.results) < 151
+        assert len(pane.outcome.results) < 601
 
 
 async def test_several_workers_run_under_textual_and_its_stderr_is_kept() -> None:
