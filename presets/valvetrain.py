@@ -161,6 +161,12 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     from vtool.presets.springs import load_sheets
 
     springs = load_sheets(top, units, n)
+    hla_table = top.table("hla", required=False)
+    hla = None
+    if hla_table is not None:
+        from vtool.presets.hla import load_hla
+
+        hla = load_hla(hla_table, units, members)
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)
     top.finish()
     spec = MechanismSpec(
@@ -181,6 +187,7 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         checks=checks,
         springs=springs,
         train=train,
+        hla=hla,
     )
     spec = split_members(spec)
     if spec.seat is not None and spec.seat.lash is not None:  # the split seat: its coordinate may have moved up
@@ -248,7 +255,7 @@ def _contact(t: Table | None) -> ContactSpec:
 
 
 TOP_KEYS = ("kind", "title", "notes", "units", "gravity", "coordinates", "members", "cam", "seat",
-            "clearances", "initial", "contact", "damping", "run", "follower", "checks", "springs")
+            "clearances", "initial", "contact", "damping", "run", "follower", "checks", "springs", "hla")
 
 
 def _magnitude(t: Table, key: str, unit: str, what: str, *, default: float | None = None,
@@ -703,6 +710,10 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         from vtool.presets.springs import sheet_document
 
         doc["springs"] = [sheet_document(s) for s in spec.springs]
+    if spec.hla is not None:
+        from vtool.presets.hla import dump_hla
+
+        doc["hla"] = dump_hla(spec.hla)
     return train_document(given, doc) or doc
 
 
