@@ -44,6 +44,11 @@ member's. The chamber pressure p is the element's one state (in the model's
 pressure unit); at the start it balances the member's static force,
 p₀ = (σ k₀ u₀ - F_s(x₀)) / A, or the supply pressure where that is lower
 (the check valve has filled the chamber: the plunger then pumps up).
+Not modelled: cavitation (with no entrained air the gauge pressure may fall
+below -1 atm while the plunger extends faster than the check valve fills it;
+with air the mixture's bulk modulus falls towards zero as the absolute
+pressure does, which holds it above vacuum), the ball's own dynamics, and
+friction of the plunger in its bore beyond the viscous ``damping``.
 """
 
 from __future__ import annotations
