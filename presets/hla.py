@@ -47,7 +47,7 @@ def read_data(t: Table, units: UnitSystem) -> tuple[HLASpec, float | None, dict[
     conductance = f"{length}^3/({units.time}*{pressure})"
     given: dict[str, Any] = {}
 
-    def number(key: str, unit: str, default: float | None = None, **bounds: float) -> float:
+    def number(key: str, unit: str, default: float | None = None, **bounds: Any) -> float:
         value = t.number(key, unit=unit, default=default, **bounds)
         if t.has(key):
             given[key] = t.raw(key)

@@ -255,12 +255,12 @@ class HLAElement(NonlinearElement):
     # the member's elongation u = q_b - q_a (signed ends; a grounded end is 0)
     def elongation(self, q: np.ndarray) -> np.ndarray:
         (ia, sa), (ib, sb) = self.ends
-        u = np.zeros(np.shape(q)[1:]) if np.ndim(q) > 1 else 0.0
+        u = np.zeros(np.shape(q)[1:])
         if ib >= 0:
             u = u + sb * q[ib]
         if ia >= 0:
             u = u - sa * q[ia]
-        return u
+        return np.asarray(u)
 
     def extension(self, q: np.ndarray) -> np.ndarray:
         """The plunger's extension x (model length)."""
@@ -286,7 +286,7 @@ class HLAElement(NonlinearElement):
     def flows(self, q: np.ndarray, v: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(Q_check, Q_leak) in m³/s at model pressure p."""
         pa = p * self.pressure_pa
-        return check_flow(self.place.hla, pa), leakage(self.place.hla, pa)
+        return np.asarray(check_flow(self.place.hla, pa)), np.asarray(leakage(self.place.hla, pa))
 
     def evaluate(self, t, q: np.ndarray, v: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
         if np.ndim(s) == 1:

@@ -113,7 +113,8 @@ class ValveForceElement(NonlinearElement):
     def on_valve(self, t: float | np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(friction, gas) forces on the valve coordinate at t with velocities v."""
         speed = v[self.index]
-        return -friction_force(self.vf, speed), gas_force(self.vf, np.asarray(t) * self.degrees_per_second)
+        return (np.asarray(-friction_force(self.vf, speed)),
+                np.asarray(gas_force(self.vf, np.asarray(t) * self.degrees_per_second)))
 
     def evaluate(self, t, q: np.ndarray, v: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
         friction, gas = self.on_valve(t, v)
