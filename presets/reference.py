@@ -389,6 +389,19 @@ MEANINGS: dict[str, dict[str, str]] = {
         "transient.tolerance": "Error above which a transient result is flagged.",
         "transient.truncation_check": "Check the exact superposition's truncation by doubling its modes.",
     },
+    "camshaft": {key: COMMON[key] for key in ("kind", "title")} | {
+        "camshaft": "The camshaft: its cylinders, firing order, speed and valves (presets/camshaft.py).",
+        "camshaft.cylinders": "Number of cylinders whose lobes the camshaft carries.",
+        "camshaft.firing_order": "Cylinder numbers in firing order: the k-th fires 360 k / cylinders cam deg "
+                                 "after the first.",
+        "camshaft.rpm": "Cam speed set into every train (default: each train preset's run.rpm).",
+        "camshaft.valves": "One table per valve (lobe) on the camshaft.",
+        "camshaft.valves[].train": "The valve's train: a shipped valvetrain preset with a follower, or a file "
+                                   "beside this preset.",
+        "camshaft.valves[].cylinder": "The valve's cylinder: its phase from the firing order.",
+        "camshaft.valves[].phase": "Phase offset of the lobe (an exhaust lobe's), added to its cylinder's.",
+        "camshaft.valves[].label": "The valve's name in the tables, CSV header and charts.",
+    },
 }
 # the explicit form's [[springs]] (a data sheet as a train writes it): the same keys as [train.spring]
 # and a nested [train.spring.inner]

@@ -47,10 +47,11 @@ class VtoolApp(App[None]):
     BINDINGS: ClassVar[list[BindingType]] = [
         Binding("ctrl+o", "open", "Open", priority=True),
         Binding("f1", "help", "Help"),
-        Binding("f2", "switch_mode('valvetrain')", "Screen", key_display="f2-4",
-                tooltip="f2 valve train, f3 sonic boom, f4 plate"),
+        Binding("f2", "switch_mode('valvetrain')", "Screen", key_display="f2-5",
+                tooltip="f2 valve train, f3 sonic boom, f4 plate, f5 camshaft"),
         Binding("f3", "switch_mode('boom')", "Sonic boom", show=False),
         Binding("f4", "switch_mode('plate')", "Plate", show=False),
+        Binding("f5", "switch_mode('camshaft')", "Camshaft", show=False),
         Binding("ctrl+q", "quit", "Quit", priority=True),
     ]
 
