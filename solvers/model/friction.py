@@ -136,3 +136,33 @@ def roller_slip(t: np.ndarray, rolling_speed: np.ndarray, normal: np.ndarray, ra
             traction[i] = limit[i] * (np.sign(slip) if slip != 0.0 else np.sign(demand))
     slip_speed = u - speed
     return RollerSlip(speed, traction, slip_speed, np.abs(traction * slip_speed), slipping)
+
+
+COULOMB = "coulomb"
+STRIBECK = "stribeck"
+SLIDING_LAWS = (COULOMB, STRIBECK)
+
+
+@dataclass(frozen=True)
+class FrictionLaws:
+    """A follower's friction laws beyond its coefficients ``friction`` and ``guide_friction``
+    (:class:`vtool.solvers.model.spec.FollowerSpec`), in the preset's units.
+
+    ``sliding``: the law of the sliding contacts (a flat face on the cam, the valve
+    guide): ``coulomb`` or ``stribeck`` (then ``static`` μ_s of the cam contact,
+    ``guide_static`` the guide's force at rest, ``stribeck_velocity`` v_S,
+    ``viscous`` k_v in time/length). ``pivot``/``pivot_radius``/``pivot_velocity``:
+    a finger's or rocker's pivot (μ, r_p, Ω_r in rad/s). ``slip``/``roller_inertia``:
+    a roller's slip law (μ_slip, J about the pin in mass × length²); 0: not evaluated.
+    """
+
+    sliding: str = COULOMB
+    static: float = 0.0
+    guide_static: float = 0.0
+    stribeck_velocity: float = 0.0
+    viscous: float = 0.0
+    pivot: float = 0.0
+    pivot_radius: float = 0.0
+    pivot_velocity: float = 1.0
+    slip: float = 0.0
+    roller_inertia: float = 0.0
