@@ -124,3 +124,21 @@ def test_camshaft_is_a_kind_solve_and_the_alias_agree(tmp_path):
     assert bad.exit_code == 2 and "camshaft preset" in bad.output
     wrong = CliRunner().invoke(cli, ["camshaft", "gnilka-1a"])
     assert wrong.exit_code == 2 and "camshaft" in wrong.output
+
+
+def test_torque_figures_are_embedded_and_regenerate():
+    """benchmarks/docs_figures.py: docs/torque.md embeds its figures, which exist; the train's redraws (--check)."""
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    sys.path.insert(0, str(root / "benchmarks"))
+    try:
+        import docs_figures
+    finally:
+        sys.path.pop(0)
+    assert docs_figures.check([]) == []
+    assert {"torque-train", "torque-camshaft"} <= set(docs_figures.PAGES)
+    for name, page in docs_figures.PAGES.items():
+        assert f"](figures/{name}.png)" in page.read_text()
+    assert docs_figures.main(["--check", "--only", "torque-train"]) == 0
