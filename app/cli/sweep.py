@@ -102,8 +102,10 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
       vtool sweep gnilka-1a --set run.rpm=9000:12000:500 --set members.valve_spring.stiffness=200,254,300 --map
       vtool sweep gnilka-1a --find jump-speed
 
-    Every point is validated like a preset before any run starts. Metrics
-    and their definitions: docs/sweep.md.
+    The values are checked like a preset before any run starts (every listed
+    value, a range's ends, the grid's corners); each point is made when it
+    runs, and one the preset loader refuses is a failed row with its message.
+    Metrics and their definitions: docs/sweep.md.
     """
     from vtool.errors import InputError, RunError
     from vtool.presets.paths import plan_sweep
@@ -139,7 +141,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         raise InputError("--set", None, "at least one FIELD=VALUES (or --find jump-speed)")
     plan = plan_sweep(preset, list(sets))
     if steady or orders or campbell:
-        plan = _with_settings(plan, steady, orders + ((campbell,) if campbell else ()))
+        plan = plan.with_settings(orders + ((campbell,) if campbell else ()), steady)
     if campbell and not any(f == "run.rpm" for f, _ in plan.fields):
         raise InputError("--campbell", campbell, "a sweep over run.rpm")
     if find == "bounce-speed" and seat_index(plan.spec) is None:
@@ -149,7 +151,8 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     names = {name: unit for name, unit in metric_columns(plan.spec)}
     if metric not in names:
         raise InputError("--metric", metric, f"one of: {', '.join(names)}")
-    axes = [f for f in plan.fields if len({dict(p.values)[f[0]] for p in plan.points}) > 1]
+    varied = plan.points.axes()
+    axes = [f for f in plan.fields if f[0] in varied]
     if as_map and len(axes) != 2:
         raise InputError("--map", len(axes), "exactly two swept fields with more than one value")
     if (plot or figure_path) and not axes:
@@ -256,12 +259,15 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:
     from vtool.solvers.studies.steady import steady_text, with_steady
     from vtool.solvers.studies.sweep import find_speed, format_value
 
-    scan = sorted({dict(p.values)["run.rpm"] for p in plan.points})
+    grid = plan.points
+    speeds = dict(grid.fields)["run.rpm"]
+    scan = sorted(set(speeds))
     others = [f for f in plan.fields if f[0] != "run.rpm"]
     searches: dict[tuple, object] = {}
-    for point in plan.points:
-        key = tuple((k, v) for k, v in point.values if k != "run.rpm")
-        searches.setdefault(key, point.spec)
+    for index in range(len(grid)):  # one search per value of the other fields, its spec at the first speed
+        values = grid.values(index)
+        if dict(values)["run.rpm"] == speeds[0]:
+            searches.setdefault(tuple((k, v) for k, v in values if k != "run.rpm"), grid.maker(values))
     rows = []
     found = []
     first = with_steady(plan.spec)
@@ -307,19 +313,3 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:
         buffer = io.StringIO()
         csv.writer(buffer, lineterminator="\n").writerows([header] + rows)
         write_atomic(csv_path, buffer.getvalue())
-
-
-def _with_settings(plan, steady: bool, orders: tuple[str, ...]):
-    """The plan with every point (and its base spec) run to steady state and reporting these order amplitudes."""
-    import dataclasses
-
-    from vtool.solvers.studies.orders import with_orders
-    from vtool.solvers.studies.steady import with_steady
-
-    def change(spec):
-        spec = with_orders(spec, orders) if orders else spec
-        return with_steady(spec) if steady else spec
-
-    return dataclasses.replace(plan, spec=change(plan.spec),
-                               points=tuple(dataclasses.replace(p, spec=change(p.spec)) for p in plan.points))
-
