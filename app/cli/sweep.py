@@ -72,9 +72,10 @@ def _scheduler(ctx: click.Context, param: click.Parameter, value: str | None) ->
 @click.option("--format", "file_format", type=click.Choice(["csv", "parquet"]),
               help="Format of the --csv/--out file (default: parquet for a .parquet file, else csv). Parquet "
                    "(needs pyarrow: pip install 'vtool[parquet]') is written in row groups, memory bounded; "
-                   "the table is then not printed unless --json, --plot, --map or --figure needs it, and an "
-                   "interrupted sweep keeps nothing (no --resume).")
-@click.option("--resume", is_flag=True, help="Continue the sweep in the --csv file, skipping finished points.")
+                   "the table is then not printed unless --json, --plot, --map or --figure needs it; an "
+                   "interrupted sweep keeps its finished points (--resume continues it), a killed one nothing.")
+@click.option("--resume", is_flag=True, help="Continue the sweep in the --csv/--out file (CSV or Parquet), skipping "
+                                            "finished points.")
 @click.option("--timing", is_flag=True, help="Also write each point's wall time to the CSV (not reproducible).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON instead of a table.")
 @click.option("--plot", is_flag=True, help="Chart --metric against the first swept field (--figure: also as a figure file).")
@@ -128,9 +129,8 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         from vtool.solvers.parquet import output_format
 
         parquet = output_format(csv_path, file_format) == "parquet"
-        if parquet and (resume or find is not None):
-            raise InputError("--format", "parquet", "csv for --resume and --find (a Parquet sweep is written "
-                             "whole at the end)")
+        if parquet and find is not None:
+            raise InputError("--format", "parquet", "csv for --find (a search writes one row per search)")
     if find is not None:
         if not any(s.partition("=")[0].strip() == "run.rpm" for s in sets):
             sets = (f"run.rpm={DEFAULT_SCAN}",) + sets
@@ -171,15 +171,19 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
             csv_path and not parquet) else None
         progress = CountProgress(f"{len(plan.points)} points")
         keep = not parquet or as_json or plot or as_map or bool(campbell) or figure_path is not None
+        outcome_rows = [0]  # rows of an interrupted Parquet sweep's file
         try:
             if parquet:
-                outcome = _run_to_parquet(plan, runner, csv_path, every_step, timing, keep, progress)
+                outcome = _run_to_parquet(plan, runner, csv_path, every_step, timing, keep, progress, resume,
+                                          outcome_rows)
             else:
                 outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress)
         except KeyboardInterrupt:
             progress.close()
-            if parquet:
-                where = "nothing was kept (an interrupted Parquet sweep is not written; --csv keeps points)"
+            if parquet and outcome_rows[0]:
+                where = f"the finished points are in {csv_path}; run again with --resume to finish"
+            elif parquet:
+                where = f"no point had finished: nothing was written ({csv_path} is as it was)"
             elif sink is not None and (sink.written or resume):
                 where = f"the finished points are in {csv_path}; run again with --resume to finish"
             elif sink is not None:
@@ -192,7 +196,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     finally:
         runner.close()
     results = outcome.results
-    if sink is not None and outcome.skipped:
+    if (sink is not None or parquet) and outcome.skipped:
         click.echo(f"resumed: {outcome.skipped} of {outcome.total} points were already in {csv_path}", err=True)
     from vtool.solvers.studies.metrics import Criteria
     from vtool.solvers.studies.steady import steady_text
@@ -239,16 +243,31 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         write_figure(items, figure_path)
 
 
-def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):
-    """The sweep with its points written to a Parquet file as they finish (renamed into place at the end)."""
-    from vtool.files import open_atomic_binary
+def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress, resume, written):
+    """The sweep with its points written to a Parquet file as they finish, renamed into place at the end; an
+    interrupted sweep's file (its footer written by run_points) is renamed into place too when it holds a
+    point (``written[0]``: its rows), so that --resume continues it; a failed one leaves the old file."""
+    from vtool.errors import InputError
+    from vtool.files import exists, open_atomic_binary
     from vtool.solvers.parquet import SweepParquet
     from vtool.solvers.studies.sweep import run_points
 
+    if resume and not exists(path):
+        raise InputError("--resume", str(path), "an existing partial sweep file (none found)")
+    interrupted = None
     with open_atomic_binary(path, "--out") as handle:
-        sink = SweepParquet(handle, plan.fields, plan.spec, timing=timing)
-        return run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress, keep=keep)
-        # (run_points finishes the sink, footer included, also when interrupted: the file is then removed)
+        sink = SweepParquet(handle, plan.fields, plan.spec, timing=timing, resume=path if resume else None)
+        try:
+            outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress,
+                                 keep=keep)
+        except KeyboardInterrupt as exc:
+            written[0] = sink.rows
+            if not sink.rows:
+                raise
+            interrupted = exc  # the block ends normally: the file with the finished points replaces the old one
+    if interrupted is not None:
+        raise interrupted
+    return outcome
 
 
 def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:
