@@ -269,13 +269,15 @@ def order_chart(spectrum: Any, frequencies: list[tuple[str, float]], highest: fl
 
 
 def campbell_chart(data: Any, subject: str = "") -> HeatMap:
-    """``vtool sweep --campbell Q``: log10 of the order amplitudes over cam speed and cam order."""
+    """``vtool sweep --campbell Q``: log10 of the order amplitudes over cam speed and cam order, with each
+    natural frequency the terminal map marks drawn as its line order = f_n 60 / rpm (the orders it meets)."""
     with np.errstate(divide="ignore", invalid="ignore"):
         values = np.where(data.amplitude > 0, np.log10(data.amplitude), np.nan)
     orders = np.arange(1, len(data.amplitude) + 1, dtype=float)
+    rpm = np.asarray(data.rpm, dtype=float)
+    lines = tuple(curve(f"{hz:.0f} Hz ({label})", rpm, data.line(hz)) for label, hz in data.frequencies)
     return HeatMap(f"{data.quantity}: amplitude per cam order and speed (log10)", "cam speed (rev/min)",
-                   "cam order (-)", f"log10 amplitude ({data.unit})", np.asarray(data.rpm, dtype=float), orders,
-                   values, subject)
+                   "cam order (-)", f"log10 amplitude ({data.unit})", rpm, orders, values, subject, lines)
 
 
 # ----------------------------------------------------------------------------

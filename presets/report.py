@@ -292,7 +292,7 @@ def sweep_section(preset: str, sets: Sequence[str], metric: str, workers: int | 
     names = dict(metric_columns(plan.spec))
     if metric not in names:
         raise InputError("--metric", metric, f"one of: {', '.join(names)}")
-    axes = [f for f in plan.fields if len({dict(p.values)[f[0]] for p in plan.points}) > 1]
+    axes = [f for f in plan.fields if f[0] in plan.points.axes()]
     if not axes:
         raise InputError("--sweep", ", ".join(sets), "a swept field with two or more values")
     runner = make_runner(workers)
