@@ -69,6 +69,7 @@ class SpringSpec:
     table_lengths: tuple[float, ...] = ()  # measured force-length table (decreasing lengths)
     table_forces: tuple[float, ...] = ()
     nodes: tuple[int, ...] = ()  # a pitch diagram's coordinates between its segments (fixed end first)
+    contacts: tuple[str, ...] = ()  # a pitch diagram's coil-contact clearances, one per segment
 
     # ----- closed forms -----
     @property
@@ -235,6 +236,29 @@ def segment_gaps(s: SpringSpec, trace: object) -> np.ndarray:
     return np.column_stack([free_gap[i] - sign * (q[i + 1] - q[i]) for i in range(len(free_gap))])
 
 
+def end_force(s: SpringSpec, trace: object, rows: slice = slice(None)) -> np.ndarray:
+    """The spring's force on its moving end at each output row (compression positive).
+
+    A pitch diagram: the top segment's bar, k_top times its compression, plus its coil contact's force
+    (the run's own force: surge and coil clash included; the bar's consistent-mass inertia is left out).
+    Otherwise the force-length law at the end's length from the run (one bar: its elastic force). The
+    CSV column ``NAME_force`` and the quantity of ``vtool solve --orders NAME_force``; ``rows``: a slice."""
+    q_end = trace.coordinate(s.coordinate, rows)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+    sign = compression_sign(trace, s.coordinate)
+    if not s.segment_coils:
+        return np.asarray(s.force_at(s.rest_length - sign * q_end), dtype=float)
+    below = trace.coordinate(s.nodes[-1], rows) if s.nodes else np.zeros_like(q_end)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+    force = segment_rates(s)[-1] * sign * (q_end - below)
+    if s.contacts:
+        force = force + trace.force(s.contacts[-1], rows)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+    return np.asarray(force, dtype=float)
+
+
+def force_quantity(s: SpringSpec) -> str:
+    """The name of a spring's end force as a quantity and CSV column: ``valve_spring_force``."""
+    return f"{s.name}_force"
+
+
 def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
     """Per spring: smallest length reached, coil-bind margin, forces and Bergstraesser stresses at installed,
     largest over the run and over the last cycle (min, max), the Goodman factor of the last cycle, surge."""
@@ -247,7 +271,7 @@ def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
     for s in springs:
         q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
         length = s.rest_length - compression_sign(trace, s.coordinate) * q
-        force = np.asarray(s.force_at(length), dtype=float)
+        force = end_force(s, trace)
         shortest = float(length.min())
         f_lo, f_hi = float(force[last].min()), float(force[last].max())
         result.append({
@@ -289,9 +313,14 @@ def report_text(report: list[dict], units: object) -> list[str]:
                                 for i, a in enumerate(r["segment_first_touch_deg"]))
             lines.append(f"    pitch segments, coils first touching (smallest gap "
                          f"{', '.join(f'{g:.3g}' for g in r['segment_min_gap'])} {L}): {touches}")
-            if r["first_coil_bind_deg"] is not None:
+            if r["first_coil_bind_deg"] is not None and "coil_contact_peak_force" in r:
+                lines.append(f"    first coil clash at {r['first_coil_bind_deg']:.1f} deg; peak coil contact force "
+                             f"{r['coil_contact_peak_force']:.5g} {F} (per segment "
+                             f"{', '.join(f'{f:.4g}' for f in r['segment_contact_peak_force'])} {F})")
+            elif r["first_coil_bind_deg"] is not None:
                 lines.append(f"    first coil clash at {r['first_coil_bind_deg']:.1f} deg: the model's segments do "
-                             "not stop there (no coil-contact force); the response after it is not to be trusted")
+                             "not stop there (coil_contact = \"none\": no coil-contact force); the response after it "
+                             "is not to be trusted")
     return lines
 
 
@@ -305,9 +334,17 @@ def _clash(s: SpringSpec, trace: object, angle: np.ndarray) -> dict:
     for i in range(gaps.shape[1]):
         touching = np.flatnonzero(gaps[:, i] <= 0.0)
         first.append(float(angle[touching[0]]) if touching.size else None)
+    result: dict = {"segment_min_gap": gaps.min(axis=0).tolist()}
+    if s.contacts:  # the coil contacts' own events and forces (the model stops the coils there)
+        names = [c.name for c in trace.spec.clearances]  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+        closed = {name: [e.cam_angle for e in trace.events if e.clearance == name and e.kind == "closed"]  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+                  for name in s.contacts}
+        first = [min(closed[name]) if closed[name] else None for name in s.contacts]
+        peaks = [float(trace.peak_force[names.index(name)]) for name in s.contacts]  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+        result |= {"coil_contacts": list(s.contacts), "segment_contact_peak_force": peaks,
+                   "coil_contact_peak_force": max(peaks)}
     seen = [a for a in first if a is not None]
-    return {"segment_first_touch_deg": first, "segment_min_gap": gaps.min(axis=0).tolist(),
-            "first_coil_bind_deg": min(seen) if seen else None}
+    return result | {"segment_first_touch_deg": first, "first_coil_bind_deg": min(seen) if seen else None}
 
 
 def coil_bind_margin(springs: tuple[SpringSpec, ...], trace: object, rows: np.ndarray | None = None) -> float:
