@@ -229,11 +229,12 @@ class Trace:
             return self.coordinate(int(match[1]), rows)
         if re.fullmatch(r"F\d+", text):
             return self.force(text, rows)
-        for spring in self.spec.springs:  # a data-sheet spring's end force (solvers/model/spring.py)
-            if text == f"{spring.name}_force":
-                from vtool.solvers.model.spring import end_force
+        if self.spec.springs:  # a data-sheet spring's end force (solvers/model/spring.py)
+            from vtool.solvers.model.spring import end_force, force_quantity
 
-                return end_force(spring, self, rows)
+            for spring in self.spec.springs:
+                if text == force_quantity(spring):
+                    return end_force(spring, self, rows)
         raise KeyError(expression)
 
     def coordinate_unit(self, number: int) -> str:
@@ -291,9 +292,12 @@ class Trace:
         if self.valve_coordinate() is not None:
             header.append(f"valve_lift ({units.length})")
             columns.append(self.valve_lift)
-        for spring in self.spec.springs:  # each data-sheet spring's force on its end (spring.end_force)
-            header.append(f"{spring.name}_force ({units.force})")
-            columns.append(lambda rows, name=f"{spring.name}_force": self.quantity(name, rows))
+        if self.spec.springs:  # each data-sheet spring's force on its end (spring.end_force)
+            from vtool.solvers.model.spring import force_quantity
+
+            for name in map(force_quantity, self.spec.springs):
+                header.append(f"{name} ({units.force})")
+                columns.append(lambda rows, name=name: self.quantity(name, rows))
         names = {h.rpartition(" (")[0] for h in header}
         for expression in quantities:
             name = expression.replace(" ", "")

@@ -317,3 +317,24 @@ def test_modes_lists_the_surge_frequencies_and_their_cam_orders() -> None:
     f1 = 0.5 * math.sqrt(79300.0 * 256.0 / (8.0 * 13824.0 * 5.25) / 3.904810e-5)  # 473.1 Hz
     assert f"{f1:.1f} Hz (order {f1 / 50.0:.1f})" in result.output
     assert f"{2 * f1:.1f} Hz (order {2 * f1 / 50.0:.1f})" in result.output
+
+
+def test_spring_end_force_is_a_csv_column_and_a_cam_order_quantity() -> None:
+    """One bar, table-free: the end force is k q_end (q = 0 unloaded), so its cam-order amplitudes are k times
+    q_end's; a CSV column with its unit; ``--orders valve_spring_force`` accepted, a wrong name refused."""
+    from vtool.presets import load_preset
+    from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.run import simulate
+    from vtool.solvers.studies.orders import spectrum, with_orders
+
+    spec = with_run_overrides(load_preset("direct-acting-bucket"), degrees=720.0)
+    sheet = spec.springs[0]
+    trace = simulate(with_orders(spec, ("valve_spring_force",)))
+    header, columns = trace.csv_columns()
+    column = columns[header.index("valve_spring_force (N)")](slice(None))
+    np.testing.assert_allclose(column, sheet.rate * trace.coordinate(sheet.coordinate), rtol=1e-12, atol=1e-9)
+    force, lift = spectrum(trace, "valve_spring_force"), spectrum(trace, f"q{sheet.coordinate}")
+    assert force.unit == "N" and force.amplitude[1:].max() > 10.0
+    np.testing.assert_allclose(force.amplitude, sheet.rate * lift.amplitude, rtol=1e-9, atol=1e-9)
+    with pytest.raises(InputError, match="valve_spring_force"):
+        with_orders(spec, ("outer_force",))

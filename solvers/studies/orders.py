@@ -69,7 +69,9 @@ def with_orders(spec: MechanismSpec, quantities: tuple[str, ...], field: str = "
     if spec.seat is not None:
         numbers.add(spec.seat.coordinate)
     forces = {c.ahead for c in spec.clearances}
-    springs = [f"{s.name}_force" for s in spec.springs]  # a data-sheet spring's end force
+    from vtool.solvers.model.spring import force_quantity
+
+    springs = [force_quantity(s) for s in spec.springs]  # a data-sheet spring's end force
     for quantity in quantities:
         match = re.fullmatch(r"q(\d+)(?:-q(\d+))?|F(\d+)", quantity.replace(" ", ""))
         ok = match is not None and (int(match[3]) in forces if match[3] else
@@ -150,8 +152,9 @@ def spectrum(trace: Trace, quantity: str) -> Spectrum:
         values = trace.quantity(quantity)
         unit = trace.quantity_unit(quantity)
     except (KeyError, ValueError, IndexError):
-        raise InputError("--orders", quantity, "a quantity of this preset: qN (a coordinate), qN-qM or FN (the "
-                         "contact force at the clearance ahead of qN)") from None
+        raise InputError("--orders", quantity, "a quantity of this preset: qN (a coordinate), qN-qM, FN (the "
+                         "contact force at the clearance ahead of qN) or NAME_force (a data-sheet spring's end "
+                         "force)") from None
     start, cycles = whole_cycles(trace)
     return series_spectrum(quantity, unit, trace.cam_angle, values, start, cycles, trace.spec.run.output_interval,
                            trace.spec.run.rpm)
