@@ -208,11 +208,7 @@ class Trace:
         return next(i for i, c in enumerate(self.spec.clearances) if c.behind == self.spec.cam.coordinate)
 
     def force_label(self, index: int) -> str:
-        """``F`` and the ahead coordinate; a second clearance on the same coordinate (a spring's top coil
-        contact on the retainer beside another contact) gets ``_2`` (``_3``, ...): CSV headers stay unique."""
-        ahead = self.spec.clearances[index].ahead
-        repeat = sum(c.ahead == ahead for c in self.spec.clearances[:index])
-        return f"F{ahead}" + (f"_{repeat + 1}" if repeat else "")
+        return self.spec.force_label(index)
 
     def force(self, label_or_name: str, rows: slice = slice(None)) -> np.ndarray:
         for i, c in enumerate(self.spec.clearances):

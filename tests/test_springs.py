@@ -305,6 +305,12 @@ def test_clashing_preset_reports_coil_clash_only_at_high_speed() -> None:
     slow = simulate(with_run_overrides(spec, rpm=3000.0))
     assert slow.summary()["springs"][0]["first_coil_bind_deg"] is None
     assert run_metrics(slow)["coil_bind_margin"] > 0.0 > run_metrics(fast)["coil_bind_margin"]
+    fast_metrics, slow_metrics = run_metrics(fast), run_metrics(slow)
+    assert report["coil_contact_peak_force"] > 100.0
+    assert 100.0 < fast_metrics["coil_contact_peak_force"] <= report["coil_contact_peak_force"]  # 2nd revolution
+    assert 360.0 < fast_metrics["coil_bind_angle"] < 720.0  # in the evaluated (second) revolution
+    assert slow_metrics["coil_contact_peak_force"] == 0.0 and math.isnan(slow_metrics["coil_bind_angle"])
+    assert {"F4", "F5", "F2"} <= {fast.force_label(i) for i in range(len(fast.spec.clearances))}
 
 
 def test_modes_lists_the_surge_frequencies_and_their_cam_orders() -> None:

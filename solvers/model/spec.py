@@ -451,6 +451,14 @@ class MechanismSpec:
     def n_coordinates(self) -> int:
         return len(self.coordinates)
 
+    def force_label(self, index: int) -> str:
+        """``F`` and clearance ``index``'s ahead coordinate; a second clearance on the same coordinate (a
+        spring's top coil contact on the retainer beside another contact) gets ``_2`` (``_3``, ...), so that
+        CSV headers and metric names stay unique."""
+        ahead = self.clearances[index].ahead
+        repeat = sum(c.ahead == ahead for c in self.clearances[:index])
+        return f"F{ahead}" + (f"_{repeat + 1}" if repeat else "")
+
     def clearance(self, name: str) -> ClearanceSpec:
         for c in self.clearances:
             if c.name == name:
