@@ -217,7 +217,11 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.spring.solid_length": "Data sheet: solid length (default total_coils x wire_diameter).",
         "train.spring.shear_modulus": "Data sheet: the wire's shear modulus G.",
         "train.spring.density": "Data sheet: the wire's density (the spring's mass).",
-        "train.spring.tensile_strength": "Data sheet: the wire's tensile strength R_m at its diameter.",
+        "train.spring.tensile_strength": "Data sheet: the wire's tensile strength R_m at its diameter, or \"VDSiCrV\" "
+                                         "(R_m = A / d^m fitted to its table), or {A, m}.",
+        "train.spring.tensile_strength.A": "R_m = A / d^m: A in MPa mm^m (d in mm).",
+        "train.spring.tensile_strength.m": "R_m = A / d^m: the exponent m.",
+        "train.spring.wire_height": "Data sheet: elliptic wire's axis along the spring (wire_diameter: the radial one).",
         "train.spring.fatigue_limit": "Data sheet: shear fatigue limit at zero mean (Goodman factor).",
         "train.spring.shear_ratio": "Data sheet: ultimate shear over tensile strength (Goodman line's end).",
         "train.spring.segment_coils": "Pitch diagram: active coils per segment, fixed end first (one bar each).",
@@ -403,7 +407,8 @@ MEANINGS["valvetrain"] |= {
     for table in ("springs[]", "train.spring.inner")
     for key in ("wire_diameter", "coil_diameter", "active_coils", "total_coils", "free_length", "installed_length",
                 "solid_length", "shear_modulus", "density", "tensile_strength", "fatigue_limit", "shear_ratio",
-                "lengths", "forces") + (("segment_coils", "segment_pitches") if table == "springs[]" else ())} | {
+                "lengths", "forces", "wire_height", "tensile_strength.A", "tensile_strength.m")
+    + (("segment_coils", "segment_pitches") if table == "springs[]" else ())} | {
     "train.spring.inner.elements": "Equal bar elements of the inner spring (surge modes).",
     "train.spring.inner.coil_contact": "Pitch diagram: linear coil contacts per segment (default) or none.",
     "train.spring.inner.block_stiffness": "Pitch diagram: a closed segment's contact stiffness (default 100 k_i).",

@@ -344,3 +344,43 @@ def test_spring_end_force_is_a_csv_column_and_a_cam_order_quantity() -> None:
     np.testing.assert_allclose(force.amplitude, sheet.rate * lift.amplitude, rtol=1e-9, atol=1e-9)
     with pytest.raises(InputError, match="valve_spring_force"):
         with_orders(spec, ("outer_force",))
+
+
+def test_elliptic_wire_rate_mass_and_stress_by_hand() -> None:
+    """Elliptic wire 4 mm radial x 3.2 mm axial (a = 2, b = 1.6): J_t = pi a^3 b^3/(a^2 + b^2) = pi 32.768/6.56
+    = 15.69264 mm^4, k = 4 G J_t/(pi D^3 n_a) = 4 * 79300 * 4.99512/(13824 * 5.25) = 21.8316 N/mm; tau = K F D/(pi a b^2)
+    (K Bergstraesser on D/d = 6: 6.5/5.25); solid length n_t h = 23.2 mm; mass rho pi a b pi D n_a."""
+    from vtool.solvers.model.spring import elliptic_torsion_constant
+
+    assert elliptic_torsion_constant(2.0, 2.0) == pytest.approx(math.pi * 4.0 ** 4 / 32.0, rel=1e-15)
+    s = _sheet(wire_height=3.2, installed_length=40.0, free_length=45.0)
+    J = math.pi * 2.0 ** 3 * 1.6 ** 3 / (2.0 ** 2 + 1.6 ** 2)
+    assert J == pytest.approx(15.69264, rel=1e-6)
+    assert s.rate == pytest.approx(4.0 * 79300.0 * J / (math.pi * 24.0 ** 3 * 5.25), rel=1e-14)
+    assert s.rate == pytest.approx(21.8316, rel=1e-5)
+    assert s.solid_length == pytest.approx(7.25 * 3.2)
+    assert s.active_mass == pytest.approx(7.85e-9 * math.pi * 2.0 * 1.6 * math.pi * 24.0 * 5.25, rel=1e-14)
+    assert s.stress(300.0) == pytest.approx(6.5 / 5.25 * 300.0 * 24.0 / (math.pi * 2.0 * 1.6 ** 2), rel=1e-14)
+    with pytest.raises(InputError, match="wire_height"):
+        _sheet(wire_height=1.0)
+
+
+def test_tensile_strength_against_wire_diameter_feeds_the_fatigue_factor() -> None:
+    """R_m = A / d^m: the VDSiCrV fit meets each point of its table within 1 %; {A, m} given; the Goodman
+    factor takes R_m at the wire's diameter."""
+    from vtool.solvers.model.spring import VDSICRV_TABLE, fitted_strength_law
+
+    A, m = fitted_strength_law(VDSICRV_TABLE)
+    for d, rm in VDSICRV_TABLE:
+        assert A / d ** m == pytest.approx(rm, rel=1e-2)
+    small = SHEET | {"wire_diameter": 2.5, "coil_diameter": 15.0}
+    s = read_sheet(Table(small | {"tensile_strength": "VDSiCr" + "V"}, "train.spring"), MM, "valve_spring", 2)
+    assert s.tensile_strength == pytest.approx(A / 2.5 ** m, rel=1e-12) and s.strength_law == (A, m)
+    assert 2060.0 < s.tensile_strength < 2160.0  # between its neighbours in the table
+    given = read_sheet(Table(small | {"tensile_strength": {"A": 2300.0, "m": 0.1}}, "train.spring"), MM, "v", 2)
+    assert given.tensile_strength == pytest.approx(2300.0 / 2.5 ** 0.1, rel=1e-14)
+    tau_lo, tau_hi = float(given.stress(100.0)), float(given.stress(300.0))
+    assert given.fatigue_factor(100.0, 300.0) == pytest.approx(
+        1.0 / (0.5 * (tau_hi - tau_lo) / 450.0 + 0.5 * (tau_hi + tau_lo) / (0.67 * 2300.0 / 2.5 ** 0.1)), rel=1e-14)
+    with pytest.raises(InputError, match="wire_diameter"):
+        read_sheet(Table(SHEET | {"tensile_strength": "VDSiCrV"}, "train.spring"), MM, "v", 2)  # 4 mm: off the table
