@@ -46,6 +46,11 @@ VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
     ("gnilka-1a", {"run.steady": {"tolerance": 1e-3, "max_cycles": 20}, "run.jump_gap": 0.002,
                    "run.bounce_lift": 0.002, "run.orders": ["F7"]}),
     ("gnilka-1a", {"run.cycles": 3}),
+    # a data-sheet spring's other branches: R_m = A / d^m, elliptic wire, coil contact settings (presets/springs.py)
+    ("nested-spring-clash", {"train.spring.tensile_strength": {"A": 2300.0, "m": 0.1}, "train.spring.wire_height": 3.8,
+                             "train.spring.block_stiffness": 1e4, "train.spring.block_damping_ratio": 0.2,
+                             "train.spring.inner.tensile_strength": {"A": 2300.0, "m": 0.1},
+                             "train.spring.inner.wire_height": 2.8, "train.spring.inner.coil_contact": "none"}),
     *((name, changes) for name in ("boom-brick-wall", "boom-tall-building") for changes in (
         {"boom.pulse": "N", "boom.envelope": None},
         {"boom.pulse": "csv", "boom.csv": "pulse.csv", "boom.envelope": None},
@@ -407,8 +412,8 @@ MEANINGS["valvetrain"] |= {
     for table in ("springs[]", "train.spring.inner")
     for key in ("wire_diameter", "coil_diameter", "active_coils", "total_coils", "free_length", "installed_length",
                 "solid_length", "shear_modulus", "density", "tensile_strength", "fatigue_limit", "shear_ratio",
-                "lengths", "forces", "wire_height", "tensile_strength.A", "tensile_strength.m")
-    + (("segment_coils", "segment_pitches") if table == "springs[]" else ())} | {
+                "lengths", "forces", "wire_height")
+    + (("segment_coils", "segment_pitches") if table == "springs[]" else ("tensile_strength.A", "tensile_strength.m"))} | {
     "train.spring.inner.elements": "Equal bar elements of the inner spring (surge modes).",
     "train.spring.inner.coil_contact": "Pitch diagram: linear coil contacts per segment (default) or none.",
     "train.spring.inner.block_stiffness": "Pitch diagram: a closed segment's contact stiffness (default 100 k_i).",
