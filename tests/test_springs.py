@@ -384,3 +384,50 @@ def test_tensile_strength_against_wire_diameter_feeds_the_fatigue_factor() -> No
         1.0 / (0.5 * (tau_hi - tau_lo) / 450.0 + 0.5 * (tau_hi + tau_lo) / (0.67 * 2300.0 / 2.5 ** 0.1)), rel=1e-14)
     with pytest.raises(InputError, match="wire_diameter"):
         read_sheet(Table(SHEET | {"tensile_strength": "VDSiCrV"}, "train.spring"), MM, "v", 2)  # 4 mm: off the table
+
+
+def test_the_clashing_preset_round_trips_through_its_explicit_form() -> None:
+    from dataclasses import replace
+
+    from vtool.presets import load_preset
+    from vtool.presets.valvetrain import dump, load
+
+    spec = load_preset("nested-spring-clash")
+    explicit = dump(replace(spec, train=""))
+    assert [c.get("opening") for c in explicit["clearances"]][2:] == pytest.approx([3.25, 6.0, 7.0])
+    again = load(copy.deepcopy(explicit))
+    assert again.clearances == spec.clearances and again.springs == spec.springs
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.floats(-5.0, 5.0), min_size=5, max_size=5))
+def test_every_clearances_monitor_is_its_gap_with_opening_and_sense(q: list) -> None:
+    """Open (nothing closed): each monitored clearance's monitor is sense (q_ahead - q_behind) + opening
+    (behind = 0: the ground at 0; the cam and seat at their sources), plus the round-off allowance."""
+    from vtool.presets import load_preset
+    from vtool.solvers.model.contact import ContactProblem
+    from vtool.solvers.model.mechanism import Mechanism
+
+    spec = load_preset("nested-spring-clash")
+    problem = ContactProblem(Mechanism(spec))
+    x, v = np.array(q), np.zeros(5)
+    src = problem.sources_at(0.0)
+    values = problem.monitors(0, 0.0, x, v, np.zeros(5))
+    for k, c in enumerate(spec.clearances):
+        behind = x[c.behind - 1] if 0 < c.behind <= 5 else 0.0 if c.behind == 0 else \
+            src[3 * problem.source_numbers.index(c.behind)]
+        assert values[k] == pytest.approx(c.gap(x[c.ahead - 1], behind) + problem.gap_noise, abs=1e-12)
+
+
+def test_a_start_with_coils_touching_is_refused_in_one_line() -> None:
+    """The polydyne bucket starts at the nose (angle 0): with coil gaps that close before full lift, its static
+    start would sit inside a coil contact; refused naming the clearance (not built: an affine static start)."""
+    doc = _bucket_doc()
+    spring = doc["train"]["spring"]
+    del spring["elements"]
+    spring.update(segment_coils=[2.0, 1.75, 1.5], segment_pitches=[6.0, 5.0, 5.5], free_length=37.0,
+                  installed_length=33.0)
+    from vtool.solvers.model.mechanism import Mechanism
+
+    with pytest.raises(InputError, match=r"initial\.closed.*valve_spring coils 2 open.*overlaps it by"):
+        assert Mechanism(load_document(doc)).start is not None
