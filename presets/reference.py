@@ -51,6 +51,11 @@ VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
     ("ohc-finger-follower", {"train.follower.friction_law": "stribeck", "train.follower.pivot_friction": 0.1,
                              "train.follower.pivot_radius": 4.0, "train.follower.slip_friction": 0.1,
                              "train.follower.roller_inertia": 4e-4}),
+    # a data-sheet spring's other branches: R_m = A / d^m, elliptic wire, coil contact settings (presets/springs.py)
+    ("nested-spring-clash", {"train.spring.tensile_strength": {"A": 2300.0, "m": 0.1}, "train.spring.wire_height": 3.8,
+                             "train.spring.block_stiffness": 1e4, "train.spring.block_damping_ratio": 0.2,
+                             "train.spring.inner.tensile_strength": {"A": 2300.0, "m": 0.1},
+                             "train.spring.inner.wire_height": 2.8, "train.spring.inner.coil_contact": "none"}),
     *((name, changes) for name in ("boom-brick-wall", "boom-tall-building") for changes in (
         {"boom.pulse": "N", "boom.envelope": None},
         {"boom.pulse": "csv", "boom.csv": "pulse.csv", "boom.envelope": None},
@@ -237,7 +242,11 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.spring.solid_length": "Data sheet: solid length (default total_coils x wire_diameter).",
         "train.spring.shear_modulus": "Data sheet: the wire's shear modulus G.",
         "train.spring.density": "Data sheet: the wire's density (the spring's mass).",
-        "train.spring.tensile_strength": "Data sheet: the wire's tensile strength R_m at its diameter.",
+        "train.spring.tensile_strength": "Data sheet: the wire's tensile strength R_m at its diameter, or \"VDSiCrV\" "
+                                         "(R_m = A / d^m fitted to its table), or {A, m}.",
+        "train.spring.tensile_strength.A": "R_m = A / d^m: A in MPa mm^m (d in mm).",
+        "train.spring.tensile_strength.m": "R_m = A / d^m: the exponent m.",
+        "train.spring.wire_height": "Data sheet: elliptic wire's axis along the spring (wire_diameter: the radial one).",
         "train.spring.fatigue_limit": "Data sheet: shear fatigue limit at zero mean (Goodman factor).",
         "train.spring.shear_ratio": "Data sheet: ultimate shear over tensile strength (Goodman line's end).",
         "train.spring.segment_coils": "Pitch diagram: active coils per segment, fixed end first (one bar each).",
@@ -245,6 +254,9 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.spring.lengths": "Force-length table: lengths, decreasing (progressive spring).",
         "train.spring.forces": "Force-length table: the force at each length.",
         "train.spring.inner": "A nested inner spring in parallel: the same data-sheet keys.",
+        "train.spring.coil_contact": "Pitch diagram: linear coil contacts per segment (default) or none.",
+        "train.spring.block_stiffness": "Pitch diagram: a closed segment's contact stiffness (default 100 k_i).",
+        "train.spring.block_damping_ratio": "Pitch diagram: coil contact damping, ratio of critical (default 0.1).",
         "checks.spring_stress_max": "Largest corrected shear stress of a data-sheet spring (Bergstraesser).",
         "checks.spring_fatigue_min": "Smallest Goodman fatigue safety factor of a spring over the last cycle.",
         "checks.coil_bind_margin_min": "Smallest length reached minus the solid length.",
@@ -252,6 +264,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         "springs[].name": "The spring's member name.",
         "springs[].coordinate": "The coordinate of the spring's moving end (retainer).",
         "springs[].nodes": "A pitch diagram's coordinates between its segments (fixed end first).",
+        "springs[].contacts": "A pitch diagram's coil-contact clearances, one per segment (fixed end first).",
         "train.cam": "The lift law at the cam (a finger's: the roller's radial lift).",
         "train.cam.law": "Harmonic (the thesis' cam), a lift table or the ramped polydyne.",
         "train.cam.angle_basis": "Angles in cam or crank degrees (crank: halved).",
@@ -310,7 +323,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         "clearances[].name": "The clearance's name in tables and events.",
         "clearances[].kind": "External (against a prescribed coordinate) or internal (between two elastic ones).",
         "clearances[].ahead": "The coordinate ahead: gap = q[ahead] - q[behind], contact when gap <= 0.",
-        "clearances[].behind": "The coordinate behind.",
+        "clearances[].behind": "The coordinate behind (0: the ground, for a compliant external contact).",
         "clearances[].state": "Enabled, pinned (always closed) or removed (never monitored).",
         "clearances[].restitution": "Coefficient of restitution of its impacts.",
         "clearances[].impact": "Its own impact law (default: contact.impact).",
@@ -319,6 +332,8 @@ MEANINGS: dict[str, dict[str, str]] = {
         "clearances[].contact_damping": "Contact damping coefficient (linear contact).",
         "clearances[].contact_damping_ratio": "Contact damping as a ratio of critical (linear contact).",
         "clearances[].contact_exponent": "Exponent n of a Hertz contact's force law.",
+        "clearances[].opening": "Gap where q[ahead] = q[behind] (compliant contacts; a coil gap), default 0.",
+        "clearances[].sense": "+1: gap = q[ahead] - q[behind] + opening; -1: q[behind] - q[ahead] + opening.",
         "initial": "The static start.",
         "initial.closed": "Clearances closed at the start (the starting configuration).",
         "initial.spring_preload": "The valve spring's preload.",
@@ -431,8 +446,12 @@ MEANINGS["valvetrain"] |= {
     for table in ("springs[]", "train.spring.inner")
     for key in ("wire_diameter", "coil_diameter", "active_coils", "total_coils", "free_length", "installed_length",
                 "solid_length", "shear_modulus", "density", "tensile_strength", "fatigue_limit", "shear_ratio",
-                "lengths", "forces") + (("segment_coils", "segment_pitches") if table == "springs[]" else ())} | {
-    "train.spring.inner.elements": "Equal bar elements of the inner spring (surge modes)."}
+                "lengths", "forces", "wire_height")
+    + (("segment_coils", "segment_pitches") if table == "springs[]" else ("tensile_strength.A", "tensile_strength.m"))} | {
+    "train.spring.inner.elements": "Equal bar elements of the inner spring (surge modes).",
+    "train.spring.inner.coil_contact": "Pitch diagram: linear coil contacts per segment (default) or none.",
+    "train.spring.inner.block_stiffness": "Pitch diagram: a closed segment's contact stiffness (default 100 k_i).",
+    "train.spring.inner.block_damping_ratio": "Pitch diagram: coil contact damping ratio (default 0.1)."}
 
 
 def _merge(into: dict[str, FieldRead], reads: dict[str, FieldRead]) -> None:

@@ -23,9 +23,10 @@ FP_SIZE = 16
 CL_AHEAD, CL_BEHIND, CL_SRC, CL_MON, CL_PIN, CL_BIT, CL_LAW, CL_SOFT = range(8)
 CL_SIZE = 8  # CL_SOFT: SOFT_LINEAR or SOFT_HERTZ for a compliant clearance (no impact, no tie), else 0
 SOFT_LINEAR, SOFT_HERTZ = 1, 2
-# float columns: restitution, SCALE; Hertz stiffness and exponent; approach velocity of the contact
-CLF_E, CLF_SCALE, CLF_HK, CLF_HN, CLF_HV = range(5)
-CLF_SIZE = 5
+# float columns: restitution, SCALE; Hertz stiffness and exponent; approach velocity of the contact; the
+# gap's opening and sense (gap = sense (x_ahead - x_behind) + opening: ClearanceSpec.opening, 0 and 1 by default)
+CLF_E, CLF_SCALE, CLF_HK, CLF_HN, CLF_HV, CLF_OPEN, CLF_SIGN = range(7)
+CLF_SIZE = 7
 # impact laws
 LAW_MOMENTUM, LAW_LOCAL, LAW_THESIS = range(3)
 # event kinds
