@@ -22,7 +22,9 @@ from vtool.units import cam_speed
 
 if TYPE_CHECKING:  # (a field's type only: the spring module imports numpy, which `vtool --help` must not)
     from vtool.solvers.model.friction import FrictionLaws
+    from vtool.solvers.model.hla import HLAPlace
     from vtool.solvers.model.spring import SpringSpec
+    from vtool.solvers.model.valveforces import ValveForces
 
 BAR = "bar"
 BEAM = "beam"
@@ -434,6 +436,10 @@ class MechanismSpec:
     #: JSON text of the preset's [train] table when it was entered by train type (provenance: a saved copy
     #: keeps the type's parameters while the model is still what they expand to; see presets/trains.py)
     train: str = field(default="", compare=False)
+    #: a hydraulic lash adjuster in a bar member's place ([hla]; a nonlinear element, solvers/model/hla.py)
+    hla: HLAPlace | None = None
+    #: forces on the valve: guide friction, gas force ([valve_forces]; solvers/model/valveforces.py)
+    valve_forces: ValveForces | None = None
     kind: str = field(default="valvetrain", init=False)
 
     @property
