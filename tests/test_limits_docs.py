@@ -17,7 +17,7 @@ def _generator():  # type: ignore[no-untyped-def]
     return load("limits_docs")
 
 
-@pytest.mark.parametrize("name", ["limits-nominal", "limits-default-damping", "limits-seat-warning",
+@pytest.mark.parametrize("name", ["limits-sane", "limits-nominal", "limits-default-damping", "limits-seat-warning",
                                   "limits-cost-text", "limits-cost-guard", "limits-step-limits",
                                   "limits-run-rules", "limits-extremes"])
 def test_committed_limits_figures_are_regenerated_unchanged(name: str) -> None:
