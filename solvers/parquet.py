@@ -241,11 +241,11 @@ class SweepParquet:
     def finished_results(self, points: Sequence[Any]) -> dict[int, Any]:
         """The points the resumed file held (read again from it: it is replaced only when the sweep ends)."""
         from vtool.solvers.studies.metrics import failed_metrics
-        from vtool.solvers.studies.sweep import PointResult
+        from vtool.solvers.studies.sweep import PointResult, point_values
 
         if self.resume is None:
             return {}
-        values_of = points.values if hasattr(points, "run_order") else {p.index: p.values for p in points}.get
+        values_of = point_values(points)
         results: dict[int, Any] = {}
         for columns, indices in self._resumed_groups(points):
             for row, index in enumerate(indices):
