@@ -86,8 +86,14 @@ def configuration_chart(trace: Any) -> Chart:
 
 
 def trace_charts(trace: Any) -> list[Chart]:
-    """What ``vtool solve --plot`` draws: forces, displacements, configuration."""
-    return [force_chart(trace), displacement_chart(trace), configuration_chart(trace)]
+    """What ``vtool solve --figure`` draws: forces, displacements, configuration; with a [follower], the cam's
+    drive torque (:func:`vtool.presets.camshaft.train_torque_chart`)."""
+    charts = [force_chart(trace), displacement_chart(trace), configuration_chart(trace)]
+    if trace.spec.follower is not None:
+        from vtool.presets.camshaft import train_torque_chart
+
+        charts.append(train_torque_chart(trace))
+    return charts
 
 
 def compare_chart(variants: Sequence[Any]) -> Chart:

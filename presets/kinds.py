@@ -18,6 +18,7 @@ valvetrain  vtool.solvers.model.spec:MechanismSpec            vtool.presets.valv
 boom_wall   vtool.assessments.sonic_boom.spec:BoomWallSpec    vtool.presets.boom        vtool.app.cli.boom:solve_preset           vtool.app.tui.boom
 boom_floor  vtool.assessments.sonic_boom.spec:BoomFloorSpec   vtool.presets.boom        vtool.app.cli.boom:solve_preset           vtool.app.tui.boom
 plate       vtool.presets.plate:PlateSpec                     vtool.presets.plate       vtool.app.cli.plate:solve_preset          vtool.app.tui.plate
+camshaft    vtool.presets.camshaft:CamshaftSpec               vtool.presets.camshaft    vtool.app.cli.camshaft:solve_preset       vtool.app.tui.camshaft
 ==========  ================================================  ========================  ========================================  ========================
 
 A loader module has ``load(doc, folder=None) -> spec`` (``folder``: the
@@ -31,7 +32,9 @@ are set into the document and checked by the loader (the loader module then
 has ``with_overrides(doc, {path: value}) -> doc``). ``vtool solve`` refuses
 any other flag for the kind. A TUI screen module has ``SCREEN``, its
 :class:`~vtool.app.tui.base.DomainScreen` class; one screen may show
-several kinds (the boom screen: walls and floors). The table above is the
+several kinds (the boom screen: walls and floors). A ``camshaft`` preset runs
+several valvetrain presets (:mod:`vtool.presets.camshaft`); ``vtool camshaft`` is
+its ``vtool solve`` under the command's older name. The table above is the
 data below (``tests/test_dispatch.py`` compares them).
 """
 
@@ -83,6 +86,10 @@ KINDS: dict[str, Kind] = {
     "plate": Kind("plate", "condensed-plate study", "vtool.presets.plate:PlateSpec",
                   "vtool.presets.plate", "vtool.app.cli.plate:solve_preset", "vtool.app.tui.plate",
                   report="vtool.presets.report:plate_report"),
+    "camshaft": Kind("camshaft", "several valve trains on one camshaft: summed drive torque",
+                     "vtool.presets.camshaft:CamshaftSpec", "vtool.presets.camshaft",
+                     "vtool.app.cli.camshaft:solve_preset", "vtool.app.tui.camshaft",
+                     ("--rpm",), (("--rpm", "camshaft.rpm"),)),
 }
 
 

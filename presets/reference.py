@@ -46,6 +46,11 @@ VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
     ("gnilka-1a", {"run.steady": {"tolerance": 1e-3, "max_cycles": 20}, "run.jump_gap": 0.002,
                    "run.bounce_lift": 0.002, "run.orders": ["F7"]}),
     ("gnilka-1a", {"run.cycles": 3}),
+    # the friction laws (presets/friction.py): Stribeck on a flat face and the guide; a finger's pivot and slip
+    ("direct-acting-bucket", {"train.follower.friction_law": "stribeck", "train.follower.guide_friction": 5.0}),
+    ("ohc-finger-follower", {"train.follower.friction_law": "stribeck", "train.follower.pivot_friction": 0.1,
+                             "train.follower.pivot_radius": 4.0, "train.follower.slip_friction": 0.1,
+                             "train.follower.roller_inertia": 4e-4}),
     *((name, changes) for name in ("boom-brick-wall", "boom-tall-building") for changes in (
         {"boom.pulse": "N", "boom.envelope": None},
         {"boom.pulse": "csv", "boom.csv": "pulse.csv", "boom.envelope": None},
@@ -53,6 +58,20 @@ VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
         {"criteria": ["own"], "criterion": [{"name": "own", "source": "a reference", "response": "velocity",
                                              "value": 1.0, "unit": "in/s", "f_min": 1.0, "f_max": 50.0}]})),
 )
+
+#: The friction-law keys of a [follower] (presets/friction.py; the laws: solvers/model/friction.py).
+FRICTION_LAWS = {
+    "follower.friction_law": "Law of the sliding contacts (flat face, valve guide): Coulomb or Stribeck.",
+    "follower.static_friction": "Stribeck: the cam contact's coefficient at rest, mu_s (friction is mu_c).",
+    "follower.guide_static_friction": "Stribeck: the valve guide's friction force at rest.",
+    "follower.stribeck_velocity": "Stribeck: the speed v_S over which mu falls from mu_s to mu_c.",
+    "follower.viscous_friction": "Stribeck: the cam contact's coefficient rise per sliding speed, k_v.",
+    "follower.pivot_friction": "Friction coefficient of a finger's or rocker's pivot: T = mu F_pivot r_p.",
+    "follower.pivot_radius": "Radius r_p of the pivot's pin or ball.",
+    "follower.pivot_velocity": "Angular velocity below which the pivot friction is regularised (tanh).",
+    "follower.slip_friction": "A roller's traction limit mu_slip: above mu_slip F_n it slips on the cam.",
+    "follower.roller_inertia": "The roller's moment of inertia about its pin (its slip).",
+}
 
 #: Keys every kind has.
 COMMON = {
@@ -135,6 +154,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         "follower.friction": "Friction coefficient of the cam-follower contact (its share of the drive torque).",
         "follower.guide_friction": "Valve-guide Coulomb friction force (stem side load times its coefficient).",
         "follower.guide_velocity": "Regularisation velocity of the guide friction: F = F_g tanh(v / v_r).",
+        **FRICTION_LAWS,
         "follower.arrangement": "Translating (bucket, tappet, roller lifter) or an end-pivot finger.",
         "follower.base_radius": "The cam's base-circle radius (profile).",
         "follower.width": "Length of the line contact (roller or lobe width).",
@@ -251,6 +271,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.follower.friction": "Friction coefficient of the cam-follower contact (its share of the drive torque).",
         "train.follower.guide_friction": "Valve-guide Coulomb friction force (stem side load times its coefficient).",
         "train.follower.guide_velocity": "Regularisation velocity of the guide friction: F = F_g tanh(v / v_r).",
+        **{f"train.{key}": meaning for key, meaning in FRICTION_LAWS.items()},
         "train.follower.arrangement": "Set by the type (not given here).",
         "train.follower.base_radius": "The cam's base-circle radius (profile).",
         "train.follower.width": "Length of the line contact.",
@@ -389,6 +410,19 @@ MEANINGS: dict[str, dict[str, str]] = {
         "transient.exact_modes": "Modes of the exact superposition.",
         "transient.tolerance": "Error above which a transient result is flagged.",
         "transient.truncation_check": "Check the exact superposition's truncation by doubling its modes.",
+    },
+    "camshaft": {key: COMMON[key] for key in ("kind", "title")} | {
+        "camshaft": "The camshaft: its cylinders, firing order, speed and valves (presets/camshaft.py).",
+        "camshaft.cylinders": "Number of cylinders whose lobes the camshaft carries.",
+        "camshaft.firing_order": "Cylinder numbers in firing order: the k-th fires 360 k / cylinders cam deg "
+                                 "after the first.",
+        "camshaft.rpm": "Cam speed set into every train (default: each train preset's run.rpm).",
+        "camshaft.valves": "One table per valve (lobe) on the camshaft.",
+        "camshaft.valves[].train": "The valve's train: a shipped valvetrain preset with a follower, or a file "
+                                   "beside this preset.",
+        "camshaft.valves[].cylinder": "The valve's cylinder: its phase from the firing order.",
+        "camshaft.valves[].phase": "Phase offset of the lobe (an exhaust lobe's), added to its cylinder's.",
+        "camshaft.valves[].label": "The valve's name in the tables, CSV header and charts.",
     },
 }
 # the explicit form's [[springs]] (a data sheet as a train writes it): the same keys as [train.spring]

@@ -302,10 +302,12 @@ class Trace:
             from vtool.solvers.studies import torque
 
             cam = self.cam_clearance_index()
-            for name in torque.ROW_UNITS:
+            whole = torque.torque_rows(self.spec, self.cam_angle, self.contact_force[:, cam]) \
+                if torque.whole_run(self.spec) else None  # (a roller's slip: each row depends on those before)
+            for name in torque.row_names(self.spec):
                 header.append(f"cam_{name} ({torque.row_unit(self.spec, name)})")
-                columns.append(lambda rows, name=name: getattr(torque.torque_rows(
-                    self.spec, self.cam_angle[rows], self.contact_force[rows, cam]), name))
+                columns.append(lambda rows, name=name: getattr(whole, name)[rows] if whole is not None else getattr(
+                    torque.torque_rows(self.spec, self.cam_angle[rows], self.contact_force[rows, cam]), name))
             valve = self.valve_coordinate()
             if self.spec.follower.guide_friction > 0.0 and valve is not None:
                 j = self.coordinate_numbers.index(valve)

@@ -42,7 +42,14 @@ def report(preset: str, output: Path, sweep: tuple[str, ...], metric: str, worke
     # the flags are the preset's run fields: the loader checks them as the file's own values
     given = (("run.backend", backend, "--backend"), ("run.rpm", rpm, "--rpm"), ("run.degrees", degrees, "--degrees"))
     spec = load_preset(preset, tuple(Override(path, value, flag) for path, value, flag in given if value is not None))
-    make = resolve(kind_named(getattr(spec, "kind", None)).report)
+    kind = kind_named(getattr(spec, "kind", None))
+    if not kind.report:
+        from vtool.errors import InputError
+        from vtool.presets.kinds import KINDS
+
+        raise InputError("preset", kind.name, "a preset of a kind with a report: "
+                         + ", ".join(name for name, k in KINDS.items() if k.report))
+    make = resolve(kind.report)
     content = make(spec, preset=preset, sweep=sweep, metric=metric, workers=workers,
                    before_run=lambda: announce_compile(spec))
     write_report(content, output)

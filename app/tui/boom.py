@@ -21,7 +21,7 @@ from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, INTEGER, NUMBERS, TEXT, Field, dotted
 from vtool.app.tui.messages import AssessmentFinished
 from vtool.app.tui.reports import REPORT_BINDING
-from vtool.app.tui.widgets import ChartView, TextPanel
+from vtool.app.tui.widgets import ChartView, TextPanel, closing
 from vtool.assessments.sonic_boom.spec import PSEUDO_HEIGHT_RULES
 from vtool.assessments.sonic_boom.spectra import FAMILIES
 
@@ -200,6 +200,8 @@ class BoomScreen(DomainScreen):
 
             spec = load_preset(self.DEFAULT_PRESET)
         await self.form.set_fields(self.fields_for(spec, doc), doc)
+        if closing(self):
+            return
         self.validate()
         self.form.row("boom.pulse").editor.focus()
 
@@ -250,6 +252,8 @@ class BoomScreen(DomainScreen):
                                                        color=c))
         stack = self.query_one("#design-charts")
         await stack.remove_children()
+        if closing(self):
+            return
         color = self.app.chart_color  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
         charts = []
         u = a.units
@@ -258,6 +262,8 @@ class BoomScreen(DomainScreen):
             chart.structure = name  # type: ignore[attr-defined]  # a label this screen puts on its chart widget
             charts.append((chart, name, freq, series))
         await stack.mount_all([c for c, *_ in charts])
+        if closing(self):
+            return
         for chart, name, freq, series in charts:
             def draw(w: int, h: int, c: bool, name: str = name, freq: Any = freq, series: Any = series) -> str:
                 return line_chart(freq, series, title=f"{name}: allowable p+ against frequency", xlabel="f [Hz]",

@@ -22,7 +22,7 @@ from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, INTEGER, NUMBERS, TEXT, Field, dotted
 from vtool.app.tui.messages import PlateStudyFinished
 from vtool.app.tui.reports import REPORT_BINDING
-from vtool.app.tui.widgets import ChartView, TextPanel
+from vtool.app.tui.widgets import ChartView, TextPanel, closing
 from vtool.errors import InputError
 
 RUN = "_run"  # run options live under this key of the form's document, never in the preset
@@ -259,6 +259,8 @@ class PlateScreen(DomainScreen):
 
             spec = load_preset(self.DEFAULT_PRESET)
         await self.form.set_fields(plate_fields(spec, self.base_doc), self.base_doc)
+        if closing(self):
+            return
         self.validate()
         if self.form.has_field(focus):
             self.form.row(focus).editor.focus()

@@ -21,6 +21,7 @@ from vtool.solvers.model.units import UNIT_SYSTEMS, UnitSystem
 from vtool.units import cam_speed
 
 if TYPE_CHECKING:  # (a field's type only: the spring module imports numpy, which `vtool --help` must not)
+    from vtool.solvers.model.friction import FrictionLaws
     from vtool.solvers.model.spring import SpringSpec
 
 BAR = "bar"
@@ -375,6 +376,9 @@ class FollowerSpec:
     #: its regularisation velocity v_r (F = F_g tanh(v / v_r)); 0: none (:mod:`vtool.solvers.studies.torque`)
     guide_friction: float = 0.0
     guide_velocity: float = 1.0
+    #: the sliding law (Coulomb or Stribeck), pivot friction and roller slip (None: Coulomb, neither);
+    #: :class:`vtool.solvers.model.friction.FrictionLaws`
+    laws: FrictionLaws | None = None
 
 
 @dataclass(frozen=True)
