@@ -109,6 +109,8 @@ def test_report_refuses_a_bad_output_before_running(tmp_path: Path) -> None:
     assert result.exit_code == 2 and ".html or .pdf" in result.output
     result = run("report", "boom-brick-wall", "--sweep", "run.rpm=1,2", "-o", str(tmp_path / "r.pdf"))
     assert result.exit_code == 2 and "no sweep for a boom preset" in result.output
+    result = run("report", "four-cylinder-intake", "-o", str(tmp_path / "r.pdf"))
+    assert result.exit_code == 2 and "a preset of a kind with a report: valvetrain, boom_wall" in result.output
     result = run("report", "gnilka-1a", "--sweep", "run.rpm=9000", "-o", str(tmp_path / "r.pdf"))
     assert result.exit_code == 2 and "--sweep" in result.output
     assert not list(tmp_path.iterdir())
