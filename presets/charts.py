@@ -208,13 +208,15 @@ def scan_charts(scan: Any, unit: str, subject: str = "") -> list[Chart]:
     """
     from vtool.presets.cam_scan import per_degree_derivatives, series_derivatives
 
-    raw_v, raw_a = per_degree_derivatives(scan.angles, scan.raw)
-    curves = {"raw scan": (scan.raw, raw_v, raw_a)}
+    raw_angles = scan.angles if scan.raw_angles is None else scan.raw_angles
+    raw_v, raw_a = per_degree_derivatives(raw_angles, scan.raw)
+    curves = {"raw scan": (raw_angles, (scan.raw, raw_v, raw_a))}
     if scan.smoothed is not None:
-        curves[f"smoothed ({scan.smoothed.harmonics} harmonics)"] = (scan.lifts,
-                                                                     *series_derivatives(scan.angles, scan.lifts))
+        how = "spline, " if scan.smoothed.method == "spline" else ""
+        curves[f"smoothed ({how}{scan.smoothed.harmonics} harmonics)"] = (
+            scan.angles, (scan.lifts, *series_derivatives(scan.angles, scan.lifts)))
     names = (("lift", unit), ("velocity", f"{unit}/deg"), ("acceleration", f"{unit}/deg^2"))
-    panels = tuple(Panel(tuple(curve(label, scan.angles, values[i]) for label, values in curves.items()),
+    panels = tuple(Panel(tuple(curve(label, angles, values[i]) for label, (angles, values) in curves.items()),
                          with_unit(name, u)) for i, (name, u) in enumerate(names))
     return [Chart("measured scan: raw against smoothed (per cam degree)", CAM_ANGLE, panels, subject)]
 

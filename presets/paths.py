@@ -246,11 +246,11 @@ class PointGrid(Sequence[Any]):
         self.maker = maker
         self.sizes = [len(values) for _, values in self.fields]
         self.strides = [math.prod(self.sizes[:k]) for k in range(len(self.sizes))]
-        self.count = math.prod(self.sizes)
+        self.total = math.prod(self.sizes)
         self._positions: list[dict[str, int]] | None = None
 
     def __len__(self) -> int:
-        return self.count
+        return self.total
 
     def values(self, index: int) -> tuple[tuple[str, Any], ...]:
         """The swept values of point ``index``, in the fields' order."""
@@ -265,22 +265,22 @@ class PointGrid(Sequence[Any]):
 
     def __getitem__(self, index: Any) -> Any:
         if isinstance(index, slice):
-            return [self[i] for i in range(*index.indices(self.count))]
-        if not -self.count <= index < self.count:
+            return [self[i] for i in range(*index.indices(self.total))]
+        if not -self.total <= index < self.total:
             raise IndexError(index)
         from vtool.solvers.studies.sweep import Point
 
-        index %= self.count
+        index %= self.total
         values = self.values(index)
         return Point(index, values, self.maker(values))
 
     def __iter__(self) -> Iterator[Any]:
-        return (self[i] for i in range(self.count))
+        return (self[i] for i in range(self.total))
 
     def run_order(self) -> Iterator[int]:
         """Every index once, the ``run.*`` fields varying fastest (then the grid's own order)."""
         axes = sorted(range(len(self.fields)), key=lambda k: not self.fields[k][0].startswith("run."))
-        for flat in range(self.count):
+        for flat in range(self.total):
             index = 0
             for k in axes:
                 index += (flat % self.sizes[k]) * self.strides[k]

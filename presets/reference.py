@@ -146,7 +146,8 @@ MEANINGS: dict[str, dict[str, str]] = {
         "cam.scan.angle": "Cam degrees, or crank degrees (halved to cam degrees: four-stroke).",
         "cam.scan.lift_of": "Tappet (cam follower) lift, or valve lift (divided by rocker_ratio).",
         "cam.scan.rocker_ratio": "Valve lift per tappet lift, for a valve-lift scan.",
-        "cam.scan.smoothing": "none, or fourier: a truncated Fourier series cut off at the scan's noise.",
+        "cam.scan.smoothing": "none; fourier: a truncated Fourier series cut off at the scan's noise (equal steps "
+                              "dividing 360); spline: a smoothing spline whose residual is the noise (any steps).",
         "cam.scan.noise": "The scan's noise rms (default: estimated from its spectrum).",
         "cam.scan.peak_tolerance": "How far smoothing may move the peak lift (default: 4 x the noise rms).",
         "cam.harmonics": "Harmonics of the lift table's Fourier fit (0: as many as the table needs).",

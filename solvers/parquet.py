@@ -81,8 +81,11 @@ class _GroupWriter:
 
         arrays = {}
         for name, parts in self.buffer.items():
-            if isinstance(parts[0], np.ndarray) and parts[0].dtype.kind == "f":
-                arrays[name] = pa.array(np.concatenate(parts), type=pa.float64())
+            if all(isinstance(p, np.ndarray) for p in parts) and parts[0].dtype.kind in "fi":
+                joined = np.concatenate(parts)
+                arrays[name] = pa.array(joined, type=pa.float64() if joined.dtype.kind == "f" else pa.int64())
+            elif isinstance(parts[0], np.ndarray) and parts[0].dtype.kind == "f":
+                arrays[name] = pa.array([v for part in parts for v in part], type=pa.float64())
             else:
                 arrays[name] = pa.array([v for part in parts for v in part])
         table = pa.table(arrays)
@@ -164,6 +167,12 @@ class SweepParquet:
         self.groups = _GroupWriter(handle, {"vtool_version": __version__, "title": spec.title})
         self.finished: set[int] = set()
         self.rows = 0
+        # the points of the group being filled: the index and the metrics in arrays (8 bytes a number; a
+        # list of one-number lists a point cost about ten times that), the fields and statuses as lists
+        self.index = np.empty(ROW_GROUP, dtype=np.int64)
+        self.block = np.empty((ROW_GROUP, len(self.metrics)))
+        self.cells: dict[str, list[Any]] = {title: [] for title in [*self.field_titles, "status"]}
+        self.held = 0
         self.resume = resume
         if resume is not None:
             with self._resumed():
@@ -225,27 +234,44 @@ class SweepParquet:
 
     def append(self, result: Any) -> None:
         values = dict(result.values)
-        data: dict[str, Any] = {"point": [result.index]}
+        row = self.held
+        self.index[row] = result.index
         for field, title in zip(self.fields, self.field_titles, strict=True):
             value = values[field]  # numbers as float64 (a grid may mix 9000 and 9500.5), names as text
-            data[title] = [float(value) if isinstance(value, int | float) and not isinstance(value, bool) else value]
-        data["status"] = [result.status]
-        for (name, _), title in zip(self.metrics, self.names[len(self.fields) + 2:], strict=True):
-            data[title] = [float(result.metrics.get(name, math.nan))]
-        self.groups.add(data, 1)
+            self.cells[title].append(float(value) if isinstance(value, int | float) and not isinstance(value, bool)
+                                     else value)
+        self.cells["status"].append(result.status)
+        self.block[row] = [float(result.metrics.get(name, math.nan)) for name, _ in self.metrics]
+        self.held += 1
         self.rows += 1
+        if self.held == ROW_GROUP:
+            self._hand_over()
+
+    def _hand_over(self) -> None:
+        """The points held so far to the group writer (which writes a group once it has ROW_GROUP rows)."""
+        if not self.held:
+            return
+        n = self.held
+        data: dict[str, Any] = {"point": self.index[:n].copy()}
+        data |= {title: self.cells[title] for title in self.field_titles}
+        data["status"] = self.cells["status"]
+        data |= {title: self.block[:n, k].copy() for k, title in enumerate(self.names[len(self.fields) + 2:])}
+        self.groups.add(data, n)
+        self.cells = {title: [] for title in self.cells}
+        self.held = 0
 
     def finish(self) -> None:
+        self._hand_over()
         self.groups.close()
 
     def finished_results(self, points: Sequence[Any]) -> dict[int, Any]:
         """The points the resumed file held (read again from it: it is replaced only when the sweep ends)."""
         from vtool.solvers.studies.metrics import failed_metrics
-        from vtool.solvers.studies.sweep import PointResult
+        from vtool.solvers.studies.sweep import PointResult, point_values
 
         if self.resume is None:
             return {}
-        values_of = points.values if hasattr(points, "run_order") else {p.index: p.values for p in points}.get
+        values_of = point_values(points)
         results: dict[int, Any] = {}
         for columns, indices in self._resumed_groups(points):
             for row, index in enumerate(indices):

@@ -8,10 +8,11 @@ assessment used (pulse or envelope).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from textual import work
 from textual.app import ComposeResult
+from textual.binding import BindingType
 from textual.containers import VerticalScroll
 from textual.widgets import TabbedContent, TabPane
 from textual.worker import Worker, get_current_worker
@@ -19,6 +20,7 @@ from textual.worker import Worker, get_current_worker
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, INTEGER, NUMBERS, TEXT, Field, dotted
 from vtool.app.tui.messages import AssessmentFinished
+from vtool.app.tui.reports import REPORT_BINDING
 from vtool.app.tui.widgets import ChartView, TextPanel, closing
 from vtool.assessments.sonic_boom.spec import PSEUDO_HEIGHT_RULES
 from vtool.assessments.sonic_boom.spectra import FAMILIES
@@ -148,6 +150,7 @@ def daf_curves(spec: Any, assessment: Any, cancel: Any = None) -> dict[str, Any]
 
 class BoomScreen(DomainScreen):
     MODE = "boom"
+    BINDINGS: ClassVar[list[BindingType]] = [REPORT_BINDING]  # ctrl+g: save the report
     DEFAULT_PRESET = "boom-brick-wall"
     TITLE_TEXT = "SONIC BOOM"
 
@@ -274,6 +277,14 @@ class BoomScreen(DomainScreen):
         from vtool.files import write_atomic
 
         write_atomic(path, limits_csv(self.results))
+
+    def action_save_report(self) -> None:
+        """ctrl+g: the last run's report (what `vtool report` writes), as .pdf or .html."""
+        from vtool.app.tui.reports import save_report
+        from vtool.presets.report import boom_report
+
+        results, spec = self.results, self.results_spec
+        save_report(self, None if results is None else lambda: boom_report(spec, assessment=results))
 
 
 #: this module's screen, named by the kinds table (vtool.presets.kinds.KINDS)

@@ -213,8 +213,8 @@ class Batches:
     def stream(self) -> Iterator[Point]:
         """The unfinished points, one by one, in run order."""
         if hasattr(self.points, "run_order"):
-            make = self.points.lazy  # type: ignore[attr-defined]
-            return (make(i) for i in self.points.run_order() if i not in self.skip)  # type: ignore[attr-defined]
+            make = self.points.lazy  # type: ignore[attr-defined]  # a PointGrid (checked above): presets/ type
+            return (make(i) for i in self.points.run_order() if i not in self.skip)
         return (p for chunk in self for p in chunk)
 
     def __iter__(self) -> Iterator[list[Point]]:
@@ -775,10 +775,17 @@ def results_csv(results: Sequence[PointResult], fields: Sequence[tuple[str, str]
 MAX_RESUME_BYTES = 256 * 1024 * 1024
 
 
+def point_values(points: Sequence[Point]) -> Callable[[int], tuple[tuple[str, Any], ...]]:
+    """A function from a point's index to its swept values."""
+    if hasattr(points, "run_order"):
+        return points.values  # type: ignore[attr-defined]  # a PointGrid: made from the index
+    return {p.index: p.values for p in points}.__getitem__
+
+
 def point_locator(points: Sequence[Point]) -> Callable[[Sequence[str]], int | None]:
     """A function from a point's values as a sweep file writes them to its index (None: not a point)."""
     if hasattr(points, "locate"):
-        return points.locate  # type: ignore[attr-defined, no-any-return]  # a planned grid: nothing per point
+        return points.locate  # a planned grid (PointGrid): nothing per point
     index_of = {tuple(format_value(v) for _, v in p.values): p.index for p in points}
     return lambda texts: index_of.get(tuple(texts))
 
@@ -898,7 +905,7 @@ class SweepFile:
         if not self.resumed or not exists(self.path):
             return {}
         locate = point_locator(points)
-        values_of = points.values if hasattr(points, "run_order") else {p.index: p.values for p in points}.get
+        values_of = point_values(points)
         results = {}
         with open(self.path, encoding="utf-8", newline="") as handle:
             for row in itertools.islice(csv.reader(handle), 1, None):
