@@ -251,6 +251,20 @@ def _compliance(t: Table, state: str, units: UnitSystem) -> dict[str, Any]:
     return result
 
 
+def _opening(t: Table, behind: int, units: UnitSystem) -> dict[str, Any]:
+    """A clearance's ``opening`` and ``sense`` (gap = sense (q[ahead] - q[behind]) + opening; see
+    ClearanceSpec): a compliant contact's only, as is the ground (behind = 0)."""
+    opening = t.number("opening", unit=units.length, default=0.0, min_value=-1e4, max_value=1e4)
+    sense = t.integer("sense", default=1, min_value=-1, max_value=1)
+    if sense == 0:
+        raise InputError(t.field("sense"), sense, "1 or -1")
+    if (opening != 0.0 or sense != 1 or behind == 0) and t.raw("contact") in (None, RIGID):
+        key = "opening" if opening != 0.0 else "sense" if sense != 1 else "behind"
+        raise InputError(t.field(key), t.raw(key), 'its default for a rigid contact (an opening, sense -1 or the '
+                         'ground (behind = 0) need contact = "linear" or "hertz")')
+    return ({"opening": opening} if opening else {}) | ({"sense": sense} if sense != 1 else {})
+
+
 def _contact(t: Table | None) -> ContactSpec:
     """[contact]: the default impact law and the thesis' SCALE (eq. 3.54)."""
     if t is None:
@@ -480,7 +494,7 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int,
         kind = t.string("kind", choices=(EXTERNAL, INTERNAL))
         ahead = _coordinate_ref(t, "ahead", elastic, "elastic coordinates")
         if kind == EXTERNAL:
-            behind = _coordinate_ref(t, "behind", prescribed, "prescribed coordinates (cam, seat)")
+            behind = _coordinate_ref(t, "behind", prescribed | {0}, "prescribed coordinates (cam, seat) or 0 (ground)")
         else:
             behind = _coordinate_ref(t, "behind", elastic - {ahead}, "other elastic coordinates")
         state = t.string("state", default=ENABLED, choices=(ENABLED, PINNED, REMOVED))
@@ -488,7 +502,7 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int,
             raise InputError(t.field("state"), state, "enabled or removed for an external clearance")
         restitution = t.number("restitution", default=0.0, min_value=0.0, max_value=1.0)
         impact = t.string("impact", choices=IMPACT_LAWS) if t.raw("impact") is not None else None
-        contact = _compliance(t, state, units)
+        contact = _compliance(t, state, units) | _opening(t, behind, units)
         if contact.get("contact") == HERTZ and not check_restitution(restitution):
             raise InputError(t.field("restitution"), restitution,
                              f">= {MIN_RESTITUTION} and <= 1 for a hertz contact (Hunt-Crossley damping gives e = 0 "
@@ -686,7 +700,7 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
     doc["clearances"] = [
         {"name": c.name, "ahead": c.ahead, "behind": c.behind, "kind": c.kind,
          "state": c.state, "restitution": c.restitution} | ({"impact": c.impact} if c.impact else {})
-        | _compliance_doc(c)
+        | _compliance_doc(c) | ({"opening": c.opening} if c.opening else {}) | ({"sense": c.sense} if c.sense != 1 else {})
         for c in spec.clearances
     ]
     doc["initial"] = {

@@ -210,7 +210,7 @@ class Trace:
         return next(i for i, c in enumerate(self.spec.clearances) if c.behind == self.spec.cam.coordinate)
 
     def force_label(self, index: int) -> str:
-        return f"F{self.spec.clearances[index].ahead}"
+        return self.spec.force_label(index)
 
     def force(self, label_or_name: str, rows: slice = slice(None)) -> np.ndarray:
         for i, c in enumerate(self.spec.clearances):
@@ -227,6 +227,12 @@ class Trace:
             return self.coordinate(int(match[1]), rows)
         if re.fullmatch(r"F\d+", text):
             return self.force(text, rows)
+        if self.spec.springs:  # a data-sheet spring's end force (solvers/model/spring.py)
+            from vtool.solvers.model.spring import end_force, force_quantity
+
+            for spring in self.spec.springs:
+                if text == force_quantity(spring):
+                    return end_force(spring, self, rows)
         raise KeyError(expression)
 
     def coordinate_unit(self, number: int) -> str:
@@ -237,7 +243,7 @@ class Trace:
 
     def quantity_unit(self, expression: str) -> str:
         text = expression.replace(" ", "")
-        if text.startswith("F"):
+        if text.startswith("F") or text.endswith("_force"):
             return self.spec.unit_system.force
         return self.coordinate_unit(int(re.findall(r"\d+", text)[0]))
 
@@ -284,6 +290,12 @@ class Trace:
         if self.valve_coordinate() is not None:
             header.append(f"valve_lift ({units.length})")
             columns.append(self.valve_lift)
+        if self.spec.springs:  # each data-sheet spring's force on its end (spring.end_force)
+            from vtool.solvers.model.spring import force_quantity
+
+            for name in map(force_quantity, self.spec.springs):
+                header.append(f"{name} ({units.force})")
+                columns.append(lambda rows, name=name: self.quantity(name, rows))
         names = {h.rpartition(" (")[0] for h in header}
         for expression in quantities:
             name = expression.replace(" ", "")
@@ -304,10 +316,12 @@ class Trace:
             from vtool.solvers.studies import torque
 
             cam = self.cam_clearance_index()
-            for name in torque.ROW_UNITS:
+            whole = torque.torque_rows(self.spec, self.cam_angle, self.contact_force[:, cam]) \
+                if torque.whole_run(self.spec) else None  # (a roller's slip: each row depends on those before)
+            for name in torque.row_names(self.spec):
                 header.append(f"cam_{name} ({torque.row_unit(self.spec, name)})")
-                columns.append(lambda rows, name=name: getattr(torque.torque_rows(
-                    self.spec, self.cam_angle[rows], self.contact_force[rows, cam]), name))
+                columns.append(lambda rows, name=name: getattr(whole, name)[rows] if whole is not None else getattr(
+                    torque.torque_rows(self.spec, self.cam_angle[rows], self.contact_force[rows, cam]), name))
             valve = self.valve_coordinate()
             if self.spec.follower.guide_friction > 0.0 and valve is not None:
                 j = self.coordinate_numbers.index(valve)
@@ -475,7 +489,7 @@ class Trace:
             if not c.rigid and self.peak_overlap is not None:
                 entry["peak_overlap"] = float(self.peak_overlap[i])
                 entry["peak_overlap_unit"] = units.length
-            if c.kind == EXTERNAL and c.behind != self.spec.cam.coordinate:
+            if c.kind == EXTERNAL and c.behind not in (self.spec.cam.coordinate, 0):  # 0: the ground (a coil)
                 entry["seating_velocities"] = [-e.relative_velocity for e in impacts]
                 entry["seating_velocity_unit"] = units.velocity
                 entry["bounces_per_revolution"] = self.bounces_per_revolution(c.name)
@@ -696,7 +710,9 @@ class TraceBuilder:
     def __init__(self, spec: MechanismSpec, source_numbers: tuple[int, ...], omega: float,
                  stream: CsvStream | None = None) -> None:
         self.spec = spec
-        self.source_numbers = tuple(source_numbers)
+        # the unit source (number 0: the constant of clearances with an opening) is no output column: it is
+        # the last source, and its column is cut from every block (add_rows)
+        self.source_numbers = tuple(number for number in source_numbers if number != 0)
         self.omega = omega
         self.stream = stream
         self.blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
@@ -743,6 +759,7 @@ class TraceBuilder:
         nonlinear elements' states at the rows (rows x states), from a back end that takes elements."""
         if not len(t):
             return
+        q3 = q3[:, :, :len(self.numbers)]
         if self.stream is not None:
             self.stream.write(self.block_trace(t, q3, F, cfg, states))
             if self.stream.thin:

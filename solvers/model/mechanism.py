@@ -89,8 +89,8 @@ class Mechanism:
         for c in self.spec.clearances:
             if c.contact == LINEAR:
                 w = np.zeros(len(K))
-                w[c.ahead - 1] = 1.0
-                if c.behind <= len(K):
+                w[c.ahead - 1] = 1.0  # the sense changes no stiffness (k w wᵀ)
+                if 0 < c.behind <= len(K):
                     w[c.behind - 1] = -1.0
                 K += c.contact_stiffness * np.outer(w, w)
         return float(undamped_modes(self.M, K).omega.max())
