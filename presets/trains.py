@@ -484,13 +484,24 @@ def train_parameters(doc: dict[str, Any]) -> list[tuple[tuple[str, ...], str]]:
     """(path, unit kind) of every number a train's form may edit: ``("train", "finger", "roller_arm")``."""
     result: list[tuple[tuple[str, ...], str]] = []
     train = doc.get("train", {})
+    units = UNIT_SYSTEMS.get(doc.get("units", ""))
     for part, table in train.items():
         if not isinstance(table, dict):
             continue
         for key, value in table.items():
             if isinstance(value, int | float) and not isinstance(value, bool):
-                result.append((("train", part, key), _unit_kind(part, key)))
+                kind = hla_unit(key, units) if part == "hla" and units is not None else _unit_kind(part, key)
+                result.append((("train", part, key), kind))
     return result
+
+
+def hla_unit(key: str, units: UnitSystem) -> str:
+    """The unit (text) of a ``[train.hla]`` number in a unit system (presets/hla.py's reads)."""
+    L, P = units.length, units.pressure
+    return {"plunger_mass": units.mass, "chamber_volume": f"{L}^3", "spring_rate": units.stiffness,
+            "spring_preload": units.force, "viscosity": "mPa*s", "supply_pressure": P, "crack_pressure": P,
+            "initial_pressure": P, "check_conductance": f"{L}^3/({units.time}*{P})", "air_fraction": "",
+            "damping": f"{units.force}*{units.time}/{L}"}.get(key, L)
 
 
 def _unit_kind(part: str, key: str) -> str:

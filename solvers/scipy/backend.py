@@ -101,7 +101,8 @@ class _ScipyRun(PiecewiseRun):
         self.x_scale = max(float(np.abs(start.q).max()), 1e-12)
         self.v_scale = max(float(np.abs(start.qd).max()), self.x_scale * problem.omega, 1e-12)
         mechanism = problem.mechanism
-        self.elements = mechanism.kept(("nonlinear elements",), lambda: elements_of(mechanism.spec))
+        # (per cam speed: the gas force reads the crank angle from t)
+        self.elements = mechanism.kept(("nonlinear elements", mechanism.omega), lambda: elements_of(mechanism.spec))
         carried = mechanism.start_states
         self.s = (np.array(carried, dtype=float) if carried is not None
                   else self.elements.initial(start.q, start.qd))  # the elements' states now
