@@ -454,7 +454,7 @@ class ContactProblem:
         self.clf[:, layout.CLF_HV] = self.rest_velocity  # a Hertz contact's approach velocity, set at closing
         self.gap_noise = 1e-13 * x_scale
         self.zeno_window = 1e-3 * 2 * math.pi / self.omega_max
-        self.start_mask = mask_of(spec, spec.initial.closed)
+        self.start_mask = mask_of(spec, tuple(spec.initial.closed) + mechanism.start.closed)  # and closed coils
 
     @classmethod
     def for_run(cls, mechanism: Mechanism, rules: EventRules | None = None) -> ContactProblem:
