@@ -161,6 +161,18 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     from vtool.presets.springs import load_sheets
 
     springs = load_sheets(top, units, n)
+    hla_table = top.table("hla", required=False)
+    hla = None
+    if hla_table is not None:
+        from vtool.presets.hla import load_hla
+
+        hla = load_hla(hla_table, units, members)
+    forces_table = top.table("valve_forces", required=False)
+    valve_forces = None
+    if forces_table is not None:
+        from vtool.presets.valveforces import load_valve_forces
+
+        valve_forces = load_valve_forces(forces_table, units, n)
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)
     top.finish()
     spec = MechanismSpec(
@@ -181,6 +193,8 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         checks=checks,
         springs=springs,
         train=train,
+        hla=hla,
+        valve_forces=valve_forces,
     )
     spec = split_members(spec)
     if spec.seat is not None and spec.seat.lash is not None:  # the split seat: its coordinate may have moved up
@@ -262,7 +276,8 @@ def _contact(t: Table | None) -> ContactSpec:
 
 
 TOP_KEYS = ("kind", "title", "notes", "units", "gravity", "coordinates", "members", "cam", "seat",
-            "clearances", "initial", "contact", "damping", "run", "follower", "checks", "springs")
+            "clearances", "initial", "contact", "damping", "run", "follower", "checks", "springs", "hla",
+            "valve_forces")
 
 
 def _magnitude(t: Table, key: str, unit: str, what: str, *, default: float | None = None,
@@ -717,10 +732,18 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         from vtool.presets.springs import sheet_document
 
         doc["springs"] = [sheet_document(s) for s in spec.springs]
+    if spec.hla is not None:
+        from vtool.presets.hla import dump_hla
+
+        doc["hla"] = dump_hla(spec.hla)
+    if spec.valve_forces is not None:
+        from vtool.presets.valveforces import dump_valve_forces
+
+        doc["valve_forces"] = dump_valve_forces(spec.valve_forces)
     return train_document(given, doc) or doc
 
 
-TRAIN_KEEPS = ("kind", "title", "notes", "units", "gravity", "contact", "damping", "run", "checks")
+TRAIN_KEEPS = ("kind", "title", "notes", "units", "gravity", "contact", "damping", "run", "checks", "valve_forces")
 
 
 def train_document(spec: MechanismSpec, explicit: dict[str, Any]) -> dict[str, Any] | None:

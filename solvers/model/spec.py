@@ -21,7 +21,10 @@ from vtool.solvers.model.units import UNIT_SYSTEMS, UnitSystem
 from vtool.units import cam_speed
 
 if TYPE_CHECKING:  # (a field's type only: the spring module imports numpy, which `vtool --help` must not)
+    from vtool.solvers.model.friction import FrictionLaws
+    from vtool.solvers.model.hla import HLAPlace
     from vtool.solvers.model.spring import SpringSpec
+    from vtool.solvers.model.valveforces import ValveForces
 
 BAR = "bar"
 BEAM = "beam"
@@ -396,6 +399,9 @@ class FollowerSpec:
     #: its regularisation velocity v_r (F = F_g tanh(v / v_r)); 0: none (:mod:`vtool.solvers.studies.torque`)
     guide_friction: float = 0.0
     guide_velocity: float = 1.0
+    #: the sliding law (Coulomb or Stribeck), pivot friction and roller slip (None: Coulomb, neither);
+    #: :class:`vtool.solvers.model.friction.FrictionLaws`
+    laws: FrictionLaws | None = None
 
 
 @dataclass(frozen=True)
@@ -430,6 +436,10 @@ class MechanismSpec:
     #: JSON text of the preset's [train] table when it was entered by train type (provenance: a saved copy
     #: keeps the type's parameters while the model is still what they expand to; see presets/trains.py)
     train: str = field(default="", compare=False)
+    #: a hydraulic lash adjuster in a bar member's place ([hla]; a nonlinear element, solvers/model/hla.py)
+    hla: HLAPlace | None = None
+    #: forces on the valve: guide friction, gas force ([valve_forces]; solvers/model/valveforces.py)
+    valve_forces: ValveForces | None = None
     kind: str = field(default="valvetrain", init=False)
 
     @property

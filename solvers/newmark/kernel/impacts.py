@@ -359,7 +359,7 @@ def release_pulling(prob, T, c, t, S, src, O, y, rhs, hertz):
     return c
 
 
-@jit
+@jit_inline
 def take_events(prob, c, t, h, W, S, O, momentum):
     """The events at t of configuration c: each monitor k that crossed within the time tolerance of
     the located step h (``tau[k] <= h + tol``) opens its contact, or closes it by an impact. Returns

@@ -273,7 +273,7 @@ def event_step(prob, C, W, t, h, hertz):
     return h
 
 
-@jit
+@jit_inline
 def steps(prob, C, W, S, O, hertz):
     """Steps in configuration C from S.fst[F_T] until an event, the chunk end, the run's end or a full
     buffer. Returns (status, event, h): status FINISHED, CHUNK_END, OUTPUT_FULL or DIVERGED (0 after an
