@@ -115,6 +115,18 @@ def _draw_map(subfigure: Any, heat: HeatMap) -> None:
         ax.set_xticks(xs, [str(v) for v in heat.x])
         ax.set_yticks(ys, [str(v) for v in heat.y])
     ax.set_facecolor("white")
+    if heat.lines and numeric:  # black lines in a white halo, each its own dash and marker: legible on any grey
+        from matplotlib import patheffects
+
+        halo = [patheffects.withStroke(linewidth=3.2, foreground="white")]
+        for k, line in enumerate(heat.lines):
+            style = _style(k, len(line.x)) | {"color": "black"}
+            ax.plot(line.x, line.y, label=line.label, path_effects=halo, **style)
+        step = [float(np.min(np.diff(v))) / 2 if len(v) > 1 else 0.5 for v in (xs, ys)]
+        ax.set_xlim(xs.min() - step[0], xs.max() + step[0])  # the map's extent: a line leaves it at its edge
+        ax.set_ylim(ys.min() - step[1], ys.max() + step[1])
+        ax.legend(fontsize="x-small", loc="upper right", framealpha=0.8, title="natural frequencies",
+                  title_fontsize="x-small")
     ax.set_xlabel(heat.xlabel)
     ax.set_ylabel(heat.ylabel)
     blank = " (blank: no value / failed)" if np.ma.count_masked(values) else ""

@@ -30,7 +30,7 @@ th, td { border: 1px solid #666; padding: 0.2em 0.5em; text-align: left; }
 th { background: #eee; } caption { text-align: left; font-weight: bold; padding: 0.3em 0; }
 td.fail { font-weight: bold; } td.fail::before { content: "\\2716 "; } td.pass::before { content: "\\2714 "; }
 figure { margin: 1em 0; page-break-inside: avoid; } figure svg { max-width: 100%; height: auto; }
-figcaption { font-style: italic; }
+figcaption { font-style: italic; } pre { font-size: 0.75em; overflow-x: auto; }
 """
 
 
@@ -76,6 +76,7 @@ def html_text(report: Report) -> str:
         parts.append(f"<section><h2>{html.escape(section.title)}</h2>")
         parts += [f"<p>{html.escape(p)}</p>" for p in section.paragraphs]
         parts += [_html_table(t) for t in section.tables]
+        parts += [f"<pre>{html.escape(block)}</pre>" for block in section.text]
         if section.checks:
             parts.append(_html_checks(section.checks))
         for figure in section.figures:
@@ -107,6 +108,8 @@ def section_lines(section: Section) -> list[str]:
         lines += textwrap.wrap(paragraph, 100) + [""]
     for table in section.tables:
         lines += _text_table(table)
+    for block in section.text:
+        lines += block.splitlines() + [""]
     if section.checks:
         lines += _text_table(Table("checks", ("check", "criterion", "value", "outcome", "margin / note"),
                                    tuple((c.name, c.criterion, c.value, c.outcome.upper(), c.margin)

@@ -49,7 +49,23 @@ def layout(ref: str, folder: Path) -> Path:
         (package / entry.name).symlink_to(entry)
     for name in SUBPACKAGES:
         (package / name).symlink_to(tree / name)
+    metadata(tree, folder / "path")
     return folder / "path"
+
+
+def metadata(tree: Path, entry: Path) -> None:
+    """A ``vtool`` distribution's metadata on ``entry`` holding the tree's own entry points (its back ends),
+    found before the installed checkout's: importlib.metadata takes the first distribution of a name."""
+    import tomllib
+    project = tomllib.loads((tree / "pyproject.toml").read_text())["project"]
+    info = entry / "vtool-0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: vtool\nVersion: 0\n")
+    lines = []
+    for group, points in project.get("entry-points", {}).items():
+        lines.append(f"[{group}]")
+        lines += [f"{name} = {target}" for name, target in points.items()]
+    (info / "entry_points.txt").write_text("\n".join(lines) + "\n")
 
 
 def compile_seconds(path_entry: Path | None, prefix: str) -> float:

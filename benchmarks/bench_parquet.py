@@ -12,13 +12,14 @@ so imports and the interpreter do not count. Two cases per size:
 ``sweep``
     ``vtool sweep gnilka-1d --set run.rpm=... --set run.degrees=0.5 --out
     f.parquet`` in one process (``--workers 1``): real points, the cheapest a
-    sweep allows (half a cam degree each, about 2 ms), planned and run. The
-    plan validates every point before any runs and keeps each point's spec in
-    memory, so this case grows with N whatever the writer does; it is
-    reported so that the number is known, not hidden.
+    sweep allows (half a cam degree each), planned and run. The plan checks
+    the range's ends and keeps the swept values only; each point's spec is
+    made when it runs and dropped (presets/paths.py PointGrid), and the sweep
+    holds the finished points' indices: bounded when the ratio is near 1.
 
-Run: ``python benchmarks/bench_parquet.py`` (about 7 minutes for the 10^5-point
-sweep on the 2-core development machine; ``--sizes 1000,10000`` for a quick look).
+Run: ``python benchmarks/bench_parquet.py`` (about 25 minutes for the 10^5-point
+sweep on the 2-core development machine, most of it the loader making each
+point's spec; ``--sizes 1000,10000`` for a quick look).
 ``--write`` puts the table into docs/sweep.md between its ``parquet`` markers.
 """
 

@@ -3,6 +3,12 @@
 Run: ``python3 benchmarks/bench_suite_ab.py REF [--pairs N] [-k EXPRESSION]`` (N = 2; a run takes
 4-5 min on the 2-core machine, so the default is about 20 min). Prints figures, asserts nothing.
 
+The suites of two commits need not hold the same tests (tests are added, moved and deleted between
+them), so besides the wall times the script sums pytest's own per-test durations (``--junitxml``)
+over the tests both suites hold, matched by test name with its parameters and class but not its file
+(a restructuring moves tests between files): the ratio of those sums says whether the same tests got
+slower, which the wall times alone cannot when one suite is larger.
+
 Each run is the suite of one commit (REF, then HEAD, alternating, so that a drift of the machine's
 speed slows both alike) in a fresh ``git archive`` of it, laid out as ``bench_compile_ab.py`` does
 and first on ``PYTHONPATH``: numba's cache and mypy's cache start
@@ -18,6 +24,8 @@ import subprocess
 import sys
 import tempfile
 import time
+import xml.etree.ElementTree as ET
+from collections import defaultdict
 from pathlib import Path
 
 from bench_compile_ab import ROOT, layout
@@ -28,8 +36,21 @@ PROBE = "import vtool.app, vtool.assessments, vtool.presets, vtool.solvers as s,
         "print(*(m.__file__ for m in (vtool.app, vtool.assessments, vtool.presets, s, e)))"
 
 
-def run_suite(ref: str, select: str | None) -> tuple[float, str]:
-    """Wall seconds of ``python3 -m pytest -q`` in a fresh tree of ``ref``, and pytest's last line."""
+def durations(report: Path) -> dict[str, list[float]]:
+    """Seconds of each passed test in a junit XML report, by test name with its class (not its file)."""
+    seconds: dict[str, list[float]] = defaultdict(list)
+    for case in ET.parse(report).getroot().iter("testcase"):
+        if any(child.tag in ("skipped", "failure", "error") for child in case):
+            continue
+        owner = case.get("classname", "").rsplit(".", 1)[-1]
+        key = f"{owner}::{case.get('name')}" if owner[:1].isupper() else str(case.get("name"))
+        seconds[key].append(float(case.get("time", "0")))
+    return seconds
+
+
+def run_suite(ref: str, select: str | None) -> tuple[float, str, dict[str, list[float]]]:
+    """Wall seconds of ``python3 -m pytest -q`` in a fresh tree of ``ref``, pytest's last line and the
+    per-test durations."""
     with tempfile.TemporaryDirectory() as folder:
         entry = layout(ref, Path(folder))
         env = dict(os.environ)
@@ -46,16 +67,22 @@ def run_suite(ref: str, select: str | None) -> tuple[float, str]:
         if where.returncode != 0 or len(files) != 5 or not all(Path(f).resolve().is_relative_to(
                 Path(folder).resolve()) for f in files):
             raise SystemExit(f"the tree of {ref} does not import its own packages: {where.stdout}{where.stderr[-500:]}")
-        command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--import-mode=append"]
+        command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--import-mode=append",
+                   f"--junitxml={Path(folder) / 'report.xml'}"]
         if select:
             command += ["-k", select]
         started = time.perf_counter()
         out = subprocess.run(command, cwd=Path(folder) / "tree", env=env, capture_output=True, text=True)
         seconds = time.perf_counter() - started
+        report = Path(folder) / "report.xml"
+        each = durations(report) if report.exists() else {}
     last = out.stdout.strip().splitlines()[-1] if out.stdout.strip() else out.stderr[-300:]
-    if out.returncode != 0:
-        raise SystemExit(f"the suite of {ref} failed ({last}):\n{out.stdout[-3000:]}")
-    return seconds, last
+    if not each:
+        raise SystemExit(f"the suite of {ref} did not run ({last}):\n{out.stdout[-3000:]}")
+    if out.returncode != 0:  # a failed test is left out of the durations; its name is printed
+        failed = [line for line in out.stdout.splitlines() if line.startswith(("FAILED", "ERROR"))]
+        print(f"  {ref}: " + "\n  ".join(failed), flush=True)
+    return seconds, last, each
 
 
 def main(argv: list[str]) -> None:
@@ -66,14 +93,24 @@ def main(argv: list[str]) -> None:
     select = argv[argv.index("-k") + 1] if "-k" in argv else None
     head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
                           check=True).stdout.strip()
-    old, new = [], []
+    old: list[float] = []
+    new: list[float] = []
+    old_each: list[dict[str, list[float]]] = []
+    new_each: list[dict[str, list[float]]] = []
     for _ in range(pairs):
-        for label, commit, times in ((ref, ref, old), (f"HEAD {head}", head, new)):
-            seconds, last = run_suite(commit, select)
+        for label, commit, times, each in ((ref, ref, old, old_each), (f"HEAD {head}", head, new, new_each)):
+            seconds, last, tests = run_suite(commit, select)
             times.append(seconds)
+            each.append(tests)
             print(f"  {label}: {seconds:.1f} s ({last})", flush=True)
     print(f"the suite, {pairs} alternating pair(s): {ref} {min(old):.1f}-{max(old):.1f} s, HEAD {head} "
           f"{min(new):.1f}-{max(new):.1f} s; ratio of the sums {sum(new) / sum(old):.2f}")
+    common = [key for key in old_each[0] if key in new_each[0] and len(old_each[0][key]) == len(new_each[0][key])]
+    summed_old = sum(sum(run[key]) for run in old_each for key in common)
+    summed_new = sum(sum(run[key]) for run in new_each for key in common)
+    print(f"the {len(common)} test names both suites hold (of {len(old_each[0])} in {ref}, {len(new_each[0])} in HEAD): "
+          f"summed test durations {summed_old / pairs:.1f} s in {ref}, {summed_new / pairs:.1f} s in HEAD; "
+          f"ratio {summed_new / summed_old:.2f}")
 
 
 if __name__ == "__main__":

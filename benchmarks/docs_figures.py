@@ -1,10 +1,12 @@
-"""The figures docs/figures.md embeds, drawn by the commands' own chart data (small PNGs at 60 dpi).
+"""The figures docs/figures.md (and docs/torque.md) embed, drawn by the commands' own chart data (small PNGs
+at 60 dpi).
 
 ``python benchmarks/docs_figures.py --write`` (re)draws every figure into
 docs/figures/; ``--check`` draws them into a temporary folder and fails if a
-figure the page embeds is missing, not a PNG, or larger than :data:`MAX_BYTES`
+figure its page embeds is missing, not a PNG, or larger than :data:`MAX_BYTES`
 (pixels differ across machines' font rasterisers, so the check is not byte
-for byte). tests/test_figures.py runs ``--check`` on one figure.
+for byte). Each figure belongs to one page (:data:`PAGES`; default
+docs/figures.md). tests/test_figures.py runs ``--check`` on one figure.
 """
 
 from __future__ import annotations
@@ -62,8 +64,27 @@ def _daf() -> list:
                               "displacement overall": res.displacement.overall}, f"DAF of {pulse.label}")]
 
 
+def _torque_train() -> list:
+    from vtool.presets import load_preset
+    from vtool.presets.camshaft import train_torque_chart
+    from vtool.solvers.run import simulate
+
+    return [train_torque_chart(simulate(load_preset("ohc-finger-follower")))]
+
+
+def _torque_camshaft() -> list:
+    from vtool.presets.camshaft import camshaft_chart, load_camshaft, solve
+
+    spec = load_camshaft("four-cylinder-intake")
+    return [camshaft_chart(spec.title, solve(spec))]
+
+
 FIGURES: dict[str, Callable[[], list]] = {"solve-gnilka-1a": _solve, "sweep-map": _sweep, "cam-ramped": _cam,
-                                          "boom-daf": _daf}
+                                          "boom-daf": _daf, "torque-train": _torque_train,
+                                          "torque-camshaft": _torque_camshaft}
+#: the page that embeds a figure, where it is not docs/figures.md
+PAGES: dict[str, Path] = {"torque-train": ROOT / "docs" / "torque.md",
+                          "torque-camshaft": ROOT / "docs" / "torque.md"}
 
 
 def draw(names: list[str], folder: Path) -> list[Path]:
@@ -74,16 +95,19 @@ def draw(names: list[str], folder: Path) -> list[Path]:
 
 def check(paths: list[Path]) -> list[str]:
     problems = []
-    embedded = set(re.findall(r"\]\(figures/([\w.-]+\.png)\)", PAGE.read_text()))
-    for name in embedded:
-        if not (FOLDER / name).is_file():
-            problems.append(f"docs/figures.md embeds figures/{name}, which is missing (run --write)")
+    embedded: dict[Path, set[str]] = {}
+    for page in {PAGE, *PAGES.values()}:
+        embedded[page] = set(re.findall(r"\]\(figures/([\w.-]+\.png)\)", page.read_text()))
+        for name in embedded[page]:
+            if not (FOLDER / name).is_file():
+                problems.append(f"{page.relative_to(ROOT)} embeds figures/{name}, which is missing (run --write)")
     for path in paths:
         data = path.read_bytes()
         if not data.startswith(b"\x89PNG") or len(data) > MAX_BYTES:
             problems.append(f"{path.name}: not a PNG of at most {MAX_BYTES} bytes ({len(data)})")
-        if path.name not in embedded:
-            problems.append(f"{path.name} is drawn but docs/figures.md does not embed it")
+        page = PAGES.get(path.stem, PAGE)
+        if path.name not in embedded[page]:
+            problems.append(f"{path.name} is drawn but {page.relative_to(ROOT)} does not embed it")
     return problems
 
 

@@ -10,7 +10,7 @@ are skipped). A ``[cam.scan]`` table says what the numbers are::
     angle = "crank"          # cam (default) | crank: 2 crank degrees per cam degree (four-stroke)
     lift_of = "valve"        # tappet (default) | valve: divided by rocker_ratio
     rocker_ratio = 1.5       # valve lift per tappet lift (with lift_of = "valve")
-    smoothing = "fourier"    # none (default) | fourier (below)
+    smoothing = "fourier"    # none (default) | fourier | spline (below)
     noise = 0.1              # optional: the scan's noise rms, in lift_unit; default: estimated
     peak_tolerance = 0.5     # optional, in lift_unit; default: 4 x the noise rms
 
@@ -36,6 +36,31 @@ cut-off comes from the noise:
    ``K`` are dropped.
 4. The peak lift must stay within ``peak_tolerance`` of the scan's: ``K`` is
    raised until it does (said), or the load fails naming the field.
+
+Smoothing (``smoothing = "spline"``), a cubic smoothing spline, for any
+angle steps (unequal, or not dividing 360; the Fourier method needs equal
+steps dividing 360):
+
+1. The noise rms ``s`` is estimated from each interior point's residual
+   against the chord of its two neighbours, ``r_i = y_i - (a y_{i-1} +
+   b y_{i+1})`` (``a``, ``b`` the linear-interpolation weights), scaled by
+   ``1 / sqrt(1 + a^2 + b^2)`` (for white noise ``E r_i^2 = s^2 (1 + a^2 +
+   b^2)``): ``s^2`` is their mean square (not a median: quantised scans make
+   most residuals exactly 0), unless ``noise`` is given. A lift's curvature
+   adds ``h^2 |L''| / 8`` to a residual, small against the noise at scan
+   steps of a degree or so.
+2. ``scipy.interpolate.make_smoothing_spline`` fits the scan (a full
+   revolution wrapped by 30 deg on each side, so the fit is periodic; a
+   partial scan is fitted as it is and extended with base-circle lift 0);
+   its penalty ``lam`` is chosen by the discrepancy principle: the mean
+   square residual at the scan's points equals ``s^2`` (bisection on
+   ``log lam``). A scan covers the revolution when the gap across 360 deg is
+   no wider than its widest step (or twice its median step).
+3. The peak lift must stay within ``peak_tolerance``: ``lam`` is lowered
+   until it does (said), or the load fails naming the field.
+4. The spline is sampled at equal steps (the scan's median step, rounded to
+   divide 360); ``harmonics`` defaults to the fewest whose series stays
+   within ``s / 4`` of those samples.
 
 The result says how far smoothing moved the lift (largest and rms change,
 in the preset's length unit) and the peak change; lift below 0 after all
@@ -66,7 +91,8 @@ from vtool.errors import InputError
 LIFT_UNITS = {"m": 1.0, "mm": 1e-3, "in": 0.0254, "thou": 2.54e-5}
 ANGLES = ("cam", "crank")
 LIFT_OF = ("tappet", "valve")
-SMOOTHING = ("none", "fourier")
+SMOOTHING = ("none", "fourier", "spline")
+WRAP_DEG = 30.0  # a full-revolution scan's points repeated on each side for a periodic spline fit
 FALSE_ALARM = 0.01  # probability that noise alone sets the cut-off (whole spectrum)
 PEAK_NOISE_FACTOR = 4.0  # default peak tolerance in noise rms
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
@@ -100,14 +126,23 @@ class Smoothed:
     peak_raw: float
     peak_smoothed: float
     peak_tolerance: float
-    raised: bool  # the cut-off was raised to keep the peak
+    raised: bool  # the cut-off was raised (the spline's penalty lowered) to keep the peak
+    method: str = "fourier"
+    raw_angles: np.ndarray | None = None  # the scan's own angles when ``lift`` is resampled (spline)
+    penalty: float | None = None  # the spline's lam
+    periodic: bool = True  # the scan covers the revolution (else extended with base-circle lift)
 
     def text(self, unit: str) -> str:
+        moved = (f"lift moved by at most {self.moved_max:.3g} {unit} (rms {self.moved_rms:.3g} {unit}); peak "
+                 f"{self.peak_raw:.6g} -> {self.peak_smoothed:.6g} {unit} (tolerance {self.peak_tolerance:.3g} {unit})")
+        if self.method == "spline":
+            lowered = " (lowered to keep the peak)" if self.raised else ""
+            return (f"smoothed by a cubic smoothing spline, penalty lam {self.penalty:.3g}{lowered} from the noise "
+                    f"(rms {self.noise_rms:.3g} {unit}), sampled at {self.angles.size} equal steps, a series of "
+                    f"{self.harmonics} harmonics: {moved}")
         raised = " (raised to keep the peak)" if self.raised else ""
         return (f"smoothed by a Fourier series of {self.harmonics} harmonics{raised}, cut off at the noise "
-                f"(rms {self.noise_rms:.3g} {unit}): lift moved by at most {self.moved_max:.3g} {unit} "
-                f"(rms {self.moved_rms:.3g} {unit}); peak {self.peak_raw:.6g} -> {self.peak_smoothed:.6g} {unit} "
-                f"(tolerance {self.peak_tolerance:.3g} {unit})")
+                f"(rms {self.noise_rms:.3g} {unit}): {moved}")
 
 
 @dataclass(frozen=True)
@@ -119,6 +154,7 @@ class Scan:
     raw: np.ndarray  # converted, not smoothed
     notes: tuple[str, ...]
     smoothed: Smoothed | None = None
+    raw_angles: np.ndarray | None = None  # the angles of ``raw`` when they are not ``angles`` (a spline's)
 
 
 # ----------------------------------------------------------------------------
@@ -209,10 +245,12 @@ def _uniform_revolution(theta: np.ndarray, lift: np.ndarray, field: str) -> tupl
     steps = np.diff(theta)
     step = float(np.median(steps)) if steps.size else 0.0
     if steps.size < 2 or step <= 0.0 or np.abs(steps - step).max() > 1e-6 * max(step, 1.0):
-        raise InputError(f"{field}.angles", f"{theta.size} points", "equal angle steps for smoothing", "deg")
+        raise InputError(f"{field}.angles", f"{theta.size} points", "equal angle steps for smoothing = \"fourier\" "
+                         "(smoothing = \"spline\" takes any steps)", "deg")
     count = 360.0 / step
     if abs(count - round(count)) > 1e-6 * count:
-        raise InputError(f"{field}.angles", f"a step of {step:g}", "a step that divides 360 for smoothing", "deg")
+        raise InputError(f"{field}.angles", f"a step of {step:g}", "a step that divides 360 for smoothing = "
+                         "\"fourier\" (smoothing = \"spline\" takes any steps)", "deg")
     count = int(round(count))
     span = theta.size
     if abs(theta[-1] - theta[0] - 360.0) < 1e-9:  # the closing point of a full revolution
@@ -255,6 +293,93 @@ def smooth(theta: np.ndarray, lift: np.ndarray, *, noise: float | None = None,
                     peak_raw, float(smoothed.max()), tolerance, raised)
 
 
+def chord_noise_rms(theta: np.ndarray, lift: np.ndarray) -> float:
+    """The rms of white noise on a lift sampled at any steps, from the residuals against neighbours' chords
+    (see the module doc)."""
+    if theta.size < 3:
+        return 0.0
+    h1, h2 = theta[1:-1] - theta[:-2], theta[2:] - theta[1:-1]
+    a, b = h2 / (h1 + h2), h1 / (h1 + h2)
+    r = (lift[1:-1] - a * lift[:-2] - b * lift[2:]) / np.sqrt(1.0 + a * a + b * b)
+    return float(np.sqrt(np.mean(r * r)))
+
+
+def _fewest_harmonics(lift: np.ndarray, within: float) -> int:
+    """The fewest harmonics whose series of the periodic samples ``lift`` stays within ``within`` of them."""
+    X = np.fft.rfft(lift)
+    top = max(1, X.size - 2)
+
+    def error(K: int) -> float:
+        kept = X.copy()
+        kept[K + 1:] = 0.0
+        return float(np.abs(np.fft.irfft(kept, lift.size) - lift).max())
+
+    low, high = 1, top
+    if error(high) > within:
+        return high
+    while low < high:  # the truncation error falls (nearly) monotonically with K: bisect
+        mid = (low + high) // 2
+        low, high = (low, mid) if error(mid) <= within else (mid + 1, high)
+    return low
+
+
+def smooth_spline(theta: np.ndarray, lift: np.ndarray, *, noise: float | None = None,
+                  peak_tolerance: float | None = None, field: str = "cam") -> Smoothed:
+    """The smoothing spline of the module doc (``theta`` in cam deg, increasing, any steps, at most a
+    revolution)."""
+    from scipy.interpolate import make_smoothing_spline
+
+    order = np.argsort(theta, kind="stable")
+    theta, lift = theta[order], lift[order]
+    if theta.size and abs(theta[-1] - theta[0] - 360.0) < 1e-9:  # the closing point of a full revolution
+        theta, lift = theta[:-1], lift[:-1]
+    steps = np.diff(theta)
+    if theta.size < 8 or steps.min() <= 0.0 or theta[-1] - theta[0] >= 360.0:
+        raise InputError(f"{field}.angles", f"{theta.size} points", "at least 8 distinct angles within one "
+                         "revolution for smoothing = \"spline\"", "deg")
+    step = float(np.median(steps))
+    count = int(min(3600, max(36, round(360.0 / step))))
+    periodic = theta[0] + 360.0 - theta[-1] <= max(float(steps.max()), 2.0 * step)  # no wider gap at the wrap
+    if periodic:
+        before, after = theta > theta[-1] - WRAP_DEG, theta < theta[0] + WRAP_DEG
+        X = np.concatenate([theta[before] - 360.0, theta, theta[after] + 360.0])
+        Y = np.concatenate([lift[before], lift, lift[after]])
+    else:
+        X, Y = theta, lift
+    s = chord_noise_rms(theta, lift) if noise is None else float(noise)
+    tolerance = PEAK_NOISE_FACTOR * s if peak_tolerance is None else float(peak_tolerance)
+    peak_raw = float(lift.max())
+    grid = theta[0] + (360.0 / count) * np.arange(count)
+    inside = np.ones(count, dtype=bool) if periodic else grid <= theta[-1]
+
+    def fitted(log_lam: float) -> tuple[Any, np.ndarray]:
+        spline = make_smoothing_spline(X, Y, lam=10.0**log_lam)
+        return spline, spline(theta)
+
+    low, high = -10.0, 12.0  # log10 lam: the discrepancy principle, mean square residual = s^2
+    for _ in range(60):
+        mid = 0.5 * (low + high)
+        if float(np.mean((fitted(mid)[1] - lift) ** 2)) > s * s:
+            high = mid
+        else:
+            low = mid
+    log_lam, raised = low, False
+    spline, at_points = fitted(log_lam)
+    while abs(float(np.where(inside, spline(grid), 0.0).max()) - peak_raw) > tolerance and log_lam > -10.0:
+        log_lam -= 0.25  # less smoothing until the peak is kept
+        raised = True
+        spline, at_points = fitted(log_lam)
+    smoothed = np.where(inside, spline(grid), 0.0)
+    if abs(float(smoothed.max()) - peak_raw) > tolerance:
+        raise InputError(f"{field}.scan.peak_tolerance", tolerance,
+                         f">= {abs(float(smoothed.max()) - peak_raw):.3g} (the peak moves that much at the least "
+                         "smoothing)")
+    moved = at_points - lift
+    return Smoothed(grid, lift, smoothed, _fewest_harmonics(smoothed, max(s, 1e-12) / 4.0), s,
+                    float(np.abs(moved).max()), float(np.sqrt(np.mean(moved**2))), peak_raw,
+                    float(smoothed.max()), tolerance, raised, "spline", theta, 10.0**log_lam, periodic)
+
+
 def _base_circle(lift: np.ndarray, unit: str, notes: list[str]) -> np.ndarray:
     """Lift below 0 (noise or ringing on the base circle) set to 0, and said: the cam's lift is >= 0."""
     below = lift < 0.0
@@ -275,22 +400,36 @@ def prepare(angles: list[float], lifts: list[float], settings: ScanSettings, len
         settings.lift_unit or length_unit) in LIFT_UNITS else 1.0
     if settings.lift_of == "valve":
         scale /= float(settings.rocker_ratio)  # type: ignore[arg-type]  # given whenever lift_of is valve (the loader checks)
+    noise = None if settings.noise is None else settings.noise * scale
+    peak = None if settings.peak_tolerance is None else settings.peak_tolerance * scale
+    if settings.smoothing == "spline":
+        result = smooth_spline(theta, lift, noise=noise, peak_tolerance=peak, field=field)
+        if not result.periodic:
+            notes.append(f"the scan covers {result.raw_angles[-1] - result.raw_angles[0]:g} of 360 cam deg: "
+                         "extended with base-circle lift (0)")
+        notes.append(result.text(length_unit))
+        return Scan(result.angles, _base_circle(result.lift, length_unit, notes), result.raw, tuple(notes), result,
+                    result.raw_angles)
     theta, lift, extended = _uniform_revolution(theta, lift, field)
     if extended:
         notes.append(extended)
-    result = smooth(theta, lift, noise=None if settings.noise is None else settings.noise * scale,
-                    peak_tolerance=None if settings.peak_tolerance is None else settings.peak_tolerance * scale,
-                    field=field)
+    result = smooth(theta, lift, noise=noise, peak_tolerance=peak, field=field)
     notes.append(result.text(length_unit))
     return Scan(theta, _base_circle(result.lift, length_unit, notes), lift, tuple(notes), result)
 
 
 def per_degree_derivatives(theta_deg: np.ndarray, lift: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Velocity (length/deg) and acceleration (length/deg^2) of a sampled lift by central differences
-    (periodic): what the raw scan says before any smoothing."""
-    step = float(np.median(np.diff(theta_deg)))
-    velocity = (np.roll(lift, -1) - np.roll(lift, 1)) / (2.0 * step)
-    acceleration = (np.roll(lift, -1) - 2.0 * lift + np.roll(lift, 1)) / step**2
+    """Velocity (length/deg) and acceleration (length/deg^2) of a sampled lift by central divided
+    differences (any steps; periodic over 360 deg): what the raw scan says before any smoothing."""
+    after = np.roll(theta_deg, -1)
+    after[-1] += 360.0
+    before = np.roll(theta_deg, 1)
+    before[0] -= 360.0
+    h_after, h_before = after - theta_deg, theta_deg - before
+    slope_after = (np.roll(lift, -1) - lift) / h_after
+    slope_before = (lift - np.roll(lift, 1)) / h_before
+    velocity = (np.roll(lift, -1) - np.roll(lift, 1)) / (h_after + h_before)
+    acceleration = 2.0 * (slope_after - slope_before) / (h_after + h_before)
     return velocity, acceleration
 
 

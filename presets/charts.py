@@ -86,8 +86,14 @@ def configuration_chart(trace: Any) -> Chart:
 
 
 def trace_charts(trace: Any) -> list[Chart]:
-    """What ``vtool solve --plot`` draws: forces, displacements, configuration."""
-    return [force_chart(trace), displacement_chart(trace), configuration_chart(trace)]
+    """What ``vtool solve --figure`` draws: forces, displacements, configuration; with a [follower], the cam's
+    drive torque (:func:`vtool.presets.camshaft.train_torque_chart`)."""
+    charts = [force_chart(trace), displacement_chart(trace), configuration_chart(trace)]
+    if trace.spec.follower is not None:
+        from vtool.presets.camshaft import train_torque_chart
+
+        charts.append(train_torque_chart(trace))
+    return charts
 
 
 def compare_chart(variants: Sequence[Any]) -> Chart:
@@ -202,13 +208,15 @@ def scan_charts(scan: Any, unit: str, subject: str = "") -> list[Chart]:
     """
     from vtool.presets.cam_scan import per_degree_derivatives, series_derivatives
 
-    raw_v, raw_a = per_degree_derivatives(scan.angles, scan.raw)
-    curves = {"raw scan": (scan.raw, raw_v, raw_a)}
+    raw_angles = scan.angles if scan.raw_angles is None else scan.raw_angles
+    raw_v, raw_a = per_degree_derivatives(raw_angles, scan.raw)
+    curves = {"raw scan": (raw_angles, (scan.raw, raw_v, raw_a))}
     if scan.smoothed is not None:
-        curves[f"smoothed ({scan.smoothed.harmonics} harmonics)"] = (scan.lifts,
-                                                                     *series_derivatives(scan.angles, scan.lifts))
+        how = "spline, " if scan.smoothed.method == "spline" else ""
+        curves[f"smoothed ({how}{scan.smoothed.harmonics} harmonics)"] = (
+            scan.angles, (scan.lifts, *series_derivatives(scan.angles, scan.lifts)))
     names = (("lift", unit), ("velocity", f"{unit}/deg"), ("acceleration", f"{unit}/deg^2"))
-    panels = tuple(Panel(tuple(curve(label, scan.angles, values[i]) for label, values in curves.items()),
+    panels = tuple(Panel(tuple(curve(label, angles, values[i]) for label, (angles, values) in curves.items()),
                          with_unit(name, u)) for i, (name, u) in enumerate(names))
     return [Chart("measured scan: raw against smoothed (per cam degree)", CAM_ANGLE, panels, subject)]
 
@@ -263,13 +271,15 @@ def order_chart(spectrum: Any, frequencies: list[tuple[str, float]], highest: fl
 
 
 def campbell_chart(data: Any, subject: str = "") -> HeatMap:
-    """``vtool sweep --campbell Q``: log10 of the order amplitudes over cam speed and cam order."""
+    """``vtool sweep --campbell Q``: log10 of the order amplitudes over cam speed and cam order, with each
+    natural frequency the terminal map marks drawn as its line order = f_n 60 / rpm (the orders it meets)."""
     with np.errstate(divide="ignore", invalid="ignore"):
         values = np.where(data.amplitude > 0, np.log10(data.amplitude), np.nan)
     orders = np.arange(1, len(data.amplitude) + 1, dtype=float)
+    rpm = np.asarray(data.rpm, dtype=float)
+    lines = tuple(curve(f"{hz:.0f} Hz ({label})", rpm, data.line(hz)) for label, hz in data.frequencies)
     return HeatMap(f"{data.quantity}: amplitude per cam order and speed (log10)", "cam speed (rev/min)",
-                   "cam order (-)", f"log10 amplitude ({data.unit})", np.asarray(data.rpm, dtype=float), orders,
-                   values, subject)
+                   "cam order (-)", f"log10 amplitude ({data.unit})", rpm, orders, values, subject, lines)
 
 
 # ----------------------------------------------------------------------------

@@ -110,9 +110,12 @@ def load_follower(t: Table, units: UnitSystem, read_law: Callable[[Table], CamSp
     guide = t.number("guide_friction", unit=units.force, default=0.0, min_value=0.0, max_value=1e9)
     guide_velocity = t.number("guide_velocity", unit=f"{L}/s", default=1e-3 / units.metres_per_length,
                               min_exclusive=0.0, max_value=1e9)
+    from vtool.presets.friction import load_friction
+
+    laws = load_friction(t, units, kind == ROLLER, arrangement in LEVERS, friction, guide)
     t.finish()
     return FollowerSpec(kind, arrangement, base, width, roller, face, finger=finger, lift=lift, oil=oil,
-                        friction=friction, guide_friction=guide, guide_velocity=guide_velocity, **moduli)
+                        friction=friction, guide_friction=guide, guide_velocity=guide_velocity, laws=laws, **moduli)
 
 
 def dump_follower(f: FollowerSpec, dump_law: Callable[[CamSpec], dict[str, Any]]) -> dict[str, Any]:
@@ -129,6 +132,9 @@ def dump_follower(f: FollowerSpec, dump_law: Callable[[CamSpec], dict[str, Any]]
         doc["friction"] = f.friction
     if f.guide_friction:
         doc |= {"guide_friction": f.guide_friction, "guide_velocity": f.guide_velocity}
+    from vtool.presets.friction import dump_friction
+
+    doc |= dump_friction(f.laws)
     if f.finger is not None:
         doc |= {key: getattr(f.finger, key) for key in FINGER_KEYS}
     if f.lift is not None:

@@ -18,6 +18,7 @@ valvetrain  vtool.solvers.model.spec:MechanismSpec            vtool.presets.valv
 boom_wall   vtool.assessments.sonic_boom.spec:BoomWallSpec    vtool.presets.boom        vtool.app.cli.boom:solve_preset           vtool.app.tui.boom
 boom_floor  vtool.assessments.sonic_boom.spec:BoomFloorSpec   vtool.presets.boom        vtool.app.cli.boom:solve_preset           vtool.app.tui.boom
 plate       vtool.presets.plate:PlateSpec                     vtool.presets.plate       vtool.app.cli.plate:solve_preset          vtool.app.tui.plate
+camshaft    vtool.presets.camshaft:CamshaftSpec               vtool.presets.camshaft    vtool.app.cli.camshaft:solve_preset       vtool.app.tui.camshaft
 ==========  ================================================  ========================  ========================================  ========================
 
 A loader module has ``load(doc, folder=None) -> spec`` (``folder``: the
@@ -31,7 +32,9 @@ are set into the document and checked by the loader (the loader module then
 has ``with_overrides(doc, {path: value}) -> doc``). ``vtool solve`` refuses
 any other flag for the kind. A TUI screen module has ``SCREEN``, its
 :class:`~vtool.app.tui.base.DomainScreen` class; one screen may show
-several kinds (the boom screen: walls and floors). The table above is the
+several kinds (the boom screen: walls and floors). A ``camshaft`` preset runs
+several valvetrain presets (:mod:`vtool.presets.camshaft`); ``vtool camshaft`` is
+its ``vtool solve`` under the command's older name. The table above is the
 data below (``tests/test_dispatch.py`` compares them).
 """
 
@@ -59,6 +62,8 @@ class Kind:
     #: those of them that are preset fields: flag -> field path, set into the document before the load
     #: (:class:`vtool.presets.Override`), so the loader checks them once, as the file's own values
     overrides: tuple[tuple[str, str], ...] = ()
+    #: ``vtool report``'s content: ``report(spec, *, preset, sweep, metric, workers, ...) -> Report``
+    report: str = ""
 
 
 KINDS: dict[str, Kind] = {
@@ -69,15 +74,22 @@ KINDS: dict[str, Kind] = {
                         "--max-steps", "--impact", "--start", "--orders", "--format"),
                        (("--backend", "run.backend"), ("--dt", "run.time_step"), ("--rpm", "run.rpm"),
                         ("--degrees", "run.degrees"), ("--impact", "contact.impact"),
-                        ("--start", "initial.velocities"))),
+                        ("--start", "initial.velocities")), "vtool.presets.report:valvetrain_report"),
     "boom_wall": Kind("boom_wall", "sonic-boom wall assessment",
                       "vtool.assessments.sonic_boom.spec:BoomWallSpec", "vtool.presets.boom",
-                      "vtool.app.cli.boom:solve_preset", "vtool.app.tui.boom"),
+                      "vtool.app.cli.boom:solve_preset", "vtool.app.tui.boom",
+                      report="vtool.presets.report:boom_report"),
     "boom_floor": Kind("boom_floor", "sonic-boom floor assessment",
                        "vtool.assessments.sonic_boom.spec:BoomFloorSpec", "vtool.presets.boom",
-                       "vtool.app.cli.boom:solve_preset", "vtool.app.tui.boom"),
+                       "vtool.app.cli.boom:solve_preset", "vtool.app.tui.boom",
+                      report="vtool.presets.report:boom_report"),
     "plate": Kind("plate", "condensed-plate study", "vtool.presets.plate:PlateSpec",
-                  "vtool.presets.plate", "vtool.app.cli.plate:solve_preset", "vtool.app.tui.plate"),
+                  "vtool.presets.plate", "vtool.app.cli.plate:solve_preset", "vtool.app.tui.plate",
+                  report="vtool.presets.report:plate_report"),
+    "camshaft": Kind("camshaft", "several valve trains on one camshaft: summed drive torque",
+                     "vtool.presets.camshaft:CamshaftSpec", "vtool.presets.camshaft",
+                     "vtool.app.cli.camshaft:solve_preset", "vtool.app.tui.camshaft",
+                     ("--rpm", "--max-steps"), (("--rpm", "camshaft.rpm"),)),
 }
 
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 import copy
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -193,25 +193,194 @@ def apply_sets(doc: dict[str, Any], sets: list[str] | tuple[str, ...]) -> dict[s
     return set_fields(doc, assignments)
 
 
+#: A swept field's values are all checked up front when it has at most this many (a typed list); a longer
+#: one (a range) has its first and last value checked, and its smallest and largest when they differ.
+CHECK_ALL_VALUES = 100
+#: Most corner points (each field at its first or last value) checked up front.
+MAX_CORNERS = 64
+
+
+@dataclass(frozen=True)
+class SpecMaker:
+    """A point's spec from its swept values: the loader on the base document with them set, then the plan's
+    study settings (``orders``: order amplitudes as metrics, ``steady``: run to steady state).
+
+    Picklable (a plain document and settings), so that a sweep's worker process makes its points' specs
+    itself; a value the loader refuses raises its own one-line InputError (the point's status, its
+    metrics the columns of ``base``, the plan's spec)."""
+
+    doc: dict[str, Any]
+    folder: Path | None = None
+    base: Any = None
+    orders: tuple[str, ...] = ()
+    steady: bool = False
+
+    def __call__(self, values: tuple[tuple[str, Any], ...]) -> Any:
+        from vtool.presets import load_document
+
+        return self.settle(load_document(set_fields(self.doc, dict(values)), self.folder))
+
+    def settle(self, spec: Any) -> Any:
+        """``spec`` with the plan's study settings."""
+        from vtool.solvers.studies.orders import with_orders
+        from vtool.solvers.studies.steady import with_steady
+
+        spec = with_orders(spec, self.orders) if self.orders else spec
+        return with_steady(spec) if self.steady else spec
+
+
+class PointGrid(Sequence[Any]):
+    """The grid of a sweep's points, made on demand: nothing per point is kept.
+
+    ``grid[i]`` is :class:`vtool.solvers.studies.sweep.Point` ``i`` (in
+    :func:`vtool.solvers.studies.sweep.grid`'s order, the first field varying
+    fastest) with its spec made and checked now; :meth:`lazy` gives it without
+    the spec, which the evaluation makes (a worker process makes its own).
+    :meth:`run_order` lists the indices with the ``run.*`` fields varying
+    fastest, so that neighbouring points share an assembled model; :meth:`locate`
+    finds a point's index from its values as a sweep file writes them.
+    """
+
+    def __init__(self, fields: Sequence[tuple[str, Sequence[Any]]], maker: SpecMaker) -> None:
+        self.fields = [(path, list(values)) for path, values in fields]
+        self.maker = maker
+        self.sizes = [len(values) for _, values in self.fields]
+        self.strides = [math.prod(self.sizes[:k]) for k in range(len(self.sizes))]
+        self.total = math.prod(self.sizes)
+        self._positions: list[dict[str, int]] | None = None
+
+    def __len__(self) -> int:
+        return self.total
+
+    def values(self, index: int) -> tuple[tuple[str, Any], ...]:
+        """The swept values of point ``index``, in the fields' order."""
+        return tuple((path, values[(index // stride) % size]) for (path, values), stride, size
+                     in zip(self.fields, self.strides, self.sizes, strict=True))
+
+    def lazy(self, index: int) -> Any:
+        """Point ``index`` without its spec (``make`` makes it when the point is evaluated)."""
+        from vtool.solvers.studies.sweep import Point
+
+        return Point(index, self.values(index), None, self.maker)
+
+    def __getitem__(self, index: Any) -> Any:
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(self.total))]
+        if not -self.total <= index < self.total:
+            raise IndexError(index)
+        from vtool.solvers.studies.sweep import Point
+
+        index %= self.total
+        values = self.values(index)
+        return Point(index, values, self.maker(values))
+
+    def __iter__(self) -> Iterator[Any]:
+        return (self[i] for i in range(self.total))
+
+    def run_order(self) -> Iterator[int]:
+        """Every index once, the ``run.*`` fields varying fastest (then the grid's own order)."""
+        axes = sorted(range(len(self.fields)), key=lambda k: not self.fields[k][0].startswith("run."))
+        for flat in range(self.total):
+            index = 0
+            for k in axes:
+                index += (flat % self.sizes[k]) * self.strides[k]
+                flat //= self.sizes[k]
+            yield index
+
+    def locate(self, texts: Sequence[str]) -> int | None:
+        """The index of the point whose values a sweep file writes as ``texts`` (None: not in this grid)."""
+        from vtool.solvers.studies.sweep import format_value
+
+        if self._positions is None:
+            self._positions = [{format_value(v): i for i, v in reversed(list(enumerate(values)))}
+                               for _, values in self.fields]
+        if len(texts) != len(self.fields):
+            return None
+        index = 0
+        for text, positions, stride in zip(texts, self._positions, self.strides, strict=True):
+            if text not in positions:
+                return None
+            index += positions[text] * stride
+        return index
+
+    def axes(self) -> list[str]:
+        """The swept fields with more than one distinct value."""
+        return [path for path, values in self.fields if len(set(map(repr, values))) > 1]
+
+    def checked_values(self) -> Iterator[tuple[tuple[str, Any], ...]]:
+        """The points checked before a sweep runs: each field's values (a long range: its ends and extremes)
+        with the other fields at their first value, then the corners (each field at its first or last value)."""
+        firsts = {path: values[0] for path, values in self.fields}
+        seen: set[str] = set()
+
+        def point(assignment: dict[str, Any]) -> tuple[tuple[str, Any], ...] | None:
+            values = tuple((path, assignment[path]) for path, _ in self.fields)
+            key = repr(values)
+            if key in seen:
+                return None
+            seen.add(key)
+            return values
+
+        for path, values in self.fields:
+            for value in _checked(values):
+                found = point(firsts | {path: value})
+                if found is not None:
+                    yield found
+        ends = [(values[0], values[-1]) for _, values in self.fields]
+        for corner in range(min(2 ** len(ends), MAX_CORNERS)):
+            found = point({path: pair[(corner >> k) & 1] for k, ((path, _), pair)
+                           in enumerate(zip(self.fields, ends, strict=True))})
+            if found is not None:
+                yield found
+
+
+def _checked(values: Sequence[Any]) -> list[Any]:
+    """A field's values checked up front (see :data:`CHECK_ALL_VALUES`)."""
+    if len(values) <= CHECK_ALL_VALUES:
+        return list(values)
+    chosen = [values[0], values[-1]]
+    if all(isinstance(v, int | float) and not isinstance(v, bool) for v in (values[0], values[-1])):
+        numbers = [v for v in values if isinstance(v, int | float) and not isinstance(v, bool)]
+        chosen += [min(numbers), max(numbers)]
+    return chosen
+
+
 @dataclass(frozen=True)
 class SweepPlan:
-    """A validated sweep: the base document and spec, the swept fields with units, every point."""
+    """A checked sweep: the base document and spec, the swept fields with units, the points (made on demand).
+
+    ``points`` is a :class:`PointGrid`: a sequence of
+    :class:`vtool.solvers.studies.sweep.Point` that keeps nothing per point.
+    """
 
     doc: dict[str, Any]
     spec: Any
     fields: tuple[tuple[str, str], ...]  # (path, unit)
-    points: tuple[Any, ...]  # vtool.solvers.studies.sweep.Point
+    points: PointGrid
+
+    def with_settings(self, orders: tuple[str, ...] = (), steady: bool = False) -> SweepPlan:
+        """The plan with every point (and its base spec) reporting ``orders``' amplitudes and run to steady
+        state when ``steady``."""
+        from dataclasses import replace
+
+        maker = replace(self.points.maker, orders=self.points.maker.orders + tuple(orders),
+                        steady=self.points.maker.steady or steady)
+        spec = maker.settle(self.spec)
+        return replace(self, spec=spec, points=PointGrid(self.points.fields, replace(maker, base=spec)))
 
 
 def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000, *,
                progress: Callable[[int, int], None] | None = None,
                cancel: Callable[[], bool] | None = None) -> SweepPlan:
-    """Parse ``FIELD=VALUES`` assignments and validate every grid point with the preset loader.
+    """Parse ``FIELD=VALUES`` assignments and check them with the preset loader; nothing runs.
 
-    Nothing runs: a bad field, range or value raises the loader's own one-line
-    InputError before any work starts. Validating a point costs about 10 ms, so a
-    large grid takes minutes: ``progress(done, total)`` is called as points are
-    checked and ``cancel()`` between them (True raises :class:`SweepCancelled`).
+    A bad field, range or value raises the loader's own one-line InputError
+    before any work starts: every value of a typed list, a range's ends (and
+    extremes) and the grid's corners are checked (:meth:`PointGrid.checked_values`),
+    about 10 ms each; ``progress(done, total)`` is called as they are and ``cancel()``
+    between them (True raises :class:`SweepCancelled`). Every other point is made
+    and checked when it runs: one the loader refuses there (a combination of
+    values no single field shows) is a failed point whose status is the loader's message.
     """
     from vtool.presets import find_preset, load_document, read_document
     from vtool.presets.kinds import require_kind
@@ -232,19 +401,19 @@ def plan_document(doc: dict[str, Any], fields: list[tuple[str, list[Any]]], max_
     """
     from vtool.presets import load_document
     from vtool.presets.kinds import require_kind
-    from vtool.solvers.studies.sweep import Point, grid
 
     spec = load_document(doc, folder)
     require_kind(spec, "valvetrain", "a sweep")
     count = math.prod(len(v) for _, v in fields)
     if count > max_points:
         raise InputError("--set", count, f"a grid of at most {max_points} points")
-    points = []
-    for index, assignment in enumerate(grid(fields)):
+    points = PointGrid(fields, SpecMaker(doc, folder, spec))
+    checks = list(points.checked_values())
+    for done, values in enumerate(checks, start=1):
         if cancel is not None and cancel():
             raise SweepCancelled
-        points.append(Point(index, assignment, load_document(set_fields(doc, dict(assignment)), folder)))
+        points.maker(values)
         if progress is not None:
-            progress(index + 1, count)
+            progress(done, len(checks))
     units = tuple((path, field_unit(doc, path, folder)) for path, _ in fields)
-    return SweepPlan(doc, spec, units, tuple(points))
+    return SweepPlan(doc, spec, units, points)

@@ -46,6 +46,21 @@ VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
     ("gnilka-1a", {"run.steady": {"tolerance": 1e-3, "max_cycles": 20}, "run.jump_gap": 0.002,
                    "run.bounce_lift": 0.002, "run.orders": ["F7"]}),
     ("gnilka-1a", {"run.cycles": 3}),
+    # the friction laws (presets/friction.py): Stribeck on a flat face and the guide; a finger's pivot and slip
+    ("direct-acting-bucket", {"train.follower.friction_law": "stribeck", "train.follower.guide_friction": 5.0}),
+    ("ohc-finger-follower", {"train.follower.friction_law": "stribeck", "train.follower.pivot_friction": 0.1,
+                             "train.follower.pivot_radius": 4.0, "train.follower.slip_friction": 0.1,
+                             "train.follower.roller_inertia": 4e-4}),
+    # a data-sheet spring's other branches: R_m = A / d^m, elliptic wire, coil contact settings (presets/springs.py)
+    ("nested-spring-clash", {"train.spring.tensile_strength": {"A": 2300.0, "m": 0.1}, "train.spring.wire_height": 3.8,
+                             "train.spring.block_stiffness": 1e4, "train.spring.block_damping_ratio": 0.2,
+                             "train.spring.inner.tensile_strength": {"A": 2300.0, "m": 0.1},
+                             "train.spring.inner.wire_height": 2.8, "train.spring.inner.coil_contact": "none"}),
+    # forces on the valve's motion (presets/valveforces.py): Stribeck guide friction and a cylinder-pressure table
+    ("direct-acting-bucket", {"run.backend": "scipy", "valve_forces": {
+        "guide_friction": 15.0, "guide_velocity": 20.0, "static_friction": 25.0, "stribeck_velocity": 100.0,
+        "viscous": 0.002, "gas_crank_angles": [0.0, 360.0], "gas_pressures": [0.1, 2.0], "head_diameter": 30.0,
+        "seat_side": "cylinder", "gas_phase": 0.0}}),
     *((name, changes) for name in ("boom-brick-wall", "boom-tall-building") for changes in (
         {"boom.pulse": "N", "boom.envelope": None},
         {"boom.pulse": "csv", "boom.csv": "pulse.csv", "boom.envelope": None},
@@ -53,6 +68,20 @@ VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
         {"criteria": ["own"], "criterion": [{"name": "own", "source": "a reference", "response": "velocity",
                                              "value": 1.0, "unit": "in/s", "f_min": 1.0, "f_max": 50.0}]})),
 )
+
+#: The friction-law keys of a [follower] (presets/friction.py; the laws: solvers/model/friction.py).
+FRICTION_LAWS = {
+    "follower.friction_law": "Law of the sliding contacts (flat face, valve guide): Coulomb or Stribeck.",
+    "follower.static_friction": "Stribeck: the cam contact's coefficient at rest, mu_s (friction is mu_c).",
+    "follower.guide_static_friction": "Stribeck: the valve guide's friction force at rest.",
+    "follower.stribeck_velocity": "Stribeck: the speed v_S over which mu falls from mu_s to mu_c.",
+    "follower.viscous_friction": "Stribeck: the cam contact's coefficient rise per sliding speed, k_v.",
+    "follower.pivot_friction": "Friction coefficient of a finger's or rocker's pivot: T = mu F_pivot r_p.",
+    "follower.pivot_radius": "Radius r_p of the pivot's pin or ball.",
+    "follower.pivot_velocity": "Angular velocity below which the pivot friction is regularised (tanh).",
+    "follower.slip_friction": "A roller's traction limit mu_slip: above mu_slip F_n it slips on the cam.",
+    "follower.roller_inertia": "The roller's moment of inertia about its pin (its slip).",
+}
 
 #: Keys every kind has.
 COMMON = {
@@ -117,7 +146,8 @@ MEANINGS: dict[str, dict[str, str]] = {
         "cam.scan.angle": "Cam degrees, or crank degrees (halved to cam degrees: four-stroke).",
         "cam.scan.lift_of": "Tappet (cam follower) lift, or valve lift (divided by rocker_ratio).",
         "cam.scan.rocker_ratio": "Valve lift per tappet lift, for a valve-lift scan.",
-        "cam.scan.smoothing": "none, or fourier: a truncated Fourier series cut off at the scan's noise.",
+        "cam.scan.smoothing": "none; fourier: a truncated Fourier series cut off at the scan's noise (equal steps "
+                              "dividing 360); spline: a smoothing spline whose residual is the noise (any steps).",
         "cam.scan.noise": "The scan's noise rms (default: estimated from its spectrum).",
         "cam.scan.peak_tolerance": "How far smoothing may move the peak lift (default: 4 x the noise rms).",
         "cam.harmonics": "Harmonics of the lift table's Fourier fit (0: as many as the table needs).",
@@ -132,8 +162,39 @@ MEANINGS: dict[str, dict[str, str]] = {
         "follower": "The cam's follower: its geometry gives the cam's shape and the contact stress.",
         "follower.kind": "A flat face or a roller.",
         "follower.friction": "Friction coefficient of the cam-follower contact (its share of the drive torque).",
+        "hla": "A hydraulic lash adjuster in a bar member's place (solvers/model/hla.py; a nonlinear element: scipy back end).",
+        "hla.member": "The stiffness-given bar member it sits in (its linear stiffness stays; the element adds the rest).",
+        "hla.sense": "What the member's positive elongation is for the adjuster: compression (it shortens) or extension.",
+        "hla.plunger_diameter": "The plunger's diameter d (area A = pi d^2/4).",
+        "hla.chamber_volume": "The high-pressure chamber's oil volume V0 at zero plunger extension.",
+        "hla.spring_rate": "The plunger spring's rate (it pushes the plunger out).",
+        "hla.spring_preload": "The plunger spring's force at zero extension.",
+        "hla.gap": "Radial clearance h of the plunger in its bore (leakage Q = pi d h^3 dp / (12 mu L)).",
+        "hla.gap_length": "Sealing length L of the plunger's gap.",
+        "hla.viscosity": "The oil's dynamic viscosity mu in the gap.",
+        "hla.supply_pressure": "The oil gallery's (gauge) pressure behind the check valve.",
+        "hla.check_conductance": "The open ball check valve's flow per pressure difference above crack_pressure.",
+        "hla.crack_pressure": "Pressure difference at which the check valve opens.",
+        "hla.bulk_pressures": "Gauge pressures of the oil's bulk-modulus table (increasing).",
+        "hla.bulk_moduli": "The oil's bulk modulus at bulk_pressures (linear between, constant beyond).",
+        "hla.air_fraction": "Entrained air by volume at atmospheric pressure (isothermal, Wood's mixture rule).",
+        "hla.damping": "Viscous damping of the plunger in its bore.",
+        "hla.initial_pressure": "Chamber pressure at the start (default: the static load's, at least the supply pressure).",
+        "valve_forces": "Forces acting on the valve's motion: guide friction and the gas force (presets/valveforces.py; scipy back end).",
+        "valve_forces.coordinate": "The coordinate they act on (default: the valve, the seat clearance's ahead coordinate).",
+        "valve_forces.guide_friction": "Coulomb guide friction F_c in F = [F_c + (F_s - F_c) exp(-(v/v_s)^2)] tanh(v/v_r) + c_v v.",
+        "valve_forces.guide_velocity": "Regularisation velocity v_r of the friction's sign (tanh).",
+        "valve_forces.static_friction": "Stribeck static peak F_s (>= F_c; default F_c: no Stribeck dip).",
+        "valve_forces.stribeck_velocity": "Stribeck velocity v_s (required with static_friction).",
+        "valve_forces.viscous": "Viscous guide friction coefficient c_v.",
+        "valve_forces.gas_crank_angles": "Crank angles of the cylinder-pressure table (increasing, within one 720-degree cycle; periodic).",
+        "valve_forces.gas_pressures": "Cylinder (gauge) pressure at gas_crank_angles (linear between).",
+        "valve_forces.head_diameter": "Valve head diameter: the gas force is the pressure on pi D^2/4.",
+        "valve_forces.seat_side": "cylinder: the pressure presses the valve onto its seat (a poppet valve); port: away from it.",
+        "valve_forces.gas_phase": "Crank angle at cam angle zero (crank = 2 cam + phase).",
         "follower.guide_friction": "Valve-guide Coulomb friction force (stem side load times its coefficient).",
         "follower.guide_velocity": "Regularisation velocity of the guide friction: F = F_g tanh(v / v_r).",
+        **FRICTION_LAWS,
         "follower.arrangement": "Translating (bucket, tappet, roller lifter) or an end-pivot finger.",
         "follower.base_radius": "The cam's base-circle radius (profile).",
         "follower.width": "Length of the line contact (roller or lobe width).",
@@ -198,6 +259,23 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.finger.inertia": "The finger's section second moment of area.",
         "train.finger.modulus": "The finger's Young's modulus.",
         "train.finger.density": "The finger's mass per volume (with its roller).",
+        "train.hla": "A hydraulic lash adjuster under the finger's pivot (solvers/model/hla.py; scipy back end).",
+        "train.hla.plunger_mass": "The plunger's moving mass (with the pivot ball).",
+        "train.hla.plunger_diameter": "The plunger's diameter d (area A = pi d^2/4).",
+        "train.hla.chamber_volume": "The high-pressure chamber's oil volume V0 at zero plunger extension.",
+        "train.hla.spring_rate": "The plunger spring's rate (it pushes the plunger out).",
+        "train.hla.spring_preload": "The plunger spring's force at zero extension.",
+        "train.hla.gap": "Radial clearance h of the plunger in its bore (leakage Q = pi d h^3 dp / (12 mu L)).",
+        "train.hla.gap_length": "Sealing length L of the plunger's gap.",
+        "train.hla.viscosity": "The oil's dynamic viscosity mu in the gap.",
+        "train.hla.supply_pressure": "The oil gallery's (gauge) pressure behind the check valve.",
+        "train.hla.check_conductance": "The open ball check valve's flow per pressure difference above crack_pressure.",
+        "train.hla.crack_pressure": "Pressure difference at which the check valve opens.",
+        "train.hla.bulk_pressures": "Gauge pressures of the oil's bulk-modulus table (increasing).",
+        "train.hla.bulk_moduli": "The oil's bulk modulus at bulk_pressures (linear between, constant beyond).",
+        "train.hla.air_fraction": "Entrained air by volume at atmospheric pressure (isothermal, Wood's mixture rule).",
+        "train.hla.damping": "Viscous damping of the plunger in its bore.",
+        "train.hla.initial_pressure": "Chamber pressure at the start (default: the static load's, at least the supply pressure).",
         "train.pivot": "The support under the finger's pivot (where a lash adjuster sits).",
         "train.pivot.mass": "The moving mass at the pivot.",
         "train.pivot.stiffness": "The pivot support's stiffness.",
@@ -217,7 +295,11 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.spring.solid_length": "Data sheet: solid length (default total_coils x wire_diameter).",
         "train.spring.shear_modulus": "Data sheet: the wire's shear modulus G.",
         "train.spring.density": "Data sheet: the wire's density (the spring's mass).",
-        "train.spring.tensile_strength": "Data sheet: the wire's tensile strength R_m at its diameter.",
+        "train.spring.tensile_strength": "Data sheet: the wire's tensile strength R_m at its diameter, or \"VDSiCrV\" "
+                                         "(R_m = A / d^m fitted to its table), or {A, m}.",
+        "train.spring.tensile_strength.A": "R_m = A / d^m: A in MPa mm^m (d in mm).",
+        "train.spring.tensile_strength.m": "R_m = A / d^m: the exponent m.",
+        "train.spring.wire_height": "Data sheet: elliptic wire's axis along the spring (wire_diameter: the radial one).",
         "train.spring.fatigue_limit": "Data sheet: shear fatigue limit at zero mean (Goodman factor).",
         "train.spring.shear_ratio": "Data sheet: ultimate shear over tensile strength (Goodman line's end).",
         "train.spring.segment_coils": "Pitch diagram: active coils per segment, fixed end first (one bar each).",
@@ -225,6 +307,9 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.spring.lengths": "Force-length table: lengths, decreasing (progressive spring).",
         "train.spring.forces": "Force-length table: the force at each length.",
         "train.spring.inner": "A nested inner spring in parallel: the same data-sheet keys.",
+        "train.spring.coil_contact": "Pitch diagram: linear coil contacts per segment (default) or none.",
+        "train.spring.block_stiffness": "Pitch diagram: a closed segment's contact stiffness (default 100 k_i).",
+        "train.spring.block_damping_ratio": "Pitch diagram: coil contact damping, ratio of critical (default 0.1).",
         "checks.spring_stress_max": "Largest corrected shear stress of a data-sheet spring (Bergstraesser).",
         "checks.spring_fatigue_min": "Smallest Goodman fatigue safety factor of a spring over the last cycle.",
         "checks.coil_bind_margin_min": "Smallest length reached minus the solid length.",
@@ -232,6 +317,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         "springs[].name": "The spring's member name.",
         "springs[].coordinate": "The coordinate of the spring's moving end (retainer).",
         "springs[].nodes": "A pitch diagram's coordinates between its segments (fixed end first).",
+        "springs[].contacts": "A pitch diagram's coil-contact clearances, one per segment (fixed end first).",
         "train.cam": "The lift law at the cam (a finger's: the roller's radial lift).",
         "train.cam.law": "Harmonic (the thesis' cam), a lift table or the ramped polydyne.",
         "train.cam.angle_basis": "Angles in cam or crank degrees (crank: halved).",
@@ -250,6 +336,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.follower.friction": "Friction coefficient of the cam-follower contact (its share of the drive torque).",
         "train.follower.guide_friction": "Valve-guide Coulomb friction force (stem side load times its coefficient).",
         "train.follower.guide_velocity": "Regularisation velocity of the guide friction: F = F_g tanh(v / v_r).",
+        **{f"train.{key}": meaning for key, meaning in FRICTION_LAWS.items()},
         "train.follower.arrangement": "Set by the type (not given here).",
         "train.follower.base_radius": "The cam's base-circle radius (profile).",
         "train.follower.width": "Length of the line contact.",
@@ -289,7 +376,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         "clearances[].name": "The clearance's name in tables and events.",
         "clearances[].kind": "External (against a prescribed coordinate) or internal (between two elastic ones).",
         "clearances[].ahead": "The coordinate ahead: gap = q[ahead] - q[behind], contact when gap <= 0.",
-        "clearances[].behind": "The coordinate behind.",
+        "clearances[].behind": "The coordinate behind (0: the ground, for a compliant external contact).",
         "clearances[].state": "Enabled, pinned (always closed) or removed (never monitored).",
         "clearances[].restitution": "Coefficient of restitution of its impacts.",
         "clearances[].impact": "Its own impact law (default: contact.impact).",
@@ -298,6 +385,8 @@ MEANINGS: dict[str, dict[str, str]] = {
         "clearances[].contact_damping": "Contact damping coefficient (linear contact).",
         "clearances[].contact_damping_ratio": "Contact damping as a ratio of critical (linear contact).",
         "clearances[].contact_exponent": "Exponent n of a Hertz contact's force law.",
+        "clearances[].opening": "Gap where q[ahead] = q[behind] (compliant contacts; a coil gap), default 0.",
+        "clearances[].sense": "+1: gap = q[ahead] - q[behind] + opening; -1: q[behind] - q[ahead] + opening.",
         "initial": "The static start.",
         "initial.closed": "Clearances closed at the start (the starting configuration).",
         "initial.spring_preload": "The valve spring's preload.",
@@ -389,6 +478,19 @@ MEANINGS: dict[str, dict[str, str]] = {
         "transient.tolerance": "Error above which a transient result is flagged.",
         "transient.truncation_check": "Check the exact superposition's truncation by doubling its modes.",
     },
+    "camshaft": {key: COMMON[key] for key in ("kind", "title")} | {
+        "camshaft": "The camshaft: its cylinders, firing order, speed and valves (presets/camshaft.py).",
+        "camshaft.cylinders": "Number of cylinders whose lobes the camshaft carries.",
+        "camshaft.firing_order": "Cylinder numbers in firing order: the k-th fires 360 k / cylinders cam deg "
+                                 "after the first.",
+        "camshaft.rpm": "Cam speed set into every train (default: each train preset's run.rpm).",
+        "camshaft.valves": "One table per valve (lobe) on the camshaft.",
+        "camshaft.valves[].train": "The valve's train: a shipped valvetrain preset with a follower, or a file "
+                                   "beside this preset.",
+        "camshaft.valves[].cylinder": "The valve's cylinder: its phase from the firing order.",
+        "camshaft.valves[].phase": "Phase offset of the lobe (an exhaust lobe's), added to its cylinder's.",
+        "camshaft.valves[].label": "The valve's name in the tables, CSV header and charts.",
+    },
 }
 # the explicit form's [[springs]] (a data sheet as a train writes it): the same keys as [train.spring]
 # and a nested [train.spring.inner]
@@ -397,8 +499,12 @@ MEANINGS["valvetrain"] |= {
     for table in ("springs[]", "train.spring.inner")
     for key in ("wire_diameter", "coil_diameter", "active_coils", "total_coils", "free_length", "installed_length",
                 "solid_length", "shear_modulus", "density", "tensile_strength", "fatigue_limit", "shear_ratio",
-                "lengths", "forces") + (("segment_coils", "segment_pitches") if table == "springs[]" else ())} | {
-    "train.spring.inner.elements": "Equal bar elements of the inner spring (surge modes)."}
+                "lengths", "forces", "wire_height")
+    + (("segment_coils", "segment_pitches") if table == "springs[]" else ("tensile_strength.A", "tensile_strength.m"))} | {
+    "train.spring.inner.elements": "Equal bar elements of the inner spring (surge modes).",
+    "train.spring.inner.coil_contact": "Pitch diagram: linear coil contacts per segment (default) or none.",
+    "train.spring.inner.block_stiffness": "Pitch diagram: a closed segment's contact stiffness (default 100 k_i).",
+    "train.spring.inner.block_damping_ratio": "Pitch diagram: coil contact damping ratio (default 0.1)."}
 
 
 def _merge(into: dict[str, FieldRead], reads: dict[str, FieldRead]) -> None:

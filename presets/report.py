@@ -20,6 +20,11 @@ Sections, in order (:data:`SECTIONS`):
    for two fields or a chart for one, and the table of points.
 6. **Accuracy note**: back end, step and event tolerance, and what they mean.
 
+Boom (wall, floor) and plate presets have their own reports
+(:func:`boom_report`, :func:`plate_report`: model, settings and version,
+results and checks, figures, accuracy note), from the same computation as
+``vtool solve`` on them; the kinds table names each kind's report function.
+
 The checks are the run's own criteria (the metrics of
 :mod:`vtool.solvers.studies.metrics`, evaluated after the first revolution):
 the run completes; the follower stays on the cam (``cam_separations = 0``);
@@ -72,11 +77,14 @@ class Figure:
 
 @dataclass(frozen=True)
 class Section:
+    """``text``: fixed-width blocks shown as they are (an assessment's own printed tables)."""
+
     title: str
     paragraphs: tuple[str, ...] = ()
     tables: tuple[Table, ...] = ()
     checks: tuple[Check, ...] = ()
     figures: tuple[Figure, ...] = ()
+    text: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -292,7 +300,7 @@ def sweep_section(preset: str, sets: Sequence[str], metric: str, workers: int | 
     names = dict(metric_columns(plan.spec))
     if metric not in names:
         raise InputError("--metric", metric, f"one of: {', '.join(names)}")
-    axes = [f for f in plan.fields if len({dict(p.values)[f[0]] for p in plan.points}) > 1]
+    axes = [f for f in plan.fields if f[0] in plan.points.axes()]
     if not axes:
         raise InputError("--sweep", ", ".join(sets), "a swept field with two or more values")
     runner = make_runner(workers)
@@ -311,3 +319,98 @@ def valvetrain_report(spec: Any, *, preset: str | None = None, sweep: Sequence[s
 
     section = sweep_section(preset or spec.title, sweep, metric, workers) if sweep else None
     return report_of_trace(simulate(spec, **run), section)
+
+
+# ----------------------------------------------------------------------------
+# boom and plate presets
+
+
+def _versions(rows: Sequence[tuple[str, str]]) -> Section:
+    import numpy
+
+    from vtool import __version__
+
+    head = [("vtool", __version__), ("Python", platform.python_version()), ("NumPy", numpy.__version__)]
+    return Section("Settings and version", (), (Table("settings", ("setting", "value"), tuple(head) + tuple(rows)),))
+
+
+def _no_sweep(sweep: Sequence[str], kind: str) -> None:
+    from vtool.errors import InputError
+
+    if sweep:
+        raise InputError("--sweep", ", ".join(sweep), f"no sweep for a {kind} preset (sweeps are of valve trains)")
+
+
+def boom_report(spec: Any, *, assessment: Any = None, sweep: Sequence[str] = (), **_: Any) -> Report:
+    """The report of a boom wall or floor preset: ``vtool solve``'s assessment (``assessment``: one already
+    made, the TUI's) as model, settings, the allowable overpressures with their checks, the design figures and
+    the note on the DAF source. A check is each row's frequency within its criterion's frequency range."""
+    from vtool.assessments.sonic_boom.assess import assess
+    from vtool.assessments.sonic_boom.report import limits_dict, limits_text
+    from vtool.presets.charts import boom_design_charts
+
+    _no_sweep(sweep, "boom")
+    a = assessment if assessment is not None else assess(spec)
+    d = limits_dict(a)
+    length, pressure = d["length_unit"], d["pressure_unit"]
+    structures = tuple((s["name"], ", ".join(f"{k} {_g(v, 5)}" for k, v in s["frequencies_hz"].items()),
+                        _g(s.get("mass_per_area")), _g(s.get("flexural_rigidity")), _g(s.get("pseudo_height")))
+                       for s in d["structures"])
+    criteria = tuple((c["name"], c["rule"], c["response"], "yes" if c["tentative"] else "no", c["description"])
+                     for c in d["criteria"])
+    model = Section("Model", (spec.title,), (
+        Table("structures", ("structure", "natural frequencies (Hz)", "mass per area", "flexural rigidity D",
+                             f"pseudo-height ({length})"), structures),
+        Table("criteria", ("criterion", "rule", "response", "tentative", "source"), criteria)))
+    rows = tuple((r["structure"], r["frequency_source"], _g(r["frequency_hz"], 5), r["criterion"], _g(r["daf"], 5),
+                  _g(r.get(f"pressure_{pressure}"), 4), "tentative" if r["tentative"] else "") for r in d["limits"])
+    checks = tuple(Check(f"{r['structure']}, {r['frequency_source']}, {r['criterion']}",
+                         "frequency within the criterion's frequency range", f"{_g(r['frequency_hz'], 5)} Hz",
+                         PASS if r["criterion_frequency_range_ok"] else FAIL,
+                         "tentative criterion" if r["tentative"] else "") for r in d["limits"])
+    results = Section("Results and checks", ("Allowable peak overpressure p+ for each structure, frequency and "
+                                             "criterion (the limit over the dynamic amplification factor).",),
+                      (Table("allowable peak overpressure", ("structure", "frequency source", "f (Hz)", "criterion",
+                                                             "DAF (-)", f"p+ ({pressure})", "note"), rows),),
+                      checks, text=(limits_text(a),))
+    charts = boom_design_charts(a, spec.title)
+    figures = Section("Figures", (), figures=tuple(Figure(c.title + ".", (c,)) for c in charts))
+    accuracy = Section("Accuracy note", (f"DAF source: {d['daf_source']}.", "Each allowable is the criterion's "
+                                         "limit divided by the DAF at the structure's tau/T; the DAF curves are "
+                                         "computed, not read off the thesis' figures (docs/sonic-boom.md)."))
+    return Report(spec.title, f"vtool report: {d['kind'].replace('_', ' ')} assessment",
+                  (model, _versions((("kind", d["kind"]), ("units", d["units"]))), results, figures, accuracy))
+
+
+def plate_report(spec: Any, *, study: Any = None, sweep: Sequence[str] = (), **_: Any) -> Report:
+    """The report of a plate preset: ``vtool solve``'s study (``study``: one already run, the TUI's) as
+    model, settings, the study's tables with its checks (each exact reference's acceleration converged:
+    its peak moves at most 1 % when its modes are halved), the transient figures and the accuracy note."""
+    from vtool.assessments.plate.report import study_dict, study_text
+    from vtool.assessments.plate.study import run_study
+    from vtool.presets.charts import plate_study_charts
+
+    _no_sweep(sweep, "plate")
+    result = study if study is not None else run_study(spec.study, transient=True)
+    d = study_dict(result)
+    text = study_text(result)
+    model = Section("Model", (spec.title, text.splitlines()[0]) + ((spec.notes.strip(),) if getattr(
+        spec, "notes", "").strip() else ()))
+    checks = tuple(Check(f"{load} exact reference", "acceleration peak moves <= 1 % when the modes are halved",
+                         f"{_g(e['peak_change_pct']['acceleration'], 3)} %",
+                         PASS if e["acceleration_converged"] else FAIL, f"{e['modes']} modes")
+                   for load, e in (d.get("exact") or {}).items())
+    results = Section("Study results and checks", tuple(d.get("warnings") or ()), checks=checks,
+                      text=("\n".join(text.splitlines()[1:]).strip("\n"),))
+    charts = plate_study_charts(spec, result) if result.exact else []
+    figures = Section("Figures", () if charts else ("No transient runs in this study: no figures.",),
+                      figures=tuple(Figure(c.title + ".", (c,)) for c in charts))
+    notes = [f"{load}: exact modal (Navier) solution with {e['modes']} modes, checked against {e['check_modes']} "
+             f"(truncation: {', '.join(f'{q} {_g(v, 3)} %' for q, v in e['truncation_pct'].items())})"
+             for load, e in (d.get("exact") or {}).items()]
+    accuracy = Section("Accuracy note", tuple(notes) + (
+        f"Errors are percentages of the exact peaks over a window of {_g(d.get('window_periods'))} fundamental "
+        "periods (docs/plate.md).",))
+    return Report(spec.title, "vtool report: condensed-plate study",
+                  (model, _versions((("kind", spec.kind), ("units", str(spec.units)), ("element", str(spec.element)))),
+                   results, figures, accuracy))

@@ -81,8 +81,11 @@ class _GroupWriter:
 
         arrays = {}
         for name, parts in self.buffer.items():
-            if isinstance(parts[0], np.ndarray) and parts[0].dtype.kind == "f":
-                arrays[name] = pa.array(np.concatenate(parts), type=pa.float64())
+            if all(isinstance(p, np.ndarray) for p in parts) and parts[0].dtype.kind in "fi":
+                joined = np.concatenate(parts)
+                arrays[name] = pa.array(joined, type=pa.float64() if joined.dtype.kind == "f" else pa.int64())
+            elif isinstance(parts[0], np.ndarray) and parts[0].dtype.kind == "f":
+                arrays[name] = pa.array([v for part in parts for v in part], type=pa.float64())
             else:
                 arrays[name] = pa.array([v for part in parts for v in part])
         table = pa.table(arrays)
@@ -138,43 +141,150 @@ class ParquetStream(CsvStream):
 class SweepParquet:
     """A sweep's points as Parquet (the sink of :func:`vtool.solvers.studies.sweep.run_points`).
 
-    Columns: the swept fields (with units), ``status``, the metrics (with
-    units), as the CSV's header names them. Points are written in the order
-    they finish (a ``point`` column gives their grid index); not resumable
-    (``--resume`` needs a CSV).
+    Columns: ``point`` (the grid index), the swept fields (with units),
+    ``status``, the metrics (with units), as the CSV's header names them.
+    Points are written in the order they finish.
+
+    Resumable: with ``resume`` (the existing file, ``--resume``), :meth:`open`
+    reads its row groups one at a time, marks the points whose index and values
+    belong to this sweep as finished and copies them into the new file first; the
+    caller renames the new file over the old one when it ends (an interrupted sweep
+    too, so that it keeps what finished: app/cli/sweep.py). The file is checked as
+    a resumed CSV is (a regular file, not a link, a FIFO or a device), and must have
+    this sweep's columns.
     """
 
     def __init__(self, handle: BinaryIO, fields: Sequence[tuple[str, str]], spec: Any, *,
-                 timing: bool = False) -> None:
+                 timing: bool = False, resume: Any = None) -> None:
         from vtool import __version__
         from vtool.solvers.studies.sweep import column_title, report_columns
 
         self.fields = [f for f, _ in fields]
         self.field_titles = [column_title(f, u) for f, u in fields]
         self.metrics = report_columns(spec, timing)
+        self.names = ["point", *self.field_titles, "status", *(column_title(n, u) for n, u in self.metrics)]
+        self.spec = spec
         self.groups = _GroupWriter(handle, {"vtool_version": __version__, "title": spec.title})
         self.finished: set[int] = set()
         self.rows = 0
+        # the points of the group being filled: the index and the metrics in arrays (8 bytes a number; a
+        # list of one-number lists a point cost about ten times that), the fields and statuses as lists
+        self.index = np.empty(ROW_GROUP, dtype=np.int64)
+        self.block = np.empty((ROW_GROUP, len(self.metrics)))
+        self.cells: dict[str, list[Any]] = {title: [] for title in [*self.field_titles, "status"]}
+        self.held = 0
+        self.resume = resume
+        if resume is not None:
+            with self._resumed():
+                pass  # checked now, before any point runs
+
+    def _resumed(self) -> Any:
+        """The resumed file as a ``pyarrow.parquet.ParquetFile`` (a context manager), checked."""
+        import contextlib
+        import os
+        import stat
+
+        from vtool.files import open_no_follow
+
+        pq = require_pyarrow()
+        where = str(self.resume)
+
+        @contextlib.contextmanager
+        def opened() -> Any:
+            fd = open_no_follow(self.resume, os.O_RDONLY | os.O_NONBLOCK, "--resume")  # a FIFO must not block
+            with os.fdopen(fd, "rb") as raw:
+                if not stat.S_ISREG(os.fstat(raw.fileno()).st_mode):
+                    raise InputError("--resume", where, "a regular file (not a device, pipe or socket)")
+                try:
+                    file = pq.ParquetFile(raw)
+                    names = file.schema_arrow.names
+                except Exception:  # pyarrow's errors for a file that is not Parquet (ArrowInvalid, OSError)
+                    raise InputError("--resume", where, "a partial Parquet sweep file (this one is not Parquet)"
+                                     ) from None
+                if names != self.names:
+                    raise InputError("--resume", where, "a partial file of this same sweep (its columns differ)")
+                yield file
+
+        return opened()
+
+    def _resumed_groups(self, points: Sequence[Any]) -> Any:
+        """(row group as columns, the indices of its rows that are this sweep's points or None), group by group."""
+        from vtool.solvers.studies.sweep import format_value, point_locator
+
+        locate = point_locator(points)
+        with self._resumed() as file:
+            for group in range(file.metadata.num_row_groups):
+                columns = file.read_row_group(group).to_pydict()
+                indices = []
+                for row, index in enumerate(columns["point"]):
+                    texts = [format_value(columns[title][row]) for title in self.field_titles]
+                    indices.append(index if index is not None and locate(texts) == index else None)
+                yield columns, indices
 
     def open(self, points: Sequence[Any]) -> None:
-        pass
+        """With ``resume``: the finished points of the old file marked and copied into this one."""
+        if self.resume is None:
+            return
+        for columns, indices in self._resumed_groups(points):
+            rows = [row for row, index in enumerate(indices) if index is not None and index not in self.finished]
+            self.finished.update(indices[row] for row in rows)
+            if rows:
+                self.groups.add({name: [columns[name][row] for row in rows] for name in self.names}, len(rows))
+                self.rows += len(rows)
 
     def append(self, result: Any) -> None:
-        from vtool.solvers.studies.sweep import column_title
-
         values = dict(result.values)
-        data: dict[str, Any] = {"point": [result.index]}
+        row = self.held
+        self.index[row] = result.index
         for field, title in zip(self.fields, self.field_titles, strict=True):
             value = values[field]  # numbers as float64 (a grid may mix 9000 and 9500.5), names as text
-            data[title] = [float(value) if isinstance(value, int | float) and not isinstance(value, bool) else value]
-        data["status"] = [result.status]
-        for name, unit in self.metrics:
-            data[column_title(name, unit)] = [float(result.metrics.get(name, math.nan))]
-        self.groups.add(data, 1)
+            self.cells[title].append(float(value) if isinstance(value, int | float) and not isinstance(value, bool)
+                                     else value)
+        self.cells["status"].append(result.status)
+        self.block[row] = [float(result.metrics.get(name, math.nan)) for name, _ in self.metrics]
+        self.held += 1
         self.rows += 1
+        if self.held == ROW_GROUP:
+            self._hand_over()
+
+    def _hand_over(self) -> None:
+        """The points held so far to the group writer (which writes a group once it has ROW_GROUP rows)."""
+        if not self.held:
+            return
+        n = self.held
+        data: dict[str, Any] = {"point": self.index[:n].copy()}
+        data |= {title: self.cells[title] for title in self.field_titles}
+        data["status"] = self.cells["status"]
+        data |= {title: self.block[:n, k].copy() for k, title in enumerate(self.names[len(self.fields) + 2:])}
+        self.groups.add(data, n)
+        self.cells = {title: [] for title in self.cells}
+        self.held = 0
 
     def finish(self) -> None:
+        self._hand_over()
         self.groups.close()
 
     def finished_results(self, points: Sequence[Any]) -> dict[int, Any]:
-        return {}
+        """The points the resumed file held (read again from it: it is replaced only when the sweep ends)."""
+        from vtool.solvers.studies.metrics import failed_metrics
+        from vtool.solvers.studies.sweep import PointResult, point_values
+
+        if self.resume is None:
+            return {}
+        values_of = point_values(points)
+        results: dict[int, Any] = {}
+        for columns, indices in self._resumed_groups(points):
+            for row, index in enumerate(indices):
+                if index is not None and index in self.finished and index not in results:
+                    metrics = failed_metrics(self.spec)  # NaN for the columns the file leaves out (wall time)
+                    metrics.update({name: _number(columns[title][row]) for (name, _), title
+                                    in zip(self.metrics, self.names[len(self.fields) + 2:], strict=True)})
+                    results[index] = PointResult(index, values_of(index), metrics, columns["status"][row])
+        return results
+
+
+def _number(value: Any) -> float:
+    """A metric read back: NaN for a missing value, integers as integers (as the CSV reads them)."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return math.nan
+    return int(value) if float(value).is_integer() else float(value)

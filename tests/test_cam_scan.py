@@ -20,12 +20,14 @@ from vtool.app.cli.main import cli
 from vtool.presets import PRESET_DIR
 from vtool.presets.cam_scan import (
     ScanSettings,
+    chord_noise_rms,
     convert,
     noise_rms,
     per_degree_derivatives,
     prepare,
     series_derivatives,
     smooth,
+    smooth_spline,
 )
 
 H_MM, W_DEG = 8.0, 70.0  # peak lift, half-width of the event
@@ -191,3 +193,81 @@ def test_bad_scan_settings_are_one_line(tmp_path: Path) -> None:
     preset.write_text(preset_text('polyline = "bad.scr"', '[cam.scan]\nlift_unit = "mm"\n'))
     result = CliRunner().invoke(cli, ["cam", "show", str(preset)])
     assert result.exit_code == 2 and "cam.polyline line 1" in result.output
+
+
+def irregular_scan(seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """The polydyne scanned at unequal steps (about 0.86 deg on average, to 0.01 deg), same noise and quanta."""
+    rng = np.random.default_rng(seed)
+    theta = np.unique(np.round(np.sort(rng.uniform(0.0, 360.0, 420)), 2))
+    noisy = polydyne(theta)[0] + rng.normal(0.0, NOISE_MM, theta.size)
+    return theta, np.round(noisy / QUANTUM_MM) * QUANTUM_MM
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_spline_smoothing_of_an_unequal_step_scan_meets_the_fourier_bounds(seed: int) -> None:
+    """The spline method, on a scan the Fourier method refuses (unequal steps): the same acceleration bounds
+    (max 0.002, rms 0.0003 mm/deg^2) on the series the dynamics uses, the peak within its tolerance, the
+    move reported at the scan's own points."""
+    theta, measured = irregular_scan(seed)
+    _, raw_acc = per_degree_derivatives(theta, measured)
+    _, true_raw = polydyne(theta)
+    assert np.abs(raw_acc - true_raw).max() > 5 * ACC_MAX_ERROR  # the raw divided differences are noise
+    result = smooth_spline(theta, measured)
+    count = result.angles.size  # sampled at the median step, rounded to divide 360
+    assert count == round(360.0 / np.median(np.diff(theta))) and np.allclose(np.diff(result.angles), 360.0 / count)
+    _, acc = series_derivatives(result.angles, result.lift)
+    error = acc - polydyne(result.angles)[1]
+    assert np.abs(error).max() <= ACC_MAX_ERROR
+    assert np.sqrt(np.mean(error**2)) <= ACC_RMS_ERROR
+    assert abs(result.peak_smoothed - result.peak_raw) <= result.peak_tolerance
+    assert result.peak_tolerance == pytest.approx(4.0 * result.noise_rms)
+    assert 0.002 < result.noise_rms < 0.006  # sqrt(0.003^2 + 0.01^2/12) = 0.0042 mm
+    assert result.moved_rms == pytest.approx(result.noise_rms, rel=1e-3)  # the discrepancy principle
+    assert 8 <= result.harmonics <= 60
+    X = np.fft.rfft(result.lift)
+    X[result.harmonics + 1:] = 0.0
+    assert np.abs(np.fft.irfft(X, result.lift.size) - result.lift).max() <= result.noise_rms / 4
+
+
+def test_chord_noise_estimate_of_white_noise_at_unequal_steps() -> None:
+    rng = np.random.default_rng(8)
+    theta = np.unique(np.sort(rng.uniform(0.0, 360.0, 3000)))
+    assert chord_noise_rms(theta, rng.normal(0.0, 0.05, theta.size)) == pytest.approx(0.05, rel=0.1)
+    assert chord_noise_rms(np.arange(0.0, 360.0, 0.5), np.arange(0.0, 360.0, 0.5) * 0.3) == pytest.approx(0.0)
+
+
+def test_a_step_that_does_not_divide_360_takes_the_spline(tmp_path: Path) -> None:
+    """0.7 deg steps: the Fourier method refuses, naming the spline; smoothing = "spline" loads, the preset's
+    table the spline sampled at equal steps, and the note says what it did."""
+    from vtool.presets import load_preset
+
+    theta = np.arange(0.0, 359.9, 0.7)
+    rng = np.random.default_rng(9)
+    measured = np.round((polydyne(theta)[0] + rng.normal(0.0, NOISE_MM, theta.size)) / QUANTUM_MM) * QUANTUM_MM
+    rows = "\n".join(f"{a:g},{v:.2f}" for a, v in zip(theta, measured, strict=True))
+    (tmp_path / "scan.csv").write_text(f"cam angle (deg),tappet lift (mm)\n{rows}\n")
+    preset = tmp_path / "scan.toml"
+    preset.write_text(preset_text('lift_table = "scan.csv"', '[cam.scan]\nlift_unit = "mm"\nsmoothing = "fourier"\n'))
+    result = CliRunner().invoke(cli, ["cam", "show", str(preset)])
+    assert result.exit_code == 2 and 'a step that divides 360 for smoothing = "fourier"' in result.output
+    assert 'smoothing = "spline" takes any steps' in result.output
+    preset.write_text(preset_text('lift_table = "scan.csv"', '[cam.scan]\nlift_unit = "mm"\nsmoothing = "spline"\n'))
+    out = tmp_path / "scan.svg"
+    result = CliRunner().invoke(cli, ["cam", "show", str(preset), "--figure", str(out)])
+    assert result.exit_code == 0, result.output
+    note = next(line for line in result.output.splitlines() if line.startswith("note: "))
+    assert "smoothed by a cubic smoothing spline" in note and "sampled at 514 equal steps" in note
+    assert "lift moved by at most" in note
+    assert re.search(r"smoothed \(spline, \d+ harmonics\)", out.read_text())
+    spec = load_preset(preset)
+    assert len(spec.cam.angles) == 514 and max(spec.cam.lifts) == pytest.approx(H_MM / 25.4, abs=0.02 / 25.4)
+
+
+def test_a_partial_scan_is_extended_with_the_base_circle_by_the_spline_too() -> None:
+    theta = np.arange(0.0, 181.0, 0.7)
+    lift = polydyne(theta - 90.0)[0]
+    result = prepare(theta.tolist(), lift.tolist(), ScanSettings(lift_unit="mm", smoothing="spline"), "mm", 1e-3)
+    assert result.smoothed is not None and not result.smoothed.periodic
+    assert any("covers 180.6 of 360 cam deg" in n for n in result.notes)
+    assert np.all(result.lifts[result.angles > 180.6] == 0.0) and result.raw_angles is not None
+    assert abs(result.lifts.max() - H_MM) <= result.smoothed.peak_tolerance

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vtool.errors import InputError
-from vtool.presets.camshaft import load
+from vtool.presets.camshaft import dump, load
 from vtool.solvers.studies.camshaft import cylinder_phases, sum_valves
 
 STEP = 1.0
@@ -51,10 +51,11 @@ def test_firing_order_gives_cylinder_phases():
 
 
 def test_camshaft_document_is_checked(tmp_path):
-    doc = {"camshaft": {"cylinders": 4, "firing_order": [1, 3, 4, 2],
+    doc = {"kind": "camshaft", "camshaft": {"cylinders": 4, "firing_order": [1, 3, 4, 2],
                         "valves": [{"train": "direct-acting-bucket", "cylinder": 3, "phase": 10.0}]}}
     spec = load(doc, tmp_path)
-    assert spec.valves[0].phase_deg == 100.0 and spec.valves[0].train.stem == "direct-acting-bucket"
+    assert spec.valves[0].phase_deg == 100.0 and spec.valves[0].path.stem == "direct-acting-bucket"
+    assert load(dump(spec), tmp_path) == spec  # the TUI's form and a save write what the loader reads back
     doc["camshaft"]["valves"][0]["cylinder"] = 5
     with pytest.raises(InputError, match=r"camshaft.valves\[0\].cylinder"):
         load(doc, tmp_path)
@@ -63,13 +64,13 @@ def test_camshaft_document_is_checked(tmp_path):
         load(doc, tmp_path)
 
 
-def test_cli_four_cylinder_intake(tmp_path):
+def test_solve_four_cylinder_intake(tmp_path):
     """The shipped camshaft: 8 valves of one train; the sum's mean is 8 times one valve's, its orders below the
     train's own content are multiples of 4 (the four cylinders 90 deg apart)."""
     from vtool.app.cli.main import cli
 
     out = tmp_path / "torque.csv"
-    run = CliRunner().invoke(cli, ["camshaft", "four-cylinder-intake", "--json", "--csv", str(out)])
+    run = CliRunner().invoke(cli, ["solve", "four-cylinder-intake", "--json", "--csv", str(out)])
     assert run.exit_code == 0, run.output
     s = json.loads(run.output)
     assert s["valves"] == 8 and s["torque_unit"] == "N*mm"
@@ -80,3 +81,64 @@ def test_cli_four_cylinder_intake(tmp_path):
     assert all(o["order"] % 4 == 0 for o in s["orders"])
     bad = CliRunner().invoke(cli, ["camshaft", "nosuch"])
     assert bad.exit_code == 2 and bad.output.count("\n") == 1
+
+
+SMALL = """kind = "camshaft"
+title = "two buckets"
+[camshaft]
+cylinders = 2
+firing_order = [2, 1]
+[[camshaft.valves]]
+train = "direct-acting-bucket"
+cylinder = 1
+[[camshaft.valves]]
+train = "direct-acting-bucket"
+cylinder = 2
+phase = 30.0
+label = "exhaust-ish"
+"""
+
+
+def test_camshaft_is_a_kind_solve_and_the_alias_agree(tmp_path):
+    """`vtool solve` runs a camshaft preset through the kinds table; `vtool camshaft` is the same run; --rpm
+    is the preset's camshaft.rpm (checked by the loader); the figure's axes name their units."""
+    from vtool.app.cli.main import cli
+
+    preset = tmp_path / "two.toml"
+    preset.write_text(SMALL)
+    figure = tmp_path / "torque.svg"
+    solved = CliRunner().invoke(cli, ["solve", str(preset), "--json", "--rpm", "2500", "--figure", str(figure)])
+    alias = CliRunner().invoke(cli, ["camshaft", str(preset), "--json", "--rpm", "2500"])
+    assert solved.exit_code == 0 and alias.exit_code == 0, solved.output + alias.output
+    s = json.loads(solved.stdout)
+    assert s == json.loads(alias.stdout)
+    assert s["rpm"] == 2500.0 and s["valves"] == 2
+    svg = figure.read_text()
+    assert "camshaft torque (N*mm)" in svg and "camshaft angle (deg)" in svg and "valve torque (N*mm)" in svg
+    # the second valve (cylinder 2 fires first: phase 0, then cylinder 1 at 180 deg) is the first shifted
+    text = CliRunner().invoke(cli, ["solve", str(preset)])
+    assert "exhaust-ish" in text.output and "30.00" in text.output and "180.00" in text.output
+    bad = CliRunner().invoke(cli, ["solve", str(preset), "--rpm", "0"])
+    assert bad.exit_code == 2 and "--rpm" in bad.output and "rev/min" in bad.output
+    bad = CliRunner().invoke(cli, ["solve", str(preset), "--dt", "1e-6"])
+    assert bad.exit_code == 2 and "camshaft preset" in bad.output
+    wrong = CliRunner().invoke(cli, ["camshaft", "gnilka-1a"])
+    assert wrong.exit_code == 2 and "camshaft" in wrong.output
+
+
+def test_torque_figures_are_embedded_and_regenerate():
+    """benchmarks/docs_figures.py: docs/torque.md embeds its figures, which exist; the train's redraws (--check)."""
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    sys.path.insert(0, str(root / "benchmarks"))
+    try:
+        import docs_figures
+    finally:
+        sys.path.pop(0)
+    assert docs_figures.check([]) == []
+    assert {"torque-train", "torque-camshaft"} <= set(docs_figures.PAGES)
+    for name, page in docs_figures.PAGES.items():
+        assert f"](figures/{name}.png)" in page.read_text()
+    assert docs_figures.main(["--check", "--only", "torque-train"]) == 0

@@ -31,6 +31,7 @@ OTHER_MEANINGS = {
     ("app/tui/plate.py", "exact"): "the plate's exact (Navier) solution",
     ("app/cli/plate.py", "exact"): "the plate's exact (Navier) solution",
     ("presets/charts.py", "exact"): "the plate's exact (Navier) solution, a curve label",
+    ("presets/report.py", "exact"): "the plate's exact (Navier) solution, a key of its study's dict",
     ("solvers/model/spec.py", "newmark"): "DEFAULT_BACKEND, re-exported as backends.DEFAULT",
     ("vtool/numba_cache.py", "newmark"): "the folder of the compiled kernel's sources (issue 35 reworks it)",
 }

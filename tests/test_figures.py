@@ -176,3 +176,30 @@ def test_order_spectrum_and_campbell_figures_name_their_axes() -> None:
     assert np.allclose(heat.values, [[0.0, 1.0], [np.nan, 2.0]], equal_nan=True)
     figure = build_figure([chart, heat])
     assert {ax.get_xlabel() for ax in figure.get_axes()} >= {"cam order (-)", "cam speed (rev/min)"}
+
+
+def test_the_campbell_figure_draws_the_natural_frequencies_the_terminal_map_marks() -> None:
+    """Each natural frequency is the line order = f_n 60 / rpm over the map, labelled with its Hz; the cells
+    the terminal map marks 'o' are those the line passes through (rounded order)."""
+    from vtool.app.figures import build_figure
+    from vtool.app.sweep_charts import campbell_map
+    from vtool.presets.charts import campbell_chart
+    from vtool.solvers.studies.orders import Campbell
+
+    rpm = np.array([6000.0, 9000.0, 12000.0])
+    data = Campbell("F7", "lbf", rpm, np.ones((24, 3)), [("all closed", 1200.0), ("start", 2000.0)])
+    heat = campbell_chart(data)
+    assert [line.label for line in heat.lines] == ["1200 Hz (all closed)", "2000 Hz (start)"]
+    assert np.allclose(heat.lines[0].y, [12.0, 8.0, 6.0]) and np.allclose(heat.lines[1].y, [20.0, 40 / 3, 10.0])
+    text = campbell_map(data).splitlines()
+    rows = {int(line.split("|")[0]): line.split("|")[1][::2] for line in text
+            if line.count("|") == 2 and line.split("|")[0].strip().isdigit()}
+    for line in heat.lines:
+        for j, order in enumerate(line.y):
+            assert rows[round(order)][j] == "o"
+    figure = build_figure([heat])
+    ax = next(a for a in figure.get_axes() if a.get_xlabel() == "cam speed (rev/min)")
+    drawn = {line.get_label(): line.get_ydata() for line in ax.get_lines()}
+    assert set(drawn) == {"1200 Hz (all closed)", "2000 Hz (start)"}
+    assert np.allclose(drawn["1200 Hz (all closed)"], [12.0, 8.0, 6.0])
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["1200 Hz (all closed)", "2000 Hz (start)"]

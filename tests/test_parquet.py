@@ -87,7 +87,7 @@ def test_sweep_writer_holds_at_most_one_row_group(tmp_path: Path, monkeypatch: p
         sink = parquet.SweepParquet(handle, (("run.rpm", "rev/min"),), spec)
         for i in range(1050):
             sink.append(PointResult(i, (("run.rpm", 1000.0 + i),), dict.fromkeys(names, float(i))))
-            most = max(most, sink.groups.buffered)
+            most = max(most, sink.groups.buffered + sink.held)
         sink.finish()
     assert most < 100
     file = pq.ParquetFile(tmp_path / "s.parquet")
@@ -95,10 +95,68 @@ def test_sweep_writer_holds_at_most_one_row_group(tmp_path: Path, monkeypatch: p
     assert file.read().column("run.rpm (rev/min)").to_pylist() == [1000.0 + i for i in range(1050)]
 
 
+def _points(path: Path) -> dict[int, dict]:
+    """Each point's row, NaN as None (to compare files)."""
+    table = pq.read_table(path).to_pylist()
+    return {row.pop("point"): {k: None if isinstance(v, float) and math.isnan(v) else v for k, v in row.items()}
+            for row in table}
+
+
+def test_a_parquet_sweep_resumes_from_its_row_groups(tmp_path: Path) -> None:
+    """--resume with Parquet: the old file's points that belong to this sweep (index and values) are copied,
+    the rest run, the new file replaces the old one: the same points as an uninterrupted sweep."""
+    sweep = ["sweep", "gnilka-1d", "--set", "run.degrees=100", "--workers", "1", "--format", "parquet"]
+    full, part, other = tmp_path / "full.pq", tmp_path / "part.pq", tmp_path / "other.pq"
+    assert run(*sweep, "--set", "run.rpm=9000,10000,11000", "--out", str(full)).exit_code == 0
+    assert run(*sweep, "--set", "run.rpm=9000,10000", "--out", str(part)).exit_code == 0  # points 0 and 1
+    result = run(*sweep, "--set", "run.rpm=9000,10000,11000", "--out", str(part), "--resume")
+    assert result.exit_code == 0, result.output
+    assert "resumed: 2 of 3 points were already in" in result.output
+    assert _points(part) == _points(full)
+    assert run(*sweep, "--set", "run.rpm=10000,11000", "--out", str(other)).exit_code == 0  # 0, 1: other speeds
+    result = run(*sweep, "--set", "run.rpm=9000,10000,11000", "--out", str(other), "--resume")
+    assert result.exit_code == 0 and "resumed:" not in result.output  # indices whose values differ: run again
+    assert _points(other) == _points(full)
+    result = run(*sweep, "--set", "run.rpm=9000,10000", "--set", "damping.factor=1", "--out", str(full), "--resume")
+    assert result.exit_code == 2 and "a partial file of this same sweep (its columns differ)" in result.output
+    (tmp_path / "text.pq").write_text("run.rpm\n")
+    result = run(*sweep, "--set", "run.rpm=9000", "--out", str(tmp_path / "text.pq"), "--resume")
+    assert result.exit_code == 2 and "this one is not Parquet" in result.output
+
+
+def test_an_interrupted_parquet_sweep_keeps_its_finished_points(tmp_path: Path) -> None:
+    """Ctrl+C (or SIGTERM) after a point finished: the file holds it (footer written, renamed into place) and
+    --resume runs the rest; before any point finished, an existing file is left as it was."""
+    from vtool.app.cli.sweep import _run_to_parquet
+    from vtool.presets.paths import plan_sweep
+    from vtool.solvers.studies.sweep import SerialRunner
+
+    class StopAfterOne(SerialRunner):
+        def run(self, batches, every_step, on_results, cancel):  # type: ignore[no-untyped-def]
+            def one(results):  # type: ignore[no-untyped-def]
+                on_results(results)
+                raise KeyboardInterrupt
+
+            return super().run(batches, every_step, one, cancel)
+
+    plan = plan_sweep("gnilka-1d", ["run.rpm=9000,10000,11000", "run.degrees=100"])
+    path = tmp_path / "s.parquet"
+    written = [0]
+    with pytest.raises(KeyboardInterrupt):
+        _run_to_parquet(plan, StopAfterOne(), path, False, False, False, None, False, written)
+    assert written == [1] and list(_points(path)) == [0]
+    outcome = _run_to_parquet(plan, SerialRunner(), path, False, False, True, None, True, [0])
+    assert outcome.skipped == 1 and [r.index for r in outcome.results] == [0, 1, 2]
+    assert sorted(_points(path)) == [0, 1, 2]
+
+
 def test_parquet_refusals_are_one_line(tmp_path: Path) -> None:
+    result = run("sweep", "gnilka-1d", "--set", "run.rpm=9000,10000", "--format", "parquet", "--find", "jump-speed",
+                 "--out", str(tmp_path / "p.parquet"))
+    assert result.exit_code == 2 and "csv for --find" in result.output
     result = run("sweep", "gnilka-1d", "--set", "run.rpm=9000,10000", "--format", "parquet", "--resume",
                  "--out", str(tmp_path / "p.parquet"))
-    assert result.exit_code == 2 and "csv for --resume" in result.output
+    assert result.exit_code == 2 and "an existing partial sweep file (none found)" in result.output
     result = run("solve", "gnilka-1d", "--format", "parquet")
     assert result.exit_code == 2 and "an output file" in result.output
     result = run("solve", "boom-brick-wall", "--format", "parquet", "--out", str(tmp_path / "b.parquet"))

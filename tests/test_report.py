@@ -107,8 +107,10 @@ def test_checks_judge_the_run_by_its_metrics() -> None:
 def test_report_refuses_a_bad_output_before_running(tmp_path: Path) -> None:
     result = run("report", "gnilka-1a", "-o", str(tmp_path / "r.docx"))
     assert result.exit_code == 2 and ".html or .pdf" in result.output
-    result = run("report", "boom-brick-wall", "-o", str(tmp_path / "r.pdf"))
-    assert result.exit_code == 2 and "valvetrain" in result.output
+    result = run("report", "boom-brick-wall", "--sweep", "run.rpm=1,2", "-o", str(tmp_path / "r.pdf"))
+    assert result.exit_code == 2 and "no sweep for a boom preset" in result.output
+    result = run("report", "four-cylinder-intake", "-o", str(tmp_path / "r.pdf"))
+    assert result.exit_code == 2 and "a preset of a kind with a report: valvetrain, boom_wall" in result.output
     result = run("report", "gnilka-1a", "--sweep", "run.rpm=9000", "-o", str(tmp_path / "r.pdf"))
     assert result.exit_code == 2 and "--sweep" in result.output
     assert not list(tmp_path.iterdir())
@@ -147,3 +149,77 @@ def test_the_presets_checks_table_is_in_the_report() -> None:
     largest = max(max(c.get("seating_velocities") or [0.0]) for c in result.summary()["clearances"])
     assert seating.outcome == FAIL and seating.criterion.startswith("<= 1 in/s")
     assert float(seating.margin.split()[0]) == pytest.approx(1.0 - largest, rel=1e-5)
+
+
+BOOM_PLATE_SECTIONS = {"boom": ["Model", "Settings and version", "Results and checks", "Figures", "Accuracy note"],
+                       "plate": ["Model", "Settings and version", "Study results and checks", "Figures",
+                                 "Accuracy note"]}
+
+
+def test_boom_report_has_its_sections_allowables_and_checks(tmp_path: Path) -> None:
+    """`vtool report boom-brick-wall`: the allowable p+ of `vtool solve` (limits_dict) in a table, a check per
+    row (frequency within the criterion's range), one design figure per curve set."""
+    from vtool.assessments.sonic_boom.assess import assess
+    from vtool.assessments.sonic_boom.report import limits_dict
+    from vtool.presets import load_preset
+    from vtool.presets.report import boom_report
+
+    out = tmp_path / "b.html"
+    result = run("report", "boom-brick-wall", "-o", str(out))
+    assert result.exit_code == 0, result.output
+    text = out.read_text()
+    assert html_sections(text) == BOOM_PLATE_SECTIONS["boom"]
+    limits = limits_dict(assess(load_preset("boom-brick-wall")))["limits"]
+    report = boom_report(load_preset("boom-brick-wall"))
+    table = report.section("Results and checks").tables[0]
+    assert [row[5] for row in table.rows] == [f"{r['pressure_psi']:.4g}" for r in limits]
+    checks = report.section("Results and checks").checks
+    assert [c.outcome for c in checks] == [PASS if r["criterion_frequency_range_ok"] else FAIL for r in limits]
+    assert text.count("<figure>") == len(report.figures) >= 1 and "allowable p+" in text
+    assert result.output.strip() == f"wrote {out}: 5 sections, {len(report.figures)} figures"
+
+
+def test_plate_report_has_its_sections_study_and_convergence_checks(tmp_path: Path) -> None:
+    """`vtool report plate-table2 -o r.pdf`: the study's tables, a check per exact reference (acceleration
+    converged: uniform load 7.6 %, so it fails), the transient figures on pages of their own."""
+    from vtool.app.report import pdf_pages
+    from vtool.presets import load_preset
+    from vtool.presets.report import plate_report
+
+    out = tmp_path / "p.pdf"
+    result = run("report", "plate-table2", "-o", str(out))
+    assert result.exit_code == 0, result.output
+    assert out.read_bytes().startswith(b"%PDF")
+    report = plate_report(load_preset("plate-table2"))
+    assert [s.title for s in report.sections] == BOOM_PLATE_SECTIONS["plate"]
+    checks = {c.name: c for c in report.section("Study results and checks").checks}
+    assert checks["uniform exact reference"].outcome == FAIL and float(
+        checks["uniform exact reference"].value.split()[0]) > 1.0
+    assert "Table 2" in report.section("Study results and checks").text[0]
+    pages = [what for what, _ in pdf_pages(report)]
+    assert sum(what.startswith("figure:") for what in pages) == len(report.figures) >= 1
+
+
+@pytest.mark.asyncio
+@pytest.mark.parametrize("preset, kind", [("boom-brick-wall", "boom"), ("plate-table3", "plate")])
+async def test_tui_boom_and_plate_screens_save_the_report(tmp_path: Path, preset: str, kind: str) -> None:
+    """ctrl+g on the boom and plate screens writes what `vtool report` writes (the plate's cost table holds
+    wall times: compared without them)."""
+    from vtool.app.tui.app import create_app
+
+    app = create_app(preset, remember=False, chart_color=False)
+    async with app.run_test(size=(100, 30)) as pilot:
+        await pilot.pause()
+        await run_and_wait(pilot, app)
+        await answer_path_dialog(pilot, app, "ctrl+g", str(tmp_path / "tui.html"))
+    assert run("report", preset, "-o", str(tmp_path / "cli.html")).exit_code == 0
+
+    def content(name: str) -> str:
+        text = (tmp_path / name).read_text()
+        return re.sub(r"\d+\.\d+e-\d+|\d+\.\d+", "#", text) if kind == "plate" else text
+
+    tui, cli_text = content("tui.html"), content("cli.html")
+    assert html_sections(tui) == BOOM_PLATE_SECTIONS[kind]
+    assert tui.count("<figure>") == cli_text.count("<figure>") >= 1
+    if kind == "boom":
+        assert tui == cli_text

@@ -252,3 +252,79 @@ def test_cli_table_csv_json_plot_and_map(tmp_path: Path) -> None:
     data = json.loads(run(*args, "--json").stdout)
     assert data["units"]["peak_F1_unit"] == "lbf" and data["units"]["run.rpm_unit"] == "rev/min"
     assert len(data["points"]) == 4 and data["points"][0]["status"] == "ok"
+
+
+# ----- a large sweep keeps nothing per point -----
+
+def test_the_grid_makes_its_points_on_demand_in_grid_order() -> None:
+    """PointGrid (the plan's points) holds the fields' values only: point i's values are grid()'s i-th, its
+    spec the loader's for them; run_order visits each index once with run.* varying fastest; locate inverts
+    the values as a sweep file writes them."""
+    from vtool.solvers.studies.sweep import format_value
+
+    plan = plan_sweep("gnilka-1a", ["damping.factor=0.5,1,2", "run.rpm=10000,10500", SHORT])
+    points = plan.points
+    assert [p.values for p in points] == grid([("damping.factor", [0.5, 1, 2]), ("run.rpm", [10000, 10500]),
+                                               ("run.degrees", [460])])
+    doc = set_field(set_field(read_document(find_preset("gnilka-1a")), "damping.factor", 1), "run.rpm", 10500)
+    from vtool.presets import load_document
+
+    assert points[4].spec == load_document(set_field(doc, "run.degrees", 460), find_preset("gnilka-1a").parent)
+    assert points.lazy(4).spec is None and points.lazy(4).make(points.values(4)) == points[4].spec
+    order = list(points.run_order())
+    assert sorted(order) == list(range(6)) and order[:2] == [0, 3]  # run.rpm first: 0.5 at 10000, 10500
+    for i in range(6):
+        assert points.locate([format_value(v) for _, v in points.values(i)]) == i
+    assert points.locate(["0.7", "10000", "460"]) is None
+    assert points.axes() == ["damping.factor", "run.rpm"]
+
+
+def test_only_ranges_ends_and_corners_are_checked_before_the_run() -> None:
+    """100,000 points are planned after a handful of loader checks, not 100,000 (each about 10 ms)."""
+    import vtool.presets as presets
+
+    calls = []
+    load = presets.load_document
+
+    def counted(*args, **kwargs):  # type: ignore[no-untyped-def]
+        calls.append(1)
+        return load(*args, **kwargs)
+
+    presets.load_document = counted
+    try:
+        plan = plan_sweep("gnilka-1a", ["run.rpm=1000:50999:1", "damping.factor=0.5,1"])
+    finally:
+        presets.load_document = load
+    assert len(plan.points) == 100_000 and len(calls) < 20
+    with pytest.raises(InputError, match="run.rpm"):  # a range's end is still refused up front
+        plan_sweep("gnilka-1a", ["run.rpm=-1000:100999:1"])
+
+
+def test_a_point_the_loader_refuses_when_it_runs_is_a_failed_row(tmp_path: Path) -> None:
+    """A value no up-front check met (here a grid made without them) is the loader's one-line message as the
+    point's status, NaN metrics, and the sweep goes on."""
+    from vtool.presets.paths import PointGrid, SpecMaker
+
+    doc = read_document(find_preset("gnilka-1a"))
+    points = PointGrid([("run.rpm", [10000, -5]), ("run.degrees", [100])],
+                       SpecMaker(doc, find_preset("gnilka-1a").parent, load_preset("gnilka-1a")))
+    path = tmp_path / "s.csv"
+    outcome = run_points(points, SerialRunner(), sink=SweepFile(path, [("run.rpm", "rev/min"),
+                                                                     ("run.degrees", "deg")],
+                                                                load_preset("gnilka-1a")))
+    good, bad = outcome.results
+    assert good.ok and not bad.ok and bad.status.startswith("run.rpm: got -5, expected")
+    assert all(math.isnan(v) for v in bad.metrics.values())
+    rows = path.read_text().splitlines()
+    assert rows[2].startswith('-5,100,"run.rpm: got -5') and len(rows) == 3
+
+
+def test_cancel_stops_the_check_of_the_points() -> None:
+    """``plan_sweep``'s ``cancel`` is asked before each checked point (the TUI's Cancel while checking)."""
+    from vtool.presets.paths import SweepCancelled, plan_sweep
+
+    asked = []
+    with pytest.raises(SweepCancelled):
+        plan_sweep("gnilka-1a", ["run.rpm=1000:30999:1", "damping.factor=0.5,1,2"],
+                   cancel=lambda: asked.append(1) or len(asked) > 2)
+    assert len(asked) == 3

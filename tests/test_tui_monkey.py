@@ -221,42 +221,57 @@ async def one_sequence(seed: int, found: Found, tmp_path) -> None:  # type: igno
     start = STARTS[seed % len(STARTS)]
     app = create_app(PRESETS[start], remember=False, chart_color=False)
     done: list[str] = []
+    inside: list[BaseException] = []  # what the sequence itself raised
     try:
         async with app.run_test(size=rng.choice(SIZES)) as pilot:
-            await pilot.pause()
-            if start in ("valvetrain", "sweep"):
-                app.screen.form.row("run.degrees").editor.value = "40"  # runs finish within a sequence
-                await pilot.pause()
-            if start == "sweep":
-                await show_sweep_tab(pilot, app)
-                await pilot.click("#sweep-run")
-                done.append("sweep #sweep-run")
-            messages = Messages(app)
-            for _ in range(EVENTS):
-                try:
-                    done.append(await send(pilot, app, rng))
-                except WaitForScreenTimeout:
-                    if not await settles(app):
-                        raise
-                    found.slow.append(f"seed {seed}: after {done[-5:]}")
-                    done.append("(slow: the app worked off the event after Pilot's 30 s)")
-                found.unexpected += [f"seed {seed}: {text} after {done[-5:]}" for text in messages.new()
-                                     if unexpected(text)]
-                if app._exception is not None or not app.is_running:
-                    break
-            for _ in range(200):  # a sweep still going is let finish (a few seconds), then stopped
-                pane = sweep_pane(app)
-                if pane is None or not pane.running:
-                    break
-                await pilot.pause(0.05)
-            app.workers.cancel_all()
-            await pilot.pause()
-            found.unexpected += [f"seed {seed}: {text} at the end" for text in messages.new() if unexpected(text)]
-            found.sweeps += sum(text.startswith(("finished: ", "stopped: ")) for where, log in messages.logs.values()
-                                if where == "sweep tab" for text in log)
+            try:
+                await drive(pilot, app, rng, start, seed, found, done)
+            except Exception as exc:
+                inside.append(exc)
+                raise
     except Exception as exc:  # the monkey's one job: record what escaped the app
-        where = " | ".join(line.strip().replace("\n", " ") for line in traceback.format_tb(exc.__traceback__)[-4:])
-        found.crashes.append(f"seed {seed}: {type(exc).__name__}: {exc} after {done[-5:]} at {where}")
+        # the sequence's own failure (a Pilot timeout) first: Textual's run_test re-raises, on
+        # leaving, the first error of the closing app instead (seed 219's ScreenStackError)
+        first = inside[0] if inside else exc
+        where = " | ".join(line.strip().replace("\n", " ") for line in traceback.format_tb(first.__traceback__)[-4:])
+        then = f" (then, closing: {type(exc).__name__}: {exc})" if exc is not first else ""
+        found.crashes.append(f"seed {seed}: {type(first).__name__}: {first}{then} after {done[-5:]} at {where}")
+
+
+async def drive(pilot, app, rng: random.Random, start: str, seed: int, found: Found,  # type: ignore[no-untyped-def]
+                done: list[str]) -> None:
+    """One sequence's events on a running app (``done`` names them as they are sent)."""
+    await pilot.pause()
+    if start in ("valvetrain", "sweep"):
+        app.screen.form.row("run.degrees").editor.value = "40"  # runs finish within a sequence
+        await pilot.pause()
+    if start == "sweep":
+        await show_sweep_tab(pilot, app)
+        await pilot.click("#sweep-run")
+        done.append("sweep #sweep-run")
+    messages = Messages(app)
+    for _ in range(EVENTS):
+        try:
+            done.append(await send(pilot, app, rng))
+        except WaitForScreenTimeout:
+            if not await settles(app):
+                raise
+            found.slow.append(f"seed {seed}: after {done[-5:]}")
+            done.append("(slow: the app worked off the event after Pilot's 30 s)")
+        found.unexpected += [f"seed {seed}: {text} after {done[-5:]}" for text in messages.new()
+                             if unexpected(text)]
+        if app._exception is not None or not app.is_running:
+            break
+    for _ in range(200):  # a sweep still going is let finish (a few seconds), then stopped
+        pane = sweep_pane(app)
+        if pane is None or not pane.running:
+            break
+        await pilot.pause(0.05)
+    app.workers.cancel_all()
+    await pilot.pause()
+    found.unexpected += [f"seed {seed}: {text} at the end" for text in messages.new() if unexpected(text)]
+    found.sweeps += sum(text.startswith(("finished: ", "stopped: ")) for where, log in messages.logs.values()
+                        if where == "sweep tab" for text in log)
 
 
 def quick_pilot(monkeypatch, tmp_path) -> None:  # type: ignore[no-untyped-def]

@@ -42,7 +42,7 @@ async def test_valvetrain_at_80x24_shows_form_units_chart_status_and_keys() -> N
         assert max(len(line) for line in lines) > 75
         assert lines[-2].startswith("done:") and "%" not in lines[-2]
         for key in ("^r Run", "^s Save", "^e CSV", "^f Form", "^t Tab", "^q Quit", "^o Open", "f1 Help",
-                    "f2-4 Screen"):
+                    "f2-5 Screen"):
             assert key in lines[-1], key
         await pilot.press("ctrl+f")  # the form comes back
         text = await shot(app, pilot, 80)

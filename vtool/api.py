@@ -132,7 +132,7 @@ class Model:
 
     def sweep(self, fields: Mapping[str, Iterable[Any]], *, workers: int | None = 1,
               every_step: bool = False) -> SweepResult:
-        """Run a grid over ``{"dotted.path": values}`` (every point validated first) and return the metrics
+        """Run a grid over ``{"dotted.path": values}`` (values checked first as `vtool sweep` does) and return the metrics
         of every point (docs/sweep.md defines them)."""
         self._require_valvetrain("sweep")
         from vtool.presets.paths import plan_document

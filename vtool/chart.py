@@ -72,7 +72,8 @@ class Chart:
 class HeatMap:
     """``values[j, i]`` of a metric at ``x[i]`` (first swept field) and ``y[j]`` (second); NaN: none.
 
-    ``x`` and ``y`` hold the swept values as given (numbers, or names such as impact laws).
+    ``x`` and ``y`` hold the swept values as given (numbers, or names such as impact laws);
+    ``lines``: curves in the map's own coordinates drawn over it (a Campbell map's natural frequencies).
     """
 
     title: str
@@ -83,6 +84,7 @@ class HeatMap:
     y: np.ndarray
     values: np.ndarray
     subject: str = ""
+    lines: tuple[Curve, ...] = ()
 
     def labels(self) -> list[str]:
         return [self.xlabel, self.ylabel, self.zlabel]

@@ -31,19 +31,27 @@ def _output(ctx: click.Context, param: click.Parameter, value: str) -> Path:
 @click.option("--degrees", type=float, help="Degrees of cam rotation; default: the preset's run.degrees.")
 def report(preset: str, output: Path, sweep: tuple[str, ...], metric: str, workers: int, backend: str | None,
            rpm: float | None, degrees: float | None) -> None:
-    """Write a report of a valve-train PRESET: model, settings, summary and checks, figures, accuracy."""
+    """Write a report of PRESET (a valve train, a boom wall or floor, a plate study): model, settings,
+    results and checks, figures, accuracy note. --sweep, --backend, --rpm and --degrees are a valve
+    train's."""
     from vtool.app.cli.solve import announce_compile
     from vtool.app.report import write_report
     from vtool.presets import Override, load_preset
-    from vtool.presets.kinds import require_kind
-    from vtool.presets.report import valvetrain_report
+    from vtool.presets.kinds import kind_named, resolve
 
     # the flags are the preset's run fields: the loader checks them as the file's own values
     given = (("run.backend", backend, "--backend"), ("run.rpm", rpm, "--rpm"), ("run.degrees", degrees, "--degrees"))
     spec = load_preset(preset, tuple(Override(path, value, flag) for path, value, flag in given if value is not None))
-    require_kind(spec, "valvetrain", "`vtool report`")
-    content = valvetrain_report(spec, preset=preset, sweep=sweep, metric=metric, workers=workers,
-                                before_run=lambda: announce_compile(spec))
+    kind = kind_named(getattr(spec, "kind", None))
+    if not kind.report:
+        from vtool.errors import InputError
+        from vtool.presets.kinds import KINDS
+
+        raise InputError("preset", kind.name, "a preset of a kind with a report: "
+                         + ", ".join(name for name, k in KINDS.items() if k.report))
+    make = resolve(kind.report)
+    content = make(spec, preset=preset, sweep=sweep, metric=metric, workers=workers,
+                   before_run=lambda: announce_compile(spec))
     write_report(content, output)
     figures = len(content.figures)
     click.echo(f"wrote {output}: {len(content.sections)} sections, {figures} figures")

@@ -72,9 +72,10 @@ def _scheduler(ctx: click.Context, param: click.Parameter, value: str | None) ->
 @click.option("--format", "file_format", type=click.Choice(["csv", "parquet"]),
               help="Format of the --csv/--out file (default: parquet for a .parquet file, else csv). Parquet "
                    "(needs pyarrow: pip install 'vtool[parquet]') is written in row groups, memory bounded; "
-                   "the table is then not printed unless --json, --plot, --map or --figure needs it, and an "
-                   "interrupted sweep keeps nothing (no --resume).")
-@click.option("--resume", is_flag=True, help="Continue the sweep in the --csv file, skipping finished points.")
+                   "the table is then not printed unless --json, --plot, --map or --figure needs it; an "
+                   "interrupted sweep keeps its finished points (--resume continues it), a killed one nothing.")
+@click.option("--resume", is_flag=True, help="Continue the sweep in the --csv/--out file (CSV or Parquet), skipping "
+                                            "finished points.")
 @click.option("--timing", is_flag=True, help="Also write each point's wall time to the CSV (not reproducible).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON instead of a table.")
 @click.option("--plot", is_flag=True, help="Chart --metric against the first swept field (--figure: also as a figure file).")
@@ -102,8 +103,10 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
       vtool sweep gnilka-1a --set run.rpm=9000:12000:500 --set members.valve_spring.stiffness=200,254,300 --map
       vtool sweep gnilka-1a --find jump-speed
 
-    Every point is validated like a preset before any run starts. Metrics
-    and their definitions: docs/sweep.md.
+    The values are checked like a preset before any run starts (every listed
+    value, a range's ends, the grid's corners); each point is made when it
+    runs, and one the preset loader refuses is a failed row with its message.
+    Metrics and their definitions: docs/sweep.md.
     """
     from vtool.errors import InputError, RunError
     from vtool.presets.paths import plan_sweep
@@ -126,9 +129,8 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         from vtool.solvers.parquet import output_format
 
         parquet = output_format(csv_path, file_format) == "parquet"
-        if parquet and (resume or find is not None):
-            raise InputError("--format", "parquet", "csv for --resume and --find (a Parquet sweep is written "
-                             "whole at the end)")
+        if parquet and find is not None:
+            raise InputError("--format", "parquet", "csv for --find (a search writes one row per search)")
     if find is not None:
         if not any(s.partition("=")[0].strip() == "run.rpm" for s in sets):
             sets = (f"run.rpm={DEFAULT_SCAN}",) + sets
@@ -139,7 +141,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         raise InputError("--set", None, "at least one FIELD=VALUES (or --find jump-speed)")
     plan = plan_sweep(preset, list(sets))
     if steady or orders or campbell:
-        plan = _with_settings(plan, steady, orders + ((campbell,) if campbell else ()))
+        plan = plan.with_settings(orders + ((campbell,) if campbell else ()), steady)
     if campbell and not any(f == "run.rpm" for f, _ in plan.fields):
         raise InputError("--campbell", campbell, "a sweep over run.rpm")
     if find == "bounce-speed" and seat_index(plan.spec) is None:
@@ -149,7 +151,8 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     names = {name: unit for name, unit in metric_columns(plan.spec)}
     if metric not in names:
         raise InputError("--metric", metric, f"one of: {', '.join(names)}")
-    axes = [f for f in plan.fields if len({dict(p.values)[f[0]] for p in plan.points}) > 1]
+    varied = plan.points.axes()
+    axes = [f for f in plan.fields if f[0] in varied]
     if as_map and len(axes) != 2:
         raise InputError("--map", len(axes), "exactly two swept fields with more than one value")
     if (plot or figure_path) and not axes:
@@ -168,15 +171,19 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
             csv_path and not parquet) else None
         progress = CountProgress(f"{len(plan.points)} points")
         keep = not parquet or as_json or plot or as_map or bool(campbell) or figure_path is not None
+        outcome_rows = [0]  # rows of an interrupted Parquet sweep's file
         try:
             if parquet:
-                outcome = _run_to_parquet(plan, runner, csv_path, every_step, timing, keep, progress)
+                outcome = _run_to_parquet(plan, runner, csv_path, every_step, timing, keep, progress, resume,
+                                          outcome_rows)
             else:
                 outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress)
         except KeyboardInterrupt:
             progress.close()
-            if parquet:
-                where = "nothing was kept (an interrupted Parquet sweep is not written; --csv keeps points)"
+            if parquet and outcome_rows[0]:
+                where = f"the finished points are in {csv_path}; run again with --resume to finish"
+            elif parquet:
+                where = f"no point had finished: nothing was written ({csv_path} is as it was)"
             elif sink is not None and (sink.written or resume):
                 where = f"the finished points are in {csv_path}; run again with --resume to finish"
             elif sink is not None:
@@ -189,7 +196,7 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
     finally:
         runner.close()
     results = outcome.results
-    if sink is not None and outcome.skipped:
+    if (sink is not None or parquet) and outcome.skipped:
         click.echo(f"resumed: {outcome.skipped} of {outcome.total} points were already in {csv_path}", err=True)
     from vtool.solvers.studies.metrics import Criteria
     from vtool.solvers.studies.steady import steady_text
@@ -236,16 +243,31 @@ def sweep(preset: str, sets: tuple[str, ...], find: str | None, workers: int | N
         write_figure(items, figure_path)
 
 
-def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress):
-    """The sweep with its points written to a Parquet file as they finish (renamed into place at the end)."""
-    from vtool.files import open_atomic_binary
+def _run_to_parquet(plan, runner, path, every_step, timing, keep, progress, resume, written):
+    """The sweep with its points written to a Parquet file as they finish, renamed into place at the end; an
+    interrupted sweep's file (its footer written by run_points) is renamed into place too when it holds a
+    point (``written[0]``: its rows), so that --resume continues it; a failed one leaves the old file."""
+    from vtool.errors import InputError
+    from vtool.files import exists, open_atomic_binary
     from vtool.solvers.parquet import SweepParquet
     from vtool.solvers.studies.sweep import run_points
 
+    if resume and not exists(path):
+        raise InputError("--resume", str(path), "an existing partial sweep file (none found)")
+    interrupted = None
     with open_atomic_binary(path, "--out") as handle:
-        sink = SweepParquet(handle, plan.fields, plan.spec, timing=timing)
-        return run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress, keep=keep)
-        # (run_points finishes the sink, footer included, also when interrupted: the file is then removed)
+        sink = SweepParquet(handle, plan.fields, plan.spec, timing=timing, resume=path if resume else None)
+        try:
+            outcome = run_points(plan.points, runner, every_step=every_step, sink=sink, progress=progress,
+                                 keep=keep)
+        except KeyboardInterrupt as exc:
+            written[0] = sink.rows
+            if not sink.rows:
+                raise
+            interrupted = exc  # the block ends normally: the file with the finished points replaces the old one
+    if interrupted is not None:
+        raise interrupted
+    return outcome
 
 
 def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:
@@ -256,12 +278,15 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:
     from vtool.solvers.studies.steady import steady_text, with_steady
     from vtool.solvers.studies.sweep import find_speed, format_value
 
-    scan = sorted({dict(p.values)["run.rpm"] for p in plan.points})
+    grid = plan.points
+    speeds = dict(grid.fields)["run.rpm"]
+    scan = sorted(set(speeds))
     others = [f for f in plan.fields if f[0] != "run.rpm"]
     searches: dict[tuple, object] = {}
-    for point in plan.points:
-        key = tuple((k, v) for k, v in point.values if k != "run.rpm")
-        searches.setdefault(key, point.spec)
+    for index in range(len(grid)):  # one search per value of the other fields, its spec at the first speed
+        values = grid.values(index)
+        if dict(values)["run.rpm"] == speeds[0]:
+            searches.setdefault(tuple((k, v) for k, v in values if k != "run.rpm"), grid.maker(values))
     rows = []
     found = []
     first = with_steady(plan.spec)
@@ -307,19 +332,3 @@ def _find(criterion, plan, runner, csv_path, as_json, every_step) -> None:
         buffer = io.StringIO()
         csv.writer(buffer, lineterminator="\n").writerows([header] + rows)
         write_atomic(csv_path, buffer.getvalue())
-
-
-def _with_settings(plan, steady: bool, orders: tuple[str, ...]):
-    """The plan with every point (and its base spec) run to steady state and reporting these order amplitudes."""
-    import dataclasses
-
-    from vtool.solvers.studies.orders import with_orders
-    from vtool.solvers.studies.steady import with_steady
-
-    def change(spec):
-        spec = with_orders(spec, orders) if orders else spec
-        return with_steady(spec) if steady else spec
-
-    return dataclasses.replace(plan, spec=change(plan.spec),
-                               points=tuple(dataclasses.replace(p, spec=change(p.spec)) for p in plan.points))
-

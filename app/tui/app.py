@@ -11,6 +11,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, ClassVar
 
+from textual import events
 from textual.app import App
 from textual.binding import Binding, BindingType
 from textual.screen import ModalScreen, Screen
@@ -47,10 +48,11 @@ class VtoolApp(App[None]):
     BINDINGS: ClassVar[list[BindingType]] = [
         Binding("ctrl+o", "open", "Open", priority=True),
         Binding("f1", "help", "Help"),
-        Binding("f2", "switch_mode('valvetrain')", "Screen", key_display="f2-4",
-                tooltip="f2 valve train, f3 sonic boom, f4 plate"),
+        Binding("f2", "switch_mode('valvetrain')", "Screen", key_display="f2-5",
+                tooltip="f2 valve train, f3 sonic boom, f4 plate, f5 camshaft"),
         Binding("f3", "switch_mode('boom')", "Sonic boom", show=False),
         Binding("f4", "switch_mode('plate')", "Plate", show=False),
+        Binding("f5", "switch_mode('camshaft')", "Camshaft", show=False),
         Binding("ctrl+q", "quit", "Quit", priority=True),
     ]
 
@@ -76,8 +78,19 @@ class VtoolApp(App[None]):
             except InputError as exc:
                 problem = exc
         await self.switch_mode(mode)
-        if problem is not None:
+        if problem is not None and self.is_running:
             self.report_error("Cannot open preset", problem)
+
+    async def on_event(self, event: events.Event) -> None:
+        """Input that reaches the app while it closes is dropped: its screens are gone.
+
+        A key or click queued behind a busy app (a preset opening on a starved machine) was
+        handled after the close had emptied the screen stacks: Textual's ``ScreenStackError:
+        No screens on stack`` (the monkey's seed 219, its own Pilot having given up waiting).
+        """
+        if isinstance(event, events.InputEvent) and not self.is_running:
+            return
+        await super().on_event(event)
 
     def take_pending(self, mode: str) -> tuple[Any, str] | None:
         return self._pending.pop(mode, None)
@@ -137,13 +150,15 @@ class VtoolApp(App[None]):
         item = name if not is_file(name) else str(Path(name).resolve())
         if mode in self.mounted_modes:
             await self.switch_mode(mode)
-            screen = self.domain_screen()
+            screen = self.domain_screen() if self.is_running else None
             if screen is None:
                 return False
             await screen.load_spec(spec, item)
         else:
             self._pending[mode] = (spec, item)
             await self.switch_mode(mode)
+        if not self.is_running:
+            return False  # the app closed while the preset was loading
         self.remember(item)
         return True
 

@@ -46,7 +46,7 @@ from textual.worker import Worker, WorkerState, get_current_worker
 from vtool.app.tui.dialogs import PathDialog
 from vtool.app.tui.form import Field, ParamForm
 from vtool.app.tui.messages import FieldEdited, RunProgressed
-from vtool.app.tui.widgets import KeyFooter
+from vtool.app.tui.widgets import KeyFooter, closing
 from vtool.errors import InputError
 from vtool.presets import kind_of, loader_for
 
@@ -223,7 +223,8 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):  # type: ignore
 
             spec, source = load_preset(self.DEFAULT_PRESET), self.DEFAULT_PRESET
         await self.load_spec(spec, source)
-        self.focus_first_field()
+        if not closing(self):
+            self.focus_first_field()
 
     def focus_first_field(self) -> None:
         """Focus the first row the form shows, if any (a preset opened meanwhile may be refilling it:
@@ -248,6 +249,8 @@ class DomainScreen(Screen[None], metaclass=_AbstractScreenMeta):  # type: ignore
         self.spec = spec
         self.problem = None
         await self.form.set_fields(self.fields_for(spec, self.base_doc), self.base_doc)
+        if closing(self):  # the app closed during the refill: its panes are being removed
+            return
         self.start_doc = copy.deepcopy(self.base_doc)  # with a screen's run options, if any
         self.query_one("#spec-title", Static).update(f"{Path(source).stem}: {getattr(spec, 'title', '')}")
         self.clear_results()

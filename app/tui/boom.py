@@ -8,10 +8,11 @@ assessment used (pulse or envelope).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from textual import work
 from textual.app import ComposeResult
+from textual.binding import BindingType
 from textual.containers import VerticalScroll
 from textual.widgets import TabbedContent, TabPane
 from textual.worker import Worker, get_current_worker
@@ -19,7 +20,8 @@ from textual.worker import Worker, get_current_worker
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, INTEGER, NUMBERS, TEXT, Field, dotted
 from vtool.app.tui.messages import AssessmentFinished
-from vtool.app.tui.widgets import ChartView, TextPanel
+from vtool.app.tui.reports import REPORT_BINDING
+from vtool.app.tui.widgets import ChartView, TextPanel, closing
 from vtool.assessments.sonic_boom.spec import PSEUDO_HEIGHT_RULES
 from vtool.assessments.sonic_boom.spectra import FAMILIES
 
@@ -148,6 +150,7 @@ def daf_curves(spec: Any, assessment: Any, cancel: Any = None) -> dict[str, Any]
 
 class BoomScreen(DomainScreen):
     MODE = "boom"
+    BINDINGS: ClassVar[list[BindingType]] = [REPORT_BINDING]  # ctrl+g: save the report
     DEFAULT_PRESET = "boom-brick-wall"
     TITLE_TEXT = "SONIC BOOM"
 
@@ -197,6 +200,8 @@ class BoomScreen(DomainScreen):
 
             spec = load_preset(self.DEFAULT_PRESET)
         await self.form.set_fields(self.fields_for(spec, doc), doc)
+        if closing(self):
+            return
         self.validate()
         self.form.row("boom.pulse").editor.focus()
 
@@ -247,6 +252,8 @@ class BoomScreen(DomainScreen):
                                                        color=c))
         stack = self.query_one("#design-charts")
         await stack.remove_children()
+        if closing(self):
+            return
         color = self.app.chart_color  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
         charts = []
         u = a.units
@@ -255,6 +262,8 @@ class BoomScreen(DomainScreen):
             chart.structure = name  # type: ignore[attr-defined]  # a label this screen puts on its chart widget
             charts.append((chart, name, freq, series))
         await stack.mount_all([c for c, *_ in charts])
+        if closing(self):
+            return
         for chart, name, freq, series in charts:
             def draw(w: int, h: int, c: bool, name: str = name, freq: Any = freq, series: Any = series) -> str:
                 return line_chart(freq, series, title=f"{name}: allowable p+ against frequency", xlabel="f [Hz]",
@@ -268,6 +277,14 @@ class BoomScreen(DomainScreen):
         from vtool.files import write_atomic
 
         write_atomic(path, limits_csv(self.results))
+
+    def action_save_report(self) -> None:
+        """ctrl+g: the last run's report (what `vtool report` writes), as .pdf or .html."""
+        from vtool.app.tui.reports import save_report
+        from vtool.presets.report import boom_report
+
+        results, spec = self.results, self.results_spec
+        save_report(self, None if results is None else lambda: boom_report(spec, assessment=results))
 
 
 #: this module's screen, named by the kinds table (vtool.presets.kinds.KINDS)

@@ -143,7 +143,7 @@ Valve-train dynamics, sonic-boom and plate checks.
 
 ## Screens
 
-- `f2` valve train, `f3` sonic boom, `f4` plate
+- `f2` valve train, `f3` sonic boom, `f4` plate, `f5` camshaft
 
 ## Everywhere
 

@@ -22,7 +22,7 @@ from textual.widget import Widget
 from textual.widgets import Input, Select, Static
 
 from vtool.app.tui.messages import FieldEdited
-from vtool.app.tui.widgets import ChoiceSelect
+from vtool.app.tui.widgets import ChoiceSelect, closing
 
 Path = tuple[str | int, ...]
 
@@ -299,6 +299,8 @@ class ParamForm(VerticalScroll, can_focus=False):
             return
         self.fields = fields
         await self.query("FieldRow, .group-title").remove()
+        if closing(self):  # the app closes: no rows to mount, no error line left to clear
+            return
         widgets: list[Widget] = []
         group = None
         for f in self.fields:
@@ -307,6 +309,8 @@ class ParamForm(VerticalScroll, can_focus=False):
                 widgets.append(Static(group, classes="group-title", markup=False))
             widgets.append(FieldRow(f, get_path(doc, f.path)))
         await self.mount_all(widgets)
+        if closing(self):
+            return
         self.show_error(None)
         self.call_after_refresh(self._done_filling)
 

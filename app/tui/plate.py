@@ -9,10 +9,11 @@ scheme, against the exact (Navier) reference.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 from textual import work
 from textual.app import ComposeResult
+from textual.binding import BindingType
 from textual.containers import VerticalScroll
 from textual.widgets import TabbedContent, TabPane
 from textual.worker import Worker, get_current_worker
@@ -20,7 +21,8 @@ from textual.worker import Worker, get_current_worker
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, INTEGER, NUMBERS, TEXT, Field, dotted
 from vtool.app.tui.messages import PlateStudyFinished
-from vtool.app.tui.widgets import ChartView, TextPanel
+from vtool.app.tui.reports import REPORT_BINDING
+from vtool.app.tui.widgets import ChartView, TextPanel, closing
 from vtool.errors import InputError
 
 RUN = "_run"  # run options live under this key of the form's document, never in the preset
@@ -194,6 +196,7 @@ def case_text(run: PlateRun) -> str:
 
 class PlateScreen(DomainScreen):
     MODE = "plate"
+    BINDINGS: ClassVar[list[BindingType]] = [REPORT_BINDING]  # ctrl+g: save the report
     DEFAULT_PRESET = "plate-table2"
     TITLE_TEXT = "PLATE (condensation)"
 
@@ -256,6 +259,8 @@ class PlateScreen(DomainScreen):
 
             spec = load_preset(self.DEFAULT_PRESET)
         await self.form.set_fields(plate_fields(spec, self.base_doc), self.base_doc)
+        if closing(self):
+            return
         self.validate()
         if self.form.has_field(focus):
             self.form.row(focus).editor.focus()
@@ -324,6 +329,14 @@ class PlateScreen(DomainScreen):
         from vtool.files import write_atomic
 
         write_atomic(path, study_csv(self.results.study))
+
+    def action_save_report(self) -> None:
+        """ctrl+g: the last run's report (what `vtool report` writes), as .pdf or .html."""
+        from vtool.app.tui.reports import save_report
+        from vtool.presets.report import plate_report
+
+        results, spec = self.results, self.results_spec
+        save_report(self, None if results is None else lambda: plate_report(spec, study=results.study))
 
 
 #: this module's screen, named by the kinds table (vtool.presets.kinds.KINDS)

@@ -10,7 +10,7 @@ from typing import Any, ClassVar
 
 from textual import work
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.containers import Horizontal
 from textual.widgets import SelectionList, TabbedContent, TabPane
 from textual.widgets.selection_list import Selection
@@ -20,6 +20,7 @@ from vtool.app.tui.animation import MechanismAnimation
 from vtool.app.tui.base import DomainScreen
 from vtool.app.tui.form import CHOICE, Field
 from vtool.app.tui.messages import CompileAnnounced, SimulationFinished
+from vtool.app.tui.reports import REPORT_BINDING
 from vtool.app.tui.sweep import SweepPane
 from vtool.app.tui.widgets import ChartView, TextPanel
 from vtool.solvers.model.spec import IMPACT_LAWS, START_VELOCITIES
@@ -143,7 +144,7 @@ class ValveTrainScreen(DomainScreen):
     DEFAULT_PRESET = "gnilka-1a"
     TITLE_TEXT = "VALVE TRAIN"
     # hidden from the footer (its keys are full at 80 columns); listed in the help and docs/tui.md
-    BINDINGS: ClassVar[list[BindingType]] = [Binding("ctrl+g", "save_report", "Report", show=False)]
+    BINDINGS: ClassVar[list[BindingType]] = [REPORT_BINDING]
     # a table cam's file is written inline (docs/cams.md): a saved copy must not depend on its folder
     FILE_REFERENCES = ((("cam",), "lift_table", ("angles", "lifts")),)
 
@@ -343,30 +344,12 @@ class ValveTrainScreen(DomainScreen):
 
     def action_save_report(self) -> None:
         """ctrl+g: the last run's report (what `vtool report` writes), as .pdf or .html."""
-        if self.results is None or self.running:
-            self.notify("run first (ctrl+r): a report needs a finished run", severity="warning")
-            return
-        from pathlib import Path
+        from vtool.app.tui.reports import save_report
+        from vtool.presets.report import report_of_trace
 
-        from vtool.app.tui.base import path_problem
-        from vtool.app.tui.dialogs import PathDialog
+        results = self.results
+        save_report(self, None if results is None else lambda: report_of_trace(results))
 
-        def save(path: str | None) -> None:
-            if not path:
-                return
-            from vtool.app.report import write_report
-            from vtool.presets.report import report_of_trace
-
-            try:
-                write_report(report_of_trace(self.results), path, "report")
-            except (OSError, ValueError) as exc:  # ValueError: InputError (suffix, folder), a NUL in the path
-                self.app.report_error("Report failed", path_problem(exc, path))  # type: ignore[attr-defined]  # VtoolApp's own attribute (Screen.app is typed as App)
-                return
-            self.set_status(f"wrote {path}")
-            self.notify(f"wrote {path}")
-
-        self.app.push_screen(PathDialog("Save report (.pdf or .html) to", f"{Path(self.source).stem}-report.pdf"),
-                             save)
 
 #: this module's screen, named by the kinds table (vtool.presets.kinds.KINDS)
 SCREEN = ValveTrainScreen

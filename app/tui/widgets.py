@@ -8,11 +8,23 @@ from typing import Literal
 from rich.text import Text
 from textual.app import ComposeResult
 from textual.containers import ScrollableContainer
+from textual.dom import DOMNode
 from textual.screen import Screen
 from textual.widgets import Footer, Select, Static
 from textual.widgets._select import SelectCurrent, SelectOverlay
 
 ChartFunction = Callable[[int, int, bool], str]  # (width, height, color) -> chart text
+
+
+def closing(node: DOMNode) -> bool:
+    """True once the app is shutting down or ``node`` has left the DOM.
+
+    A handler that awaited (a form refill, a mount, a mode switch) checks this before it
+    goes on: while the app closes (``ctrl+q``, or a test's teardown) Textual removes the
+    screens' widgets under it, and a query for a result pane then raised ``NoMatches``
+    (the monkey's seed 555: ``#limits`` on the sonic-boom screen, mounting at the close).
+    """
+    return not node.app.is_running or not node.is_attached
 
 
 class ChartView(Static):

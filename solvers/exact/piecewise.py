@@ -94,7 +94,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
     for k in range(ncl):
         kind, ahead, behind = (int(v) for v in mk[k, :layout.MK_M])
         if kind in (layout.MK_GAP, layout.MK_OVERLAP):
-            sign = 1.0 if kind == layout.MK_GAP else -1.0
+            sign = (1.0 if kind == layout.MK_GAP else -1.0) * problem.clf[k, layout.CLF_SIGN]  # and the gap's sense
             G[k] += sign * Zy[0, ahead]
             H[k] += sign * Zb[0, ahead]
             if behind >= 0:
@@ -102,7 +102,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
                 H[k] -= sign * Zb[0, behind]
             else:
                 H[k] -= sign * src[3 * (-1 - behind)]
-            H[k, 0] += problem.gap_noise
+            H[k, 0] += problem.gap_noise + (1.0 if kind == layout.MK_GAP else -1.0) * problem.clf[k, layout.CLF_OPEN]
         if kind in (layout.MK_FORCE, layout.MK_OVERLAP):
             row = mon[k]
             for i in range(3):

@@ -290,6 +290,10 @@ class Contact:
     #: the tangent line's distance from the camshaft axis ((x - C)·n at the contact point x; flat face:
     #: r_b + L): drive torque per unit friction force at the contact
     tangent_arm: np.ndarray
+    #: a finger's or rocker's: the cam's outward normal at the contact (2 x rows, finger frame) and the
+    #: lever's rotation φ (rad); None for a translating follower
+    normal: np.ndarray | None = None
+    lever_angle: np.ndarray | None = None
 
 
 def contact(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> Contact:
@@ -326,7 +330,7 @@ def contact(follower: FollowerSpec, law: CamSpec, theta: np.ndarray) -> Contact:
         return Contact(np.degrees(theta), np.degrees(psi), p.R - g.R0, np.degrees(alpha), rho,
                        1.0 / rho + 1.0 / r_r, ratio_model * dV / n_dQ,
                        np.abs(p.speed * rho / p.pitch_radius * dpsi), 0.0 * ones, np.full_like(theta, np.nan),
-                       V, dV / du, V * ratio_model, arm, d[0] * n[0] + d[1] * n[1] - r_r)
+                       V, dV / du, V * ratio_model, arm, d[0] * n[0] + d[1] * n[1] - r_r, n, phi)
     L, dL, ddL, dddL = law_derivatives(law, theta)
     if follower.kind == FLAT:
         f = np.array([dL, follower.base_radius + L])

@@ -93,9 +93,11 @@ def camshaft_text(result: CamshaftTorque) -> str:
     lines = [f"camshaft: {s['valves']} valves at {s['rpm']:g} cam rev/min",
              f"drive torque: mean {s['mean_torque']:.5g} {u}, {s['min_torque']:.5g} .. {s['max_torque']:.5g} {u} "
              f"(peak-to-peak {s['peak_to_peak_torque']:.5g} {u}, largest at {s['max_torque_angle_deg']:.1f} deg)",
-             f"{'valve':<28} {'phase (cam deg)':>16} {'mean (' + u + ')':>16} {'peak (' + u + ')':>16}"]
+             f"each valve's torque ({u}); phase in cam deg:",
+             f"{'valve':<24} {'phase':>7} {'mean':>10} {'max':>10} {'min':>10} {'peak-peak':>10}"]
     for label, phase, share in zip(result.valves, result.phases_deg, result.valve_torque, strict=True):
-        lines.append(f"{label:<28} {phase:>16.2f} {share.mean():>16.5g} {share.max():>16.5g}")
+        lines.append(f"{label[:24]:<24} {phase:>7.2f} {share.mean():>10.5g} {share.max():>10.5g} {share.min():>10.5g} "
+                     f"{share.max() - share.min():>10.5g}")
     lines.append(result.spectrum().table(8))
     return "\n".join(lines)
 

@@ -29,10 +29,12 @@ assignments). This module evaluates them and keeps the results:
 
 from __future__ import annotations
 
+import array
 import contextlib
 import csv
 import functools
 import io
+import itertools
 import logging
 import math
 import os
@@ -46,7 +48,7 @@ from typing import Any
 
 from vtool.csvrows import csv_text
 from vtool.errors import InputError, RunError
-from vtool.files import check_output_path, exists, open_no_follow, write_atomic
+from vtool.files import check_output_path, exists, open_atomic, open_no_follow
 from vtool.solvers import backends
 from vtool.solvers.model.mechanism import Mechanism, assemble
 from vtool.solvers.model.spec import MechanismSpec
@@ -63,11 +65,39 @@ OK = "ok"
 
 @dataclass(frozen=True)
 class Point:
-    """One sweep point: its index in the grid, the swept values (path -> value), its spec."""
+    """One sweep point: its index in the grid, the swept values (path -> value), its spec.
+
+    A planned sweep's points carry no spec but ``make`` (a picklable callable: values -> spec, raising
+    the loader's InputError for values it refuses), so that the spec is made where the point runs and
+    not kept: :func:`point_spec`.
+    """
 
     index: int
     values: tuple[tuple[str, Any], ...]
-    spec: MechanismSpec
+    spec: MechanismSpec | None
+    make: Callable[[tuple[tuple[str, Any], ...]], MechanismSpec] | None = None
+
+
+def point_spec(point: Point) -> tuple[MechanismSpec, str]:
+    """(the point's spec, ``"ok"``), or (``make.base``, the loader's one-line message) for values it refuses."""
+    if point.spec is not None:
+        return point.spec, OK
+    assert point.make is not None
+    try:
+        return point.make(point.values), OK
+    except InputError as exc:
+        return point.make.base, exc.one_line()  # type: ignore[attr-defined]  # SpecMaker.base: its columns
+
+
+def evaluate(point: Point, *, every_step: bool = False, previous: Mechanism | None = None,
+             cancel: Callable[[], bool] | None = None) -> tuple[PointResult, Mechanism | None]:
+    """One point's result (a point whose values the loader refuses: NaN metrics, the message as status)
+    and the mechanism for the next point to reuse."""
+    spec, status = point_spec(point)
+    if status != OK:
+        return PointResult(point.index, point.values, failed_metrics(spec), status), previous
+    metrics, status, mechanism = evaluate_point(spec, every_step=every_step, previous=previous, cancel=cancel)
+    return PointResult(point.index, point.values, metrics, status), mechanism
 
 
 @dataclass(frozen=True)
@@ -147,21 +177,67 @@ def evaluate_chunk(chunk: Sequence[Point], every_step: bool = False) -> list[Poi
     results = []
     previous: Mechanism | None = None
     for point in chunk:
-        metrics, status, previous = evaluate_point(point.spec, every_step=every_step, previous=previous)
-        results.append(PointResult(point.index, point.values, metrics, status))
+        result, previous = evaluate(point, every_step=every_step, previous=previous)
+        results.append(result)
     return results
 
 
+def batched(points: Iterable[Point], size: int) -> Iterator[list[Point]]:
+    """``points`` in lists of ``size`` (the last shorter), taken as they are needed."""
+    batch: list[Point] = []
+    for point in points:
+        batch.append(point)
+        if len(batch) >= size:
+            yield batch
+            batch = []
+    if batch:
+        yield batch
+
+
+class Batches:
+    """The chunks of a sweep's unfinished points, made as a runner takes them; ``count`` points in all.
+
+    A planned grid (with ``run_order`` and ``lazy``: :class:`vtool.presets.paths.PointGrid`) is cut in its
+    run order (the ``run.*`` fields varying fastest, so that neighbouring points share a model) into points
+    without specs; nothing per point is held. A plain sequence of points is grouped by model (:func:`chunks`).
+    """
+
+    def __init__(self, points: Sequence[Point], skip: set[int], workers: int, per_worker: int = 4,
+                 largest: int = 25) -> None:
+        self.points = points
+        self.skip = skip
+        self.count = len(points) - len(skip)
+        self.shape = (max(1, workers), per_worker, largest)
+        self.size = max(1, min(largest, math.ceil(self.count / max(1, workers * per_worker))))
+
+    def stream(self) -> Iterator[Point]:
+        """The unfinished points, one by one, in run order."""
+        if hasattr(self.points, "run_order"):
+            make = self.points.lazy  # type: ignore[attr-defined]  # a PointGrid (checked above): presets/ type
+            return (make(i) for i in self.points.run_order() if i not in self.skip)
+        return (p for chunk in self for p in chunk)
+
+    def __iter__(self) -> Iterator[list[Point]]:
+        if hasattr(self.points, "run_order"):
+            return batched(self.stream(), self.size)
+        return iter(chunks([p for p in self.points if p.index not in self.skip], *self.shape))
+
+
 def chunks(points: Sequence[Point], workers: int, per_worker: int = 4, largest: int = 25) -> list[list[Point]]:
-    """Points grouped by model, in index order, cut into about ``per_worker`` chunks per worker."""
+    """Points (with specs) grouped by model, in index order, cut into about ``per_worker`` chunks per worker."""
     groups: dict[Any, list[Point]] = {}
     for point in sorted(points, key=lambda p: p.index):
-        groups.setdefault(_model_key(point.spec), []).append(point)
+        groups.setdefault(_model_key(point_spec(point)[0]), []).append(point)
     size = max(1, min(largest, math.ceil(len(points) / max(1, workers * per_worker))))
     result = []
     for group in groups.values():
         result += [group[i:i + size] for i in range(0, len(group), size)]
     return result
+
+
+#: Chunks a pool or a Dask cluster holds at once per worker (submitted, running or waiting to be read):
+#: the rest are made as these finish, so that a large sweep's memory does not grow with its length.
+IN_FLIGHT_PER_WORKER = 4
 
 
 # ----- execution -----
@@ -237,19 +313,33 @@ class DaskRunner:
                              ) from None
         self.workers = max(1, len(self.client.scheduler_info().get("workers", {})) or count or 1)
 
-    def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
-            cancel: Callable[[], bool]) -> bool:
+    def run(self, batches: Iterable[list[Point]], every_step: bool,
+            on_results: Callable[[list[PointResult]], None], cancel: Callable[[], bool]) -> bool:
         from distributed import as_completed
 
-        futures = [self.client.submit(evaluate_chunk, b, every_step, pure=False) for b in batches]
+        source = iter(batches)
+        limit = IN_FLIGHT_PER_WORKER * self.workers
+
+        def submit() -> Any:
+            batch = next(source, None)
+            return None if batch is None else self.client.submit(evaluate_chunk, batch, every_step, pure=False)
+
+        futures = [f for f in (submit() for _ in range(limit)) if f is not None]
+        pending = set(futures)
         try:
-            for future in as_completed(futures):
+            queue = as_completed(futures)
+            for future in queue:
+                pending.discard(future)
                 on_results(future.result())
                 if cancel():
-                    self.client.cancel(futures)
+                    self.client.cancel(list(pending))
                     return False
+                more = submit()
+                if more is not None:
+                    pending.add(more)
+                    queue.add(more)
         except BaseException:
-            self.client.cancel(futures)
+            self.client.cancel(list(pending))
             raise
         return True
 
@@ -389,13 +479,23 @@ class ProcessRunner:
                     raise RunError(f"the sweep's {self.workers} worker processes did not start within {timeout:g} s")
         self.started = True
 
-    def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
-            cancel: Callable[[], bool]) -> bool:
+    def run(self, batches: Iterable[list[Point]], every_step: bool,
+            on_results: Callable[[list[PointResult]], None], cancel: Callable[[], bool]) -> bool:
         from concurrent.futures import FIRST_COMPLETED, wait
 
         self.start()
-        pending = {self.pool.submit(evaluate_chunk, b, every_step) for b in batches}
+        source = iter(batches)
+        pending: set[Any] = set()
+
+        def fill() -> None:  # at most IN_FLIGHT_PER_WORKER chunks a worker: the rest are made later
+            while len(pending) < IN_FLIGHT_PER_WORKER * self.workers:
+                batch = next(source, None)
+                if batch is None:
+                    return
+                pending.add(self.pool.submit(evaluate_chunk, batch, every_step))
+
         try:
+            fill()
             while pending:
                 done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
                 for future in done:
@@ -404,6 +504,7 @@ class ProcessRunner:
                     for future in pending:
                         future.cancel()
                     return False
+                fill()
         except BaseException:
             for future in pending:
                 future.cancel()
@@ -419,18 +520,17 @@ class SerialRunner:
 
     workers = 1
 
-    def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
-            cancel: Callable[[], bool]) -> bool:
+    def run(self, batches: Iterable[Iterable[Point]], every_step: bool,
+            on_results: Callable[[list[PointResult]], None], cancel: Callable[[], bool]) -> bool:
         for batch in batches:
             previous = None
             for point in batch:
                 if cancel():
                     return False
-                metrics, status, previous = evaluate_point(point.spec, every_step=every_step, previous=previous,
-                                                           cancel=cancel)
-                if cancel() and status != OK:
+                result, previous = evaluate(point, every_step=every_step, previous=previous, cancel=cancel)
+                if cancel() and not result.ok:
                     return False
-                on_results([PointResult(point.index, point.values, metrics, status)])
+                on_results([result])
         return True
 
     def close(self) -> None:
@@ -495,30 +595,40 @@ class AutoRunner:
         self.pool: ProcessRunner | None = None
         self.serial = SerialRunner()
 
-    def run(self, batches: list[list[Point]], every_step: bool, on_results: Callable[[list[PointResult]], None],
-            cancel: Callable[[], bool]) -> bool:
-        points = [p for batch in batches for p in batch]
+    def run(self, batches: Iterable[list[Point]], every_step: bool,
+            on_results: Callable[[list[PointResult]], None], cancel: Callable[[], bool]) -> bool:
+        """``batches``: a :class:`Batches` (its ``count`` tells the choice how many points there are) or
+        lists of points; the points are taken from it one by one."""
+        stream: Iterator[Point] = batches.stream() if isinstance(batches, Batches) else (
+            p for batch in batches for p in batch)
+        count = batches.count if isinstance(batches, Batches) else None
         if self.choice is None:
+            first = list(itertools.islice(stream, MEASURED_POINTS))
             seconds = 0.0
-            for point in points[:MEASURED_POINTS]:
+            for point in first:
                 started = time.perf_counter()
                 if not self.serial.run([[point]], every_step, on_results, cancel):
                     return False
                 seconds = time.perf_counter() - started
-            points = points[MEASURED_POINTS:]
+            if count is None:  # plain lists: counted (they are held anyway)
+                rest = list(stream)
+                stream, left = iter(rest), len(rest)
+            else:
+                left = count - len(first)
             load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
-            self.choice = choose_workers(seconds, len(points), self.cores, load)
+            self.choice = choose_workers(seconds, left, self.cores, load)
             self.workers = self.choice.workers
             if self.announce is not None:
                 self.announce(f"sweep: {self.choice.reason}")
-        if not points:
-            return True
+            points = left
+        else:
+            points = count if count is not None else 1
         if self.choice.workers < 2:
-            return self.serial.run([points], every_step, on_results, cancel)
+            return self.serial.run([stream], every_step, on_results, cancel)
         if self.pool is None:
             self.pool = ProcessRunner(self.choice.workers, self.stderr)
-        return self.pool.run(chunks(points, self.choice.workers, per_worker=2, largest=self.choice.chunk),
-                             every_step, on_results, cancel)
+        size = max(1, min(self.choice.chunk, math.ceil(points / (2 * self.choice.workers))))
+        return self.pool.run(batched(stream, size), every_step, on_results, cancel)
 
     def close(self) -> None:
         if self.pool is not None:
@@ -572,16 +682,20 @@ def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False
     Points already in ``sink`` (a resumed sweep) are skipped. KeyboardInterrupt
     stops the workers, leaves the sink in point order and propagates.
     ``keep=False`` (with a sink) keeps no result in memory: the outcome's
-    ``results`` is empty and the file has them (a large sweep's memory stays bounded).
+    ``results`` is empty and the file has them. With a planned grid
+    (:class:`vtool.presets.paths.PointGrid`) the points' specs are made as they
+    run (:class:`Batches`) and only the finished points' indices are held, so a
+    large sweep's memory stays bounded (benchmarks/bench_parquet.py).
     """
     cancel = cancel or (lambda: False)
     started = time.perf_counter()
     if sink is not None:
         sink.open(points)
     finished = sink.finished if sink is not None else set()
-    todo = [p for p in points if p.index not in finished]
+    total = len(points)
     results: dict[int, PointResult] = {}
-    done = len(points) - len(todo)
+    skipped = len(finished)
+    done = skipped
 
     def collect(batch: list[PointResult]) -> None:
         nonlocal done
@@ -592,20 +706,21 @@ def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False
                 sink.append(result)
         done += len(batch)
         if progress is not None:
-            progress(done, len(points))
+            progress(done, total)
 
     if progress is not None:
-        progress(done, len(points))
+        progress(done, total)
     complete = False
+    batches = Batches(points, set(finished), runner.workers)
     try:
-        complete = runner.run(chunks(todo, runner.workers), every_step, collect, cancel)
+        complete = runner.run(batches, every_step, collect, cancel)
     finally:
         if sink is not None:
             sink.finish()
     if sink is not None and keep:
         results = sink.finished_results(points) | results
     ordered = [results[i] for i in sorted(results)]
-    return SweepOutcome(ordered, complete, time.perf_counter() - started, len(points) - len(todo), len(points))
+    return SweepOutcome(ordered, complete, time.perf_counter() - started, skipped, total)
 
 
 # ----- output -----
@@ -660,6 +775,21 @@ def results_csv(results: Sequence[PointResult], fields: Sequence[tuple[str, str]
 MAX_RESUME_BYTES = 256 * 1024 * 1024
 
 
+def point_values(points: Sequence[Point]) -> Callable[[int], tuple[tuple[str, Any], ...]]:
+    """A function from a point's index to its swept values."""
+    if hasattr(points, "run_order"):
+        return points.values  # type: ignore[attr-defined]  # a PointGrid: made from the index
+    return {p.index: p.values for p in points}.__getitem__
+
+
+def point_locator(points: Sequence[Point]) -> Callable[[Sequence[str]], int | None]:
+    """A function from a point's values as a sweep file writes them to its index (None: not a point)."""
+    if hasattr(points, "locate"):
+        return points.locate  # a planned grid (PointGrid): nothing per point
+    index_of = {tuple(format_value(v) for _, v in p.values): p.index for p in points}
+    return lambda texts: index_of.get(tuple(texts))
+
+
 class SweepFile:
     """A CSV written as points finish, kept valid and resumable; see the module doc.
 
@@ -672,6 +802,10 @@ class SweepFile:
     is checked before it is read (a regular file, not a link, a FIFO or a
     device, at most :data:`MAX_RESUME_BYTES`); the appends go through a
     descriptor opened without following a link (``O_NOFOLLOW``).
+
+    Memory: no row is held. Each line's point index, offset and length in the
+    file are (three numbers a point); :meth:`finish` copies the lines in point
+    order into the rewritten file, and a resumed file is read line by line.
     """
 
     def __init__(self, path: str | os.PathLike[str], fields: Sequence[tuple[str, str]], spec: MechanismSpec,
@@ -681,19 +815,22 @@ class SweepFile:
         self.metrics = report_columns(spec, timing)
         self.spec = spec
         self.header = csv_header(fields, spec, timing)
-        self.keys: dict[tuple[str, ...], int] = {}
-        self.rows: list[list[str]] = []
         self.resumed = resume
+        self.previous: bytes | None = None  # the resumed file's content is read again when the file starts
         if resume and exists(self.path):
-            self._read_partial()
+            self._check_partial()
         elif resume:
             raise InputError("--resume", str(self.path), "an existing partial sweep file (none found)")
         self.finished: set[int] = set()
-        self.index_of: dict[tuple[str, ...], int] = {}
+        self.locate: Callable[[Sequence[str]], int | None] = lambda texts: None
         self.handle: io.TextIOWrapper | None = None
         self.written = False
+        self.size = 0
+        self.lines = array.array("q")  # (index, offset, length) of each data line written, flat
 
-    def _read_partial(self) -> None:
+    @contextlib.contextmanager
+    def _resumed(self) -> Iterator[io.BufferedReader]:
+        """The resumed file, checked, read from its start."""
         fd = open_no_follow(self.path, os.O_RDONLY | os.O_NONBLOCK, "--resume")  # a FIFO must not block
         with os.fdopen(fd, "rb") as raw:
             st = os.fstat(raw.fileno())
@@ -702,52 +839,84 @@ class SweepFile:
             if st.st_size > MAX_RESUME_BYTES:
                 raise InputError("--resume", str(self.path), f"a partial sweep file of at most "
                                  f"{MAX_RESUME_BYTES // 2**20} MB (this one has {st.st_size:,} bytes)")
-            data = raw.read(MAX_RESUME_BYTES + 1)
+            yield raw
+
+    def _resumed_rows(self) -> Iterator[tuple[list[str], bytes]]:
+        """(cells, line with its newline) of each complete data line of the resumed file, read line by line."""
+        with self._resumed() as raw:
+            raw.readline()  # the header (checked when the file was opened)
+            for line in raw:
+                if not line.endswith(b"\n"):  # the last piece without a newline: a line cut by a kill
+                    return
+                try:
+                    cells = next(csv.reader([line.decode("utf-8")]), [])
+                except (csv.Error, UnicodeDecodeError):
+                    continue
+                if len(cells) == len(self.header):
+                    yield cells, line
+
+    def _check_partial(self) -> None:
+        with self._resumed() as raw:
+            first = raw.readline(1 << 20)
         try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError:
+            header = next(csv.reader([first.decode("utf-8")]), []) if first.endswith(b"\n") else []
+        except (UnicodeDecodeError, csv.Error):
             raise InputError("--resume", str(self.path), "a partial sweep file (UTF-8 CSV text)") from None
-        lines = text.split("\n")
-        complete = lines[:-1]  # the last piece has no newline: empty, or a line cut by a kill
-        try:
-            rows = list(csv.reader(complete))
-        except csv.Error:
-            rows = []
-        if not rows or rows[0] != self.header:
+        if header != self.header:
             raise InputError("--resume", str(self.path), "a partial file of this same sweep (its header differs)")
-        self.rows = [r for r in rows[1:] if len(r) == len(self.header)]
 
     def open(self, points: Sequence[Point]) -> None:
         """Marks the points already in the file as finished; the file is written at the first new point."""
-        index_of = {tuple(format_value(v) for _, v in p.values): p.index for p in points}
-        kept = []
-        for row in self.rows:
-            key = tuple(row[: len(self.fields)])
-            if key in index_of and index_of[key] not in self.finished:
-                self.finished.add(index_of[key])
-                kept.append(row)
-        self.rows = kept
-        self.index_of = index_of
+        self.locate = point_locator(points)
+        if self.resumed:
+            for cells, _ in self._resumed_rows():
+                index = self.locate(cells[: len(self.fields)])
+                if index is not None:
+                    self.finished.add(index)
 
     def _start(self) -> None:
         """The file with its header and the kept rows, then a no-follow append descriptor on it."""
-        write_atomic(self.path, self._text([self.header] + self.rows), "--csv")
+        kept: set[int] = set()
+        with open_atomic(self.path, "--csv") as out:
+            self._write(out, self.header_text(), -1)
+            if self.resumed:
+                for cells, line in self._resumed_rows():
+                    index = self.locate(cells[: len(self.fields)])
+                    if index is not None and index in self.finished and index not in kept:
+                        kept.add(index)
+                        self._write(out, line.decode("utf-8"), index)
         fd = open_no_follow(self.path, os.O_WRONLY | os.O_APPEND, "--csv")
         self.handle = os.fdopen(fd, "a", encoding="utf-8", newline="")
         self.written = True
 
+    def header_text(self) -> str:
+        return self._text([self.header])
+
+    def _write(self, handle: Any, text: str, index: int) -> None:
+        """Write one line, noting where it is (``index`` -1: the header)."""
+        handle.write(text)
+        length = len(text.encode("utf-8"))
+        if index >= 0:
+            self.lines.extend((index, self.size, length))
+        self.size += length
+
     def finished_results(self, points: Sequence[Point]) -> dict[int, PointResult]:
         """The points read back from a resumed file (numbers parsed; empty cells NaN)."""
-        by_index = {p.index: p for p in points}
+        if not self.resumed or not exists(self.path):
+            return {}
+        locate = point_locator(points)
+        values_of = point_values(points)
         results = {}
-        for row in self.rows:
-            index = self.index_of.get(tuple(row[: len(self.fields)]))
-            if index is None or index not in self.finished:
-                continue
-            cells = row[len(self.fields) + 1:]
-            metrics = failed_metrics(self.spec)  # NaN for the columns the file leaves out (wall time)
-            metrics.update({name: _parse_cell(cell) for (name, _), cell in zip(self.metrics, cells, strict=True)})
-            results[index] = PointResult(index, by_index[index].values, metrics, row[len(self.fields)])
+        with open(self.path, encoding="utf-8", newline="") as handle:
+            for row in itertools.islice(csv.reader(handle), 1, None):
+                index = locate(row[: len(self.fields)]) if len(row) == len(self.header) else None
+                if index is None or index not in self.finished:
+                    continue
+                cells = row[len(self.fields) + 1:]
+                metrics = failed_metrics(self.spec)  # NaN for the columns the file leaves out (wall time)
+                metrics.update({name: _parse_cell(cell) for (name, _), cell in zip(self.metrics, cells,
+                                                                                    strict=True)})
+                results[index] = PointResult(index, values_of(index), metrics, row[len(self.fields)])
         return results
 
     def row(self, result: PointResult) -> list[str]:
@@ -761,9 +930,7 @@ class SweepFile:
         if self.handle is None:
             self._start()
         assert self.handle is not None
-        row = self.row(result)
-        self.rows.append(row)
-        self.handle.write(self._text([row]))
+        self._write(self.handle, self._text([self.row(result)]), result.index)
         self.handle.flush()
 
     def finish(self) -> None:
@@ -773,8 +940,23 @@ class SweepFile:
             self.handle = None
         if not (self.written or self.resumed):
             return
-        rows = sorted(self.rows, key=lambda r: self.index_of.get(tuple(r[: len(self.fields)]), -1))
-        write_atomic(self.path, self._text([self.header] + rows), "--csv")
+        if not self.written:  # resumed, nothing new: the kept rows, in order, without the cut line
+            self._start()
+            assert self.handle is not None
+            self.handle.close()
+            self.handle = None
+        import numpy as np
+
+        lines = np.frombuffer(self.lines, dtype=np.int64).reshape(-1, 3)
+        order = np.argsort(lines[:, 0], kind="stable")
+        fd = open_no_follow(self.path, os.O_RDONLY, "--csv")
+        try:
+            with open_atomic(self.path, "--csv") as out:
+                out.write(self.header_text())
+                for _, offset, length in lines[order]:
+                    out.write(os.pread(fd, int(length), int(offset)).decode("utf-8"))
+        finally:
+            os.close(fd)
 
 
 # ----- derived speeds -----
