@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import copy
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -66,6 +67,10 @@ from vtool.solvers.trace import EVENT_KINDS, OPENED, TraceBuilder
 
 LAW_CODES = {MOMENTUM: layout.LAW_MOMENTUM, LOCAL: layout.LAW_LOCAL, THESIS: layout.LAW_THESIS}
 SOFT_CODES = {RIGID: 0, LINEAR: layout.SOFT_LINEAR, HERTZ: layout.SOFT_HERTZ}
+
+#: Settling at t: (configuration, t, x, v, a) -> the configuration once no closed contact pulls (events
+#: recorded), as :meth:`Transitions.settle`
+Release = Callable[[int, float, np.ndarray, np.ndarray, np.ndarray], int]
 
 
 def source_series(mechanism: Mechanism) -> SourceSeries:
@@ -222,7 +227,7 @@ class ConfigurationTables:
             raw = np.ascontiguousarray(np.swapaxes(cp[layout.CP_RAW, :, :, :nf], 1, 2))  # R's free rows
             cp[layout.CP_STD, :, :, :nf] = np.swapaxes(cm[layout.CM_SINV, :nf, :nf] @ raw, 1, 2)
             cp[layout.CP_FINE, :, :, :nf] = np.swapaxes(cm[layout.CM_SINVF, :nf, :nf] @ raw, 1, 2)
-        self._force_rows(mask, beta, gamma, ((layout.CP_STD, dt), (layout.CP_FINE, fine)))
+        self._force_rows(mask, beta, gamma, ((int(layout.CP_STD), dt), (int(layout.CP_FINE), fine)))
 
     def _force_rows(self, mask: int, beta: float, gamma: float, planes: tuple[tuple[int, float], ...]) -> None:
         """The force rows of the step operators (``layout.CP_RAW``): each closed rigid clearance's contact
@@ -610,9 +615,9 @@ class ContactProblem:
         """Which clearances are watched for events (enabled ones)."""
         return self.cl[:, layout.CL_MON].astype(bool)
 
-    def transitions(self, builder: TraceBuilder) -> Transitions:
+    def transitions(self, builder: TraceBuilder, release: Release | None = None) -> Transitions:
         """The event rules for one run into ``builder`` (see :class:`Transitions`)."""
-        return Transitions(self, builder)
+        return Transitions(self, builder, release)
 
     def label(self, mask: int) -> str:
         return configuration_label(self.spec, mask)
@@ -634,9 +639,13 @@ class Transitions:
     * :meth:`apply`: at an event, open the closed clearances whose force reached zero, apply the impact
       laws of those whose gap closed (after ``zeno_stick`` rapid events, closing contacts stick), settle,
       record every event in the builder; ``zeno_stop`` rapid events stop the run (RunError).
+
+    Both settle through ``release`` (default :meth:`settle`, the compiled rule on the linear equations):
+    a back end whose forces the compiled rules do not see (the scipy back end's nonlinear elements)
+    passes its own, called as :meth:`settle` is.
     """
 
-    def __init__(self, problem: ContactProblem, builder: TraceBuilder) -> None:
+    def __init__(self, problem: ContactProblem, builder: TraceBuilder, release: Release | None = None) -> None:
         from vtool.solvers.newmark import (
             kernel,  # the compiled rules (numba: imported by those who call them)
         )
@@ -649,12 +658,13 @@ class Transitions:
         self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
         self.fst = np.zeros(layout.F_SIZE)
         self.rapid, self.last_event = 0, -math.inf
+        self.release: Release = self.settle if release is None else release
 
     def start(self) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
         """(configuration, x, v, a) at t = 0: the mechanism's static start, settled (fresh arrays)."""
         start = self.problem.mechanism.start
         x, v, a = start.q.copy(), start.qd.copy(), start.qdd.copy()
-        mask = self.settle(self.problem.start_mask, 0.0, x, v, a)
+        mask = self.release(self.problem.start_mask, 0.0, x, v, a)
         return mask, x, v, self.problem.accelerations(mask, 0.0, x, v)
 
     def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
@@ -709,5 +719,5 @@ class Transitions:
                                                self.rapid >= problem.rules.zeno_stick, self.events, t,
                                                problem.momentum))
             self.take_events()
-        new = self.settle(new, t, x, v, np.zeros_like(x))  # (settle computes the accelerations it needs)
+        new = self.release(new, t, x, v, np.zeros_like(x))  # (settle computes the accelerations it needs)
         return new, x, v, problem.accelerations(new, t, x, v) if accelerations else None
