@@ -295,7 +295,7 @@ def test_piecewise_back_ends_take_the_event_rules_from_transitions(name: str, mo
     from vtool.solvers.exact import piecewise
     from vtool.solvers.model.contact import Transitions
 
-    assert not hasattr(piecewise.PiecewiseRun, "apply_events")  # (settle: the shared rule, or a back end's own)
+    assert not hasattr(piecewise.PiecewiseRun, "apply_events") and not hasattr(piecewise.PiecewiseRun, "settle")
     calls = {"start": 0, "apply": 0}
     start, apply = Transitions.start, Transitions.apply
 

@@ -161,7 +161,7 @@ class PiecewiseRun(ABC):
         self.next_out = 0
         self.monitored = problem.cl[:, layout.CL_MON].astype(bool)
         self.closed_bit = problem.cl[:, layout.CL_BIT]
-        self.transitions = problem.transitions(builder, self.settle)  # the shared event and impact rules
+        self.transitions = problem.transitions(builder)  # the shared event and impact rules
         self.rules = self.transitions.rules  # the compiled kernel's sources and Hertz law
 
     # ----- configuration data -----
@@ -324,13 +324,6 @@ class PiecewiseRun(ABC):
                 progress(min(t / self.t_end, 1.0))
             if cancel is not None and cancel():
                 raise RunError(f"cancelled at t = {t:.6g} s")
-
-    def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
-        """Release the contacts that pull in configuration ``mask`` at t: the shared rule
-        (:meth:`~vtool.solvers.model.contact.Transitions.settle`), which ``self.transitions`` calls
-        through this method at the start and after every event; a back end with forces the compiled
-        rules do not see overrides it."""
-        return self.transitions.settle(mask, t, x, v, a)
 
     def statistics(self, settings: dict[str, Any]) -> RunStats:
         self.flush_rows()

@@ -68,10 +68,6 @@ from vtool.solvers.trace import EVENT_KINDS, OPENED, TraceBuilder
 LAW_CODES = {MOMENTUM: layout.LAW_MOMENTUM, LOCAL: layout.LAW_LOCAL, THESIS: layout.LAW_THESIS}
 SOFT_CODES = {RIGID: 0, LINEAR: layout.SOFT_LINEAR, HERTZ: layout.SOFT_HERTZ}
 
-#: Settling at t: (configuration, t, x, v, a) -> the configuration once no closed contact pulls (events
-#: recorded), as :meth:`Transitions.settle`
-Release = Callable[[int, float, np.ndarray, np.ndarray, np.ndarray], int]
-
 
 def source_series(mechanism: Mechanism) -> SourceSeries:
     """The cam and the seat as Fourier series at the mechanism's cam speed.
@@ -227,9 +223,10 @@ class ConfigurationTables:
             raw = np.ascontiguousarray(np.swapaxes(cp[layout.CP_RAW, :, :, :nf], 1, 2))  # R's free rows
             cp[layout.CP_STD, :, :, :nf] = np.swapaxes(cm[layout.CM_SINV, :nf, :nf] @ raw, 1, 2)
             cp[layout.CP_FINE, :, :, :nf] = np.swapaxes(cm[layout.CM_SINVF, :nf, :nf] @ raw, 1, 2)
-        self._force_rows(mask, beta, gamma, ((int(layout.CP_STD), dt), (int(layout.CP_FINE), fine)))
+        self._force_rows(mask, beta, gamma, ((layout.CP_STD, dt), (layout.CP_FINE, fine)))
 
-    def _force_rows(self, mask: int, beta: float, gamma: float, planes: tuple[tuple[int, float], ...]) -> None:
+    def _force_rows(self, mask: int, beta: float, gamma: float,
+                    planes: tuple[tuple[int | np.int64, float], ...]) -> None:
         """The force rows of the step operators (``layout.CP_RAW``): each closed rigid clearance's contact
         force at a step's end, less its constant, from the step's predictor y = (ż̃_F, z̃_F, (z̈, ż, z)_P, src).
 
@@ -615,9 +612,9 @@ class ContactProblem:
         """Which clearances are watched for events (enabled ones)."""
         return self.cl[:, layout.CL_MON].astype(bool)
 
-    def transitions(self, builder: TraceBuilder, release: Release | None = None) -> Transitions:
+    def transitions(self, builder: TraceBuilder) -> Transitions:
         """The event rules for one run into ``builder`` (see :class:`Transitions`)."""
-        return Transitions(self, builder, release)
+        return Transitions(self, builder)
 
     def label(self, mask: int) -> str:
         return configuration_label(self.spec, mask)
@@ -639,13 +636,9 @@ class Transitions:
     * :meth:`apply`: at an event, open the closed clearances whose force reached zero, apply the impact
       laws of those whose gap closed (after ``zeno_stick`` rapid events, closing contacts stick), settle,
       record every event in the builder; ``zeno_stop`` rapid events stop the run (RunError).
-
-    Both settle through ``release`` (default :meth:`settle`, the compiled rule on the linear equations):
-    a back end whose forces the compiled rules do not see (the scipy back end's nonlinear elements)
-    passes its own, called as :meth:`settle` is.
     """
 
-    def __init__(self, problem: ContactProblem, builder: TraceBuilder, release: Release | None = None) -> None:
+    def __init__(self, problem: ContactProblem, builder: TraceBuilder) -> None:
         from vtool.solvers.newmark import (
             kernel,  # the compiled rules (numba: imported by those who call them)
         )
@@ -658,17 +651,21 @@ class Transitions:
         self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
         self.fst = np.zeros(layout.F_SIZE)
         self.rapid, self.last_event = 0, -math.inf
-        self.release: Release = self.settle if release is None else release
+        #: A back end whose equations hold more than the linear ones the compiled rules see (the scipy back
+        #: end's nonlinear elements) judges the release of pulling contacts itself: (mask, t, x, v, a) -> mask.
+        self.release: Callable[[int, float, np.ndarray, np.ndarray, np.ndarray], int] | None = None
 
     def start(self) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
         """(configuration, x, v, a) at t = 0: the mechanism's static start, settled (fresh arrays)."""
         start = self.problem.mechanism.start
         x, v, a = start.q.copy(), start.qd.copy(), start.qdd.copy()
-        mask = self.release(self.problem.start_mask, 0.0, x, v, a)
+        mask = self.settle(self.problem.start_mask, 0.0, x, v, a)
         return mask, x, v, self.problem.accelerations(mask, 0.0, x, v)
 
     def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
         """Release the contacts that pull in configuration ``mask`` at t (events recorded); the new mask."""
+        if self.release is not None:
+            return self.release(mask, t, x, v, a)
         problem, tables, m = self.problem, self.problem.tables, self.problem.n
         while True:
             self.ist[layout.I_NEV] = 0
@@ -719,5 +716,5 @@ class Transitions:
                                                self.rapid >= problem.rules.zeno_stick, self.events, t,
                                                problem.momentum))
             self.take_events()
-        new = self.release(new, t, x, v, np.zeros_like(x))  # (settle computes the accelerations it needs)
+        new = self.settle(new, t, x, v, np.zeros_like(x))  # (settle computes the accelerations it needs)
         return new, x, v, problem.accelerations(new, t, x, v) if accelerations else None
