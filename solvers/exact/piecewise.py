@@ -317,7 +317,7 @@ class PiecewiseRun(ABC):
             self.flush_rows()
             if fired:
                 x, v, _ = self.full_state(ss, t, y)
-                mask, x, v, _ = transitions.apply(ss.mask, t, x, v, fired)
+                mask, x, v, _ = transitions.apply(ss.mask, t, x, v, fired, accelerations=False)
                 ss = self.space(mask)
                 y = self.state_of(ss, x, v)
             if progress is not None:

@@ -513,8 +513,11 @@ class ContactProblem:
         """(x, v, a) of every source at t, as the kernel's src vector."""
         from vtool.solvers.newmark import kernel  # numba: only the back ends that call it load it
 
+        record = self.__dict__.get("_sources_record")
+        if record is None:  # made once: numba reads a fresh record's arrays anew on every call
+            record = self.__dict__["_sources_record"] = self.record()
         src = np.zeros(3 * self.ns)
-        kernel.sources(self.record(), t, src)
+        kernel.sources(record, t, src)
         return src
 
     def impact(self, mask: int, closing: list[int], t: float, x: np.ndarray, v: np.ndarray,
@@ -680,9 +683,10 @@ class Transitions:
         self.builder.add_events(self.ev_f[:count], self.ev_i[:count])
         self.ist[layout.I_NEV] = 0
 
-    def apply(self, mask: int, t: float, x: np.ndarray, v: np.ndarray,
-              crossed: list[int]) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
-        """The configuration and (x, v, a) after the events of the clearances ``crossed`` at t."""
+    def apply(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, crossed: list[int],
+              accelerations: bool = True) -> tuple[int, np.ndarray, np.ndarray, np.ndarray | None]:
+        """The configuration and (x, v, a) after the events of the clearances ``crossed`` at t (a is None
+        unless ``accelerations``: a back end that restarts from (x, v) alone skips its solve)."""
         problem = self.problem
         x, v = x.copy(), v.copy()
         bits = problem.cl[:, layout.CL_BIT]
@@ -712,6 +716,5 @@ class Transitions:
                                                self.rapid >= problem.rules.zeno_stick, self.events, t,
                                                problem.momentum))
             self.take_events()
-        a = problem.accelerations(new, t, x, v)
-        new = self.settle(new, t, x, v, a)
-        return new, x, v, problem.accelerations(new, t, x, v)
+        new = self.settle(new, t, x, v, np.zeros_like(x))  # (settle computes the accelerations it needs)
+        return new, x, v, problem.accelerations(new, t, x, v) if accelerations else None
