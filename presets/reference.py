@@ -24,7 +24,6 @@ from vtool.presets import list_presets, load_document, read_document
 from vtool.presets.fields import REQUIRED, FieldRead, recording
 from vtool.presets.kinds import KINDS
 from vtool.presets.paths import set_fields
-from vtool.solvers import backends
 
 #: Shipped presets with fields changed (None: removed) so that the loader reads the keys of its other branches.
 VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
@@ -58,7 +57,7 @@ VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
                              "train.spring.inner.tensile_strength": {"A": 2300.0, "m": 0.1},
                              "train.spring.inner.wire_height": 2.8, "train.spring.inner.coil_contact": "none"}),
     # forces on the valve's motion (presets/valveforces.py): Stribeck guide friction and a cylinder-pressure table
-    ("direct-acting-bucket", {"run.backend": backends.with_flag("nonlinear_elements")[0], "valve_forces": {
+    ("direct-acting-bucket", {"valve_forces": {
         "guide_friction": 15.0, "guide_velocity": 20.0, "static_friction": 25.0, "stribeck_velocity": 100.0,
         "viscous": 0.002, "gas_crank_angles": [0.0, 360.0], "gas_pressures": [0.1, 2.0], "head_diameter": 30.0,
         "seat_side": "cylinder", "gas_phase": 0.0}}),
@@ -260,8 +259,8 @@ MEANINGS: dict[str, dict[str, str]] = {
         "train.finger.inertia": "The finger's section second moment of area.",
         "train.finger.modulus": "The finger's Young's modulus.",
         "train.finger.density": "The finger's mass per volume (with its roller).",
-        "train.hla": "A hydraulic lash adjuster under the finger's pivot (solvers/model/hla.py; scipy back end).",
-        "train.hla.plunger_mass": "The plunger's moving mass (with the pivot ball).",
+        "train.hla": "A hydraulic lash adjuster under a finger's pivot or in a bucket (solvers/model/hla.py; scipy back end).",
+        "train.hla.plunger_mass": "A finger's: the plunger's moving mass with the pivot ball (a bucket's is the bucket's mass).",
         "train.hla.plunger_diameter": "The plunger's diameter d (area A = pi d^2/4).",
         "train.hla.chamber_volume": "The high-pressure chamber's oil volume V0 at zero plunger extension.",
         "train.hla.spring_rate": "The plunger spring's rate (it pushes the plunger out).",

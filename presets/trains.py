@@ -42,14 +42,17 @@ Types and the clearance names [damping] may use:
 * ``direct-acting`` (type I bucket): ``[train.bucket]`` (``mass``,
   ``stiffness``: crown, shim and stem tip in series; ``length`` for
   drawings), ``[train.valve]``; flat follower; clearances ``cam``, ``seat``.
+  With ``[train.hla]`` (no bucket ``stiffness``) a hydraulic bucket: the
+  adjuster in the ``bucket`` member's place (``sense = "extension"``).
 * ``finger-follower`` (type II, end pivot, roller):
   ``[train.finger]`` (``roller_arm``, ``valve_arm``, ``roller_height``,
   ``cam_offset`` as :class:`vtool.solvers.model.spec.FingerSpec`, and a
   beam section), ``[train.pivot]`` (``stiffness``, ``mass``: the support
   under the finger's pivot, a member named ``pivot`` on the coordinate
   ``finger pivot (lash adjuster)``, the place a hydraulic lash adjuster
-  takes), ``[train.valve]``; clearances ``cam``, ``pad`` (finger pad on the
-  valve tip), ``seat``. The model's finger is a beam lever with the nominal
+  takes: ``[train.hla]`` instead, with ``plunger_mass``, puts one there,
+  :mod:`vtool.presets.hla`), ``[train.valve]``; clearances ``cam``, ``pad``
+  (finger pad on the valve tip), ``seat``. The model's finger is a beam lever with the nominal
   ratio valve_arm/roller_arm; its cam coordinate moves as the geometric
   valve lift over that ratio (:func:`vtool.solvers.model.camshape.model_lift`),
   so the valve side follows the finger's varying ratio.
@@ -267,10 +270,19 @@ def ohv_pushrod(train: Table, units: UnitSystem, folder: Path | None) -> dict[st
 
 
 def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
-    """Bucket on the valve: cam -> bucket (q1) -> stem top / retainer (q2) -> valve head (q3)."""
+    """Bucket on the valve: cam -> bucket (q1) -> stem top / retainer (q2) -> valve head (q3); with
+    ``[train.hla]`` a hydraulic bucket: the adjuster in the bucket member's place (its stiffness the closed
+    chamber's; a positive elongation q2 - q1 extends it)."""
     bucket_t, valve_t = _part(train, "bucket"), _part(train, "valve")
-    bucket = {"mass": bucket_t.number("mass", unit=units.mass, min_exclusive=0.0, max_value=1e9),
-              "stiffness": bucket_t.number("stiffness", unit=units.stiffness, min_exclusive=0.0, max_value=1e16)}
+    adjuster = hla_member(train, units, "bucket", "extension", plunger=False)
+    bucket = {"mass": bucket_t.number("mass", unit=units.mass, min_exclusive=0.0, max_value=1e9)}
+    if adjuster is None:
+        bucket["stiffness"] = bucket_t.number("stiffness", unit=units.stiffness, min_exclusive=0.0, max_value=1e16)
+    elif bucket_t.has("stiffness"):
+        raise InputError(bucket_t.field("stiffness"), bucket_t.raw("stiffness"), "no stiffness beside [train.hla] "
+                         "(the bucket's is the adjuster's closed chamber)", units.stiffness)
+    else:
+        bucket |= adjuster[0]
     bucket_length = _length(bucket_t, "length", units, default=1.0)
     valve_length = _length(valve_t, "length", units)
     valve = _section(valve_t, units, "bar")
@@ -286,27 +298,29 @@ def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[
     return {"coordinates": coordinates, "members": members, "cam": n + 1, "seat": n + 2,
             "clearances": [_clearance("cam", 1, n + 1, "external"), _clearance("seat", 3, n + 2, "external")]
             + spring.clearances, "closed": ["cam"], "preload": spring.preload, "springs": spring.sheets, "ratio": 1.0,
-            "follower_kind": "flat"}
+            "follower_kind": "flat"} | ({"hla": adjuster[1]} if adjuster is not None else {})
 
 
-def hla_pivot(train: Table, units: UnitSystem, length: float) -> tuple[dict[str, Any], dict[str, Any]] | None:
-    """``[train.hla]``: the adjuster under a pivot (None without one): the pivot member (the closed chamber's
-    stiffness K_oil(p_s) A²/V₀ of the oil alone at the supply pressure, the stiffness the loaded adjuster
-    approaches as its air compresses away; the plunger's mass) and the explicit ``[hla]`` table on it
-    (:mod:`vtool.presets.hla`)."""
+def hla_member(train: Table, units: UnitSystem, member: str, sense: str,
+               plunger: bool) -> tuple[dict[str, Any], dict[str, Any]] | None:
+    """``[train.hla]``: the adjuster in a bar member's place (None without one): the member's stiffness (the
+    closed chamber's K_oil(p_s) A²/V₀ of the oil alone at the supply pressure, the stiffness the loaded
+    adjuster approaches as its air compresses away) and, with ``plunger``, its mass (``plunger_mass``); and the
+    explicit ``[hla]`` table on it (:mod:`vtool.presets.hla`)."""
     t = train.table("hla", required=False)
     if t is None:
         return None
     from vtool.presets.hla import read_data
     from vtool.solvers.model.hla import closed_stiffness
 
-    mass = t.number("plunger_mass", unit=units.mass, min_exclusive=0.0, max_value=1e9)
+    values: dict[str, Any] = {}
+    if plunger:
+        values["mass"] = t.number("plunger_mass", unit=units.mass, min_exclusive=0.0, max_value=1e9)
     spec, _, given = read_data(t, units)
     t.finish()
     oil = dataclasses.replace(spec, air_fraction=0.0)
-    stiffness = closed_stiffness(oil, spec.supply_pressure) * units.metres_per_length / units.newtons_per_force
-    member = {"stiffness": stiffness, "mass": mass}
-    return member, {"member": "pivot", "sense": "compression"} | given
+    values["stiffness"] = closed_stiffness(oil, spec.supply_pressure) * units.metres_per_length / units.newtons_per_force
+    return values, {"member": member, "sense": sense} | given
 
 
 def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
@@ -315,7 +329,7 @@ def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dic
     geometry = _lever(finger_t, units)
     a, b = geometry["roller_arm"], geometry["valve_arm"]
     finger = _section(finger_t, units, "beam")
-    adjuster = hla_pivot(train, units, 0.5 * a)
+    adjuster = hla_member(train, units, "pivot", "compression", plunger=True)
     if adjuster is not None:
         if train.has("pivot"):
             raise InputError(train.field("pivot"), "given", "no [train.pivot] beside [train.hla] (the adjuster is "

@@ -168,3 +168,26 @@ def test_bad_hla_input_is_one_line(key: str, value: object):
     with pytest.raises(InputError) as error:
         load_document(document(**{key: value}))
     assert f"train.hla.{key}" in str(error.value) or "train.hla.bulk" in str(error.value)
+
+
+def test_hydraulic_bucket_takes_up_its_lash():
+    """[train.hla] on a direct-acting bucket: the adjuster in the bucket member's place pumps up the 0.15 mm
+    lash on the base circle (the bucket's ratio is 1), after which the cam contact carries its push."""
+    doc = copy.deepcopy(read_document(PRESET_DIR / "direct-acting-bucket.toml"))
+    del doc["train"]["bucket"]["stiffness"]
+    hla = dict(read_document(PRESET_DIR / f"{NAME}.toml")["train"]["hla"])
+    del hla["plunger_mass"]
+    doc["train"]["hla"] = hla
+    doc["run"].update(backend="scipy", degrees=360.0, output_interval=1.0)
+    spec = load_document(doc)
+    assert spec.hla is not None and spec.hla.member == "bucket" and spec.hla.sense == "extension"
+    trace = simulate(spec)
+    report = trace.summary()["hla"]
+    theta = report["base_circle_angle_deg"]
+    x = hla_series(trace).columns["hla_plunger_extension"]
+    base = int(np.argmin(np.abs(trace.cam_angle - theta)))
+    assert 0.9 * 0.15 < x[base] - x[0] < 1.2 * 0.15
+    assert trace.force("cam")[base] > 0.0
+    with pytest.raises(InputError, match="train.bucket.stiffness"):
+        doc["train"]["bucket"]["stiffness"] = 1.5e5
+        load_document(doc)

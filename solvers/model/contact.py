@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import copy
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -651,9 +650,6 @@ class Transitions:
         self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
         self.fst = np.zeros(layout.F_SIZE)
         self.rapid, self.last_event = 0, -math.inf
-        #: A back end whose equations hold more than the linear ones the compiled rules see (the scipy back
-        #: end's nonlinear elements) judges the release of pulling contacts itself: (mask, t, x, v, a) -> mask.
-        self.release: Callable[[int, float, np.ndarray, np.ndarray, np.ndarray], int] | None = None
 
     def start(self) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
         """(configuration, x, v, a) at t = 0: the mechanism's static start, settled (fresh arrays)."""
@@ -664,8 +660,6 @@ class Transitions:
 
     def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
         """Release the contacts that pull in configuration ``mask`` at t (events recorded); the new mask."""
-        if self.release is not None:
-            return self.release(mask, t, x, v, a)
         problem, tables, m = self.problem, self.problem.tables, self.problem.n
         while True:
             self.ist[layout.I_NEV] = 0

@@ -39,7 +39,7 @@ from vtool.solvers.exact.backend import peak_brackets
 from vtool.solvers.exact.piecewise import PiecewiseBackend, PiecewiseRun
 from vtool.solvers.exact.statespace import StateSpace
 from vtool.solvers.model.attached import elements_of
-from vtool.solvers.model.contact import ContactProblem
+from vtool.solvers.model.contact import ContactProblem, Transitions
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.spec import RunSpec
 from vtool.solvers.newmark import layout
@@ -107,8 +107,8 @@ class _ScipyRun(PiecewiseRun):
                   else self.elements.initial(start.q, start.qd))  # the elements' states now
         self.s_scale = np.maximum(np.abs(self.s), 1e-6)
         self.state_rows: list[np.ndarray] = []
-        if self.elements.elements:
-            self.transitions.release = self.release_pulling
+        if self.elements.elements:  # the shared rules, with the release of pulling contacts judged here
+            self.transitions = ElementTransitions(problem, builder, self)
 
     # ----- the nonlinear elements' states beside y (module doc) -----
     def split(self, ss: StateSpace, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -154,10 +154,10 @@ class _ScipyRun(PiecewiseRun):
         if self.elements.elements:
             self.state_rows.append(np.array(s, dtype=float))
 
-    def release_pulling(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
-        """With elements, the release of pulling contacts is judged here, on the contact forces with the
-        elements' share (the compiled rules see the linear equations only): the most pulling closed rigid
-        contact is released first, until every one pushes (at most one release per clearance)."""
+    def release_pulling(self, mask: int, t: float, x: np.ndarray, v: np.ndarray) -> int:
+        """With elements, the release of pulling contacts judged on the contact forces with the elements'
+        share (the compiled rules see the linear equations only): the most pulling closed rigid contact is
+        released first, until every one pushes (at most one release per clearance)."""
         tolerance = self.problem.force_tolerance()
         for _ in range(self.ncl + 1):
             self.problem.build(mask)
@@ -300,6 +300,19 @@ class _ScipyRun(PiecewiseRun):
                 best = minimize_scalar(overlap, bounds=(low, high), method="bounded",
                                        options={"xatol": 1e-9 * (high - low)})
                 self.peak_overlap[k] = max(self.peak_overlap[k], -float(best.fun))
+
+
+class ElementTransitions(Transitions):
+    """The shared event rules (:class:`~vtool.solvers.model.contact.Transitions`) of a run with nonlinear
+    elements: their settle releases the contacts that pull with the elements' share of the contact forces
+    (:meth:`_ScipyRun.release_pulling`), not on the linear equations the compiled rules see."""
+
+    def __init__(self, problem: ContactProblem, builder: TraceBuilder, run: _ScipyRun) -> None:
+        super().__init__(problem, builder)
+        self.run = run
+
+    def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
+        return self.run.release_pulling(mask, t, x, v)
 
 
 ScipyBackend.run_class = _ScipyRun
