@@ -165,3 +165,25 @@ def test_hla_charts_carry_the_series_with_units():
     assert drift.ylabel == "drift per cycle (mm)"
     labels = [ax.get_ylabel() for ax in build_figure([pressure, pump]).get_axes()]
     assert "chamber pressure (MPa)" in labels and "drift per cycle (mm)" in labels
+
+
+def test_a_run_with_an_hla_figures_its_pressure_and_pump_up():
+    """`vtool solve --figure` of a train with an adjuster (presets/charts.py trace_charts): its chamber pressure
+    and pump-up charts join the run's, from the run's own series (a short closed-chamber run)."""
+    import dataclasses
+
+    from vtool.presets import PRESET_DIR, load_document, read_document
+    from vtool.presets.charts import trace_charts
+    from vtool.solvers.run import simulate
+    from vtool.solvers.studies.hla import hla_series
+
+    doc = read_document(PRESET_DIR / "ohc-finger-follower-hla.toml")
+    doc["train"]["hla"].update(check_conductance=0.0, gap=0.0)
+    spec = load_document(doc)
+    spec = dataclasses.replace(spec, run=dataclasses.replace(spec.run, cycles=0, degrees=30.0))
+    trace = simulate(spec)
+    charts = {c.title: c for c in trace_charts(trace)}
+    pressure = charts["HLA chamber pressure (MPa)"]
+    assert np.array_equal(pressure.panels[0].curves[0].y, hla_series(trace).columns["hla_pressure"])
+    assert any(title.startswith("HLA pump-up") for title in charts)
+    assert "cam drive torque (N*mm)" in charts
