@@ -8,6 +8,7 @@ blocks
   impact law) and from the quasi-static start the extremes table's variants
   use (tests/test_extremes.py ``variant()``): throw-off, first seating and its
   bounce, peak forces, largest valve coordinate, events;
+* ``limits-sane``: what every run must satisfy (tests/test_extremes.py ``assert_sane``, its bounds);
 * ``limits-default-damping``, ``limits-seat-warning``: the two preset warnings,
   with what deleting [damping] does to 1A's events and the warning 1A prints
   with its seat at -0.6 in;
@@ -112,6 +113,28 @@ def _problem(name: str):  # type: ignore[no-untyped-def]
     from vtool.solvers.model.mechanism import assemble
 
     return ContactProblem(assemble(load_preset(name)))
+
+
+def sane_block() -> str:
+    """What ``assert_sane`` (tests/test_extremes.py) checks, with its bounds."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+    from tests.test_extremes import PEAK_FRACTION, PENETRATION, PULL, SHUT, SHUT_RATE
+
+    units = load_document(_doc(None)).unit_system
+    return (f"* contacts push and never pull (contact force ≥ −{_sci(PULL)} × peak);\n"
+            f"* an open clearance is not penetrated (gap ≥ −{_sci(PENETRATION)} {units.length});\n"
+            "* a closed clearance is shut exactly: gap and gap rate zero to round-off\n"
+            f"  ({_sci(SHUT)} {units.length}, {_sci(SHUT_RATE)} {units.velocity}), computed from the trace as "
+            "q_ahead − q_behind with\n  q9 the cam and q10 the seat;\n"
+            "* every impact approaches: its relative velocity is below the resting-contact\n"
+            "  speed (a bounce is never recorded as a closing);\n"
+            "* the events chain from the start configuration to the last row's;\n"
+            "* the valve rises no higher than its highest static lift plus a throw at\n"
+            "  twice the cam's top speed (a rebound with e ≤ 1), through the rocker,\n"
+            "  against a spring–mass at the lowest natural frequency;\n"
+            f"* the peak force per clearance (over every step) is at least {100 * PEAK_FRACTION:g} % of the\n"
+            "  largest sampled force (samples are interpolated and may exceed the step\n"
+            "  values a little near the stability limit).\n")
 
 
 def default_damping_block() -> str:
@@ -240,7 +263,7 @@ def extremes_long_block() -> str:
     return _extremes().long_block()
 
 
-BLOCKS = {"limits-nominal": nominal_block, "limits-default-damping": default_damping_block,
+BLOCKS = {"limits-sane": sane_block, "limits-nominal": nominal_block, "limits-default-damping": default_damping_block,
           "limits-seat-warning": seat_warning_block, "limits-cost-text": cost_text_block,
           "limits-cost-guard": cost_guard_block, "limits-step-limits": step_limits_block,
           "limits-run-rules": run_rules_block, "limits-extremes": extremes_block}

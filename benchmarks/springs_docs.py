@@ -60,7 +60,7 @@ def pitch_table() -> str:
     spec = load_preset("nested-spring-clash")
     s = spec.springs[0]
     u = spec.unit_system
-    rows = [[str(i + 1), f"{n:g}", f"{p:g} {u.length}", f"{n * (p - s.wire_diameter):.3f} {u.length}",
+    rows = [[str(i + 1), f"{n:g}", f"{p:g} {u.length}", f"{n * (p - s.axial_wire):.3f} {u.length}",
              f"{f:.1f} {u.force}"]
             for i, (n, p, f) in enumerate(zip(s.segment_coils, s.segment_pitches, closing_forces(s), strict=True))]
     return table(["segment", "active coils", "free pitch", "coil gap n (p - d)", "closes at G d^4 (p - d)/(8 D^3)"],
@@ -78,11 +78,43 @@ def run_table() -> str:
         for r in summary["springs"]:
             fatigue = "-" if r["fatigue_factor"] is None else f"{r['fatigue_factor']:.3f}"
             clash = "-" if r.get("first_coil_bind_deg") is None else f"{r['first_coil_bind_deg']:.1f} deg"
+            peak = f"{r['coil_contact_peak_force']:.1f} {u.force}" if "coil_contact_peak_force" in r else "-"
             rows.append([f"`{name}`", r["name"], f"{r['max_stress']:.0f} {u.pressure}",
                          f"{r['last_cycle_force'][0]:.1f} .. {r['last_cycle_force'][1]:.1f} {u.force}", fatigue,
-                         f"{r['coil_bind_margin']:.3f} {u.length}", clash])
+                         f"{r['coil_bind_margin']:.3f} {u.length}", clash, peak])
     return table(["preset", "spring", "largest stress", "last cycle force", "Goodman factor", "coil-bind margin",
-                  "first coil clash"], rows)
+                  "first coil clash", "peak coil contact force"], rows)
+
+
+def contact_table() -> str:
+    """The nested preset's coil contacts: opening, block stiffness and damping, and a run's peak force on every
+    back end (the opening is each back end's own code)."""
+    from vtool.solvers.run import simulate
+
+    spec = load_preset("nested-spring-clash")
+    u = spec.unit_system
+    runs = {b: simulate(with_run_overrides(spec, backend=b)) for b in ("newmark", "exact", "scipy")}
+    rows = []
+    for i, c in enumerate(spec.clearances):
+        if "coils" not in c.name:
+            continue
+        rows.append([c.name, f"{c.opening:.3f} {u.length}", f"{c.contact_stiffness:,.0f} {u.stiffness}",
+                     f"{c.contact_damping_ratio:g}"] + [f"{runs[b].peak_force[i]:.2f} {u.force}" for b in runs])
+    return table(["clearance", "opening (coil gap)", "block stiffness", "damping ratio", "peak force newmark",
+                  "exact", "scipy"], rows)
+
+
+def strength_table() -> str:
+    from vtool.solvers.model.spring import STRENGTH_MATERIALS, fitted_strength_law
+
+    rows = []
+    for material, points in STRENGTH_MATERIALS.items():
+        A, m = fitted_strength_law(points)
+        for d, rm in points:
+            rows.append([material, f"{d:g} mm", f"{rm:g} MPa", f"{A / d ** m:.0f} MPa",
+                         f"{100.0 * (A / d ** m / rm - 1.0):+.2f} %", f"A = {A:.1f} MPa mm^m, m = {m:.4f}"])
+    return table(["material", "wire diameter (band's upper end)", "minimum R_m (sheet)", "A / d^m", "difference",
+                  "fit"], rows)
 
 
 def bind_table() -> str:
@@ -99,11 +131,13 @@ def bind_table() -> str:
 
 
 def closed_form_blocks() -> dict[str, str]:
-    return {"springs-sheets": sheet_table(), "springs-surge": surge_table(), "springs-pitch": pitch_table()}
+    return {"springs-sheets": sheet_table(), "springs-surge": surge_table(), "springs-pitch": pitch_table(),
+            "springs-strength": strength_table()}
 
 
 def blocks() -> dict[str, str]:
-    return closed_form_blocks() | {"springs-run": run_table(), "springs-bind": bind_table()}
+    return closed_form_blocks() | {"springs-run": run_table(), "springs-contacts": contact_table(),
+                                   "springs-bind": bind_table()}
 
 
 def main() -> int:

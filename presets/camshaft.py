@@ -169,11 +169,11 @@ def train_spec(path: Path, rpm: float | None) -> Any:
 
 
 def solve(camshaft: CamshaftSpec, progress: Callable[[float], None] | None = None,
-          cancel: Callable[[], bool] | None = None) -> Any:
+          cancel: Callable[[], bool] | None = None, max_steps: float | None = None) -> Any:
     """Run each distinct train once and sum the valves' torques (:func:`vtool.solvers.studies.camshaft.sum_valves`).
 
     ``progress(fraction)`` and ``cancel()`` are handed to each train's run (the TUI's worker); a cancelled run
-    returns None."""
+    returns None. ``max_steps``: each train's cost limit (``vtool solve --max-steps``; default the back end's)."""
     from vtool.solvers.run import simulate
     from vtool.solvers.studies.camshaft import sum_valves
     from vtool.solvers.studies.torque import last_revolution, row_unit, torque_rows
@@ -185,7 +185,7 @@ def solve(camshaft: CamshaftSpec, progress: Callable[[float], None] | None = Non
         spec = train_spec(path, camshaft.rpm)
         units.add(spec.units)
         share = None if progress is None else (lambda f, k=k: progress((k + f) / len(trains)))
-        trace = simulate(spec, progress=share, cancel=cancel)
+        trace = simulate(spec, progress=share, cancel=cancel, max_steps=max_steps)
         if cancel is not None and cancel():
             return None
         window = last_revolution(trace.cam_angle)

@@ -89,7 +89,7 @@ KINDS: dict[str, Kind] = {
     "camshaft": Kind("camshaft", "several valve trains on one camshaft: summed drive torque",
                      "vtool.presets.camshaft:CamshaftSpec", "vtool.presets.camshaft",
                      "vtool.app.cli.camshaft:solve_preset", "vtool.app.tui.camshaft",
-                     ("--rpm",), (("--rpm", "camshaft.rpm"),)),
+                     ("--rpm", "--max-steps"), (("--rpm", "camshaft.rpm"),)),
 }
 
 

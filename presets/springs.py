@@ -36,10 +36,12 @@ from vtool.errors import InputError
 from vtool.presets.fields import Table
 from vtool.solvers.model.spring import (
     SHEAR_RATIO,
+    STRENGTH_MATERIALS,
     SpringSpec,
     closing_forces,
+    fitted_strength_law,
+    power_law_strength,
     segment_rates,
-    wire_mass,
 )
 from vtool.units import UnitSystem
 
@@ -47,7 +49,16 @@ MAX_ELEMENTS = 64
 SPRING_KEYS = ("rate", "preload", "mass", "length", "free_length", "installed_length", "elements")
 SHEET_KEYS = ("wire_diameter", "coil_diameter", "active_coils", "total_coils", "free_length", "installed_length",
               "shear_modulus", "density", "tensile_strength", "fatigue_limit", "solid_length", "shear_ratio",
-              "segment_coils", "segment_pitches", "lengths", "forces", "elements", "inner")
+              "segment_coils", "segment_pitches", "lengths", "forces", "elements", "inner", "coil_contact", "wire_height",
+              "block_stiffness", "block_damping_ratio")
+#: A closed pitch segment's block stiffness, as a multiple of the segment's own coil rate k_i, and its
+#: dashpot as a ratio of critical on the local masses: our stand-ins (no measured block stiffness in our
+#: sources), chosen so that a closed segment is 100 times stiffer than while open (the static force-length
+#: curve then follows the pitch diagram's to within the closed segments' 1/(101 k_i)) and a coil clash
+#: rebounds with e = exp(-pi zeta / sqrt(1 - zeta^2)) = 0.73 for a lone mass. A data sheet's
+#: ``block_stiffness`` (force/length) and ``block_damping_ratio`` replace them.
+BLOCK_FACTOR = 100.0
+BLOCK_DAMPING_RATIO = 0.1
 
 
 @dataclass(frozen=True)
@@ -119,7 +130,10 @@ def read_sheet(t: Table, units: UnitSystem, name: str, coordinate: int) -> Sprin
         raise InputError(t.field("solid_length"), solid, f"< installed_length ({installed:g})", L)
     G = t.number("shear_modulus", unit=P, min_exclusive=0.0, max_value=1e16)
     rho = t.number("density", unit=units.density, min_exclusive=0.0, max_value=1e9)
-    rm = t.number("tensile_strength", unit=P, min_exclusive=0.0, max_value=1e16)
+    height = t.number("wire_height", unit=L, required=False, min_exclusive=0.0, max_value=1e3)
+    if height is not None and not 0.5 * d <= height <= 2.0 * d:
+        raise InputError(t.field("wire_height"), height, f"within 0.5 .. 2 wire_diameter ({0.5 * d:g} .. {2 * d:g})", L)
+    rm, law = tensile_strength(t, units, d)
     fatigue = t.number("fatigue_limit", unit=P, required=False, min_exclusive=0.0, max_value=1e16)
     if fatigue is not None and fatigue > rm:
         raise InputError(t.field("fatigue_limit"), fatigue, f"<= tensile_strength ({rm:g})", P)
@@ -134,8 +148,9 @@ def read_sheet(t: Table, units: UnitSystem, name: str, coordinate: int) -> Sprin
                              f"as many entries as segment_coils ({len(coils)}), 1 to {MAX_ELEMENTS}")
         if any(c <= 0.0 for c in coils) or abs(sum(coils) - n_a) > 1e-9 * n_a:
             raise InputError(t.field("segment_coils"), list(coils), f"positive, summing to active_coils ({n_a:g})")
-        if any(p <= d for p in pitches):
-            raise InputError(t.field("segment_pitches"), list(pitches), f"each > wire_diameter ({d:g})", L)
+        axial = d if height is None else height
+        if any(p <= axial for p in pitches):
+            raise InputError(t.field("segment_pitches"), list(pitches), f"each > the wire's axial size ({axial:g})", L)
     lengths: tuple[float, ...] = ()
     forces: tuple[float, ...] = ()
     if t.has("lengths") or t.has("forces"):
@@ -151,7 +166,30 @@ def read_sheet(t: Table, units: UnitSystem, name: str, coordinate: int) -> Sprin
         if coils:
             raise InputError(t.field("lengths"), list(lengths), "a table or a pitch diagram, not both")
     return SpringSpec(name, d, D, n_a, n_t, free, installed, G, rho, rm, coordinate, fatigue, solid, ratio,
-                      coils, pitches, lengths, forces)
+                      coils, pitches, lengths, forces, wire_height=height, strength_law=law)
+
+
+def tensile_strength(t: Table, units: UnitSystem, d: float) -> tuple[float, tuple[float, float] | None]:
+    """``tensile_strength``: a number (the preset's pressure unit), or R_m = A / d^m at the wire's diameter:
+    a material of :data:`vtool.solvers.model.spring.STRENGTH_MATERIALS` ("VDSiCrV": A, m fitted to its table,
+    within the table's diameters), or ``{A = ..., m = ...}`` (A in MPa mm^m, d in mm). Returns (R_m, (A, m))."""
+    raw = t.raw("tensile_strength")
+    if not isinstance(raw, str | dict):
+        return t.number("tensile_strength", unit=units.pressure, min_exclusive=0.0, max_value=1e16), None
+    d_mm = d * units.metres_per_length * 1e3
+    if isinstance(raw, str):
+        table = STRENGTH_MATERIALS[t.string("tensile_strength", choices=tuple(STRENGTH_MATERIALS))]
+        low, high = table[0][0], table[-1][0]
+        if not low - 0.3 <= d_mm <= high:
+            raise InputError(t.field("wire_diameter"), d, f"within {low - 0.3:g} .. {high:g} mm for the "
+                             f"tensile strength law of {raw} (its table's diameters)", units.length)
+        A, m = fitted_strength_law(table)
+    else:
+        law = t.table("tensile_strength")
+        A = law.number("A", unit="MPa*mm^m", min_exclusive=0.0, max_value=1e6)
+        m = law.number("m", min_value=0.0, max_value=1.0)
+        law.finish()
+    return power_law_strength(A, m, d_mm) * 1e6 / units.pascals_per_pressure, (A, m)
 
 
 def sheet_spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
@@ -167,6 +205,7 @@ def sheet_spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
     springs = [(t, "valve_spring")] + ([(inner_t, "inner_spring")] if inner_t is not None else [])
     members: dict[str, dict[str, Any]] = {}
     coordinates: list[dict[str, Any]] = []
+    clearances: list[dict[str, Any]] = []
     sheets: list[dict[str, Any]] = []
     preload = rate = 0.0
     for table, name in springs:
@@ -176,6 +215,10 @@ def sheet_spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
                              "a length at which no pitch segment is closed yet (the model's segments are linear "
                              "bars)", units.length)
         elements = table.integer("elements", default=1, min_value=1, max_value=MAX_ELEMENTS)
+        contact = table.string("coil_contact", default="linear", choices=("linear", "none"))
+        block = table.number("block_stiffness", unit=units.stiffness, required=False, min_exclusive=0.0,
+                             max_value=1e13)
+        ratio = table.number("block_damping_ratio", default=BLOCK_DAMPING_RATIO, min_value=0.0, max_value=10.0)
         table.finish()
         x = position[0] + (0.0 if name == "valve_spring" else 0.05 * spec.installed_length)
         base = (x, position[1] - spec.installed_length)
@@ -186,13 +229,17 @@ def sheet_spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
                 coordinates.append({"name": f"{name} coil node {i + 1}", "motion": "translation"})
                 nodes.append(first_new + len(coordinates) - 1)
             nodes.append(end)
+            if contact == "linear":
+                made = coil_contacts(spec, nodes, block, ratio)
+                clearances += made
+                spec = replace(spec, contacts=tuple(c["name"] for c in made))
             spec = replace(spec, nodes=tuple(nodes[1:-1]))
             share = spec.installed_length / spec.active_coils
             below = 0.0
             for i, (n_i, k_i) in enumerate(zip(spec.segment_coils, rates, strict=True)):
                 members[f"{name}_{i + 1}"] = {
                     "element": "bar", "length": n_i * share, "stiffness": float(k_i),
-                    "mass": wire_mass(spec.density, spec.wire_diameter, spec.coil_diameter, n_i),
+                    "mass": spec.wire_mass(n_i),
                     "coordinates": [nodes[i], nodes[i + 1]], "position": [base[0], base[1] + below],
                     "direction": 90.0}
                 below += n_i * share
@@ -207,14 +254,30 @@ def sheet_spring_model(t: Table, units: UnitSystem, end: int, first_new: int,
         rate += spec.rate
         sheets.append(sheet_document(spec))
     t.finish()
-    return SpringModel(members, preload, rate, coordinates, [], sheets)
+    return SpringModel(members, preload, rate, coordinates, clearances, sheets)
+
+
+def coil_contacts(spec: SpringSpec, nodes: list[int], block: float | None, ratio: float) -> list[dict[str, Any]]:
+    """One compliant clearance per pitch segment: its coils touch when the segment's compression
+    q_top - q_bottom reaches its free coil gap n_i (p_i - d) (the bars are unloaded at q = 0, and a train's
+    spring end moves with the valve's lift, so compression is positive), i.e. the clearance
+    ``ahead`` = top node, ``behind`` = bottom node (0: the ground under the first segment), ``sense`` = -1,
+    ``opening`` = n_i (p_i - d). Closed, a spring of ``block`` (default BLOCK_FACTOR k_i) and a dashpot of
+    ``ratio`` of critical act across the segment (module constants)."""
+    rates = segment_rates(spec)
+    gaps = np.asarray(spec.segment_coils) * (np.asarray(spec.segment_pitches) - spec.axial_wire)
+    return [{"name": f"{spec.name} coils {i + 1}", "ahead": nodes[i + 1], "behind": nodes[i],
+             "kind": "internal" if nodes[i] else "external", "state": "enabled", "restitution": 0.0,
+             "contact": "linear", "contact_stiffness": float(block if block is not None else BLOCK_FACTOR * k_i),
+             "contact_damping_ratio": ratio, "opening": float(gap), "sense": -1}
+            for i, (k_i, gap) in enumerate(zip(rates, gaps, strict=True))]
 
 
 def sheet_document(spec: SpringSpec) -> dict[str, Any]:
     """The explicit form's ``[[springs]]`` entry of a data sheet (read back by :func:`load_sheets`)."""
     doc: dict[str, Any] = {"name": spec.name, "coordinate": spec.coordinate}
     for key in ("wire_diameter", "coil_diameter", "active_coils", "total_coils", "free_length", "installed_length",
-                "shear_modulus", "density", "tensile_strength", "fatigue_limit", "shear_ratio"):
+                "shear_modulus", "density", "tensile_strength", "fatigue_limit", "shear_ratio", "wire_height"):
         value = getattr(spec, key)
         if value is not None:
             doc[key] = value
@@ -223,6 +286,8 @@ def sheet_document(spec: SpringSpec) -> dict[str, Any]:
     if spec.segment_coils:
         doc["segment_coils"], doc["segment_pitches"] = list(spec.segment_coils), list(spec.segment_pitches)
         doc["nodes"] = list(spec.nodes)
+        if spec.contacts:
+            doc["contacts"] = list(spec.contacts)
     if spec.table_lengths:
         doc["lengths"], doc["forces"] = list(spec.table_lengths), list(spec.table_forces)
     return doc
@@ -248,6 +313,14 @@ def load_sheets(top: Table, units: UnitSystem, n: int) -> tuple[SpringSpec, ...]
             if len(nodes) != len(sheet.segment_coils) - 1 or any(k != int(k) or not 1 <= k <= n for k in nodes):
                 raise InputError(t.field("nodes"), nodes, f"{len(sheet.segment_coils) - 1} coordinates in 1 .. {n}")
             sheet = replace(sheet, nodes=tuple(int(k) for k in nodes))
+            if t.has("contacts"):
+                names = [c.get("name") for c in top.raw("clearances") or [] if isinstance(c, dict)]
+                contacts = t.raw("contacts")
+                if (not isinstance(contacts, list) or len(contacts) != len(sheet.segment_coils)
+                        or not all(isinstance(x, str) and x in names for x in contacts)):
+                    raise InputError(t.field("contacts"), t.raw("contacts"),
+                                     f"{len(sheet.segment_coils)} clearance names (one per pitch segment)")
+                sheet = replace(sheet, contacts=tuple(contacts))
         result.append(sheet)
         t.finish()
     return tuple(result)
@@ -258,7 +331,9 @@ def describe(spec: SpringSpec, units: UnitSystem) -> str:
     f = spec.surge_frequencies(1)[0]
     return (f"{spec.name}: rate {spec.rate:.5g} {units.stiffness}, active mass {spec.active_mass:.4g} {units.mass} "
             f"(whole wire {spec.total_mass:.4g}), installed preload {spec.preload:.5g} {units.force}, "
-            f"solid length {spec.solid_length:.4g} {units.length}, first surge {f:.5g} Hz")
+            f"solid length {spec.solid_length:.4g} {units.length}, first surge {f:.5g} Hz"
+            + (f", tensile strength {spec.tensile_strength:.5g} {units.pressure} (R_m = {spec.strength_law[0]:.5g} / "
+               f"d^{spec.strength_law[1]:.4g}, MPa and mm)" if spec.strength_law else ""))
 
 
 def describe_document(explicit: dict[str, Any]) -> list[str]:

@@ -62,6 +62,7 @@ Types and the clearance names [damping] may use:
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -80,7 +81,7 @@ CENTRE_PIVOT_ROCKER = "centre-pivot-rocker"
 TYPES = (OHV_PUSHROD, DIRECT_ACTING, FINGER_FOLLOWER, CENTRE_PIVOT_ROCKER)
 
 #: top-level tables a train builds (refused beside [train])
-BUILT = ("coordinates", "members", "cam", "seat", "clearances", "follower")
+BUILT = ("coordinates", "members", "cam", "seat", "clearances", "follower", "hla")
 SECTION_KEYS = ("diameter", "area", "inertia", "modulus", "specific_weight", "density", "mass", "stiffness",
                 "elements")
 LAWS = ("harmonic", "table", "polydyne")
@@ -288,18 +289,47 @@ def direct_acting(train: Table, units: UnitSystem, folder: Path | None) -> dict[
             "follower_kind": "flat"}
 
 
+def hla_pivot(train: Table, units: UnitSystem, length: float) -> tuple[dict[str, Any], dict[str, Any]] | None:
+    """``[train.hla]``: the adjuster under a pivot (None without one): the pivot member (the closed chamber's
+    stiffness K_oil(p_s) A²/V₀ of the oil alone at the supply pressure, the stiffness the loaded adjuster
+    approaches as its air compresses away; the plunger's mass) and the explicit ``[hla]`` table on it
+    (:mod:`vtool.presets.hla`)."""
+    t = train.table("hla", required=False)
+    if t is None:
+        return None
+    from vtool.presets.hla import read_data
+    from vtool.solvers.model.hla import closed_stiffness
+
+    mass = t.number("plunger_mass", unit=units.mass, min_exclusive=0.0, max_value=1e9)
+    spec, _, given = read_data(t, units)
+    t.finish()
+    oil = dataclasses.replace(spec, air_fraction=0.0)
+    stiffness = closed_stiffness(oil, spec.supply_pressure) * units.metres_per_length / units.newtons_per_force
+    member = {"stiffness": stiffness, "mass": mass}
+    return member, {"member": "pivot", "sense": "compression"} | given
+
+
 def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dict[str, Any]:
     """End-pivot roller finger: pivot support, two beams (pivot-roller, roller-pad), valve (module doc)."""
-    finger_t, pivot_t, valve_t = _part(train, "finger"), _part(train, "pivot"), _part(train, "valve")
+    finger_t, valve_t = _part(train, "finger"), _part(train, "valve")
     geometry = _lever(finger_t, units)
     a, b = geometry["roller_arm"], geometry["valve_arm"]
     finger = _section(finger_t, units, "beam")
-    pivot = {"mass": pivot_t.number("mass", unit=units.mass, min_exclusive=0.0, max_value=1e9),
-             "stiffness": pivot_t.number("stiffness", unit=units.stiffness, min_exclusive=0.0, max_value=1e16)}
-    pivot_length = _length(pivot_t, "length", units, default=0.5 * a)
+    adjuster = hla_pivot(train, units, 0.5 * a)
+    if adjuster is not None:
+        if train.has("pivot"):
+            raise InputError(train.field("pivot"), "given", "no [train.pivot] beside [train.hla] (the adjuster is "
+                             "the pivot: its plunger_mass and closed chamber)")
+        pivot, pivot_length = adjuster[0], 0.5 * a
+    else:
+        pivot_t = _part(train, "pivot")
+        pivot = {"mass": pivot_t.number("mass", unit=units.mass, min_exclusive=0.0, max_value=1e9),
+                 "stiffness": pivot_t.number("stiffness", unit=units.stiffness, min_exclusive=0.0, max_value=1e16)}
+        pivot_length = _length(pivot_t, "length", units, default=0.5 * a)
+        pivot_t.finish()
     valve_length = _length(valve_t, "length", units)
     valve = _section(valve_t, units, "bar")
-    for t in (finger_t, pivot_t, valve_t):
+    for t in (finger_t, valve_t):
         t.finish()
     spring = spring_model(_part(train, "spring"), units, 7, 9, (b, 0.0))
     coordinates = _coordinates(
@@ -317,7 +347,7 @@ def finger_follower(train: Table, units: UnitSystem, folder: Path | None) -> dic
             "clearances": [_clearance("cam", 3, n + 1, "external"), _clearance("pad", 7, 5, "internal"),
                            _clearance("seat", 8, n + 2, "external")] + spring.clearances,
             "closed": ["cam", "pad"], "preload": spring.preload, "springs": spring.sheets, "ratio": b / a, "follower_kind": "roller",
-            "finger": geometry, "arrangement": "finger"}
+            "finger": geometry, "arrangement": "finger"} | ({"hla": adjuster[1]} if adjuster is not None else {})
 
 
 def _lever(t: Table, units: UnitSystem) -> dict[str, float]:
@@ -401,6 +431,8 @@ def expand(doc: dict[str, Any], folder: Path | None = None) -> dict[str, Any]:
     if built["springs"]:
         explicit["springs"] = built["springs"]
     explicit["initial"] = _initial(doc, built["closed"], built["preload"], built["ratio"])
+    if "hla" in built:
+        explicit["hla"] = built["hla"]
     if follower is not None:
         explicit["follower"] = follower
     return explicit

@@ -161,6 +161,18 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
     from vtool.presets.springs import load_sheets
 
     springs = load_sheets(top, units, n)
+    hla_table = top.table("hla", required=False)
+    hla = None
+    if hla_table is not None:
+        from vtool.presets.hla import load_hla
+
+        hla = load_hla(hla_table, units, members)
+    forces_table = top.table("valve_forces", required=False)
+    valve_forces = None
+    if forces_table is not None:
+        from vtool.presets.valveforces import load_valve_forces
+
+        valve_forces = load_valve_forces(forces_table, units, n)
     run = _run(top.table("run"), _quantity_names(coordinates, cam, seat, clearances), units)
     top.finish()
     spec = MechanismSpec(
@@ -181,6 +193,8 @@ def load(doc: dict[str, Any], folder: Path | None = None) -> MechanismSpec:
         checks=checks,
         springs=springs,
         train=train,
+        hla=hla,
+        valve_forces=valve_forces,
     )
     spec = split_members(spec)
     if spec.seat is not None and spec.seat.lash is not None:  # the split seat: its coordinate may have moved up
@@ -237,6 +251,20 @@ def _compliance(t: Table, state: str, units: UnitSystem) -> dict[str, Any]:
     return result
 
 
+def _opening(t: Table, behind: int, units: UnitSystem) -> dict[str, Any]:
+    """A clearance's ``opening`` and ``sense`` (gap = sense (q[ahead] - q[behind]) + opening; see
+    ClearanceSpec): a compliant contact's only, as is the ground (behind = 0)."""
+    opening = t.number("opening", unit=units.length, default=0.0, min_value=-1e4, max_value=1e4)
+    sense = t.integer("sense", default=1, min_value=-1, max_value=1)
+    if sense == 0:
+        raise InputError(t.field("sense"), sense, "1 or -1")
+    if (opening != 0.0 or sense != 1 or behind == 0) and t.raw("contact") in (None, RIGID):
+        key = "opening" if opening != 0.0 else "sense" if sense != 1 else "behind"
+        raise InputError(t.field(key), t.raw(key), 'its default for a rigid contact (an opening, sense -1 or the '
+                         'ground (behind = 0) need contact = "linear" or "hertz")')
+    return ({"opening": opening} if opening else {}) | ({"sense": sense} if sense != 1 else {})
+
+
 def _contact(t: Table | None) -> ContactSpec:
     """[contact]: the default impact law and the thesis' SCALE (eq. 3.54)."""
     if t is None:
@@ -248,7 +276,8 @@ def _contact(t: Table | None) -> ContactSpec:
 
 
 TOP_KEYS = ("kind", "title", "notes", "units", "gravity", "coordinates", "members", "cam", "seat",
-            "clearances", "initial", "contact", "damping", "run", "follower", "checks", "springs")
+            "clearances", "initial", "contact", "damping", "run", "follower", "checks", "springs", "hla",
+            "valve_forces")
 
 
 def _magnitude(t: Table, key: str, unit: str, what: str, *, default: float | None = None,
@@ -465,7 +494,7 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int,
         kind = t.string("kind", choices=(EXTERNAL, INTERNAL))
         ahead = _coordinate_ref(t, "ahead", elastic, "elastic coordinates")
         if kind == EXTERNAL:
-            behind = _coordinate_ref(t, "behind", prescribed, "prescribed coordinates (cam, seat)")
+            behind = _coordinate_ref(t, "behind", prescribed | {0}, "prescribed coordinates (cam, seat) or 0 (ground)")
         else:
             behind = _coordinate_ref(t, "behind", elastic - {ahead}, "other elastic coordinates")
         state = t.string("state", default=ENABLED, choices=(ENABLED, PINNED, REMOVED))
@@ -473,7 +502,7 @@ def _clearances(top: Table, n: int, prescribed: set[int], cam_coordinate: int,
             raise InputError(t.field("state"), state, "enabled or removed for an external clearance")
         restitution = t.number("restitution", default=0.0, min_value=0.0, max_value=1.0)
         impact = t.string("impact", choices=IMPACT_LAWS) if t.raw("impact") is not None else None
-        contact = _compliance(t, state, units)
+        contact = _compliance(t, state, units) | _opening(t, behind, units)
         if contact.get("contact") == HERTZ and not check_restitution(restitution):
             raise InputError(t.field("restitution"), restitution,
                              f">= {MIN_RESTITUTION} and <= 1 for a hertz contact (Hunt-Crossley damping gives e = 0 "
@@ -671,7 +700,7 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
     doc["clearances"] = [
         {"name": c.name, "ahead": c.ahead, "behind": c.behind, "kind": c.kind,
          "state": c.state, "restitution": c.restitution} | ({"impact": c.impact} if c.impact else {})
-        | _compliance_doc(c)
+        | _compliance_doc(c) | ({"opening": c.opening} if c.opening else {}) | ({"sense": c.sense} if c.sense != 1 else {})
         for c in spec.clearances
     ]
     doc["initial"] = {
@@ -703,10 +732,18 @@ def dump(spec: MechanismSpec) -> dict[str, Any]:
         from vtool.presets.springs import sheet_document
 
         doc["springs"] = [sheet_document(s) for s in spec.springs]
+    if spec.hla is not None:
+        from vtool.presets.hla import dump_hla
+
+        doc["hla"] = dump_hla(spec.hla)
+    if spec.valve_forces is not None:
+        from vtool.presets.valveforces import dump_valve_forces
+
+        doc["valve_forces"] = dump_valve_forces(spec.valve_forces)
     return train_document(given, doc) or doc
 
 
-TRAIN_KEEPS = ("kind", "title", "notes", "units", "gravity", "contact", "damping", "run", "checks")
+TRAIN_KEEPS = ("kind", "title", "notes", "units", "gravity", "contact", "damping", "run", "checks", "valve_forces")
 
 
 def train_document(spec: MechanismSpec, explicit: dict[str, Any]) -> dict[str, Any] | None:

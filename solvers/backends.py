@@ -11,7 +11,11 @@ The contract every back end follows (subclass :class:`Backend`)
    steps, its step may be bounded by :meth:`Backend.stable_step`);
    ``reference`` (its events are located on the exact solution: the
    reference of accuracy studies); ``library_dependent`` (its last bits
-   follow the numerical libraries' versions and BLAS kernels).
+   follow the numerical libraries' versions and BLAS kernels);
+   ``nonlinear_elements`` (it runs the nonlinear elements of
+   :mod:`vtool.solvers.model.nonlinear`: an HLA, friction and gas forces on the
+   motion; :meth:`Backend.simulate` refuses a preset with one on a back end
+   without the flag, in one line naming the field and the back ends that run it).
    Other modules ask the registry (:func:`available`, :func:`get`,
    :func:`with_flag`) and these flags, and never name a back end.
 2. ``options_from_run(run: RunSpec, every_step: bool) -> Options``: the back
@@ -159,6 +163,7 @@ class Backend(ABC, Generic[OptionsT]):
     fixed_step: ClassVar[bool] = False
     reference: ClassVar[bool] = False
     library_dependent: ClassVar[bool] = False
+    nonlinear_elements: ClassVar[bool] = False
     #: the cost guard's default step limit for this back end (None: vtool.solvers.cost.MAX_STEPS)
     max_steps: ClassVar[float | None] = None
     #: what to try when a run's result is not to be trusted (the trace's warnings say it)
@@ -196,6 +201,18 @@ class Backend(ABC, Generic[OptionsT]):
     def check(self, mechanism: Mechanism, options: OptionsT) -> None:  # noqa: B027 (optional hook)
         """Raise InputError for settings the user can fix (default: none to check)."""
 
+    @classmethod
+    def refuse_elements(cls, spec: MechanismSpec) -> None:
+        """One line (InputError) if ``spec`` has nonlinear elements and this back end does not take them."""
+        if cls.nonlinear_elements:
+            return
+        from vtool.solvers.model.nonlinear import element_fields
+
+        fields = element_fields(spec)
+        if fields:
+            raise InputError("run.backend", cls.name, f"a back end that runs nonlinear elements "
+                             f"({', '.join(with_flag('nonlinear_elements'))}) for a preset with [{fields[0]}]")
+
     def event_rules(self, options: OptionsT) -> EventRules | None:
         """The settings of the shared event rules from the options (None: the defaults)."""
         return None
@@ -211,6 +228,7 @@ class Backend(ABC, Generic[OptionsT]):
         from vtool.solvers.trace import RunStatistics, TraceBuilder
         from vtool.threads import limited
 
+        self.refuse_elements(mechanism.spec)
         options = options if options is not None else self.default_options(mechanism)
         self.check(mechanism, options)
         rules = self.event_rules(options) or EventRules()

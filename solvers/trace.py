@@ -162,6 +162,8 @@ class Trace:
     peak_force_after_first_revolution: np.ndarray | None = None  # per clearance, over every step
     peak_overlap: np.ndarray | None = None  # per clearance, largest overlap of a compliant contact
     cycles: Cycles | None = None  # a run cycle by cycle (run.cycles, run.steady): how it went
+    #: rows x states of the nonlinear elements (solvers/model/nonlinear.py; None: a linear model)
+    states: np.ndarray | None = None
 
     # ----- results that should not be trusted -----
     def tensile_forces(self) -> np.ndarray:
@@ -208,7 +210,7 @@ class Trace:
         return next(i for i, c in enumerate(self.spec.clearances) if c.behind == self.spec.cam.coordinate)
 
     def force_label(self, index: int) -> str:
-        return f"F{self.spec.clearances[index].ahead}"
+        return self.spec.force_label(index)
 
     def force(self, label_or_name: str, rows: slice = slice(None)) -> np.ndarray:
         for i, c in enumerate(self.spec.clearances):
@@ -225,6 +227,12 @@ class Trace:
             return self.coordinate(int(match[1]), rows)
         if re.fullmatch(r"F\d+", text):
             return self.force(text, rows)
+        if self.spec.springs:  # a data-sheet spring's end force (solvers/model/spring.py)
+            from vtool.solvers.model.spring import end_force, force_quantity
+
+            for spring in self.spec.springs:
+                if text == force_quantity(spring):
+                    return end_force(spring, self, rows)
         raise KeyError(expression)
 
     def coordinate_unit(self, number: int) -> str:
@@ -235,7 +243,7 @@ class Trace:
 
     def quantity_unit(self, expression: str) -> str:
         text = expression.replace(" ", "")
-        if text.startswith("F"):
+        if text.startswith("F") or text.endswith("_force"):
             return self.spec.unit_system.force
         return self.coordinate_unit(int(re.findall(r"\d+", text)[0]))
 
@@ -282,6 +290,12 @@ class Trace:
         if self.valve_coordinate() is not None:
             header.append(f"valve_lift ({units.length})")
             columns.append(self.valve_lift)
+        if self.spec.springs:  # each data-sheet spring's force on its end (spring.end_force)
+            from vtool.solvers.model.spring import force_quantity
+
+            for name in map(force_quantity, self.spec.springs):
+                header.append(f"{name} ({units.force})")
+                columns.append(lambda rows, name=name: self.quantity(name, rows))
         names = {h.rpartition(" (")[0] for h in header}
         for expression in quantities:
             name = expression.replace(" ", "")
@@ -314,7 +328,38 @@ class Trace:
                 for k, name in enumerate(("valve_guide_friction_force", "valve_guide_friction_power")):
                     header.append(f"{name} ({torque.row_unit(self.spec, name.removeprefix('valve_guide_'))})")
                     columns.append(lambda rows, k=k: torque.guide_rows(self.spec, self.qd[rows, j])[k])
+        for name, unit, column in self.element_columns():
+            header.append(f"{name} ({unit})")
+            columns.append(column)
         return header + ["configuration", "closed"], columns
+
+    def element_columns(self) -> list[tuple[str, str, Any]]:
+        """(name, unit, values on a slice of rows) of every nonlinear element's output column (an HLA's
+        chamber pressure, plunger extension, flows: solvers/model/nonlinear.py)."""
+        if self.states is None:
+            return []
+        from vtool.solvers.model.attached import elements_of
+
+        elements = elements_of(self.spec)
+        n = self.spec.n_coordinates
+        result = []
+        for element, part in zip(elements.elements, elements.slices, strict=True):
+            def values(rows, element=element, part=part):  # noqa: ANN001, ANN202 (a slice; all columns)
+                return element.columns(self.time[rows], self.q[rows, :n].T, self.qd[rows, :n].T,
+                                       self.states[rows, part].T)
+            for index, (name, unit, _) in enumerate(values(slice(0, 1))):
+                result.append((name, unit, lambda rows, values=values, index=index: values(rows)[index][2]))
+        return result
+
+    def element_summary(self) -> dict:
+        """Each nonlinear element's summary entry, by its key (``hla``)."""
+        if self.states is None or not len(self.time):
+            return {}
+        from vtool.solvers.model.attached import elements_of
+
+        elements = elements_of(self.spec)
+        return {element.key: element.summary(self, self.states[:, part].T)
+                for element, part in zip(elements.elements, elements.slices, strict=True)}
 
     def configuration_csv(self, mask: int) -> str:
         """The last two CSV columns of a configuration: its thesis number (or nothing) and closed clearances."""
@@ -444,7 +489,7 @@ class Trace:
             if not c.rigid and self.peak_overlap is not None:
                 entry["peak_overlap"] = float(self.peak_overlap[i])
                 entry["peak_overlap_unit"] = units.length
-            if c.kind == EXTERNAL and c.behind != self.spec.cam.coordinate:
+            if c.kind == EXTERNAL and c.behind not in (self.spec.cam.coordinate, 0):  # 0: the ground (a coil)
                 entry["seating_velocities"] = [-e.relative_velocity for e in impacts]
                 entry["seating_velocity_unit"] = units.velocity
                 entry["bounces_per_revolution"] = self.bounces_per_revolution(c.name)
@@ -506,6 +551,7 @@ class Trace:
             from vtool.solvers.model.spring import run_report
 
             result["springs"] = run_report(self.spec.springs, self)
+        result |= self.element_summary()
         if self.spec.checks:
             from vtool.solvers.studies.checks import evaluate
 
@@ -559,6 +605,12 @@ class Trace:
             from vtool.solvers.studies.torque import torque_text
 
             lines += torque_text(s["cam_torque"])
+        if self.states is not None:
+            from vtool.solvers.model.attached import elements_of
+
+            for element in elements_of(self.spec).elements:
+                if element.key in s:
+                    lines += element.summary_text(s[element.key])
         if "springs" in s:
             from vtool.solvers.model.spring import report_text
 
@@ -658,10 +710,13 @@ class TraceBuilder:
     def __init__(self, spec: MechanismSpec, source_numbers: tuple[int, ...], omega: float,
                  stream: CsvStream | None = None) -> None:
         self.spec = spec
-        self.source_numbers = tuple(source_numbers)
+        # the unit source (number 0: the constant of clearances with an opening) is no output column: it is
+        # the last source, and its column is cut from every block (add_rows)
+        self.source_numbers = tuple(number for number in source_numbers if number != 0)
         self.omega = omega
         self.stream = stream
         self.blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self.state_blocks: list[np.ndarray] = []  # the nonlinear elements' states, block by block (if any)
         self.events: list[Event] = []
         self.numbers = tuple(range(1, spec.n_coordinates + 1)) + self.source_numbers
         self.out_dt = spec.run.output_interval * math.pi / 180.0 / omega if omega > 0 else math.inf
@@ -671,11 +726,12 @@ class TraceBuilder:
                       if c.kind == EXTERNAL and c.behind != spec.cam.coordinate
                       and c.ahead in self.numbers and c.behind in self.numbers]
 
-    def block_trace(self, t: np.ndarray, q3: np.ndarray, F: np.ndarray, cfg: np.ndarray) -> Trace:
+    def block_trace(self, t: np.ndarray, q3: np.ndarray, F: np.ndarray, cfg: np.ndarray,
+                    states: np.ndarray | None = None) -> Trace:
         """A Trace of one block of rows (no events or statistics): what the CSV writer reads."""
         empty = RunStatistics("", 0, 0, 0.0, ())
         return Trace(self.spec, t, cam_angle_deg(t, self.omega), self.numbers, q3[:, 0], q3[:, 1], q3[:, 2], F,
-                     cfg, (), np.zeros(len(self.spec.clearances)), empty)
+                     cfg, (), np.zeros(len(self.spec.clearances)), empty, states=states)
 
     def thinned(self, t: np.ndarray, q3: np.ndarray, cfg: np.ndarray) -> np.ndarray:
         """The rows of a block a thinning stream keeps (see :class:`CsvStream`), as a boolean mask."""
@@ -696,16 +752,22 @@ class TraceBuilder:
             keep[at_top[np.unique(stretch[at_top], return_index=True)[1]]] = True
         return keep
 
-    def add_rows(self, t: np.ndarray, q3: np.ndarray, F: np.ndarray, cfg: np.ndarray, copy: bool = True) -> None:
+    def add_rows(self, t: np.ndarray, q3: np.ndarray, F: np.ndarray, cfg: np.ndarray, copy: bool = True,
+                 states: np.ndarray | None = None) -> None:
         """Take a block of rows. ``copy=False``: the caller never writes these arrays again, so the
-        builder keeps them as they are (and the trace may too, see :meth:`build`)."""
+        builder keeps them as they are (and the trace may too, see :meth:`build`). ``states``: the
+        nonlinear elements' states at the rows (rows x states), from a back end that takes elements."""
         if not len(t):
             return
+        q3 = q3[:, :, :len(self.numbers)]
         if self.stream is not None:
-            self.stream.write(self.block_trace(t, q3, F, cfg))
+            self.stream.write(self.block_trace(t, q3, F, cfg, states))
             if self.stream.thin:
                 keep = self.thinned(t, q3, cfg)
                 t, q3, F, cfg = t[keep], q3[keep], F[keep], cfg[keep]
+                states = None if states is None else states[keep]
+        if states is not None:
+            self.state_blocks.append(np.array(states, dtype=float))
         how = True if copy else None  # None: a copy only where numpy must make one (another dtype)
         self.blocks.append((np.array(t, dtype=float, copy=how), np.array(q3, dtype=float, copy=how),
                             np.array(F, dtype=float, copy=how), np.array(cfg, dtype=np.int64, copy=how)))
@@ -743,6 +805,8 @@ class TraceBuilder:
         n = self.spec.n_coordinates + len(self.source_numbers)
         ncl = len(self.spec.clearances)
         rows = sum(len(b[0]) for b in self.blocks)
+        states = np.concatenate(self.state_blocks) if self.state_blocks else None
+        self.state_blocks = []
         if len(self.blocks) == 1:  # the block's own arrays (a copy only where one is not contiguous)
             bt, bq, bF, bc = self.blocks.pop()
             t, F, cfg = np.ascontiguousarray(bt), np.ascontiguousarray(bF), np.ascontiguousarray(bc)
@@ -764,9 +828,11 @@ class TraceBuilder:
                 raise RunError("this back end hands rows over out of time order: its CSV cannot be streamed")
             order = np.argsort(t, kind="stable")
             t, q, qd, qdd, F, cfg = t[order], q[order], qd[order], qdd[order], F[order], cfg[order]
+            states = None if states is None else states[order]
         if self.stream is not None and not self.stream.header_written:  # a run without rows: the header alone
             self.stream.write(self.block_trace(t, np.zeros((0, 3, n)), F, cfg))
         return Trace(self.spec, t, cam_angle_deg(t, self.omega), self.numbers, q, qd, qdd, F, cfg,
                      tuple(self.events), np.array(peak, dtype=float), statistics,
                      peak_force_after_first_revolution=None if peak_late is None else np.array(peak_late),
-                     peak_overlap=None if peak_overlap is None else np.array(peak_overlap, dtype=float))
+                     peak_overlap=None if peak_overlap is None else np.array(peak_overlap, dtype=float),
+                     states=states)

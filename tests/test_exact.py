@@ -284,3 +284,35 @@ def test_the_documented_1a_figures_are_regenerated() -> None:
     trace = ExactBackend().simulate(assemble(load_preset("gnilka-1a")))
     peaks = ", ".join(f"{p:.4f}" for p in trace.peak_force)
     assert first[4:7] == [str(trace.statistics.steps), str(trace.statistics.events), peaks]
+
+
+@pytest.mark.parametrize("name", ["exact", "scipy"])
+def test_piecewise_back_ends_take_the_event_rules_from_transitions(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The piecewise back ends keep no event or impact rules of their own (issue 36): every event of a
+    1A run goes through the contact problem's Transitions (one rule, one place), and the run's events
+    are the Newmark kernel's rules' (59, the thesis preset's count, docs/valvetrain.md)."""
+    from vtool.solvers import backends
+    from vtool.solvers.exact import piecewise
+    from vtool.solvers.model.contact import Transitions
+
+    assert not hasattr(piecewise.PiecewiseRun, "apply_events") and not hasattr(piecewise.PiecewiseRun, "settle")
+    calls = {"start": 0, "apply": 0}
+    start, apply = Transitions.start, Transitions.apply
+
+    def counted_start(self: Transitions):  # noqa: ANN202
+        calls["start"] += 1
+        return start(self)
+
+    def counted_apply(self: Transitions, *args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+        calls["apply"] += 1
+        return apply(self, *args, **kwargs)
+
+    monkeypatch.setattr(Transitions, "start", counted_start)
+    monkeypatch.setattr(Transitions, "apply", counted_apply)
+    spec = load_preset("gnilka-1a")
+    backend = backends.get(name)()
+    trace = backend.simulate(assemble(spec), backend.options_from_run(spec.run))
+    assert len(trace.events) == 59
+    # one call per event instant (an impact and the release it causes share one)
+    assert calls["start"] == 1 and 0 < calls["apply"] <= len(trace.events)
+    assert calls["apply"] == len({e.time for e in trace.events if e.time > 0.0})

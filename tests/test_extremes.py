@@ -55,6 +55,13 @@ FOLLOWER, VALVE, SPRING_END, CAM, SEAT = 1, 7, 4, 9, 10  # coordinate numbers (q
 PENETRATION = 1e-8
 #: a closed gap is the same number on both sides (tied or prescribed), so zero to round-off
 SHUT = 1e-12
+#: ... and its rate (length/s) zero to round-off too
+SHUT_RATE = 1e-6
+#: a contact force may be this fraction of the run's peak force below zero (round-off): it never pulls
+PULL = 1e-6
+#: the peak force (over every step) is at least this fraction of the largest sampled force (samples
+#: are interpolated inside the steps and may exceed the step values a little at the stability limit)
+PEAK_FRACTION = 0.9
 #: wall time after which a run counts as hung (each run here takes 0.01-2 s on two cores)
 WALL_TIME_BUDGET = 60.0
 
@@ -197,15 +204,14 @@ def assert_sane(trace: Trace, mechanism: Mechanism) -> None:
         gap_rate = trace.qd[:, trace.coordinate_numbers.index(c.ahead)] - \
             trace.qd[:, trace.coordinate_numbers.index(c.behind)]
         assert np.abs(gap[closed]).max(initial=0.0) <= SHUT, f"{c.name}: closed but not shut"
-        assert np.abs(gap_rate[closed]).max(initial=0.0) <= SHUT * 1e6, f"{c.name}: closed but moving apart"
+        assert np.abs(gap_rate[closed]).max(initial=0.0) <= SHUT_RATE, f"{c.name}: closed but moving apart"
         worst = gap[~closed].min(initial=math.inf)
         assert worst >= -PENETRATION, f"{c.name}: open gap penetrated by {-worst:.3g} at {trace.cam_angle[np.argmin(np.where(closed, np.inf, gap))]:.2f} deg"
         force = trace.contact_force[:, i]
         if c.state == "enabled":
-            assert force.min() >= -1e-6 * force_scale, f"{c.name}: pulls with {force.min():.4g}"
-        # peaks are taken at step ends; an interpolated sample may exceed them a little (3 % at the
-        # stability limit), never grossly
-        assert trace.peak_force[i] >= 0.9 * force.max(), f"{c.name}: peak force below a sampled force"
+            assert force.min() >= -PULL * force_scale, f"{c.name}: pulls with {force.min():.4g}"
+        # peaks are taken at step ends; an interpolated sample may exceed them a little, never grossly
+        assert trace.peak_force[i] >= PEAK_FRACTION * force.max(), f"{c.name}: peak force below a sampled force"
     rest = rest_velocity(mechanism)
     for e in trace.events:
         if e.kind == CLOSED:

@@ -3,24 +3,21 @@ regeneration (benchmarks/limits_docs.py; the extremes table's slow rows are writ
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import pytest
 
+from tests.benchmark_scripts import load
 from vtool.markdown import read_block
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
 def _generator():  # type: ignore[no-untyped-def]
-    spec = importlib.util.spec_from_file_location("limits_docs", ROOT / "benchmarks" / "limits_docs.py")
-    module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
-    spec.loader.exec_module(module)  # type: ignore[union-attr]
-    return module
+    return load("limits_docs")
 
 
-@pytest.mark.parametrize("name", ["limits-nominal", "limits-default-damping", "limits-seat-warning",
+@pytest.mark.parametrize("name", ["limits-sane", "limits-nominal", "limits-default-damping", "limits-seat-warning",
                                   "limits-cost-text", "limits-cost-guard", "limits-step-limits",
                                   "limits-run-rules", "limits-extremes"])
 def test_committed_limits_figures_are_regenerated_unchanged(name: str) -> None:

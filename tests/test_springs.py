@@ -189,48 +189,98 @@ def test_explicit_form_round_trip_keeps_the_data_sheet() -> None:
     assert again.members == spec.members
 
 
-def _pitch_bucket(rpm: float) -> dict:
-    """The bucket with a pitch-diagram spring whose segments close at 2C, C and 1.5C (C = 183.565 N), all
-    inside the lift: 140 N installed, 35 N/mm in series, 420 N at full lift (8 mm), past solid (29 mm)."""
+def _slow_pitch_bucket(backend: str = "newmark") -> dict:
+    """The bucket on a harmonic cam (mid-stroke at angle 0, the nose at 90 deg: every coil open at the start)
+    at 60 rev/min, with a pitch diagram whose free coil gaps n_i (p_i - d) = 2 x 1.65, 1.75 x 1.4, 1.5 x 1.5 mm
+    (8 mm: free 37 mm to solid 29 mm) close at 1.65 C, 1.4 C and 1.5 C = 302.9, 257.0, 275.3 N (C = G d^4/(8 D^3)
+    = 183.565 N/mm); preload 3 mm x 34.965 N/mm = 104.9 N at 34 mm; 7.85 mm of lift past the 0.15 mm lash
+    takes the spring 2.85 mm past solid."""
     doc = _bucket_doc()
     spring = doc["train"]["spring"]
     del spring["elements"]
-    spring.update(segment_coils=[2.0, 1.75, 1.5], segment_pitches=[6.0, 5.0, 5.5], free_length=37.0,
-                  installed_length=33.0)
-    doc["run"].update(rpm=rpm, degrees=360.0, time_step=2e-6, output_interval=0.25)
+    spring.update(segment_coils=[2.0, 1.75, 1.5], segment_pitches=[5.65, 5.4, 5.5], free_length=37.0,
+                  installed_length=34.0)
+    doc["train"]["cam"] = {"law": "harmonic", "lift": 8.0}
+    doc["run"].update(rpm=60.0, degrees=100.0, time_step=1e-5, output_interval=0.25, backend=backend)
     doc["checks"] = {"coil_bind_margin_min": 0.0}
     return doc
 
 
-def test_slow_compression_closes_the_segments_in_the_pitch_diagrams_order() -> None:
+def series_law_length(sheet, force: np.ndarray) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """By hand: the spring's length at a force when each segment is k_i up to its coil gap g_i = close_i / k_i
+    and k_i + k_b,i past it (the block stiffness k_b,i = 100 k_i in series), all carrying the same force."""
+    k, close = C / np.asarray(sheet.segment_coils), closing_forces(sheet)
+    F = np.asarray(force)[:, None]
+    deflection = np.where(F <= close, F / k, close / k + (F - close) / (101.0 * k)).sum(axis=1)
+    return sheet.free_length - deflection
+
+
+def test_slow_compression_past_solid_closes_the_coils_in_order_and_follows_the_table() -> None:
+    from vtool.solvers.model.spring import end_force
     from vtool.solvers.run import simulate
 
-    spec = load_document(_pitch_bucket(300.0))
+    spec = load_document(_slow_pitch_bucket())
     sheet = spec.springs[0]
-    np.testing.assert_allclose(closing_forces(sheet), [2.0 * C, C, 1.5 * C], rtol=1e-12)
-    assert sheet.preload == pytest.approx(4.0 * C / 5.25, rel=1e-12)
+    np.testing.assert_allclose(closing_forces(sheet), [1.65 * C, 1.4 * C, 1.5 * C], rtol=1e-12)
+    assert sheet.preload == pytest.approx(3.0 * C / 5.25, rel=1e-12)
+    assert sheet.contacts == ("valve_spring coils 1", "valve_spring coils 2", "valve_spring coils 3")
     trace = simulate(spec)
-    report = trace.summary()["springs"][0]
-    first = report["segment_first_touch_deg"]
-    assert all(a is not None for a in first)
-    # the cam turns from the nose (0 deg): the spring compresses from the start and relaxes towards 180 deg;
-    # the run starts at full lift, so every segment is closed at once: look at the re-closing on the next lift
+    first = [min(e.cam_angle for e in trace.events if e.clearance == name and e.kind == "closed")
+             for name in sheet.contacts]
+    assert sorted(range(3), key=lambda i: first[i]) == [1, 2, 0]  # smallest coil gap first (hand order)
     angle = np.asarray(trace.cam_angle)
-    from vtool.solvers.model.spring import segment_gaps
-
-    gaps = segment_gaps(sheet, trace)
-    second_lift = angle >= 180.0
-    touch = [float(angle[second_lift][np.argmax(gaps[second_lift, i] <= 0.0)]) for i in range(3)]
-    assert sorted(range(3), key=lambda i: touch[i]) == [1, 2, 0]  # smallest pitch first (hand order)
-    # at each closing the spring's force (35 N/mm in series from the rest length) equals G d^4 (p - d)/(8 D^3)
-    length = sheet.rest_length - compression_sign_of(trace, sheet) * trace.coordinate(sheet.coordinate)
-    for i, a in enumerate(touch):
-        row = int(np.flatnonzero(angle == a)[0])
-        assert sheet.model_rate * (sheet.rest_length - length[row]) == pytest.approx(closing_forces(sheet)[i],
-                                                                                      rel=2e-2)
-    assert report["coil_bind_margin"] < 0.0 and "COIL BIND" in trace.summary_text()
+    rising = angle <= 90.0  # mid-stroke to the nose
+    length = sheet.rest_length - trace.coordinate(sheet.coordinate)
+    force = end_force(sheet, trace)
+    assert length[rising].min() < sheet.solid_length - 2.5  # 2.85 mm past solid at the nose
+    # each coil closes at its force G d^4 (p - d)/(8 D^3): the output row before its closing (past the last one
+    # the force rises 3.5 kN/mm, 60 N a row)
+    for a, close in zip(first, closing_forces(sheet), strict=True):
+        assert force[int(np.searchsorted(angle, a)) - 1] == pytest.approx(close, rel=1e-2)
+    # the force-length curve follows the pitch diagram's (the table) up to the last coil's closing ...
+    table = pitch_force_length(sheet, length)
+    inside = rising & np.isfinite(table)
+    assert inside.sum() > 40
+    np.testing.assert_allclose(force[inside], table[inside], rtol=1e-2)
+    # ... and, past solid, the coils' block springs in series: the length by hand at the run's force
+    np.testing.assert_allclose(series_law_length(sheet, force[rising]), length[rising], atol=1.5e-2)  # surge at closing
+    assert force[rising].max() > 10_000.0
+    report = trace.summary()["springs"][0]
+    assert report["first_coil_bind_deg"] == pytest.approx(min(first))
+    peak = report["coil_contact_peak_force"]
+    assert peak == pytest.approx(float(trace.peak_force[[c.name for c in spec.clearances].index(sheet.contacts[1])]))
+    assert peak > 9_000.0 and report["force_unit"] == "N"
+    text = trace.summary_text()
+    assert "peak coil contact force" in text and "not to be trusted" not in text
     check = next(c for c in trace.summary()["checks"] if c["name"] == "coil_bind_margin_min")
     assert check["passed"] is False
+
+
+@pytest.mark.parametrize("backend", ["exact", "scipy"])
+def test_coil_contacts_agree_on_every_back_end(backend: str) -> None:
+    """The coil contacts' opening (a constant force term, gaps shifted) on the piecewise back ends: the
+    clashing preset's events and peak coil contact force as the Newmark back end's."""
+    from vtool.presets import load_preset
+    from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.run import simulate
+
+    spec = with_run_overrides(load_preset("nested-spring-clash"), degrees=400.0)
+    newmark, other = simulate(spec), simulate(with_run_overrides(spec, backend=backend))
+    assert [(e.clearance, e.kind) for e in other.events] == [(e.clearance, e.kind) for e in newmark.events]
+    coils = [i for i, c in enumerate(spec.clearances) if "coils" in c.name]
+    assert newmark.peak_force[coils].max() > 100.0
+    np.testing.assert_allclose(other.peak_force[coils], newmark.peak_force[coils], rtol=2e-3, atol=1e-6)
+
+
+def test_an_opening_needs_a_compliant_contact() -> None:
+    from vtool.presets import find_preset
+
+    doc = read_document(find_preset("gnilka-1a"))
+    doc["clearances"][1]["opening"] = 0.01
+    with pytest.raises(InputError, match=r"clearances\[1\]\.opening.*contact = \"linear\""):
+        load_document(doc)
+    doc["clearances"][1]["contact"], doc["clearances"][1]["contact_stiffness"] = "linear", 1e5
+    assert load_document(doc).clearances[1].opening == 0.01
 
 
 def compression_sign_of(trace, sheet) -> float:  # type: ignore[no-untyped-def]
@@ -248,13 +298,19 @@ def test_clashing_preset_reports_coil_clash_only_at_high_speed() -> None:
     spec = load_preset("nested-spring-clash")
     fast = simulate(spec)
     text = fast.summary_text()
-    assert "first coil clash at" in text and "not to be trusted" in text
+    assert "first coil clash at" in text and "peak coil contact force" in text and "not to be trusted" not in text
     report = fast.summary()["springs"][0]
     assert report["first_coil_bind_deg"] is not None
     assert (report["stress_unit"], report["length_unit"], report["force_unit"]) == ("MPa", "mm", "N")
     slow = simulate(with_run_overrides(spec, rpm=3000.0))
     assert slow.summary()["springs"][0]["first_coil_bind_deg"] is None
     assert run_metrics(slow)["coil_bind_margin"] > 0.0 > run_metrics(fast)["coil_bind_margin"]
+    fast_metrics, slow_metrics = run_metrics(fast), run_metrics(slow)
+    assert report["coil_contact_peak_force"] > 100.0
+    assert 100.0 < fast_metrics["coil_contact_peak_force"] <= report["coil_contact_peak_force"]  # 2nd revolution
+    assert 360.0 < fast_metrics["coil_bind_angle"] < 720.0  # in the evaluated (second) revolution
+    assert slow_metrics["coil_contact_peak_force"] == 0.0 and math.isnan(slow_metrics["coil_bind_angle"])
+    assert {"F4", "F5", "F2"} <= {fast.force_label(i) for i in range(len(fast.spec.clearances))}
 
 
 def test_modes_lists_the_surge_frequencies_and_their_cam_orders() -> None:
@@ -267,3 +323,111 @@ def test_modes_lists_the_surge_frequencies_and_their_cam_orders() -> None:
     f1 = 0.5 * math.sqrt(79300.0 * 256.0 / (8.0 * 13824.0 * 5.25) / 3.904810e-5)  # 473.1 Hz
     assert f"{f1:.1f} Hz (order {f1 / 50.0:.1f})" in result.output
     assert f"{2 * f1:.1f} Hz (order {2 * f1 / 50.0:.1f})" in result.output
+
+
+def test_spring_end_force_is_a_csv_column_and_a_cam_order_quantity() -> None:
+    """One bar, table-free: the end force is k q_end (q = 0 unloaded), so its cam-order amplitudes are k times
+    q_end's; a CSV column with its unit; ``--orders valve_spring_force`` accepted, a wrong name refused."""
+    from vtool.presets import load_preset
+    from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.run import simulate
+    from vtool.solvers.studies.orders import spectrum, with_orders
+
+    spec = with_run_overrides(load_preset("direct-acting-bucket"), degrees=720.0)
+    sheet = spec.springs[0]
+    trace = simulate(with_orders(spec, ("valve_spring_force",)))
+    header, columns = trace.csv_columns()
+    column = columns[header.index("valve_spring_force (N)")](slice(None))
+    np.testing.assert_allclose(column, sheet.rate * trace.coordinate(sheet.coordinate), rtol=1e-12, atol=1e-9)
+    force, lift = spectrum(trace, "valve_spring_force"), spectrum(trace, f"q{sheet.coordinate}")
+    assert force.unit == "N" and force.amplitude[1:].max() > 10.0
+    np.testing.assert_allclose(force.amplitude, sheet.rate * lift.amplitude, rtol=1e-9, atol=1e-9)
+    with pytest.raises(InputError, match="valve_spring_force"):
+        with_orders(spec, ("outer_force",))
+
+
+def test_elliptic_wire_rate_mass_and_stress_by_hand() -> None:
+    """Elliptic wire 4 mm radial x 3.2 mm axial (a = 2, b = 1.6): J_t = pi a^3 b^3/(a^2 + b^2) = pi 32.768/6.56
+    = 15.69264 mm^4, k = 4 G J_t/(pi D^3 n_a) = 4 * 79300 * 4.99512/(13824 * 5.25) = 21.8316 N/mm; tau = K F D/(pi a b^2)
+    (K Bergstraesser on D/d = 6: 6.5/5.25); solid length n_t h = 23.2 mm; mass rho pi a b pi D n_a."""
+    from vtool.solvers.model.spring import elliptic_torsion_constant
+
+    assert elliptic_torsion_constant(2.0, 2.0) == pytest.approx(math.pi * 4.0 ** 4 / 32.0, rel=1e-15)
+    s = _sheet(wire_height=3.2, installed_length=40.0, free_length=45.0)
+    J = math.pi * 2.0 ** 3 * 1.6 ** 3 / (2.0 ** 2 + 1.6 ** 2)
+    assert J == pytest.approx(15.69264, rel=1e-6)
+    assert s.rate == pytest.approx(4.0 * 79300.0 * J / (math.pi * 24.0 ** 3 * 5.25), rel=1e-14)
+    assert s.rate == pytest.approx(21.8316, rel=1e-5)
+    assert s.solid_length == pytest.approx(7.25 * 3.2)
+    assert s.active_mass == pytest.approx(7.85e-9 * math.pi * 2.0 * 1.6 * math.pi * 24.0 * 5.25, rel=1e-14)
+    assert s.stress(300.0) == pytest.approx(6.5 / 5.25 * 300.0 * 24.0 / (math.pi * 2.0 * 1.6 ** 2), rel=1e-14)
+    with pytest.raises(InputError, match="wire_height"):
+        _sheet(wire_height=1.0)
+
+
+def test_tensile_strength_against_wire_diameter_feeds_the_fatigue_factor() -> None:
+    """R_m = A / d^m: the VDSiCrV fit meets each point of its table within 1 %; {A, m} given; the Goodman
+    factor takes R_m at the wire's diameter."""
+    from vtool.solvers.model.spring import VDSICRV_TABLE, fitted_strength_law
+
+    A, m = fitted_strength_law(VDSICRV_TABLE)
+    for d, rm in VDSICRV_TABLE:
+        assert A / d ** m == pytest.approx(rm, rel=1e-2)
+    small = SHEET | {"wire_diameter": 2.5, "coil_diameter": 15.0}
+    s = read_sheet(Table(small | {"tensile_strength": "VDSiCr" + "V"}, "train.spring"), MM, "valve_spring", 2)
+    assert s.tensile_strength == pytest.approx(A / 2.5 ** m, rel=1e-12) and s.strength_law == (A, m)
+    assert 2060.0 < s.tensile_strength < 2160.0  # between its neighbours in the table
+    given = read_sheet(Table(small | {"tensile_strength": {"A": 2300.0, "m": 0.1}}, "train.spring"), MM, "v", 2)
+    assert given.tensile_strength == pytest.approx(2300.0 / 2.5 ** 0.1, rel=1e-14)
+    tau_lo, tau_hi = float(given.stress(100.0)), float(given.stress(300.0))
+    assert given.fatigue_factor(100.0, 300.0) == pytest.approx(
+        1.0 / (0.5 * (tau_hi - tau_lo) / 450.0 + 0.5 * (tau_hi + tau_lo) / (0.67 * 2300.0 / 2.5 ** 0.1)), rel=1e-14)
+    with pytest.raises(InputError, match="wire_diameter"):
+        read_sheet(Table(SHEET | {"tensile_strength": "VDSiCrV"}, "train.spring"), MM, "v", 2)  # 4 mm: off the table
+
+
+def test_the_clashing_preset_round_trips_through_its_explicit_form() -> None:
+    from dataclasses import replace
+
+    from vtool.presets import load_preset
+    from vtool.presets.valvetrain import dump, load
+
+    spec = load_preset("nested-spring-clash")
+    explicit = dump(replace(spec, train=""))
+    assert [c.get("opening") for c in explicit["clearances"]][2:] == pytest.approx([3.25, 6.0, 7.0])
+    again = load(copy.deepcopy(explicit))
+    assert again.clearances == spec.clearances and again.springs == spec.springs
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.floats(-5.0, 5.0), min_size=5, max_size=5))
+def test_every_clearances_monitor_is_its_gap_with_opening_and_sense(q: list) -> None:
+    """Open (nothing closed): each monitored clearance's monitor is sense (q_ahead - q_behind) + opening
+    (behind = 0: the ground at 0; the cam and seat at their sources), plus the round-off allowance."""
+    from vtool.presets import load_preset
+    from vtool.solvers.model.contact import ContactProblem
+    from vtool.solvers.model.mechanism import Mechanism
+
+    spec = load_preset("nested-spring-clash")
+    problem = ContactProblem(Mechanism(spec))
+    x, v = np.array(q), np.zeros(5)
+    src = problem.sources_at(0.0)
+    values = problem.monitors(0, 0.0, x, v, np.zeros(5))
+    for k, c in enumerate(spec.clearances):
+        behind = x[c.behind - 1] if 0 < c.behind <= 5 else 0.0 if c.behind == 0 else \
+            src[3 * problem.source_numbers.index(c.behind)]
+        assert values[k] == pytest.approx(c.gap(x[c.ahead - 1], behind) + problem.gap_noise, abs=1e-12)
+
+
+def test_a_start_with_coils_touching_is_refused_in_one_line() -> None:
+    """The polydyne bucket starts at the nose (angle 0): with coil gaps that close before full lift, its static
+    start would sit inside a coil contact; refused naming the clearance (not built: an affine static start)."""
+    doc = _bucket_doc()
+    spring = doc["train"]["spring"]
+    del spring["elements"]
+    spring.update(segment_coils=[2.0, 1.75, 1.5], segment_pitches=[6.0, 5.0, 5.5], free_length=37.0,
+                  installed_length=33.0)
+    from vtool.solvers.model.mechanism import Mechanism
+
+    with pytest.raises(InputError, match=r"initial\.closed.*valve_spring coils 2 open.*overlaps it by"):
+        assert Mechanism(load_document(doc)).start is not None

@@ -16,7 +16,7 @@ def test_committed_closed_form_tables_are_regenerated_unchanged() -> None:
     module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
     spec.loader.exec_module(module)  # type: ignore[union-attr]
     blocks = module.closed_form_blocks()
-    assert set(blocks) == {"springs-sheets", "springs-surge", "springs-pitch"}
+    assert set(blocks) == {"springs-sheets", "springs-surge", "springs-pitch", "springs-strength"}
     for name, text in blocks.items():
         assert read_block(ROOT / "docs" / "springs.md", name) == text, \
             f"{name}: run python benchmarks/springs_docs.py --write"

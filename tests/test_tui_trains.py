@@ -63,4 +63,5 @@ async def test_the_clashing_spring_preset_shows_its_coil_clash_in_the_summary() 
 
         summary = app.screen.query_one("#summary", TextPanel).text
         assert "first coil clash at" in summary and "COIL BIND" in summary
+        assert "peak coil contact force" in summary and "not to be trusted" not in summary
         assert "FAIL  valve spring coil-bind margin" in summary

@@ -4,11 +4,11 @@ Newmark and event-rule figures, the exact back end's conditioning) match a fresh
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import pytest
 
+from tests.benchmark_scripts import load
 from vtool.markdown import read_block
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -16,10 +16,7 @@ DOC = ROOT / "docs" / "valvetrain.md"
 
 
 def _generator():  # type: ignore[no-untyped-def]
-    spec = importlib.util.spec_from_file_location("valvetrain_docs", ROOT / "benchmarks" / "valvetrain_docs.py")
-    module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
-    spec.loader.exec_module(module)  # type: ignore[union-attr]
-    return module
+    return load("valvetrain_docs")
 
 
 @pytest.mark.parametrize("name", ["thesis-disagreements", "static-start", "newmark-figures", "exact-conditioning"])

@@ -48,17 +48,25 @@ def _mark(name: str, key: str) -> Path | None:
     return None if folder is None else folder / f"{name}-{key}.done"
 
 
+#: (name, key) pairs compiled or found compiled in this process: a run's later chunks ask again.
+_READY: set[tuple[str, str]] = set()
+
+
 def is_compiled(dispatcher: Any, name: str, key: str) -> bool:
-    """True when ``dispatcher`` needs no compile: plain Python, compiled in this process, or marked done
-    in the cache folder for ``key``."""
-    if not hasattr(dispatcher, "signatures") or dispatcher.signatures:
+    """True when ``dispatcher`` needs no compile for ``key``: plain Python, compiled in this process, or
+    marked done in the cache folder."""
+    if (name, key) in _READY or not hasattr(dispatcher, "signatures"):
         return True
     mark = _mark(name, key)
-    return mark is not None and mark.exists()
+    if mark is not None and mark.exists():
+        _READY.add((name, key))
+        return True
+    return False
 
 
 def compiled(name: str, key: str, seconds: float) -> None:
     """Mark ``name`` compiled into the cache for ``key``, and keep how long it took."""
+    _READY.add((name, key))
     numba_cache.record_compile(name, seconds)
     mark = _mark(name, key)
     if mark is not None:

@@ -5,7 +5,8 @@ command's older name, kept as an alias (it takes only camshaft presets).
 Both print the summed drive torque's mean, extremes, each valve's share and the largest cam orders
 (``--json``: the summary), write each valve's torque and the sum against camshaft angle (``--csv``),
 draw the torque in the terminal (``--plot``) or as a figure (``--figure out.png|svg|pdf``; axes with
-units). ``--rpm`` sets ``camshaft.rpm`` (every train at this cam speed).
+units). ``--rpm`` sets ``camshaft.rpm`` (every train at this cam speed); ``--max-steps`` is each train's
+cost limit, as for a valve train.
 """
 
 from __future__ import annotations
@@ -19,7 +20,8 @@ import click
 from vtool.app.cli.options import OUTPUT, figure_option, json_alone, write_figure
 
 
-def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *, figure: Path | None = None) -> None:
+def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *, figure: Path | None = None,
+                 max_steps: float | None = None) -> None:
     """Run a camshaft preset's trains, sum the valves' torques, print, write and draw (module doc)."""
     from vtool.app.cli.progress import DelayedProgress
     from vtool.files import write_atomic
@@ -28,7 +30,7 @@ def solve_preset(spec: Any, csv_path: Path | None, plot: bool, as_json: bool, *,
 
     progress = DelayedProgress(f"camshaft, {len({v.path for v in spec.valves})} train run(s)")
     try:
-        result = solve(spec, progress=progress)
+        result = solve(spec, progress=progress, max_steps=max_steps)
     finally:
         progress.close()
     if csv_path is not None:

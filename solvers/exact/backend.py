@@ -89,27 +89,35 @@ class ExactBackend(PiecewiseBackend[ExactOptions]):
 
 
 def peak_brackets(values: np.ndarray, closed: np.ndarray, peak: np.ndarray,
-                  margin: float = PEAK_MARGIN) -> list[tuple[int, int, int]]:
+                  margin: float = PEAK_MARGIN, tail: np.ndarray | None = None) -> list[tuple[int, int, int]]:
     """Sample intervals that may hold a contact force's maximum: (clearance, first, last sample).
 
     ``values`` (ncl, ns) are monitor samples in time order. A sample of a
     closed clearance at least as large as its neighbours (a missing neighbour
     counts as smaller) and within ``margin`` of the ``peak`` so far brackets a
     maximum between its neighbours (a sample alone at an end: between it and
-    its one neighbour).
+    its one neighbour). ``tail`` (bool per clearance): the last interval ends
+    at an event, which may leave a maximum with no sample near it (a contact
+    closing and opening again within one scan interval); it is a bracket of
+    these clearances too.
     """
     count = values.shape[1]
+    if count < 2:
+        return []
+    tails = [(int(k), count - 2, count - 1) for k in np.flatnonzero(closed & tail)] if tail is not None else []
     threshold = peak - margin * np.abs(peak)
     rows = np.flatnonzero(closed & (values.max(axis=1) >= threshold))
-    if count < 2 or not rows.size:
-        return []
+    if not rows.size:
+        return tails
     values, threshold = values[rows], threshold[rows]
     pad = np.full((values.shape[0], 1), -np.inf)
     padded = np.concatenate([pad, values, pad], axis=1)
     centre = padded[:, 1:-1]
     local = (centre >= padded[:, :-2]) & (centre > padded[:, 2:])
     local &= centre >= threshold[:, None]
-    return [(int(rows[k]), max(int(j) - 1, 0), min(int(j) + 1, count - 1)) for k, j in zip(*np.nonzero(local), strict=True)]
+    found = [(int(rows[k]), max(int(j) - 1, 0), min(int(j) + 1, count - 1))
+             for k, j in zip(*np.nonzero(local), strict=True)]
+    return found + [bracket for bracket in tails if bracket not in found]
 
 
 def safe_newton(both: Callable[[float], tuple[float, float]], low: float, high: float, f_low: float,
@@ -256,15 +264,6 @@ class _ExactRun(PiecewiseRun):
             times = t + taus
             crossed = ((values[monitored] if self.some_unmonitored else values) < 0.0).any(axis=0)
             last = int(np.argmax(crossed)) if crossed.any() else count
-            if last:
-                if cfg.soft:
-                    self.overlap_peaks(ss, cfg, t, h, base_v, taus[:last], values[:, :last])
-                    forces = (cfg.GFV @ states(slice(0, last))).real + (
-                        shift_coefficients(cfg.HFm, ss.omega, ss.n_harmonics, t) @ ss.basis(taus[:last]))
-                    base_f = (cfg.GFV @ h).real + cfg.HFm @ ss.basis(t)
-                    self.peaks(ss, cfg, t, h, base_f, taus[:last], forces)
-                else:
-                    self.peaks(ss, cfg, t, h, base_v, taus[:last], values[:, :last])
             start_tau, start_h = (float(taus[last - 1]), states(last - 1)) if last else (0.0, h)
             self.outputs(ss, cfg, t, h, self.output_times(t, t + start_tau))
             if self.every_step and last:
@@ -280,12 +279,69 @@ class _ExactRun(PiecewiseRun):
                 self.steps += 1
                 h_event = prop.at(start_h, tau)
                 y_event = prop.real(h_event) + ss.particular(start_t + tau)
-                self.track_peaks(ss, (cfg.GFV @ h_event).real + cfg.HFm @ ss.basis(start_t + tau), start_t + tau)
+                # the peaks over [t, event]: the samples before the event and the event itself (an
+                # event inside the first scan interval leaves no sample: a stiff contact's force is
+                # largest where it closes, and this interval may hold the run's peak)
+                at_event = (cfg.GV @ h_event).real + cfg.Hm @ ss.basis(start_t + tau)
+                self.scan_peaks(ss, cfg, t, h, base_v, np.append(taus[:last], start_tau + tau),
+                                np.column_stack([values[:, :last], at_event]),
+                                states, (start_h, h_event))
                 return start_t + tau, y_event, [k for k, r in roots.items() if r <= tau + tol]
+            self.scan_peaks(ss, cfg, t, h, base_v, taus, values, states)
             t, h, base_v = float(times[-1]), states(count - 1), values[:, -1]
         y = prop.real(h) + ss.particular(t)
         self._carry = (ss.mask, t, h, y)
         return t, y, []
+
+    def scan_peaks(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, base_v: np.ndarray,
+                   taus: np.ndarray, values: np.ndarray, states: Callable,
+                   tail: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+        """Peak forces (and a compliant contact's overlaps) over [t, t + taus[-1]], from the monitors
+        ``base_v`` at t and ``values`` at t + taus (columns); ``states(index)`` gives the modal states at
+        the scan samples (asked only when a compliant contact is closed: its force is not its monitor).
+        ``tail``: the last τ is an event's, not a sample's: the modal states at the start of its interval
+        and at the event (see :meth:`tail_rows`)."""
+        tail_at = None
+        if tail is not None:
+            width = float(taus[-1]) - (float(taus[-2]) if taus.size > 1 else 0.0)
+            tail_at = (np.column_stack(tail), ss.basis_rate(t + float(taus[-1]) - np.array([width, 0.0])), width)
+        if cfg.soft:
+            noise = self.problem.gap_noise
+            self.overlap_peaks(ss, cfg, t, h, base_v, taus, values,
+                               self.tail_rows(cfg, tail_at, cfg.GAV, cfg.Hm, base_v, values, self.peak_overlap + noise))
+            hs = states(slice(0, taus.size - (tail is not None)))
+            if tail is not None:
+                hs = np.column_stack([hs, tail[1]])
+            forces = (cfg.GFV @ hs).real + (
+                shift_coefficients(cfg.HFm, ss.omega, ss.n_harmonics, t) @ ss.basis(taus))
+            base_f = (cfg.GFV @ h).real + cfg.HFm @ ss.basis(t)
+            self.peaks(ss, cfg, t, h, base_f, taus, forces,
+                       self.tail_rows(cfg, tail_at, cfg.GFAV, cfg.HFm, base_f, forces, self.peak))
+        else:
+            self.peaks(ss, cfg, t, h, base_v, taus, values,
+                       self.tail_rows(cfg, tail_at, cfg.GAV, cfg.Hm, base_v, values, self.peak))
+
+    @staticmethod
+    def tail_rows(cfg: _Config, tail_at: tuple[np.ndarray, np.ndarray, float] | None, rate_h: np.ndarray,
+                  forced: np.ndarray, base: np.ndarray, values: np.ndarray, peak: np.ndarray) -> np.ndarray | None:
+        """The closed clearances that may peak inside the interval ending at an event, where no sample
+        may show it: the value (rate: ``rate_h`` from h, ``forced`` on u'(t)) rises at the interval's start
+        and falls at the event, and the two end tangents meet within :data:`PEAK_MARGIN` of ``peak`` (the
+        samples' rule, :func:`peak_brackets`). ``tail_at``: the modal states at the two ends (columns), u'
+        there (columns) and the interval's width; None: no event. ``base``, ``values``: the values at the
+        block's start and at its samples (the last at the event)."""
+        if tail_at is None:
+            return None
+        hs, basis_rates, width = tail_at
+        rates = (rate_h @ hs).real + forced @ basis_rates
+        v0 = values[:, -2] if values.shape[1] > 1 else base
+        v1, r0, r1 = values[:, -1], rates[:, 0], rates[:, 1]
+        candidates = cfg.closed & (r0 > 0.0) & (r1 < 0.0)
+        if not candidates.any():
+            return candidates
+        with np.errstate(divide="ignore", invalid="ignore"):
+            meet = np.clip((v1 - v0 - r1 * width) / (r0 - r1), 0.0, width)  # where the tangents cross
+        return candidates & (v0 + r0 * meet >= peak - PEAK_MARGIN * np.abs(peak))
 
     def monitor(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, k: int,  # noqa: ANN202
                 force: bool = False):
@@ -357,19 +413,20 @@ class _ExactRun(PiecewiseRun):
         return safe_newton(both, low, width, start, last, tol)
 
     def peaks(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, base_v: np.ndarray,
-              taus: np.ndarray, values: np.ndarray) -> None:
-        """Peak forces from the samples at t (``base_v``) and t + taus, local maxima refined where g' = 0."""
+              taus: np.ndarray, values: np.ndarray, tail: np.ndarray | None = None) -> None:
+        """Peak forces from the samples at t (``base_v``) and t + taus, local maxima refined where g' = 0
+        (``tail``: the last τ is an event's, see :func:`peak_brackets`)."""
         highest = values.max(axis=1)
         top = np.maximum(highest, base_v)
         self.raise_peaks(cfg.closed, top, t)
         if t + taus[-1] >= self.t_rev:  # samples after the first revolution: the last ones
             first = 0 if t + taus[0] >= self.t_rev else int(np.searchsorted(t + taus, self.t_rev))
             self.raise_peaks(cfg.closed, highest if first == 0 else values[:, first:].max(axis=1), self.t_rev)
-        if not (cfg.closed & (top >= self.peak - PEAK_MARGIN * np.abs(self.peak))).any():
+        if (tail is None or not tail.any()) and not (cfg.closed & (top >= self.peak - PEAK_MARGIN * np.abs(self.peak))).any():
             return
         taus = np.concatenate([[0.0], taus])
         values = np.concatenate([base_v[:, None], values], axis=1)
-        for k, first, last in peak_brackets(values, cfg.closed, self.peak):
+        for k, first, last in peak_brackets(values, cfg.closed, self.peak, tail=tail):
             value, rate, _ = self.monitor(ss, cfg, t, h, k, force=True)
             low, high = float(taus[first]), float(taus[last])
             if rate(low) > 0.0 > rate(high):
@@ -379,13 +436,13 @@ class _ExactRun(PiecewiseRun):
                     self.peak_late[k] = max(self.peak_late[k], value(tau))
 
     def overlap_peaks(self, ss: StateSpace, cfg: _Config, t: float, h: np.ndarray, base_v: np.ndarray,
-                      taus: np.ndarray, values: np.ndarray) -> None:
+                      taus: np.ndarray, values: np.ndarray, tail: np.ndarray | None = None) -> None:
         """Peak overlaps of the closed compliant contacts: samples, local maxima refined where δ' = 0."""
         self.track_overlap(ss, np.concatenate([base_v[:, None], values], axis=1))
         taus = np.concatenate([[0.0], taus])
         values = np.concatenate([base_v[:, None], values], axis=1) - self.problem.gap_noise
         assert ss.compliant is not None  # (a configuration with compliant contacts: set by state_space)
-        for k, first, last in peak_brackets(values, ss.compliant, self.peak_overlap):
+        for k, first, last in peak_brackets(values, ss.compliant, self.peak_overlap, tail=tail):
             value, rate, _ = self.monitor(ss, cfg, t, h, k)
             low, high = float(taus[first]), float(taus[last])
             if rate(low) > 0.0 > rate(high):

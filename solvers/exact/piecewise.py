@@ -16,8 +16,9 @@ particular solution y_p(t) = Y u(t), one direct solve per harmonic
 (:mod:`vtool.solvers.exact.statespace`). Every output (coordinates, contact
 forces, gaps) is affine in y and u(t): the maps P, Q, G, H built here.
 The configurations, contact forces, impact laws and event rules are the
-contact problem's (:mod:`vtool.solvers.model.contact`, the kernel's ``impact`` and
-``settle``): only the integration differs. A back end subclasses
+contact problem's (:mod:`vtool.solvers.model.contact`: its
+:class:`~vtool.solvers.model.contact.Transitions` start the run and apply
+every event): only the integration differs. A back end subclasses
 :class:`PiecewiseRun` and implements :meth:`PiecewiseRun.advance`.
 """
 
@@ -34,13 +35,12 @@ import numpy as np
 from vtool.errors import InputError, RunError
 from vtool.solvers.backends import Backend, Cancel, OptionsT, Progress, RunStats
 from vtool.solvers.exact.statespace import StateSpace, from_layer
-from vtool.solvers.model.contact import ContactProblem, OrderedLayer, event_buffers
+from vtool.solvers.model.contact import ContactProblem, OrderedLayer
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.sources import SourceSeries
 from vtool.solvers.model.spec import HERTZ, MechanismSpec
 from vtool.solvers.newmark import layout
-from vtool.solvers.newmark.records import Motion, Output, State
-from vtool.solvers.trace import OPENED, TraceBuilder
+from vtool.solvers.trace import TraceBuilder
 
 #: The state spaces of a mechanism's configurations, kept as long as its configuration tables: a
 #: second run of the same mechanism (a sweep, a benchmark, the TUI) reuses them and what the back
@@ -94,7 +94,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
     for k in range(ncl):
         kind, ahead, behind = (int(v) for v in mk[k, :layout.MK_M])
         if kind in (layout.MK_GAP, layout.MK_OVERLAP):
-            sign = 1.0 if kind == layout.MK_GAP else -1.0
+            sign = (1.0 if kind == layout.MK_GAP else -1.0) * problem.clf[k, layout.CLF_SIGN]  # and the gap's sense
             G[k] += sign * Zy[0, ahead]
             H[k] += sign * Zb[0, ahead]
             if behind >= 0:
@@ -102,7 +102,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
                 H[k] -= sign * Zb[0, behind]
             else:
                 H[k] -= sign * src[3 * (-1 - behind)]
-            H[k, 0] += problem.gap_noise
+            H[k, 0] += problem.gap_noise + (1.0 if kind == layout.MK_GAP else -1.0) * problem.clf[k, layout.CLF_OPEN]
         if kind in (layout.MK_FORCE, layout.MK_OVERLAP):
             row = mon[k]
             for i in range(3):
@@ -159,16 +159,10 @@ class PiecewiseRun(ABC):
         self.t_rev = 2 * math.pi / problem.omega
         self.steps = 0
         self.next_out = 0
-        self.rapid = 0
-        self.last_event = -1.0
         self.monitored = problem.cl[:, layout.CL_MON].astype(bool)
         self.closed_bit = problem.cl[:, layout.CL_BIT]
-        self.events = Output(*event_buffers(4 * self.ncl + 4))
-        self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
-        self.fst = np.zeros(layout.F_SIZE)
-        from vtool.solvers.newmark import kernel  # numba: imported by the back ends that call it
-
-        self.rules = kernel
+        self.transitions = problem.transitions(builder)  # the shared event and impact rules
+        self.rules = self.transitions.rules  # the compiled kernel's sources and Hertz law
 
     # ----- configuration data -----
     def space(self, mask: int) -> StateSpace:
@@ -309,9 +303,10 @@ class PiecewiseRun(ABC):
             jit.compiled("rules", key, time.perf_counter() - started)
 
     def integrate(self, progress: Progress | None, cancel: Cancel | None) -> None:
-        start = self.mechanism.start
-        x, v, a = start.q.copy(), start.qd.copy(), start.qdd.copy()
-        mask = self.settle(self.problem.start_mask, 0.0, x, v, a)
+        """Event to event: :meth:`advance` in the current configuration, then the shared rules
+        (:class:`~vtool.solvers.model.contact.Transitions`) give the next one and its state."""
+        transitions = self.transitions
+        mask, x, v, _ = transitions.start()
         ss = self.space(mask)
         t, y = 0.0, self.state_of(ss, x, v)
         for t_out in self.output_times(-1.0, 0.0):
@@ -321,7 +316,8 @@ class PiecewiseRun(ABC):
             t, y, fired = self.advance(ss, t, y, min(t + chunk, self.t_end))
             self.flush_rows()
             if fired:
-                mask, x, v, a = self.apply_events(ss, t, y, fired)
+                x, v, _ = self.full_state(ss, t, y)
+                mask, x, v, _ = transitions.apply(ss.mask, t, x, v, fired)
                 ss = self.space(mask)
                 y = self.state_of(ss, x, v)
             if progress is not None:
@@ -329,66 +325,10 @@ class PiecewiseRun(ABC):
             if cancel is not None and cancel():
                 raise RunError(f"cancelled at t = {t:.6g} s")
 
-    def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
-        """The kernel's settle (release of pulling contacts), building configurations as it asks."""
-        problem, tables = self.problem, self.problem.tables
-        m = problem.n
-        while True:
-            self.ist[layout.I_NEV] = 0
-            result = int(self.rules.release_pulling(
-                self.record, tables.record(), mask, t, State(x, v, a, self.ist, self.fst), self.sources(t),
-                self.events, Motion(np.zeros(m), np.zeros(m), np.zeros(m)), np.zeros(m), problem.hertz))
-            self._take_events()
-            if result >= 0:
-                return result
-            mask = -1 - result
-            problem.build(mask)
-            self.space(mask)
-
-    def _take_events(self) -> None:
-        nev = int(self.ist[layout.I_NEV])
-        self.builder.add_events(self.events.ev_f[:nev], self.events.ev_i[:nev])
-        self.ist[layout.I_NEV] = 0
-
-    def apply_events(self, ss: StateSpace, t: float, y: np.ndarray,
-                     fired: list[int]) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
-        """Open, or impact, the clearances whose monitor crossed zero at t, then settle."""
-        x, v, a = (part.copy() for part in self.full_state(ss, t, y))
-        c = ss.mask
-        new_c = c
-        closing = np.zeros(self.ncl, dtype=np.int64)
-        for k in fired:
-            if c & self.closed_bit[k]:
-                new_c &= ~int(self.closed_bit[k])
-            else:
-                closing[k] = 1
-        self.rapid = self.rapid + 1 if t - self.last_event <= self.problem.zeno_window else 0
-        self.last_event = t
-        if self.rapid >= self.problem.rules.zeno_stop:
-            raise RunError(f"chattering contact at t = {t:.6g} s in configuration {self.problem.label(c)}")
-        src = self.sources(t)
-        for k in range(self.ncl):
-            if (c & self.closed_bit[k]) and not (new_c & self.closed_bit[k]):
-                u = 0.0
-                if self.problem.cl[k, layout.CL_SOFT]:  # the parts leave with their relative velocity
-                    self.rules.shut_gap(self.problem.cl, k, x, src)
-                    u = float(self.rules.gap_velocity(self.problem.cl, k, v, src))
-                self.builder.add_event(t, k, OPENED, u, c, new_c)
-        if closing.any():
-            stick = self.rapid >= self.problem.rules.zeno_stick
-            problem = self.problem
-            self.ist[layout.I_NEV] = 0
-            new_c = int(self.rules.apply_impacts(self.record, new_c, closing, self.sources(t),
-                                                 State(x, v, a, self.ist, self.fst), stick, self.events, t,
-                                                 problem.momentum))
-            self._take_events()
-        new_c = self.settle(new_c, t, x, v, a)
-        return new_c, x, v, a
-
     def statistics(self, settings: dict[str, Any]) -> RunStats:
         self.flush_rows()
-        return RunStats(self.steps, self.peak, self.peak_late, self.peak_overlap, tuple(sorted(self.spaces)),
-                        settings)
+        # configurations=None: the ones this run held, from its start and events (as every back end)
+        return RunStats(self.steps, self.peak, self.peak_late, self.peak_overlap, None, settings)
 
 
 def refuse_hertz(mechanism: Mechanism, backend: str) -> None:

@@ -42,12 +42,21 @@ import numpy as np
 
 from vtool.solvers.model.layers import Layer
 from vtool.solvers.model.mechanism import Mechanism
-from vtool.solvers.model.spec import EXTERNAL, HERTZ, INTERNAL, PINNED, REMOVED, MechanismSpec
+from vtool.solvers.model.spec import (
+    EXTERNAL,
+    HERTZ,
+    INTERNAL,
+    PINNED,
+    REMOVED,
+    ClearanceSpec,
+    MechanismSpec,
+)
 
 ROMAN = ("I", "II", "III", "IV", "V", "VI", "VII", "VIII")
 
 HARMONIC_SOURCE = 0
 FIXED_SOURCE = 1
+UNIT_SOURCE = 0  # the coordinate number of the unit source (see unit_source): the ground's number
 
 
 def clearance_bit(spec: MechanismSpec, index: int) -> int:
@@ -89,7 +98,23 @@ def sources(spec: MechanismSpec) -> list[tuple[int, int, tuple[float, float, flo
     result = [(spec.cam.coordinate, HARMONIC_SOURCE, (spec.cam.amplitude, 0.0, 0.0))]
     if spec.seat is not None:
         result.append((spec.seat.coordinate, FIXED_SOURCE, (spec.seat.position, 0.0, 0.0)))
+    if any(c.offset for c in spec.clearances):
+        result.append((UNIT_SOURCE, FIXED_SOURCE, (1.0, 0.0, 0.0)))
     return result
+
+
+def unit_source(spec: MechanismSpec) -> int:
+    """Index of the unit source (x ≡ 1, numbered :data:`UNIT_SOURCE`), present when a clearance's gap has an
+    offset (:attr:`ClearanceSpec.offset`): the constant force k·opening of its closed contact is a column
+    on it, and the ground (behind = 0) is this source with the opening moved by the sense; -1 without one."""
+    entries = sources(spec)
+    return len(entries) - 1 if entries[-1][0] == UNIT_SOURCE else -1
+
+
+def kernel_opening(c: ClearanceSpec) -> float:
+    """The opening the back ends add to sense·(q_ahead - x_behind): the ground (behind = 0) is the unit
+    source at x = 1, so its opening grows by the sense (sense·(q - 0) + o = sense·(q - 1) + o + sense)."""
+    return c.opening + (c.sense if c.behind == 0 else 0.0)
 
 
 def source_parameters(mechanism: Mechanism) -> tuple[np.ndarray, np.ndarray, list[int]]:
@@ -249,23 +274,23 @@ def compliant_terms(mechanism: Mechanism, mask: int) -> CompliantTerms:
     for index, c in enumerate(spec.clearances):
         if c.rigid or not mask & clearance_bit(spec, index):
             continue
+        w = np.zeros(n)  # the gap's gradient: sense (e_ahead - e_behind)
+        w[c.ahead - 1] = c.sense
+        if c.kind == INTERNAL:
+            w[c.behind - 1] = -c.sense
         if c.contact == HERTZ:
-            w = np.zeros(n)
-            w[c.ahead - 1] = 1.0
-            if c.kind == INTERNAL:
-                w[c.behind - 1] = -1.0
             hertz[index] = w
             continue
         k, d = c.contact_stiffness, contact_damping(mechanism, index)
-        w = np.zeros(n)
-        w[c.ahead - 1] = 1.0
         row = np.zeros(3 * n + 3 * ns)
-        if c.kind == INTERNAL:
-            w[c.behind - 1] = -1.0
-        else:
+        if c.kind != INTERNAL:
             s = source_of[c.behind]
             S[c.ahead - 1, 3 * s], S[c.ahead - 1, 3 * s + 1] = -k, -d
-            row[3 * n + 3 * s], row[3 * n + 3 * s + 1] = k, d
+            row[3 * n + 3 * s], row[3 * n + 3 * s + 1] = c.sense * k, c.sense * d
+        if c.offset:  # the opening's constant force k o w (on the unit source's x ≡ 1), in the force -k o
+            u, o = unit_source(spec), kernel_opening(c)
+            S[:, 3 * u] += k * o * w
+            row[3 * n + 3 * u] -= k * o
         K += k * np.outer(w, w)
         C += d * np.outer(w, w)
         row[:n], row[n:2 * n] = -k * w, -d * w
@@ -280,10 +305,12 @@ def hertz_row(mechanism: Mechanism, index: int) -> np.ndarray:
     n, ns = spec.n_coordinates, len(sources(spec))
     c = spec.clearances[index]
     row = np.zeros(3 * n + 3 * ns)
-    row[c.ahead - 1] = row[n + c.ahead - 1] = -1.0
+    row[c.ahead - 1] = row[n + c.ahead - 1] = -c.sense
     if c.kind == INTERNAL:
-        row[c.behind - 1] = row[n + c.behind - 1] = 1.0
+        row[c.behind - 1] = row[n + c.behind - 1] = c.sense
     else:
         s = next(s for s, (number, _, _) in enumerate(sources(spec)) if number == c.behind)
-        row[3 * n + 3 * s] = row[3 * n + 3 * s + 1] = 1.0
+        row[3 * n + 3 * s] = row[3 * n + 3 * s + 1] = c.sense
+    if c.offset:  # δ = -gap: less the opening, on the unit source's x ≡ 1
+        row[3 * n + 3 * unit_source(spec)] -= kernel_opening(c)
     return row

@@ -40,9 +40,11 @@ from vtool.solvers.model.configurations import (
     configuration_label,
     hertz_row,
     internal_force_coefficients,
+    kernel_opening,
     mask_of,
     partition,
     sources,
+    unit_source,
 )
 from vtool.solvers.model.hertz import kernel_restitution
 from vtool.solvers.model.mechanism import Mechanism
@@ -82,6 +84,8 @@ def source_series(mechanism: Mechanism) -> SourceSeries:
     cos[0, :len(a)], sin[0, :len(b)] = a, b
     if spec.seat is not None:
         const[1] = spec.seat.position
+    if unit_source(spec) >= 0:
+        const[unit_source(spec)] = 1.0
     return SourceSeries(mechanism.omega, tuple(numbers), const, cos, sin)
 
 
@@ -430,14 +434,15 @@ class ContactProblem:
         cl = np.zeros((self.ncl, layout.CL_SIZE), dtype=np.int64)
         clf = np.zeros((self.ncl, layout.CLF_SIZE))
         for k, c in enumerate(spec.clearances):
-            cl[k] = (c.ahead - 1, c.behind - 1 if c.behind <= self.n else -1,
-                     self.series.index(c.behind) if c.behind > self.n else -1,
+            external = c.behind > self.n or c.behind == 0  # 0: the ground, the unit source
+            cl[k] = (c.ahead - 1, -1 if external else c.behind - 1, self.series.index(c.behind) if external else -1,
                      int(c.state == ENABLED), int(c.state == PINNED), clearance_bit(spec, k),
                      LAW_CODES[spec.impact_law(c)], SOFT_CODES[c.contact])
             # a Hertz contact's slot holds the e' whose a = 3(1 - e')/2 rebounds at c.restitution (hertz.py)
             restitution = kernel_restitution(c.restitution) if c.contact == HERTZ else c.restitution
             clf[k, :layout.CLF_HV] = (restitution, spec.contact.rocker_scale, c.contact_stiffness,
                                       c.contact_exponent)
+            clf[k, layout.CLF_OPEN], clf[k, layout.CLF_SIGN] = kernel_opening(c), c.sense
         self.cl, self.clf = cl, clf
         self.hertz, self.momentum = layout.laws(cl)  # the kernel's law switches
         self.mass = mechanism.mass_and_inverse
@@ -578,7 +583,8 @@ class ContactProblem:
         for k, (kind, ahead, behind) in enumerate(self.tables.of(mask)[3][:, :layout.MK_M]):
             if kind in (layout.MK_GAP, layout.MK_OVERLAP):
                 other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
-                values[k] = (1.0 if kind == layout.MK_GAP else -1.0) * (z[ahead] - other) + self.gap_noise
+                gap = self.clf[k, layout.CLF_SIGN] * (z[ahead] - other) + self.clf[k, layout.CLF_OPEN]
+                values[k] = (1.0 if kind == layout.MK_GAP else -1.0) * gap + self.gap_noise
             elif kind == layout.MK_FORCE:
                 values[k] = forces[k]
         return values
@@ -689,8 +695,8 @@ class Transitions:
             if (mask & bits[k]) and not (new & bits[k]):
                 u = 0.0
                 if problem.cl[k, layout.CL_SOFT]:  # a linear contact's parts leave with their relative velocity
-                    self.rules.shut_gap(problem.cl, k, x, src)
-                    u = float(self.rules.gap_velocity(problem.cl, k, v, src))
+                    self.rules.shut_gap(problem.cl, problem.clf, k, x, src)
+                    u = float(self.rules.gap_velocity(problem.cl, problem.clf, k, v, src))
                 self.builder.add_event(t, k, OPENED, u, mask, new)
         if closing.any():
             self.ist[layout.I_NEV] = 0

@@ -90,10 +90,17 @@ def check_open_gaps(spec: MechanismSpec, q: np.ndarray) -> None:
                 raise InputError("seat.position", spec.seat.position,
                                  f"<= {ahead:.6g} (where the static start puts q{c.ahead}; the run would "
                                  f"start inside the seat)", length)
-        elif c.behind <= spec.n_coordinates and ahead - q[c.behind - 1] < -1e-12 * max(abs(ahead), 1.0):
-            raise InputError("initial.closed", list(spec.initial.closed),
-                             f"a start with clearance {c.name} open or closed consistently (its gap would be "
-                             f"{ahead - q[c.behind - 1]:.3g} {length})")
+        elif c.behind <= spec.n_coordinates:
+            gap = c.gap(ahead, q[c.behind - 1] if c.behind > 0 else 0.0)
+            if gap < -1e-12 * max(abs(ahead), 1.0) and c.offset:  # e.g. a spring's coils touching at the start
+                raise InputError("initial.closed", list(spec.initial.closed),
+                                 f"a start with clearance {c.name} open: the static start at cam angle 0 overlaps it "
+                                 f"by {-gap:.3g} {length} (a start inside a contact with an opening is not built: "
+                                 f"start where it is open, e.g. a spring's coils apart at angle 0)")
+            if gap < -1e-12 * max(abs(ahead), 1.0):
+                raise InputError("initial.closed", list(spec.initial.closed),
+                                 f"a start with clearance {c.name} open or closed consistently (its gap would be "
+                                 f"{gap:.3g} {length})")
 
 
 def start_stiffness(spec: MechanismSpec, layer: Layer) -> np.ndarray:

@@ -34,6 +34,8 @@ class Mechanism:
     def __init__(self, spec: MechanismSpec, _shared: Mechanism | None = None) -> None:
         self.spec = spec
         self.start_mask: int | None = None  # a carried start's configuration (with_start); None: the preset's
+        #: a carried start's nonlinear-element states (solvers/model/nonlinear.py); None: the elements' own
+        self.start_states: np.ndarray | None = None
         if _shared is None:
             self.M, self.K = assemble_full(spec)
             self._layers: dict[frozenset[str], Layer] = {}
@@ -63,7 +65,8 @@ class Mechanism:
             self._lasting[key] = make()
         return self._lasting[key]
 
-    def with_start(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, mask: int) -> Mechanism:
+    def with_start(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, mask: int,
+                   states: np.ndarray | None = None) -> Mechanism:
         """This mechanism started from a given state (full elastic coordinates, cam angle zero) in
         configuration ``mask`` instead of its static start: the next cam cycle of a run, whose state at
         the cycle's end it is (the cam is periodic in 360 deg). The cam's offset and the force scales
@@ -75,6 +78,7 @@ class Mechanism:
                                               np.array(q, dtype=float), np.array(qd, dtype=float),
                                               np.array(qdd, dtype=float))
         other.start_mask = int(mask)
+        other.start_states = None if states is None else np.array(states, dtype=float)
         return other
 
     @cached_property
@@ -85,8 +89,8 @@ class Mechanism:
         for c in self.spec.clearances:
             if c.contact == LINEAR:
                 w = np.zeros(len(K))
-                w[c.ahead - 1] = 1.0
-                if c.behind <= len(K):
+                w[c.ahead - 1] = 1.0  # the sense changes no stiffness (k w wᵀ)
+                if 0 < c.behind <= len(K):
                     w[c.behind - 1] = -1.0
                 K += c.contact_stiffness * np.outer(w, w)
         return float(undamped_modes(self.M, K).omega.max())

@@ -22,7 +22,9 @@ from vtool.units import cam_speed
 
 if TYPE_CHECKING:  # (a field's type only: the spring module imports numpy, which `vtool --help` must not)
     from vtool.solvers.model.friction import FrictionLaws
+    from vtool.solvers.model.hla import HLAPlace
     from vtool.solvers.model.spring import SpringSpec
+    from vtool.solvers.model.valveforces import ValveForces
 
 BAR = "bar"
 BEAM = "beam"
@@ -130,6 +132,16 @@ class ClearanceSpec:
     expansion near e = 1), and a Hertz contact takes 0.01 <= e <= 1 (e = 0
     would need infinite damping). Nonlinear: the Newmark back end iterates,
     scipy integrates it, exact refuses it.
+
+    ``opening`` (length, default 0) and ``sense`` (+1 or -1, default +1) make
+    the gap ``sense (q[ahead] - q[behind]) + opening``: a clearance that is
+    open by ``opening`` when its pair sits where the model's coordinates are
+    zero (a pitch segment's coil gap: :mod:`vtool.solvers.model.spring`).
+    ``behind = 0`` is the ground (the frame, q ≡ 0; kind ``external``).
+    Only a compliant contact takes a nonzero opening, sense -1 or the ground
+    (its spring then carries a constant force term k·opening; a rigid one
+    would need an affine tie). With the defaults the gap is exactly
+    q[ahead] - q[behind], as before.
     """
 
     name: str
@@ -144,6 +156,17 @@ class ClearanceSpec:
     contact_damping: float | None = None  # force*time/length
     contact_damping_ratio: float | None = None  # of critical, on the local masses
     contact_exponent: float = 1.5  # hertz
+    opening: float = 0.0  # length: the gap where q[ahead] = q[behind] (compliant contacts)
+    sense: int = 1  # +1: gap = q[ahead] - q[behind] + opening; -1: q[behind] - q[ahead] + opening
+
+    @property
+    def offset(self) -> bool:
+        """The gap is not plainly q[ahead] - q[behind]: an opening, sense -1 or the ground behind."""
+        return self.opening != 0.0 or self.sense != 1 or self.behind == 0
+
+    def gap(self, q_ahead: float, q_behind: float) -> float:
+        """The gap at these positions of its pair (``q_behind`` = 0 for the ground)."""
+        return self.sense * (q_ahead - q_behind) + self.opening
 
     @property
     def rigid(self) -> bool:
@@ -413,6 +436,10 @@ class MechanismSpec:
     #: JSON text of the preset's [train] table when it was entered by train type (provenance: a saved copy
     #: keeps the type's parameters while the model is still what they expand to; see presets/trains.py)
     train: str = field(default="", compare=False)
+    #: a hydraulic lash adjuster in a bar member's place ([hla]; a nonlinear element, solvers/model/hla.py)
+    hla: HLAPlace | None = None
+    #: forces on the valve: guide friction, gas force ([valve_forces]; solvers/model/valveforces.py)
+    valve_forces: ValveForces | None = None
     kind: str = field(default="valvetrain", init=False)
 
     @property
@@ -433,6 +460,14 @@ class MechanismSpec:
     @property
     def n_coordinates(self) -> int:
         return len(self.coordinates)
+
+    def force_label(self, index: int) -> str:
+        """``F`` and clearance ``index``'s ahead coordinate; a second clearance on the same coordinate (a
+        spring's top coil contact on the retainer beside another contact) gets ``_2`` (``_3``, ...), so that
+        CSV headers and metric names stay unique."""
+        ahead = self.clearances[index].ahead
+        repeat = sum(c.ahead == ahead for c in self.clearances[:index])
+        return f"F{ahead}" + (f"_{repeat + 1}" if repeat else "")
 
     def clearance(self, name: str) -> ClearanceSpec:
         for c in self.clearances:

@@ -38,7 +38,7 @@ in series (:func:`closing_forces` gives the order).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import overload
 
 import numpy as np
@@ -69,6 +69,9 @@ class SpringSpec:
     table_lengths: tuple[float, ...] = ()  # measured force-length table (decreasing lengths)
     table_forces: tuple[float, ...] = ()
     nodes: tuple[int, ...] = ()  # a pitch diagram's coordinates between its segments (fixed end first)
+    contacts: tuple[str, ...] = ()  # a pitch diagram's coil-contact clearances, one per segment
+    wire_height: float | None = None  # elliptic wire: its axis along the spring's (wire_diameter: the radial one)
+    strength_law: tuple[float, float] | None = field(default=None, compare=False)  # (A, m): R_m = A / d^m (MPa, mm)
 
     # ----- closed forms -----
     @property
@@ -81,20 +84,40 @@ class SpringSpec:
         """G d^4 / (8 D^3 n_a); with a table, its slope at the installed length."""
         if self.table_lengths:
             return table_rate(self.table_lengths, self.table_forces, self.installed_length)
-        return coil_rate(self.shear_modulus, self.wire_diameter, self.coil_diameter, self.active_coils)
+        return self.coil_rate(self.active_coils)
+
+    def coil_rate(self, coils: float) -> float:
+        """The rate of ``coils`` active coils: G d^4/(8 D^3 n), or for an elliptic wire 4 G J_t/(pi D^3 n)
+        (:func:`elliptic_torsion_constant`; the round wire's J_t = pi d^4/32 gives the first)."""
+        if self.wire_height is None:
+            return coil_rate(self.shear_modulus, self.wire_diameter, self.coil_diameter, coils)
+        J = elliptic_torsion_constant(0.5 * self.wire_diameter, 0.5 * self.wire_height)
+        return 4.0 * self.shear_modulus * J / (math.pi * self.coil_diameter ** 3 * coils)
+
+    def wire_mass(self, coils: float) -> float:
+        """rho A pi D n, A = pi a b (round: pi d^2/4)."""
+        if self.wire_height is None:
+            return wire_mass(self.density, self.wire_diameter, self.coil_diameter, coils)
+        return self.density * 0.25 * math.pi * self.wire_diameter * self.wire_height * math.pi * self.coil_diameter \
+            * coils
+
+    @property
+    def axial_wire(self) -> float:
+        """The wire's size along the spring's axis (coils touch across it): d, or an elliptic wire's height."""
+        return self.wire_diameter if self.wire_height is None else self.wire_height
 
     @property
     def active_mass(self) -> float:
-        return wire_mass(self.density, self.wire_diameter, self.coil_diameter, self.active_coils)
+        return self.wire_mass(self.active_coils)
 
     @property
     def total_mass(self) -> float:
-        return wire_mass(self.density, self.wire_diameter, self.coil_diameter, self.total_coils)
+        return self.wire_mass(self.total_coils)
 
     @property
     def solid_length(self) -> float:
         return self.solid_length_given if self.solid_length_given is not None else self.total_coils * \
-            self.wire_diameter
+            self.axial_wire
 
     @property
     def preload(self) -> float:
@@ -136,8 +159,14 @@ class SpringSpec:
     @overload
     def stress(self, force: np.ndarray, factor: str = "bergstrasser") -> np.ndarray: ...
     def stress(self, force: float | np.ndarray, factor: str = "bergstrasser") -> float | np.ndarray:
-        """Corrected shear stress K 8 F D / (pi d^3)."""
-        return stress_factor(self.index, factor) * 8.0 * force * self.coil_diameter / (math.pi * self.wire_diameter ** 3)
+        """Corrected shear stress K 8 F D / (pi d^3); elliptic wire K F D / (pi a b^2), a >= b its semi-axes
+        (:func:`elliptic_torsion_constant`), K on the index D / d of the radial axis d (our choice: DIN EN
+        13906-1's factors are for round wire)."""
+        if self.wire_height is None:
+            return stress_factor(self.index, factor) * 8.0 * force * self.coil_diameter / \
+                (math.pi * self.wire_diameter ** 3)
+        a, b = 0.5 * max(self.wire_diameter, self.wire_height), 0.5 * min(self.wire_diameter, self.wire_height)
+        return stress_factor(self.index, factor) * force * self.coil_diameter / (math.pi * a * b * b)
 
     def fatigue_factor(self, force_min: float, force_max: float) -> float | None:
         """Goodman safety factor of a cycle between two forces (module doc); None without a fatigue limit."""
@@ -149,6 +178,34 @@ class SpringSpec:
 
 def coil_rate(G: float, d: float, D: float, n: float) -> float:
     return G * d ** 4 / (8.0 * D ** 3 * n)
+
+
+def elliptic_torsion_constant(a: float, b: float) -> float:
+    """Saint-Venant torsion constant of an ellipse of semi-axes a, b: J_t = pi a^3 b^3 / (a^2 + b^2)
+    (Timoshenko and Goodier, Theory of Elasticity, 3rd ed. 1970, section 105); its largest shear stress,
+    at the ends of the minor axis, is 2 T / (pi a b^2) for a >= b. a = b = d/2 gives pi d^4/32 and 16 T/(pi d^3)."""
+    return math.pi * a ** 3 * b ** 3 / (a * a + b * b)
+
+
+def power_law_strength(A: float, m: float, d: float) -> float:
+    """Tensile strength R_m = A / d^m at wire diameter d (the form wire standards' tables follow)."""
+    return A / d ** m
+
+
+#: Minimum tensile strength (MPa) of oil-hardened and tempered valve spring wire EN 10270-2:2011 VDSiCrV
+#: against wire diameter (mm, the upper end of each diameter band), as printed in voestalpine Boehler's
+#: data sheet "Penthor 964" (edition 04/2016, "conforms to VDSiCrV according to EN 10270-2:2011"): bands
+#: >1.00-1.30, >1.30-1.40, >1.40-1.60, >1.60-2.00, >2.00-2.50, >2.50-2.70 mm. We could not read the standard
+#: itself; the sheet's bands below 1 mm (2230 MPa) are left out of the fit (valve spring wire is thicker).
+VDSICRV_TABLE = ((1.30, 2230.0), (1.40, 2210.0), (1.60, 2210.0), (2.00, 2160.0), (2.50, 2100.0), (2.70, 2060.0))
+STRENGTH_MATERIALS = {"VDSiCrV": VDSICRV_TABLE}
+
+
+def fitted_strength_law(table: tuple[tuple[float, float], ...]) -> tuple[float, float]:
+    """(A, m) of R_m = A / d^m (MPa, mm) fitted to a table of (d, R_m) by least squares on the logarithms."""
+    d, rm = np.log([row[0] for row in table]), np.log([row[1] for row in table])
+    slope, intercept = np.polyfit(d, rm, 1)
+    return float(math.exp(intercept)), float(-slope)
 
 
 def wire_mass(density: float, d: float, D: float, n: float) -> float:
@@ -177,13 +234,13 @@ def table_rate(lengths: tuple[float, ...], forces: tuple[float, ...], at: float)
 
 
 def segment_rates(s: SpringSpec) -> np.ndarray:
-    return np.array([coil_rate(s.shear_modulus, s.wire_diameter, s.coil_diameter, n) for n in s.segment_coils])
+    return np.array([s.coil_rate(n) for n in s.segment_coils])
 
 
 def closing_forces(s: SpringSpec) -> np.ndarray:
     """Force at which each pitch segment closes: G d^4 (p_i - d) / (8 D^3) (its coils touch)."""
     k = segment_rates(s)
-    return k * np.asarray(s.segment_coils) * (np.asarray(s.segment_pitches) - s.wire_diameter)
+    return k * np.asarray(s.segment_coils) * (np.asarray(s.segment_pitches) - s.axial_wire)
 
 
 def pitch_force_length(s: SpringSpec, length: float | np.ndarray) -> float | np.ndarray:
@@ -231,8 +288,31 @@ def segment_gaps(s: SpringSpec, trace: object) -> np.ndarray:
     ends = (0, *s.nodes, s.coordinate)
     q = [np.zeros_like(trace.cam_angle, dtype=np.float64) if k == 0 else trace.coordinate(k)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
          for k in ends]
-    free_gap = np.asarray(s.segment_coils) * (np.asarray(s.segment_pitches) - s.wire_diameter)
+    free_gap = np.asarray(s.segment_coils) * (np.asarray(s.segment_pitches) - s.axial_wire)
     return np.column_stack([free_gap[i] - sign * (q[i + 1] - q[i]) for i in range(len(free_gap))])
+
+
+def end_force(s: SpringSpec, trace: object, rows: slice = slice(None)) -> np.ndarray:
+    """The spring's force on its moving end at each output row (compression positive).
+
+    A pitch diagram: the top segment's bar, k_top times its compression, plus its coil contact's force
+    (the run's own force: surge and coil clash included; the bar's consistent-mass inertia is left out).
+    Otherwise the force-length law at the end's length from the run (one bar: its elastic force). The
+    CSV column ``NAME_force`` and the quantity of ``vtool solve --orders NAME_force``; ``rows``: a slice."""
+    q_end = trace.coordinate(s.coordinate, rows)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+    sign = compression_sign(trace, s.coordinate)
+    if not s.segment_coils:
+        return np.asarray(s.force_at(s.rest_length - sign * q_end), dtype=float)
+    below = trace.coordinate(s.nodes[-1], rows) if s.nodes else np.zeros_like(q_end)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+    force = segment_rates(s)[-1] * sign * (q_end - below)
+    if s.contacts:
+        force = force + trace.force(s.contacts[-1], rows)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+    return np.asarray(force, dtype=float)
+
+
+def force_quantity(s: SpringSpec) -> str:
+    """The name of a spring's end force as a quantity and CSV column: ``valve_spring_force``."""
+    return f"{s.name}_force"
 
 
 def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
@@ -247,7 +327,7 @@ def run_report(springs: tuple[SpringSpec, ...], trace: object) -> list[dict]:
     for s in springs:
         q = trace.coordinate(s.coordinate)  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
         length = s.rest_length - compression_sign(trace, s.coordinate) * q
-        force = np.asarray(s.force_at(length), dtype=float)
+        force = end_force(s, trace)
         shortest = float(length.min())
         f_lo, f_hi = float(force[last].min()), float(force[last].max())
         result.append({
@@ -289,9 +369,14 @@ def report_text(report: list[dict], units: object) -> list[str]:
                                 for i, a in enumerate(r["segment_first_touch_deg"]))
             lines.append(f"    pitch segments, coils first touching (smallest gap "
                          f"{', '.join(f'{g:.3g}' for g in r['segment_min_gap'])} {L}): {touches}")
-            if r["first_coil_bind_deg"] is not None:
+            if r["first_coil_bind_deg"] is not None and "coil_contact_peak_force" in r:
+                lines.append(f"    first coil clash at {r['first_coil_bind_deg']:.1f} deg; peak coil contact force "
+                             f"{r['coil_contact_peak_force']:.5g} {F} (per segment "
+                             f"{', '.join(f'{f:.4g}' for f in r['segment_contact_peak_force'])} {F})")
+            elif r["first_coil_bind_deg"] is not None:
                 lines.append(f"    first coil clash at {r['first_coil_bind_deg']:.1f} deg: the model's segments do "
-                             "not stop there (no coil-contact force); the response after it is not to be trusted")
+                             "not stop there (coil_contact = \"none\": no coil-contact force); the response after it "
+                             "is not to be trusted")
     return lines
 
 
@@ -305,9 +390,17 @@ def _clash(s: SpringSpec, trace: object, angle: np.ndarray) -> dict:
     for i in range(gaps.shape[1]):
         touching = np.flatnonzero(gaps[:, i] <= 0.0)
         first.append(float(angle[touching[0]]) if touching.size else None)
+    result: dict = {"segment_min_gap": gaps.min(axis=0).tolist()}
+    if s.contacts:  # the coil contacts' own events and forces (the model stops the coils there)
+        names = [c.name for c in trace.spec.clearances]  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+        closed = {name: [e.cam_angle for e in trace.events if e.clearance == name and e.kind == "closed"]  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+                  for name in s.contacts}
+        first = [min(closed[name]) if closed[name] else None for name in s.contacts]
+        peaks = [float(trace.peak_force[names.index(name)]) for name in s.contacts]  # type: ignore[attr-defined]  # a Trace, duck-typed: the model does not import the result module
+        result |= {"coil_contacts": list(s.contacts), "segment_contact_peak_force": peaks,
+                   "coil_contact_peak_force": max(peaks)}
     seen = [a for a in first if a is not None]
-    return {"segment_first_touch_deg": first, "segment_min_gap": gaps.min(axis=0).tolist(),
-            "first_coil_bind_deg": min(seen) if seen else None}
+    return result | {"segment_first_touch_deg": first, "first_coil_bind_deg": min(seen) if seen else None}
 
 
 def coil_bind_margin(springs: tuple[SpringSpec, ...], trace: object, rows: np.ndarray | None = None) -> float:

@@ -73,13 +73,11 @@ from vtool.solvers.backends import (
     Progress,
     RunStats,
 )
-from vtool.solvers.model.contact import ContactProblem, EventRules
+from vtool.solvers.model.contact import LAW_CODES, SOFT_CODES, ContactProblem, EventRules
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.spec import (
     BETA_RANGE,
     GAMMA_RANGE,
-    HERTZ,
-    MOMENTUM,
     RIGID,
     MechanismSpec,
     RunSpec,
@@ -128,12 +126,16 @@ class NewmarkOptions:
 
 
 def kernel_laws(spec: Any, impacts: tuple[str, ...] = ()) -> tuple[bool | None, bool | None]:
-    """The kernel's (hertz, momentum) switches (:func:`vtool.solvers.newmark.kernel.laws`) for a
-    valve-train spec, and for its runs under the impact laws ``impacts`` besides (``vtool compare``)."""
-    hertz = any(c.contact == HERTZ for c in spec.clearances)
-    momentum = MOMENTUM in impacts or any(c.contact == RIGID and spec.impact_law(c) == MOMENTUM
-                                          for c in spec.clearances)
-    return (True if hertz else None), (True if momentum else None)
+    """The kernel's (hertz, momentum) switches for a valve-train spec, and for its runs under the impact
+    laws ``impacts`` besides (``vtool compare``): :func:`~vtool.solvers.newmark.layout.laws` of the
+    codes :class:`~vtool.solvers.model.contact.ContactProblem` puts in its clearance table (one
+    derivation), with a rigid clearance per law of ``impacts``."""
+    codes = [(SOFT_CODES[c.contact], LAW_CODES[spec.impact_law(c)]) for c in spec.clearances]
+    codes += [(SOFT_CODES[RIGID], LAW_CODES[law]) for law in impacts]
+    cl = np.zeros((len(codes), layout.CL_SIZE), dtype=np.int64)
+    if codes:
+        cl[:, [layout.CL_SOFT, layout.CL_LAW]] = codes
+    return layout.laws(cl)
 
 
 def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | None] = (None, None)) -> str | None:

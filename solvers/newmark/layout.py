@@ -23,9 +23,10 @@ FP_SIZE = 16
 CL_AHEAD, CL_BEHIND, CL_SRC, CL_MON, CL_PIN, CL_BIT, CL_LAW, CL_SOFT = range(8)
 CL_SIZE = 8  # CL_SOFT: SOFT_LINEAR or SOFT_HERTZ for a compliant clearance (no impact, no tie), else 0
 SOFT_LINEAR, SOFT_HERTZ = 1, 2
-# float columns: restitution, SCALE; Hertz stiffness and exponent; approach velocity of the contact
-CLF_E, CLF_SCALE, CLF_HK, CLF_HN, CLF_HV = range(5)
-CLF_SIZE = 5
+# float columns: restitution, SCALE; Hertz stiffness and exponent; approach velocity of the contact; the
+# gap's opening and sense (gap = sense (x_ahead - x_behind) + opening: ClearanceSpec.opening, 0 and 1 by default)
+CLF_E, CLF_SCALE, CLF_HK, CLF_HN, CLF_HV, CLF_OPEN, CLF_SIGN = range(7)
+CLF_SIZE = 7
 # impact laws
 LAW_MOMENTUM, LAW_LOCAL, LAW_THESIS = range(3)
 # event kinds
@@ -50,7 +51,7 @@ CM_SIZE = 6
 # row w on (z, ż, z̈, sources) with the step's z̈_F = -G·y substituted), so that a quiet step gets its
 # force monitors from the vector pass it makes anyway (see ``ConfigurationTables._force_rows``). The
 # last dimension is n + ncl.
-CP_RAW, CP_STD, CP_FINE = range(3)
+CP_RAW, CP_STD, CP_FINE = np.int64(0), np.int64(1), np.int64(2)  # np.int64: apply_operator compiles once
 CP_SIZE = 3
 PART_C, PART_K, PART_P, PART_S = range(4)
 PART_SIZE = 4

@@ -12,6 +12,12 @@ a contact force among the steps (within 1 % of the peak so far) is refined on
 the dense output by a bounded Brent search between its neighbouring steps
 (steps alone read peaks 0.04-6.6 % low).
 
+Nonlinear elements (:mod:`vtool.solvers.model.nonlinear`: an HLA's chamber,
+the valve's guide friction and gas force) run here: their states are
+integrated beside y, their forces enter the accelerations and the closed
+rigid contacts' forces (:mod:`vtool.solvers.scipy.elements`), their states
+go to the trace's rows. At an event the states carry over unchanged.
+
 This is what a Python user would reach for, and its known weakness shows:
 solve_ivp only looks for sign changes between its own steps, so a monitor
 that crosses zero twice within one step is missed, and every impact needs a
@@ -32,10 +38,13 @@ from vtool.solvers.cost import MAX_SCIPY_STEPS
 from vtool.solvers.exact.backend import peak_brackets
 from vtool.solvers.exact.piecewise import PiecewiseBackend, PiecewiseRun
 from vtool.solvers.exact.statespace import StateSpace
+from vtool.solvers.model.attached import elements_of
 from vtool.solvers.model.contact import ContactProblem
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.spec import RunSpec
-from vtool.solvers.trace import TraceBuilder
+from vtool.solvers.newmark import layout
+from vtool.solvers.scipy.elements import terms
+from vtool.solvers.trace import OPENED, TraceBuilder
 
 METHODS = ("DOP853", "Radau", "RK45", "LSODA")
 GUARD = 1e-12  # s after a restart during which no event is taken
@@ -59,6 +68,7 @@ class ScipyBackend(PiecewiseBackend[ScipyOptions]):
 
     name = "scipy"
     library_dependent = True
+    nonlinear_elements = True
     max_steps = MAX_SCIPY_STEPS
     remedy = "a tighter rtol, or the exact back end"
 
@@ -90,6 +100,92 @@ class _ScipyRun(PiecewiseRun):
         start = problem.mechanism.start
         self.x_scale = max(float(np.abs(start.q).max()), 1e-12)
         self.v_scale = max(float(np.abs(start.qd).max()), self.x_scale * problem.omega, 1e-12)
+        mechanism = problem.mechanism
+        self.elements = mechanism.kept(("nonlinear elements",), lambda: elements_of(mechanism.spec))
+        carried = mechanism.start_states
+        self.s = (np.array(carried, dtype=float) if carried is not None
+                  else self.elements.initial(start.q, start.qd))  # the elements' states now
+        self.s_scale = np.maximum(np.abs(self.s), 1e-6)
+        self.state_rows: list[np.ndarray] = []
+
+    # ----- the nonlinear elements' states beside y (module doc) -----
+    def split(self, ss: StateSpace, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(y, s) of an extended state (or of a configuration state y, with the states now)."""
+        if y.shape[0] > ss.size:
+            return y[:ss.size], y[ss.size:]
+        return y, (self.s if y.ndim == 1 else np.repeat(self.s[:, None], y.shape[1], axis=1))
+
+    def element_force(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray,
+                      s: np.ndarray) -> np.ndarray:
+        e = terms(self.problem, ss)
+        u = ss.basis(t)
+        x, v = e.Px @ y + e.Qx @ u, e.Pv @ y + e.Qv @ u
+        return self.elements.evaluate(t, x, v, s)[0]
+
+    def full_state(self, ss: StateSpace, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        y, s = self.split(ss, y)
+        x, v, a = super().full_state(ss, t, y)
+        if self.elements.size or self.elements.elements:
+            e = terms(self.problem, ss)
+            a = a + e.Sel @ (e.R @ self.element_force(ss, t, y, s))
+        return x, v, a
+
+    def forces(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
+        y, s = self.split(ss, y)
+        out = super().forces(ss, t, y)
+        if self.elements.elements:
+            out = out + terms(self.problem, ss).Phi @ self.element_force(ss, t, y, s)
+        return out
+
+    def monitors(self, ss: StateSpace, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
+        y, s = self.split(ss, y)
+        out = super().monitors(ss, t, y)
+        if self.elements.elements:  # Φ is zero but on the closed rigid contacts, whose monitor is their force
+            out = out + terms(self.problem, ss).Phi @ self.element_force(ss, t, y, s)
+        return out
+
+    def emit(self, ss: StateSpace, t: float, y: np.ndarray) -> None:
+        y, s = self.split(ss, y)
+        saved, self.s = self.s, s
+        super().emit(ss, t, y)
+        self.s = saved
+        if self.elements.elements:
+            self.state_rows.append(np.array(s, dtype=float))
+
+    def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
+        """With elements, the release of pulling contacts is judged here, on the contact forces with the
+        elements' share (the compiled rules see the linear equations only): the most pulling closed rigid
+        contact is released first, until every one pushes (at most one release per clearance)."""
+        if not self.elements.elements:
+            return super().settle(mask, t, x, v, a)
+        tolerance = self.problem.force_tolerance()
+        for _ in range(self.ncl + 1):
+            self.problem.build(mask)
+            ss = self.space(mask)
+            forces = self.forces(ss, t, self.state_of(ss, x, v))
+            kinds = self.problem.tables.of(mask)[3][:, layout.MK_KIND]
+            pulling = (kinds == layout.MK_FORCE) & self.monitored & (forces < -tolerance)
+            if not pulling.any():
+                return mask
+            worst = int(np.argmin(np.where(pulling, forces, np.inf)))
+            released = mask & ~int(self.closed_bit[worst])
+            self.builder.add_event(t, worst, OPENED, 0.0, mask, released)
+            mask = released
+        return mask
+
+    def flush_rows(self) -> None:
+        if not self.elements.elements:
+            super().flush_rows()
+            return
+        if not self.rows:
+            return
+        blocks, self.rows = self.rows, []
+        states, self.state_rows = np.array(self.state_rows), []
+        t, q3, F, cfg = (np.concatenate(parts) for parts in zip(*blocks, strict=True))
+        if np.any(np.diff(t) < 0.0):
+            order = np.argsort(t, kind="stable")
+            t, q3, F, cfg, states = t[order], q3[order], F[order], cfg[order], states[order]
+        self.builder.add_rows(t, q3, F, cfg, states=states)
 
     def advance(self, ss: StateSpace, t0: float, y0: np.ndarray, t_stop: float) -> tuple[float, np.ndarray, list[int]]:
         nf = ss.size // 2
@@ -99,15 +195,42 @@ class _ScipyRun(PiecewiseRun):
 
         if ss.hertz is not None and ss.hertz.size:
 
-            def rhs(t: float, y: np.ndarray) -> np.ndarray:
+            def linear(t: float, y: np.ndarray) -> np.ndarray:
                 return ss.A @ y + ss.forcing(t) + ss.hertz_rate @ self.hertz_forces(ss, t, y)
         else:
 
-            def rhs(t: float, y: np.ndarray) -> np.ndarray:
+            def linear(t: float, y: np.ndarray) -> np.ndarray:
                 return ss.A @ y + ss.forcing(t)
+
+        rhs = linear
+        if self.elements.elements:  # y extended by the elements' states (module doc)
+            e = terms(self.problem, ss)
+            size = ss.size
+            evaluate = self.elements.evaluate
+
+            hertz = ss.hertz is not None and ss.hertz.size
+
+            def rhs(t: float, y: np.ndarray) -> np.ndarray:
+                z, s = y[:size], y[size:]
+                u = ss.basis(t)
+                force, rates = evaluate(t, e.Px @ z + e.Qx @ u, e.Pv @ z + e.Qv @ u, s)
+                dz = linear(t, z) if hertz else ss.A @ z + ss.B @ u
+                dz[nf:] += e.R @ force
+                return np.concatenate([dz, rates])
+
+            y0 = np.concatenate([y0, self.s])
+            if np.ndim(atol):
+                atol = np.concatenate([atol, self.s_scale * self.options.rtol])
 
         events = []
         monitored = [int(k) for k in np.flatnonzero(self.monitored)]
+        last: list = [None, None, None]  # (t, y, monitors): solve_ivp asks every event at the same (t, y) in turn
+
+        def monitors_at(t: float, y: np.ndarray) -> np.ndarray:
+            if last[0] != t or last[1] is not y:
+                last[:] = t, y, self.monitors(ss, t, y)
+            return last[2]
+
         for k in monitored:
 
             def event(t: float, y: np.ndarray, k: int = k, t0: float = t0) -> float:
@@ -115,7 +238,7 @@ class _ScipyRun(PiecewiseRun):
                 # the first picosecond counts as positive (a crossing there is taken at its end)
                 if t - t0 <= GUARD:
                     return 1.0
-                return float(self.monitors(ss, t, y)[k])
+                return float(monitors_at(t, y)[k])
 
             event.terminal = True  # type: ignore[attr-defined]  # solve_ivp reads an event's function attributes
             event.direction = -1  # type: ignore[attr-defined]  # (as above)
@@ -127,6 +250,9 @@ class _ScipyRun(PiecewiseRun):
             raise RunError(f"solve_ivp failed at t = {solution.t[-1]:.6g} s: {solution.message}")
         self.steps += len(solution.t) - 1
         t_end = float(solution.t[-1])
+        end = solution.y[:, -1]
+        if self.elements.elements:
+            end, self.s = end[:ss.size], end[ss.size:].copy()
         fired = [k for k, times_k in zip(monitored, solution.t_events, strict=True)
                  if solution.status == 1 and len(times_k) and times_k[-1] == t_end]
         for t_out in times:
@@ -138,7 +264,7 @@ class _ScipyRun(PiecewiseRun):
         for t_sample in samples:
             self.emit(ss, float(t_sample), solution.sol(t_sample))
         self.refine_peaks(ss, solution)
-        return t_end, solution.y[:, -1], fired
+        return t_end, end, fired
 
     def refine_peaks(self, ss: StateSpace, solution) -> None:  # noqa: ANN001 (an OdeResult)
         """Peak contact forces: at the steps, and each local maximum between steps refined on the

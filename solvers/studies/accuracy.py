@@ -101,7 +101,7 @@ def with_run(spec: MechanismSpec, **changes: Any) -> MechanismSpec:
 
 def seat_clearance(spec: MechanismSpec) -> str | None:
     for c in spec.clearances:
-        if c.kind == EXTERNAL and c.behind != spec.cam.coordinate and c.state == "enabled":
+        if c.kind == EXTERNAL and c.behind not in (spec.cam.coordinate, 0) and c.state == "enabled":
             return c.name
     return None
 

@@ -138,7 +138,7 @@ def seat_index(spec: MechanismSpec) -> int | None:
 
 
 def force_label(spec: MechanismSpec, index: int) -> str:
-    return f"F{spec.clearances[index].ahead}"
+    return spec.force_label(index)
 
 
 # ----- the lift event and the criteria -----
@@ -266,6 +266,8 @@ def metric_columns(spec: MechanismSpec) -> list[tuple[str, str]]:
                 ("cycles", ""), ("cycle_change", ""), ("events", ""), ("wall_time", "s")]
     if spec.springs:  # data-sheet springs (vtool.solvers.model.spring): <= 0 when coils touch
         columns.append(("coil_bind_margin", u.length))
+    if any(s.contacts for s in spec.springs):  # coil contacts: the first clash in the window and its peak force
+        columns += [("coil_bind_angle", "deg"), ("coil_contact_peak_force", u.force)]
     return columns + order_columns(spec)
 
 
@@ -442,6 +444,12 @@ def run_metrics(trace: Trace, window: tuple[float, float] | None = None) -> dict
         from vtool.solvers.model.spring import coil_bind_margin
 
         metrics["coil_bind_margin"] = coil_bind_margin(spec.springs, trace, rows)
+    contacts = [spec.clearances.index(spec.clearance(name)) for s in spec.springs for name in s.contacts]
+    if contacts:  # the first coil contact closing in the window (NaN: none) and the largest coil contact force
+        closings = [e.cam_angle for e in trace.events if e.kind == "closed" and e.clearance in
+                    {spec.clearances[k].name for k in contacts} and window[0] <= e.cam_angle <= window[1]]
+        metrics["coil_bind_angle"] = min(closings) if closings else NAN
+        metrics["coil_contact_peak_force"] = float(max(peaks[k] for k in contacts))
     for quantity in spec.run.orders:  # over the whole cycles of the evaluated window (NaN: none to analyse)
         try:
             orders = spectrum(trace, quantity)

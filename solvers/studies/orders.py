@@ -40,7 +40,7 @@ from vtool.solvers.trace import Trace
 def quantity_unit(spec: MechanismSpec, quantity: str) -> str:
     """The unit of ``q7``, ``q1-q9`` or ``F2`` (a rotation's coordinate: rad)."""
     text = quantity.replace(" ", "")
-    if text.startswith("F"):
+    if text.startswith("F") or text.endswith("_force"):  # a clearance's force or a spring's end force
         return spec.unit_system.force
     number = int(text[1:].split("-")[0])
     if number <= spec.n_coordinates and spec.coordinates[number - 1].motion == "rotation":
@@ -69,13 +69,16 @@ def with_orders(spec: MechanismSpec, quantities: tuple[str, ...], field: str = "
     if spec.seat is not None:
         numbers.add(spec.seat.coordinate)
     forces = {c.ahead for c in spec.clearances}
+    from vtool.solvers.model.spring import force_quantity
+
+    springs = [force_quantity(s) for s in spec.springs]  # a data-sheet spring's end force
     for quantity in quantities:
         match = re.fullmatch(r"q(\d+)(?:-q(\d+))?|F(\d+)", quantity.replace(" ", ""))
         ok = match is not None and (int(match[3]) in forces if match[3] else
                                     int(match[1]) in numbers and (match[2] is None or int(match[2]) in numbers))
-        if not ok:
-            raise InputError(field, quantity, f"'q<i>', 'q<i>-q<j>' (i, j in {sorted(numbers)}) or 'F<i>' "
-                                              f"(i in {sorted(forces)})")
+        if not ok and quantity.replace(" ", "") not in springs:
+            raise InputError(field, quantity, f"'q<i>', 'q<i>-q<j>' (i, j in {sorted(numbers)}), 'F<i>' "
+                                              f"(i in {sorted(forces)})" + "".join(f" or '{s}'" for s in springs))
     added = tuple(q for q in dict.fromkeys(quantities) if q not in spec.run.orders)
     return dataclasses.replace(spec, run=dataclasses.replace(spec.run, orders=spec.run.orders + added))
 
@@ -149,8 +152,9 @@ def spectrum(trace: Trace, quantity: str) -> Spectrum:
         values = trace.quantity(quantity)
         unit = trace.quantity_unit(quantity)
     except (KeyError, ValueError, IndexError):
-        raise InputError("--orders", quantity, "a quantity of this preset: qN (a coordinate), qN-qM or FN (the "
-                         "contact force at the clearance ahead of qN)") from None
+        raise InputError("--orders", quantity, "a quantity of this preset: qN (a coordinate), qN-qM, FN (the "
+                         "contact force at the clearance ahead of qN) or NAME_force (a data-sheet spring's end "
+                         "force)") from None
     start, cycles = whole_cycles(trace)
     return series_spectrum(quantity, unit, trace.cam_angle, values, start, cycles, trace.spec.run.output_interval,
                            trace.spec.run.rpm)

@@ -75,17 +75,19 @@ class State:
     qdd: np.ndarray
     mask: int
     omega: float
+    states: np.ndarray | None = None  # the nonlinear elements' states (an HLA's chamber pressure)
 
     @classmethod
     def at_end(cls, trace: Trace, omega: float) -> State:
         n = trace.spec.n_coordinates
+        states = None if trace.states is None else trace.states[-1].copy()
         return cls(trace.q[-1, :n].copy(), trace.qd[-1, :n].copy(), trace.qdd[-1, :n].copy(),
-                   int(trace.configuration[-1]), omega)
+                   int(trace.configuration[-1]), omega, states)
 
     def start(self, mechanism: Mechanism) -> Mechanism:
         """``mechanism`` started from this state, scaled to its cam speed."""
         ratio = mechanism.omega / self.omega if self.omega > 0 else 1.0
-        return mechanism.with_start(self.q, self.qd * ratio, self.qdd * ratio**2, self.mask)
+        return mechanism.with_start(self.q, self.qd * ratio, self.qdd * ratio**2, self.mask, self.states)
 
 
 def is_cyclic(spec: Any) -> bool:
@@ -204,10 +206,11 @@ def concatenate(traces: list[Trace], spec: Any, omega: float, cycles: Cycles) ->
     peak = np.max([t.peak_force for t in traces], axis=0)
     late = np.max([t.peak_force for t in traces[1:]], axis=0) if len(traces) > 1 else None
     overlaps = [t.peak_overlap for t in traces if t.peak_overlap is not None]
+    states = join("states") if traces[0].states is not None else None
     return Trace(spec, time, angle, traces[0].coordinate_numbers, join("q"), join("qd"), join("qdd"),
                  join("contact_force"), join("configuration"), events, peak, stats,
                  peak_force_after_first_revolution=late,
-                 peak_overlap=np.max(overlaps, axis=0) if overlaps else None, cycles=cycles)
+                 peak_overlap=np.max(overlaps, axis=0) if overlaps else None, cycles=cycles, states=states)
 
 
 def simulate_cycles(backend: Any, mechanism: Mechanism, *, every_step: bool = False,

@@ -13,6 +13,8 @@ from vtool.solvers.newmark.layout import (
     CLF_HK,
     CLF_HN,
     CLF_HV,
+    CLF_OPEN,
+    CLF_SIGN,
     FP_BETA,
     FP_GAMMA,
     IP_N,
@@ -127,7 +129,8 @@ def monitor_value(prob, C, k, y, src, gap_noise, hertz):
     if kind == MK_GAP or kind == MK_OVERLAP:
         behind = C.mk[k, MK_BEHIND]
         other = y.z[behind] if behind >= 0 else src[3 * (-1 - behind)]
-        return signed_gap(kind, y.z[C.mk[k, MK_AHEAD]] - other, gap_noise)
+        gap = prob.clf[k, CLF_SIGN] * (y.z[C.mk[k, MK_AHEAD]] - other) + prob.clf[k, CLF_OPEN]
+        return signed_gap(kind, gap, gap_noise)
     if kind == MK_FORCE:
         if hertz is None:  # the linear row alone
             return contact_force(prob, C, k, y, src)
@@ -140,13 +143,13 @@ def monitors(prob, C, y, src, gap_noise, phi, hertz):
     """phi[k] = :func:`monitor_value` of every clearance k: one call for all of them (gaps and linear
     forces on arrays taken out of the records once; see step_rows)."""
     n, ns = prob.ip[IP_N], prob.ip[IP_NS]
-    mk, mon, z, zd, zdd = C.mk, C.mon, y.z, y.zd, y.zdd
+    mk, mon, z, zd, zdd, clf = C.mk, C.mon, y.z, y.zd, y.zdd, prob.clf
     for k in range(prob.cl.shape[0]):
         kind = mk[k, MK_KIND]
         if kind == MK_GAP or kind == MK_OVERLAP:
             behind = mk[k, MK_BEHIND]
             other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
-            phi[k] = signed_gap(kind, z[mk[k, MK_AHEAD]] - other, gap_noise)
+            phi[k] = signed_gap(kind, clf[k, CLF_SIGN] * (z[mk[k, MK_AHEAD]] - other) + clf[k, CLF_OPEN], gap_noise)
         elif kind == MK_FORCE and hertz is None:
             phi[k] = linear_force(mon, k, n, ns, mk[k, MK_M], z, zd, zdd, src)
         else:

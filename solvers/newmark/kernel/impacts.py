@@ -33,7 +33,9 @@ from vtool.solvers.newmark.layout import (
     CL_SRC,
     CLF_E,
     CLF_HV,
+    CLF_OPEN,
     CLF_SCALE,
+    CLF_SIGN,
     EV_CLOSED,
     EV_OPENED,
     EV_RELEASED,
@@ -270,16 +272,18 @@ def impact_local(prob, c, k, src, S, stick, O, t):
 
 
 @jit
-def shut_gap(cl, k, x, src):
-    """Clearance k's gap (or overlap) set to exactly zero: it is within the time tolerance of zero."""
-    x[cl[k, CL_AHEAD]] = x[cl[k, CL_BEHIND]] if cl[k, CL_BEHIND] >= 0 else src[3 * cl[k, CL_SRC]]
+def shut_gap(cl, clf, k, x, src):
+    """Clearance k's gap (or overlap) set to exactly zero: it is within the time tolerance of zero
+    (sense (x_ahead - x_behind) + opening = 0)."""
+    other = x[cl[k, CL_BEHIND]] if cl[k, CL_BEHIND] >= 0 else src[3 * cl[k, CL_SRC]]
+    x[cl[k, CL_AHEAD]] = other - clf[k, CLF_SIGN] * clf[k, CLF_OPEN]
 
 
 @jit
-def gap_velocity(cl, k, v, src):
-    """Velocity of clearance k's gap: v_ahead - v_behind (or the source's)."""
+def gap_velocity(cl, clf, k, v, src):
+    """Velocity of clearance k's gap: sense (v_ahead - v_behind (or the source's))."""
     behind = cl[k, CL_BEHIND]
-    return v[cl[k, CL_AHEAD]] - (v[behind] if behind >= 0 else src[3 * cl[k, CL_SRC] + 1])
+    return clf[k, CLF_SIGN] * (v[cl[k, CL_AHEAD]] - (v[behind] if behind >= 0 else src[3 * cl[k, CL_SRC] + 1]))
 
 @jit
 def apply_impacts(prob, c, closing, src, S, stick, O, t, momentum):
@@ -299,10 +303,10 @@ def apply_impacts(prob, c, closing, src, S, stick, O, t, momentum):
     for k in range(ncl):
         if not closing[k]:
             continue
-        shut_gap(cl, k, x, src)
+        shut_gap(cl, clf, k, x, src)
         if cl[k, CL_SOFT]:
             mask |= cl[k, CL_BIT]
-            u = gap_velocity(cl, k, v, src)
+            u = gap_velocity(cl, clf, k, v, src)
             clf[k, CLF_HV] = max(-u, fp[FP_VREST], 1e-300)  # the Hertz contact's approach velocity
             add_event(O, S, t, k, EV_CLOSED, u, c, mask)
         elif cl[k, CL_LAW] == LAW_MOMENTUM:
@@ -355,7 +359,7 @@ def release_pulling(prob, T, c, t, S, src, O, y, rhs, hertz):
     return c
 
 
-@jit
+@jit_inline
 def take_events(prob, c, t, h, W, S, O, momentum):
     """The events at t of configuration c: each monitor k that crossed within the time tolerance of
     the located step h (``tau[k] <= h + tol``) opens its contact, or closes it by an impact. Returns
@@ -385,8 +389,8 @@ def take_events(prob, c, t, h, W, S, O, momentum):
         if (c & cl[k, CL_BIT]) and not (new_c & cl[k, CL_BIT]):
             u = 0.0
             if cl[k, CL_SOFT]:  # the parts leave with their relative velocity; the overlap is shut
-                shut_gap(cl, k, x, src0)
-                u = gap_velocity(cl, k, v, src0)
+                shut_gap(cl, prob.clf, k, x, src0)
+                u = gap_velocity(cl, prob.clf, k, v, src0)
             add_event(O, S, t, k, EV_OPENED, u, c, new_c)
     if any_closing:
         new_c = apply_impacts(prob, new_c, W.closing, W.src0, S, stick, O, t, momentum)

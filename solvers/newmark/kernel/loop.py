@@ -39,6 +39,8 @@ from vtool.solvers.newmark.layout import (
     CI_NF,
     CI_SRC,
     CL_MON,
+    CLF_OPEN,
+    CLF_SIGN,
     CP_RAW,
     DIVERGED,
     F_CHUNK_END,
@@ -138,7 +140,8 @@ def locate_event(prob, C, W, k, t, h, hertz):
         if kind == MK_GAP or kind == MK_OVERLAP:
             behind = mk[k, MK_BEHIND]
             other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
-            f = signed_gap(kind, z1[mk[k, MK_AHEAD]] - other, gap_noise)
+            gap = prob.clf[k, CLF_SIGN] * (z1[mk[k, MK_AHEAD]] - other) + prob.clf[k, CLF_OPEN]
+            f = signed_gap(kind, gap, gap_noise)
         elif kind == MK_FORCE and hertz is None:
             f = linear_force(mon, k, n, ns, mk[k, MK_M], z1, zd1, zdd1, src1)
         else:
@@ -270,7 +273,7 @@ def event_step(prob, C, W, t, h, hertz):
     return h
 
 
-@jit
+@jit_inline
 def steps(prob, C, W, S, O, hertz):
     """Steps in configuration C from S.fst[F_T] until an event, the chunk end, the run's end or a full
     buffer. Returns (status, event, h): status FINISHED, CHUNK_END, OUTPUT_FULL or DIVERGED (0 after an

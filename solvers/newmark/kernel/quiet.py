@@ -25,6 +25,8 @@ from vtool.solvers.newmark.layout import (
     CI_ROWS,
     CI_SRCSTEP,
     CL_MON,
+    CLF_OPEN,
+    CLF_SIGN,
     CP_FINE,
     CP_STD,
     F_CHUNK_END,
@@ -80,7 +82,7 @@ def advance(prob, C, W, S, O, hertz):
     computed into W.end and copied back into W.now (m values), cheaper than swapping the two.
     """
     ip, fp, ist, fst = prob.ip, prob.fp, S.ist, S.fst
-    sc, sa, sb, cl = prob.sc, prob.sa, prob.sb, prob.cl
+    sc, sa, sb, cl, clf = prob.sc, prob.sa, prob.sb, prob.cl, prob.clf
     ci, cp, mk, mon = C.ci, C.cp, C.mk, C.mon
     z, zd, zdd = W.now.z, W.now.zd, W.now.zdd
     z1, zd1, zdd1 = W.end.z, W.end.zd, W.end.zdd
@@ -149,7 +151,8 @@ def advance(prob, C, W, S, O, hertz):
             if kind == MK_GAP or kind == MK_OVERLAP:
                 behind = mk[k, MK_BEHIND]
                 other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
-                value = signed_gap(kind, z1[mk[k, MK_AHEAD]] - other, gap_noise)
+                value = signed_gap(kind, clf[k, CLF_SIGN] * (z1[mk[k, MK_AHEAD]] - other) + clf[k, CLF_OPEN],
+                                   gap_noise)
                 if value < 0.0:
                     stop = True
                     break
