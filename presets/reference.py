@@ -24,6 +24,7 @@ from vtool.presets import list_presets, load_document, read_document
 from vtool.presets.fields import REQUIRED, FieldRead, recording
 from vtool.presets.kinds import KINDS
 from vtool.presets.paths import set_fields
+from vtool.solvers import backends
 
 #: Shipped presets with fields changed (None: removed) so that the loader reads the keys of its other branches.
 VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
@@ -57,7 +58,7 @@ VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
                              "train.spring.inner.tensile_strength": {"A": 2300.0, "m": 0.1},
                              "train.spring.inner.wire_height": 2.8, "train.spring.inner.coil_contact": "none"}),
     # forces on the valve's motion (presets/valveforces.py): Stribeck guide friction and a cylinder-pressure table
-    ("direct-acting-bucket", {"run.backend": "scipy", "valve_forces": {
+    ("direct-acting-bucket", {"run.backend": backends.with_flag("nonlinear_elements")[0], "valve_forces": {
         "guide_friction": 15.0, "guide_velocity": 20.0, "static_friction": 25.0, "stribeck_velocity": 100.0,
         "viscous": 0.002, "gas_crank_angles": [0.0, 360.0], "gas_pressures": [0.1, 2.0], "head_diameter": 30.0,
         "seat_side": "cylinder", "gas_phase": 0.0}}),

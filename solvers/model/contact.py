@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import copy
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -224,7 +225,8 @@ class ConfigurationTables:
             cp[layout.CP_FINE, :, :, :nf] = np.swapaxes(cm[layout.CM_SINVF, :nf, :nf] @ raw, 1, 2)
         self._force_rows(mask, beta, gamma, ((layout.CP_STD, dt), (layout.CP_FINE, fine)))
 
-    def _force_rows(self, mask: int, beta: float, gamma: float, planes: tuple[tuple[int, float], ...]) -> None:
+    def _force_rows(self, mask: int, beta: float, gamma: float,
+                    planes: tuple[tuple[int | np.int64, float], ...]) -> None:
         """The force rows of the step operators (``layout.CP_RAW``): each closed rigid clearance's contact
         force at a step's end, less its constant, from the step's predictor y = (ż̃_F, z̃_F, (z̈, ż, z)_P, src).
 
@@ -646,6 +648,9 @@ class Transitions:
         self.ist = np.zeros(layout.I_SIZE, dtype=np.int64)
         self.fst = np.zeros(layout.F_SIZE)
         self.rapid, self.last_event = 0, -math.inf
+        #: A back end whose equations hold more than the linear ones the compiled rules see (the scipy back
+        #: end's nonlinear elements) judges the release of pulling contacts itself: (mask, t, x, v, a) -> mask.
+        self.release: Callable[[int, float, np.ndarray, np.ndarray, np.ndarray], int] | None = None
 
     def start(self) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
         """(configuration, x, v, a) at t = 0: the mechanism's static start, settled (fresh arrays)."""
@@ -656,6 +661,8 @@ class Transitions:
 
     def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
         """Release the contacts that pull in configuration ``mask`` at t (events recorded); the new mask."""
+        if self.release is not None:
+            return self.release(mask, t, x, v, a)
         problem, tables, m = self.problem, self.problem.tables, self.problem.n
         while True:
             self.ist[layout.I_NEV] = 0

@@ -107,6 +107,8 @@ class _ScipyRun(PiecewiseRun):
                   else self.elements.initial(start.q, start.qd))  # the elements' states now
         self.s_scale = np.maximum(np.abs(self.s), 1e-6)
         self.state_rows: list[np.ndarray] = []
+        if self.elements.elements:
+            self.transitions.release = self.release_pulling
 
     # ----- the nonlinear elements' states beside y (module doc) -----
     def split(self, ss: StateSpace, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -152,12 +154,10 @@ class _ScipyRun(PiecewiseRun):
         if self.elements.elements:
             self.state_rows.append(np.array(s, dtype=float))
 
-    def settle(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
+    def release_pulling(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, a: np.ndarray) -> int:
         """With elements, the release of pulling contacts is judged here, on the contact forces with the
         elements' share (the compiled rules see the linear equations only): the most pulling closed rigid
         contact is released first, until every one pushes (at most one release per clearance)."""
-        if not self.elements.elements:
-            return super().settle(mask, t, x, v, a)
         tolerance = self.problem.force_tolerance()
         for _ in range(self.ncl + 1):
             self.problem.build(mask)
