@@ -405,8 +405,8 @@ def prepare(angles: list[float], lifts: list[float], settings: ScanSettings, len
     if settings.smoothing == "spline":
         result = smooth_spline(theta, lift, noise=noise, peak_tolerance=peak, field=field)
         if not result.periodic:
-            notes.append(f"the scan covers {result.raw_angles[-1] - result.raw_angles[0]:g} of 360 cam deg: "
-                         "extended with base-circle lift (0)")
+            scanned = float(theta.max() - theta.min())
+            notes.append(f"the scan covers {scanned:g} of 360 cam deg: extended with base-circle lift (0)")
         notes.append(result.text(length_unit))
         return Scan(result.angles, _base_circle(result.lift, length_unit, notes), result.raw, tuple(notes), result,
                     result.raw_angles)

@@ -87,12 +87,23 @@ def configuration_chart(trace: Any) -> Chart:
 
 def trace_charts(trace: Any) -> list[Chart]:
     """What ``vtool solve --figure`` draws: forces, displacements, configuration; with a [follower], the cam's
-    drive torque (:func:`vtool.presets.camshaft.train_torque_chart`)."""
+    drive torque (:func:`vtool.presets.camshaft.train_torque_chart`); with a hydraulic lash adjuster, its
+    chamber pressure and pump-up (:func:`vtool.presets.hla_charts.hla_charts`)."""
     charts = [force_chart(trace), displacement_chart(trace), configuration_chart(trace)]
     if trace.spec.follower is not None:
         from vtool.presets.camshaft import train_torque_chart
 
         charts.append(train_torque_chart(trace))
+    if trace.states is not None:
+        from vtool.presets.hla_charts import hla_charts
+        from vtool.solvers.studies.hla import hla_series
+
+        try:
+            series = hla_series(trace)
+        except KeyError:  # nonlinear elements, none of them an adjuster
+            series = None
+        if series is not None:
+            charts += hla_charts(series, trace.spec.title)
     return charts
 
 

@@ -344,9 +344,10 @@ def _no_sweep(sweep: Sequence[str], kind: str) -> None:
 def boom_report(spec: Any, *, assessment: Any = None, sweep: Sequence[str] = (), **_: Any) -> Report:
     """The report of a boom wall or floor preset: ``vtool solve``'s assessment (``assessment``: one already
     made, the TUI's) as model, settings, the allowable overpressures with their checks, the design figures and
-    the note on the DAF source. A check is each row's frequency within its criterion's frequency range."""
+    the note on the DAF source. A check is each row's frequency within its criterion's frequency range.
+    (``vtool solve``'s printed table is the allowables table here: not repeated as text.)"""
     from vtool.assessments.sonic_boom.assess import assess
-    from vtool.assessments.sonic_boom.report import limits_dict, limits_text
+    from vtool.assessments.sonic_boom.report import limits_dict
     from vtool.presets.charts import boom_design_charts
 
     _no_sweep(sweep, "boom")
@@ -356,12 +357,11 @@ def boom_report(spec: Any, *, assessment: Any = None, sweep: Sequence[str] = (),
     structures = tuple((s["name"], ", ".join(f"{k} {_g(v, 5)}" for k, v in s["frequencies_hz"].items()),
                         _g(s.get("mass_per_area")), _g(s.get("flexural_rigidity")), _g(s.get("pseudo_height")))
                        for s in d["structures"])
-    criteria = tuple((c["name"], c["rule"], c["response"], "yes" if c["tentative"] else "no", c["description"])
-                     for c in d["criteria"])
-    model = Section("Model", (spec.title,), (
+    criteria = tuple((c["name"], c["rule"], c["response"], "yes" if c["tentative"] else "no") for c in d["criteria"])
+    model = Section("Model", (spec.title, *(f"Criterion {c['description']}" for c in d["criteria"])), (
         Table("structures", ("structure", "natural frequencies (Hz)", "mass per area", "flexural rigidity D",
                              f"pseudo-height ({length})"), structures),
-        Table("criteria", ("criterion", "rule", "response", "tentative", "source"), criteria)))
+        Table("criteria", ("criterion", "rule", "response", "tentative"), criteria)))
     rows = tuple((r["structure"], r["frequency_source"], _g(r["frequency_hz"], 5), r["criterion"], _g(r["daf"], 5),
                   _g(r.get(f"pressure_{pressure}"), 4), "tentative" if r["tentative"] else "") for r in d["limits"])
     checks = tuple(Check(f"{r['structure']}, {r['frequency_source']}, {r['criterion']}",
@@ -372,7 +372,7 @@ def boom_report(spec: Any, *, assessment: Any = None, sweep: Sequence[str] = (),
                                              "criterion (the limit over the dynamic amplification factor).",),
                       (Table("allowable peak overpressure", ("structure", "frequency source", "f (Hz)", "criterion",
                                                              "DAF (-)", f"p+ ({pressure})", "note"), rows),),
-                      checks, text=(limits_text(a),))
+                      checks)
     charts = boom_design_charts(a, spec.title)
     figures = Section("Figures", (), figures=tuple(Figure(c.title + ".", (c,)) for c in charts))
     accuracy = Section("Accuracy note", (f"DAF source: {d['daf_source']}.", "Each allowable is the criterion's "

@@ -142,3 +142,48 @@ def test_torque_figures_are_embedded_and_regenerate():
     for name, page in docs_figures.PAGES.items():
         assert f"](figures/{name}.png)" in page.read_text()
     assert docs_figures.main(["--check", "--only", "torque-train"]) == 0
+
+
+def test_hla_charts_carry_the_series_with_units():
+    """presets/hla_charts.py: the pressure chart draws the series against cam angle; the pump-up chart the
+    extension at each base circle against the cycle and its drift (the differences) from the second cycle."""
+    from vtool.app.figures import build_figure
+    from vtool.presets.hla_charts import hla_charts
+    from vtool.solvers.studies.hla import HLASeries
+
+    angle = np.arange(0.0, 721.0)
+    columns = {"hla_pressure": 2.0 + np.sin(np.radians(angle)), "hla_plunger_extension": 0.01 * angle / 720.0}
+    units = {"hla_pressure": "MPa", "hla_plunger_extension": "mm"}
+    cycles = {"extension": [0.0, 0.05, 0.075, 0.08], "drift": [0.05, 0.025, 0.005]}
+    pressure, pump = hla_charts(HLASeries(angle, columns, units, cycles, "mm"), "an HLA train")
+    assert pressure.panels[0].ylabel == "chamber pressure (MPa)" and pressure.xlabel == "cam angle (deg)"
+    assert np.array_equal(pressure.panels[0].curves[0].y, columns["hla_pressure"])
+    assert pressure.panels[1].ylabel == "plunger extension (mm)"
+    extension, drift = pump.panels
+    assert np.array_equal(extension.curves[0].x, [0, 1, 2, 3]) and np.array_equal(drift.curves[0].x, [1, 2, 3])
+    assert np.allclose(np.diff(extension.curves[0].y), drift.curves[0].y)
+    assert drift.ylabel == "drift per cycle (mm)"
+    labels = [ax.get_ylabel() for ax in build_figure([pressure, pump]).get_axes()]
+    assert "chamber pressure (MPa)" in labels and "drift per cycle (mm)" in labels
+
+
+def test_a_run_with_an_hla_figures_its_pressure_and_pump_up():
+    """`vtool solve --figure` of a train with an adjuster (presets/charts.py trace_charts): its chamber pressure
+    and pump-up charts join the run's, from the run's own series (a short closed-chamber run)."""
+    import dataclasses
+
+    from vtool.presets import PRESET_DIR, load_document, read_document
+    from vtool.presets.charts import trace_charts
+    from vtool.solvers.run import simulate
+    from vtool.solvers.studies.hla import hla_series
+
+    doc = read_document(PRESET_DIR / "ohc-finger-follower-hla.toml")
+    doc["train"]["hla"].update(check_conductance=0.0, gap=0.0)
+    spec = load_document(doc)
+    spec = dataclasses.replace(spec, run=dataclasses.replace(spec.run, cycles=0, degrees=30.0))
+    trace = simulate(spec)
+    charts = {c.title: c for c in trace_charts(trace)}
+    pressure = charts["HLA chamber pressure (MPa)"]
+    assert np.array_equal(pressure.panels[0].curves[0].y, hla_series(trace).columns["hla_pressure"])
+    assert any(title.startswith("HLA pump-up") for title in charts)
+    assert "cam drive torque (N*mm)" in charts

@@ -474,3 +474,25 @@ def test_stiff_contacts_exact_and_scipy_agree_on_the_peak_forces() -> None:
     assert exact[0] == pytest.approx(646.6e3, rel=1e-3)
     assert exact[0] == pytest.approx(scipy[0], rel=1e-4)
     assert exact[1] == pytest.approx(scipy[1], rel=1e-3)
+
+
+def test_lash_geometry_of_a_compliant_rocker_tends_to_the_rigid_one() -> None:
+    """The follower's base on the base circle and the follower/valve ratio (solvers/model/lash.py, read by
+    the speed criteria of every valve-train summary) with the rocker a linear contact closed at the start:
+    its spring joins the two sides (it was left out, and ``vtool solve gnilka-1a --set
+    clearances[1].contact=linear`` stopped with "no spring to ground" after the run). As k grows the base
+    tends to the rigid rocker's, its excess the spring's deflection under the preload, falling as 1/k;
+    the ratio is the rigid one (the spring's deflection moves both sides' coordinates alike)."""
+    from tests.valvetrain_cases import thesis_doc
+    from vtool.solvers.model.lash import base_and_ratio
+
+    base, ratio = base_and_ratio(spec_from(thesis_doc("gnilka-1a")))
+    excess = []
+    for k in (1e6, 1e7, 1e8):
+        doc = thesis_doc("gnilka-1a")
+        doc["clearances"][1].update(contact="linear", contact_stiffness=k)
+        soft_base, soft_ratio = base_and_ratio(spec_from(doc))
+        assert soft_ratio == pytest.approx(ratio, rel=1e-12)
+        excess.append(soft_base - base)
+    assert excess[0] > 0.0
+    assert excess[1] == pytest.approx(excess[0] / 10.0, rel=0.05) and excess[2] == pytest.approx(excess[1] / 10.0, rel=0.05)

@@ -419,15 +419,31 @@ def test_every_clearances_monitor_is_its_gap_with_opening_and_sense(q: list) -> 
         assert values[k] == pytest.approx(c.gap(x[c.ahead - 1], behind) + problem.gap_noise, abs=1e-12)
 
 
-def test_a_start_with_coils_touching_is_refused_in_one_line() -> None:
-    """The polydyne bucket starts at the nose (angle 0): with coil gaps that close before full lift, its static
-    start would sit inside a coil contact; refused naming the clearance (not built: an affine static start)."""
+def test_a_start_with_coils_touching_closes_them_in_static_equilibrium() -> None:
+    """The polydyne bucket starts at the nose (angle 0), 3.9 mm past solid: the static start closes the coil
+    contacts it overlaps (an affine start: their constant forces k o w), its follower force is the spring's end
+    force, and its length is the hand series law's at that force; every back end opens them alike."""
+    from vtool.presets.valvetrain import with_run_overrides
+    from vtool.solvers.model.mechanism import Mechanism
+    from vtool.solvers.model.spring import end_force
+    from vtool.solvers.run import simulate
+
     doc = _bucket_doc()
     spring = doc["train"]["spring"]
     del spring["elements"]
     spring.update(segment_coils=[2.0, 1.75, 1.5], segment_pitches=[6.0, 5.0, 5.5], free_length=37.0,
                   installed_length=33.0)
-    from vtool.solvers.model.mechanism import Mechanism
-
-    with pytest.raises(InputError, match=r"initial\.closed.*valve_spring coils 2 open.*overlaps it by"):
-        assert Mechanism(load_document(doc)).start is not None
+    doc["run"].update(rpm=300.0, degrees=75.0, time_step=2e-6)
+    spec = load_document(doc)
+    sheet = spec.springs[0]
+    start = Mechanism(spec).start
+    assert start.closed == sheet.contacts
+    length = sheet.rest_length - start.q[sheet.coordinate - 1]
+    assert length < sheet.solid_length - 3.5
+    assert series_law_length(sheet, np.array([start.follower_force]))[0] == pytest.approx(length, abs=1e-9)
+    runs = [simulate(with_run_overrides(spec, backend=b)) for b in ("newmark", "exact", "scipy")]
+    assert end_force(sheet, runs[0])[0] == pytest.approx(start.follower_force, rel=1e-9)
+    opened = [[(e.clearance, round(e.cam_angle, 3)) for e in run.events if e.kind == "opened"][:3] for run in runs]
+    # the largest closing force opens first: the hand closing order (2, 3, 1) reversed
+    assert [name for name, _ in opened[0]] == ["valve_spring coils 1", "valve_spring coils 3", "valve_spring coils 2"]
+    assert opened[1] == opened[0] == opened[2]

@@ -21,7 +21,7 @@ def tune_collector() -> None:
 @click.command()
 @click.option("--preset", default=None, help="Preset to open (shipped name or path); default: gnilka-1a.")
 def tui(preset: str | None) -> None:
-    """Interactive screens for the valve train, sonic boom and plate (keys: f1 for help)."""
+    """Interactive screens for the valve train, sonic boom, plate and camshaft (keys: f1 for help)."""
     from vtool.app.tui.app import create_app
 
     tune_collector()  # after the app's imports

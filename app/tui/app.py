@@ -38,7 +38,7 @@ def mode_for_kind(kind: str) -> str:
 
 
 class VtoolApp(App[None]):
-    """Valve train, sonic boom and plate screens over the vtool library."""
+    """Valve train, sonic boom, plate and camshaft screens over the vtool library."""
 
     CSS_PATH = "vtool.tcss"
     TITLE = "vtool"

@@ -89,7 +89,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
     src = np.zeros((3 * ns, nb))  # the sources (x, v, a), s-major as the kernel's src vector
     for s in range(ns):
         src[3 * s:3 * s + 3] = source_coefficients(series, s)
-    G, H = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # monitors (kernel.monitor_value)
+    G, H = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # monitors (kernel.monitors)
     GF, HF = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # contact forces (kernel.contact_force)
     for k in range(ncl):
         kind, ahead, behind = (int(v) for v in mk[k, :layout.MK_M])
@@ -317,7 +317,7 @@ class PiecewiseRun(ABC):
             self.flush_rows()
             if fired:
                 x, v, _ = self.full_state(ss, t, y)
-                mask, x, v, _ = transitions.apply(ss.mask, t, x, v, fired)
+                mask, x, v, _ = transitions.apply(ss.mask, t, x, v, fired, accelerations=False)
                 ss = self.space(mask)
                 y = self.state_of(ss, x, v)
             if progress is not None:

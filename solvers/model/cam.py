@@ -399,7 +399,7 @@ def report_text(report: dict) -> str:
     return "\n".join(lines)
 
 
-def table_start(spec, harmonic, omega: float):
+def table_start(spec, harmonic, omega: float, layer):
     """The static start of a table cam, from the harmonic rule's start ``harmonic``.
 
     :func:`vtool.solvers.model.initial.static_start` places the harmonic cam at
@@ -409,7 +409,7 @@ def table_start(spec, harmonic, omega: float):
     the cam's series constant ("cam offset") is base + c0, so that
     q_cam = base + L(ωt).
     """
-    from vtool.solvers.model.initial import StaticStart, cam_clearance, check_open_gaps
+    from vtool.solvers.model.initial import StaticStart, cam_clearance, start_state
     from vtool.solvers.model.spec import QUASI_STATIC_START
 
     base = harmonic.cam_offset - spec.cam.amplitude
@@ -417,12 +417,13 @@ def table_start(spec, harmonic, omega: float):
     L, dL, ddL, _ = derivatives(c0, a, b, np.zeros(1))[:, 0]
     shape = harmonic.q / harmonic.cam_offset
     x0 = base + L
-    check_open_gaps(spec, shape * x0)
+    q, shape, closed, force = start_state(spec, layer, x0, shape)  # (a spring's coils closed at the start)
     if spec.initial.velocities == QUASI_STATIC_START:
         qd, qdd = shape * dL * omega, shape * ddL * omega**2
     else:  # the thesis' INITAL: the follower moves with the cam, everything else at rest
         follower = cam_clearance(spec).ahead
         qd, qdd = np.zeros_like(shape), np.zeros_like(shape)
         qd[follower - 1], qdd[follower - 1] = dL * omega, ddL * omega**2
-    return StaticStart(cam_offset=base + c0, follower_force=harmonic.follower_stiffness * x0,
-                       follower_stiffness=harmonic.follower_stiffness, q=shape * x0, qd=qd, qdd=qdd)
+    return StaticStart(cam_offset=base + c0,
+                       follower_force=harmonic.follower_stiffness * x0 if force is None else force,
+                       follower_stiffness=harmonic.follower_stiffness, q=q, qd=qd, qdd=qdd, closed=closed)

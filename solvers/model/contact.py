@@ -224,7 +224,8 @@ class ConfigurationTables:
             cp[layout.CP_FINE, :, :, :nf] = np.swapaxes(cm[layout.CM_SINVF, :nf, :nf] @ raw, 1, 2)
         self._force_rows(mask, beta, gamma, ((layout.CP_STD, dt), (layout.CP_FINE, fine)))
 
-    def _force_rows(self, mask: int, beta: float, gamma: float, planes: tuple[tuple[int, float], ...]) -> None:
+    def _force_rows(self, mask: int, beta: float, gamma: float,
+                    planes: tuple[tuple[int | np.int64, float], ...]) -> None:
         """The force rows of the step operators (``layout.CP_RAW``): each closed rigid clearance's contact
         force at a step's end, less its constant, from the step's predictor y = (ż̃_F, z̃_F, (z̈, ż, z)_P, src).
 
@@ -454,7 +455,7 @@ class ContactProblem:
         self.clf[:, layout.CLF_HV] = self.rest_velocity  # a Hertz contact's approach velocity, set at closing
         self.gap_noise = 1e-13 * x_scale
         self.zeno_window = 1e-3 * 2 * math.pi / self.omega_max
-        self.start_mask = mask_of(spec, spec.initial.closed)
+        self.start_mask = mask_of(spec, tuple(spec.initial.closed) + mechanism.start.closed)  # and closed coils
 
     @classmethod
     def for_run(cls, mechanism: Mechanism, rules: EventRules | None = None) -> ContactProblem:
@@ -511,8 +512,11 @@ class ContactProblem:
         """(x, v, a) of every source at t, as the kernel's src vector."""
         from vtool.solvers.newmark import kernel  # numba: only the back ends that call it load it
 
+        record = self.__dict__.get("_sources_record")
+        if record is None:  # made once: numba reads a fresh record's arrays anew on every call
+            record = self.__dict__["_sources_record"] = self.record()
         src = np.zeros(3 * self.ns)
-        kernel.sources(self.record(), t, src)
+        kernel.sources(record, t, src)
         return src
 
     def impact(self, mask: int, closing: list[int], t: float, x: np.ndarray, v: np.ndarray,
@@ -673,9 +677,10 @@ class Transitions:
         self.builder.add_events(self.ev_f[:count], self.ev_i[:count])
         self.ist[layout.I_NEV] = 0
 
-    def apply(self, mask: int, t: float, x: np.ndarray, v: np.ndarray,
-              crossed: list[int]) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
-        """The configuration and (x, v, a) after the events of the clearances ``crossed`` at t."""
+    def apply(self, mask: int, t: float, x: np.ndarray, v: np.ndarray, crossed: list[int],
+              accelerations: bool = True) -> tuple[int, np.ndarray, np.ndarray, np.ndarray | None]:
+        """The configuration and (x, v, a) after the events of the clearances ``crossed`` at t (a is None
+        unless ``accelerations``: a back end that restarts from (x, v) alone skips its solve)."""
         problem = self.problem
         x, v = x.copy(), v.copy()
         bits = problem.cl[:, layout.CL_BIT]
@@ -705,6 +710,5 @@ class Transitions:
                                                self.rapid >= problem.rules.zeno_stick, self.events, t,
                                                problem.momentum))
             self.take_events()
-        a = problem.accelerations(new, t, x, v)
-        new = self.settle(new, t, x, v, a)
-        return new, x, v, problem.accelerations(new, t, x, v)
+        new = self.settle(new, t, x, v, np.zeros_like(x))  # (settle computes the accelerations it needs)
+        return new, x, v, problem.accelerations(new, t, x, v) if accelerations else None

@@ -35,6 +35,12 @@ a preset choice (``initial.velocities``):
 The accelerations are the consistent ones of the starting configuration
 (computed by the back end before the first step).
 
+Linear clearances with an opening (a spring's coil contacts) that the
+start's deflection would overlap are closed at the start: the start is then
+the affine equilibrium with their springs and constant forces, found by
+active sets (:func:`coils_closed_at_start`); the configuration starts with
+them closed.
+
 Compliant contacts closed at the start (``contact = "linear"``): an internal
 one adds its spring to K_L; a compliant cam contact is a spring k_c in
 series with the mechanism, so k_eff above becomes 1 / (1/k_eff + 1/k_c) (the
@@ -50,7 +56,7 @@ import numpy as np
 
 from vtool.errors import InputError
 from vtool.solvers.model.layers import Layer
-from vtool.solvers.model.spec import ENABLED, INTERNAL, QUASI_STATIC_START, MechanismSpec
+from vtool.solvers.model.spec import ENABLED, INTERNAL, LINEAR, QUASI_STATIC_START, MechanismSpec
 
 
 @dataclass(frozen=True)
@@ -63,6 +69,7 @@ class StaticStart:
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
+    closed: tuple[str, ...] = ()  # compliant clearances with an opening closed at the start (coils_closed_at_start)
 
 
 def cam_clearance(spec: MechanismSpec):
@@ -72,11 +79,12 @@ def cam_clearance(spec: MechanismSpec):
     raise InputError("clearances", "no clearance on the cam", f"one clearance with behind = {spec.cam.coordinate}")
 
 
-def check_open_gaps(spec: MechanismSpec, q: np.ndarray) -> None:
-    """Refuse a start in which a clearance that is not closed would already be penetrated."""
+def check_open_gaps(spec: MechanismSpec, q: np.ndarray, closed: tuple[str, ...] = ()) -> None:
+    """Refuse a start in which a clearance that is not closed would already be penetrated (``closed``: the
+    clearances with an opening the static start closed)."""
     length = spec.unit_system.length
     for c in spec.clearances:
-        if c.state != ENABLED or c.name in spec.initial.closed:
+        if c.state != ENABLED or c.name in spec.initial.closed or c.name in closed:
             continue
         ahead = q[c.ahead - 1]
         if spec.seat is not None and c.behind == spec.seat.coordinate:
@@ -119,8 +127,10 @@ def start_stiffness(spec: MechanismSpec, layer: Layer) -> np.ndarray:
     return K
 
 
-def static_start(spec: MechanismSpec, layer: Layer, omega: float) -> StaticStart:
-    """Apply the thesis' static-start rule in the starting layer (see module doc)."""
+def static_start(spec: MechanismSpec, layer: Layer, omega: float, final: bool = True) -> StaticStart:
+    """Apply the thesis' static-start rule in the starting layer (see module doc). ``final`` False: the
+    harmonic rule's linear start that a table cam's start scales (:func:`vtool.solvers.model.cam.table_start`,
+    which then calls :func:`start_state`), not checked here."""
     cam = cam_clearance(spec)
     follower = cam.ahead
     f = int(np.argmax(layer.T[follower - 1]))  # the follower's column in the layer
@@ -148,7 +158,11 @@ def static_start(spec: MechanismSpec, layer: Layer, omega: float) -> StaticStart
         shape = shape * follower_share  # per unit cam displacement
     cam_velocity = amplitude * omega  # d/dt (A sin wt) at t = 0
     cam_acceleration = 0.0  # -A w² sin(0)
-    check_open_gaps(spec, shape * cam_offset)
+    q = shape * cam_offset
+    closed: tuple[str, ...] = ()
+    if final:
+        q, shape, closed, force = start_state(spec, layer, cam_offset, shape, follower_share == 1.0)
+        follower_force = follower_force if force is None else force
     if spec.initial.velocities == QUASI_STATIC_START:
         qd, qdd = shape * cam_velocity, shape * cam_acceleration
     else:  # the thesis' INITAL: the follower moves with the cam, everything else at rest
@@ -158,7 +172,62 @@ def static_start(spec: MechanismSpec, layer: Layer, omega: float) -> StaticStart
         cam_offset=cam_offset,
         follower_force=follower_force,
         follower_stiffness=follower_stiffness,
-        q=shape * cam_offset,
+        q=q,
         qd=qd,
         qdd=qdd,
+        closed=closed,
     )
+
+
+def start_state(spec: MechanismSpec, layer: Layer, X: float, shape: np.ndarray, rigid_cam: bool = True
+                ) -> tuple[np.ndarray, np.ndarray, tuple[str, ...], float | None]:
+    """(q, dq/dX, closed, follower force or None) of the start with the follower at X: the linear shape X, or,
+    where that overlaps a linear clearance with an opening (a spring's coils touching at the start, rigid cam
+    contact), :func:`coils_closed_at_start`; checked by :func:`check_open_gaps`."""
+    q = shape * X
+    if rigid_cam and any(c.offset and c.contact == LINEAR and c.name not in spec.initial.closed
+                         and c.gap(q[c.ahead - 1], q[c.behind - 1] if c.behind else 0.0) < 0.0
+                         for c in spec.clearances if 0 <= c.behind <= spec.n_coordinates):
+        f = int(np.argmax(layer.T[cam_clearance(spec).ahead - 1]))
+        q, shape, closed, force = coils_closed_at_start(spec, layer, f, X)
+        check_open_gaps(spec, q, closed)
+        return q, shape, closed, force
+    check_open_gaps(spec, q)
+    return q, shape, (), None
+
+
+def coils_closed_at_start(spec: MechanismSpec, layer: Layer, f: int,
+                          cam_offset: float) -> tuple[np.ndarray, np.ndarray, tuple[str, ...], float]:
+    """The static start with the linear clearances that have an opening (a spring's coil contacts) closed where
+    the start overlaps them: (q, dq/dq_cam, their names, the follower force).
+
+    With the cam's follower at z_f = X (rigid cam contact), the layer's equilibrium with the closed contacts'
+    springs k w wᵀ and their constant forces k o w (w the gap's gradient on the layer, o the opening) is affine
+    in X: z_F = -K_FF⁻¹ (K_Ff X + b_F), b = Σ k o w. The closed set is found by active sets: close every
+    such clearance whose gap is negative, open every closed one whose gap is positive, until none changes
+    (at most one pass per clearance)."""
+    candidates = [c for c in spec.clearances
+                  if c.offset and c.contact == LINEAR and 0 <= c.behind <= spec.n_coordinates
+                  and c.name not in spec.initial.closed]
+    K0 = start_stiffness(spec, layer)
+    free = [j for j in range(layer.size) if j != f]
+    closed: set[str] = set()
+    for _ in range(len(candidates) + 1):
+        K, b = K0.copy(), np.zeros(layer.size)
+        for c in candidates:
+            if c.name in closed:
+                w = c.sense * layer.T[c.ahead - 1] - (c.sense * layer.T[c.behind - 1] if c.behind else 0.0)
+                K += c.contact_stiffness * np.outer(w, w)
+                b += c.contact_stiffness * c.opening * w
+        z, dz = np.zeros(layer.size), np.zeros(layer.size)
+        z[f], dz[f] = cam_offset, 1.0
+        z[free] = -np.linalg.solve(K[np.ix_(free, free)], K[free, f] * cam_offset + b[free])
+        dz[free] = -np.linalg.solve(K[np.ix_(free, free)], K[free, f])
+        q = layer.T @ z
+        now = {c.name for c in candidates if c.gap(q[c.ahead - 1], q[c.behind - 1] if c.behind else 0.0) < 0.0
+               or (c.name in closed and c.gap(q[c.ahead - 1], q[c.behind - 1] if c.behind else 0.0) <= 0.0)}
+        if now == closed:
+            break
+        closed = now
+    force = float(K[f] @ z + b[f])
+    return q, layer.T @ dz, tuple(c.name for c in candidates if c.name in closed), force

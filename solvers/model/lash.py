@@ -32,15 +32,17 @@ def _seat_clearance(spec: MechanismSpec):
 
 def base_and_ratio(spec: MechanismSpec) -> tuple[float, float]:
     """(base, r): the follower on the base circle and q_f / q_v with the valve seated (module doc)."""
-    from vtool.solvers.model.initial import cam_clearance
+    from vtool.solvers.model.initial import cam_clearance, start_stiffness
     from vtool.solvers.model.mechanism import Mechanism
 
     layer = Mechanism(spec).start_layer
+    stiffness = start_stiffness(spec, layer)  # with the springs of compliant contacts closed at the start
+
     def unit_load_response(coordinate: int) -> np.ndarray:
         load = np.zeros(layer.size)
         load[int(np.argmax(layer.T[coordinate - 1]))] = 1.0
         try:
-            return layer.T @ np.linalg.solve(layer.K, load)
+            return layer.T @ np.linalg.solve(stiffness, load)
         except np.linalg.LinAlgError:
             raise InputError("members", "no spring to ground",
                              "a mechanism that is statically stable with the cam released") from None

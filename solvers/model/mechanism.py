@@ -144,11 +144,12 @@ class Mechanism:
         """The static start at this cam speed (its arrays shared by the runs at this speed: every back end
         copies them before it integrates)."""
         def make() -> StaticStart:
-            start = static_start(self.spec, self.start_layer, self.omega)
-            if self.spec.cam.profile != "harmonic":  # a lift table: start where its lift puts the cam
+            table = self.spec.cam.profile != "harmonic"
+            start = static_start(self.spec, self.start_layer, self.omega, final=not table)
+            if table:  # a lift table: start where its lift puts the cam
                 from vtool.solvers.model.cam import table_start
 
-                start = table_start(self.spec, start, self.omega)
+                start = table_start(self.spec, start, self.omega, self.start_layer)
             return start
 
         return self.kept(("start", self.omega), make)

@@ -51,7 +51,7 @@ CM_SIZE = 6
 # row w on (z, ż, z̈, sources) with the step's z̈_F = -G·y substituted), so that a quiet step gets its
 # force monitors from the vector pass it makes anyway (see ``ConfigurationTables._force_rows``). The
 # last dimension is n + ncl.
-CP_RAW, CP_STD, CP_FINE = np.int64(0), np.int64(1), np.int64(2)  # np.int64: apply_operator compiles once
+CP_RAW, CP_STD, CP_FINE = range(3)
 CP_SIZE = 3
 PART_C, PART_K, PART_P, PART_S = range(4)
 PART_SIZE = 4

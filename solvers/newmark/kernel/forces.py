@@ -119,29 +119,12 @@ def signed_gap(kind, gap, gap_noise):
 
 
 @jit
-def monitor_value(prob, C, k, y, src, gap_noise, hertz):
-    """What changes sign at clearance k's next event; 0 when not monitored.
-
-    Open: gap + allowance. Closed rigid: the contact force. Closed compliant:
-    the overlap δ = -gap + allowance (the contact ends when the parts part).
-    """
-    kind = C.mk[k, MK_KIND]
-    if kind == MK_GAP or kind == MK_OVERLAP:
-        behind = C.mk[k, MK_BEHIND]
-        other = y.z[behind] if behind >= 0 else src[3 * (-1 - behind)]
-        gap = prob.clf[k, CLF_SIGN] * (y.z[C.mk[k, MK_AHEAD]] - other) + prob.clf[k, CLF_OPEN]
-        return signed_gap(kind, gap, gap_noise)
-    if kind == MK_FORCE:
-        if hertz is None:  # the linear row alone
-            return contact_force(prob, C, k, y, src)
-        return rigid_force(prob, C, k, y, src, hertz)
-    return 0.0
-
-
-@jit
 def monitors(prob, C, y, src, gap_noise, phi, hertz):
-    """phi[k] = :func:`monitor_value` of every clearance k: one call for all of them (gaps and linear
-    forces on arrays taken out of the records once; see step_rows)."""
+    """phi[k] = what changes sign at clearance k's next event, for every clearance k; 0 when not monitored.
+
+    Open: gap + allowance. Closed rigid: the contact force. Closed compliant: the overlap δ = -gap +
+    allowance (the contact ends when the parts part). Gaps and linear forces on arrays taken out of
+    the records once; with no Hertz contact (``hertz`` None) nothing else is called."""
     n, ns = prob.ip[IP_N], prob.ip[IP_NS]
     mk, mon, z, zd, zdd, clf = C.mk, C.mon, y.z, y.zd, y.zdd, prob.clf
     for k in range(prob.cl.shape[0]):
@@ -150,10 +133,13 @@ def monitors(prob, C, y, src, gap_noise, phi, hertz):
             behind = mk[k, MK_BEHIND]
             other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
             phi[k] = signed_gap(kind, clf[k, CLF_SIGN] * (z[mk[k, MK_AHEAD]] - other) + clf[k, CLF_OPEN], gap_noise)
-        elif kind == MK_FORCE and hertz is None:
-            phi[k] = linear_force(mon, k, n, ns, mk[k, MK_M], z, zd, zdd, src)
+        elif kind == MK_FORCE:
+            if hertz is None:  # the linear row alone
+                phi[k] = linear_force(mon, k, n, ns, mk[k, MK_M], z, zd, zdd, src)
+            else:
+                phi[k] = rigid_force(prob, C, k, y, src, hertz)
         else:
-            phi[k] = monitor_value(prob, C, k, y, src, gap_noise, hertz)
+            phi[k] = 0.0
 
 
 @jit

@@ -9,8 +9,8 @@ from vtool.solvers.newmark.kernel.algebra import apply_operator, cholesky_solve,
 from vtool.solvers.newmark.kernel.forces import (
     hertz_correction,
     linear_force,
-    monitor_value,
     monitors,
+    rigid_force,
     signed_gap,
 )
 from vtool.solvers.newmark.kernel.impacts import release_pulling, take_events
@@ -74,7 +74,6 @@ from vtool.solvers.newmark.layout import (
     IP_NS,
     MK_AHEAD,
     MK_BEHIND,
-    MK_FORCE,
     MK_GAP,
     MK_KIND,
     MK_M,
@@ -102,7 +101,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
     fp, ip = prob.fp, prob.ip
     beta, gamma, omega, tol, gap_noise = fp[FP_BETA], fp[FP_GAMMA], fp[FP_OMEGA], fp[FP_TTOL], fp[FP_GAPNOISE]
     n, ns = ip[IP_N], ip[IP_NS]
-    sc, sa, sb = prob.sc, prob.sa, prob.sb
+    sc, sa, sb, clf = prob.sc, prob.sa, prob.sb, prob.clf
     ci, cm, cp, mk, mon = C.ci, C.cm, C.cp, C.mk, C.mon
     z, zd, zdd, z1, zd1, zdd1 = W.now.z, W.now.zd, W.now.zdd, W.end.z, W.end.zd, W.end.zdd
     src1, rhs, sol, L = W.src1, W.rhs, W.sol, W.L
@@ -136,16 +135,15 @@ def locate_event(prob, C, W, k, t, h, hertz):
         if hertz is not None:
             if closed_hertz:
                 hertz_correction(prob, C, W, tau, CHOLESKY)
-        # monitor_value(prob, C, k, W.end, src1, gap_noise, hertz), on the arrays
+        # monitor k (see forces.monitors), on the arrays
         if kind == MK_GAP or kind == MK_OVERLAP:
             behind = mk[k, MK_BEHIND]
             other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
-            gap = prob.clf[k, CLF_SIGN] * (z1[mk[k, MK_AHEAD]] - other) + prob.clf[k, CLF_OPEN]
-            f = signed_gap(kind, gap, gap_noise)
-        elif kind == MK_FORCE and hertz is None:
+            f = signed_gap(kind, clf[k, CLF_SIGN] * (z1[mk[k, MK_AHEAD]] - other) + clf[k, CLF_OPEN], gap_noise)
+        elif hertz is None:  # a closed rigid contact's force: the linear row alone
             f = linear_force(mon, k, n, ns, mk[k, MK_M], z1, zd1, zdd1, src1)
         else:
-            f = monitor_value(prob, C, k, W.end, src1, gap_noise, hertz)
+            f = rigid_force(prob, C, k, W.end, src1, hertz)
         if f < 0.0:
             hi, fhi = tau, f
             if side == -1:

@@ -144,7 +144,7 @@ def advance(prob, C, W, S, O, hertz):
                 stop = True
         if stop:
             break
-        # monitors (see forces.monitor_value): stop before a sign change
+        # monitors (see forces.monitors): stop before a sign change
         for k in range(ncl):
             kind = mk[k, MK_KIND]
             value = 0.0
