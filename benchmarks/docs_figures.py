@@ -16,6 +16,7 @@ import re
 import sys
 import tempfile
 from collections.abc import Callable
+from functools import cache
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -79,12 +80,30 @@ def _torque_camshaft() -> list:
     return [camshaft_chart(spec.title, solve(spec))]
 
 
+@cache
+def _hla_charts() -> list:
+    """The chamber pressure and pump-up charts of the shipped HLA finger train over four cycles (one run for
+    both figures; above the cost guard's default scipy limit, hence max_steps)."""
+    import dataclasses
+
+    from vtool.presets import load_preset
+    from vtool.presets.hla_charts import hla_charts
+    from vtool.solvers.run import simulate
+    from vtool.solvers.studies.hla import hla_series
+
+    spec = load_preset("ohc-finger-follower-hla")
+    spec = dataclasses.replace(spec, run=dataclasses.replace(spec.run, cycles=4, degrees=1440.0))
+    return hla_charts(hla_series(simulate(spec, max_steps=1e7)), spec.title)
+
+
 FIGURES: dict[str, Callable[[], list]] = {"solve-gnilka-1a": _solve, "sweep-map": _sweep, "cam-ramped": _cam,
                                           "boom-daf": _daf, "torque-train": _torque_train,
-                                          "torque-camshaft": _torque_camshaft}
+                                          "torque-camshaft": _torque_camshaft,
+                                          "hla-pressure": lambda: _hla_charts()[:1],
+                                          "hla-pump-up": lambda: _hla_charts()[1:]}
 #: the page that embeds a figure, where it is not docs/figures.md
-PAGES: dict[str, Path] = {"torque-train": ROOT / "docs" / "torque.md",
-                          "torque-camshaft": ROOT / "docs" / "torque.md"}
+PAGES: dict[str, Path] = {name: ROOT / "docs" / "torque.md"
+                          for name in ("torque-train", "torque-camshaft", "hla-pressure", "hla-pump-up")}
 
 
 def draw(names: list[str], folder: Path) -> list[Path]:

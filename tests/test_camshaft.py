@@ -160,8 +160,9 @@ def test_hla_charts_carry_the_series_with_units():
     assert np.array_equal(pressure.panels[0].curves[0].y, columns["hla_pressure"])
     assert pressure.panels[1].ylabel == "plunger extension (mm)"
     extension, drift = pump.panels
-    assert np.array_equal(extension.curves[0].x, [0, 1, 2, 3]) and np.array_equal(drift.curves[0].x, [1, 2, 3])
-    assert np.allclose(np.diff(extension.curves[0].y), drift.curves[0].y)
+    assert np.array_equal(extension.curves[0].x, [0, 1, 2, 3, 4]) and np.array_equal(drift.curves[0].x, [2, 3, 4])
+    assert np.array_equal(extension.curves[0].y, [0.0, 0.0, 0.05, 0.075, 0.08])  # the start, then each base circle
+    assert np.allclose(np.diff(extension.curves[0].y)[1:], drift.curves[0].y)
     assert drift.ylabel == "drift per cycle (mm)"
     labels = [ax.get_ylabel() for ax in build_figure([pressure, pump]).get_axes()]
     assert "chamber pressure (MPa)" in labels and "drift per cycle (mm)" in labels
