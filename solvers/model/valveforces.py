@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vtool.solvers.model import friction
 from vtool.solvers.model.nonlinear import NonlinearElement
 
 SEAT_SIDES = ("cylinder", "port")
@@ -66,10 +67,16 @@ class ValveForces:
 
 
 def friction_force(vf: ValveForces, v: float | np.ndarray) -> float | np.ndarray:
-    """F_f(v) (module doc): positive along v; the force on the valve is -F_f."""
-    peak = vf.guide_friction if vf.static_friction is None else vf.static_friction
-    level = vf.guide_friction + (peak - vf.guide_friction) * np.exp(-(np.asarray(v) / vf.stribeck_velocity) ** 2)
-    return level * np.tanh(np.asarray(v) / vf.guide_velocity) + vf.viscous * np.asarray(v)
+    """F_f(v) (module doc): positive along v; the force on the valve is -F_f. The dry part is the Stribeck
+    law of :mod:`vtool.solvers.model.friction` on a unit load (its coefficients are forces here)."""
+    velocity = np.asarray(v, dtype=float)
+    if vf.static_friction is None:  # no Stribeck dip: the static peak is the Coulomb level
+        dry, _ = friction.coulomb(velocity, np.ones_like(velocity), vf.guide_friction, vf.guide_velocity)
+    else:
+        dry, _ = friction.stribeck(velocity, np.ones_like(velocity), vf.guide_friction, vf.static_friction,
+                                   float(vf.stribeck_velocity), 0.0, vf.guide_velocity)
+    out = dry + vf.viscous * velocity
+    return float(out) if np.ndim(v) == 0 else out
 
 
 def cylinder_pressure(vf: ValveForces, cam_deg: float | np.ndarray) -> float | np.ndarray:
