@@ -67,6 +67,7 @@ SHOTS = (
     ("boom-form", "boom", "boom-brick-wall", (120, 40), ()),
     ("boom-daf", "boom", "boom-brick-wall", (80, 24), ("ctrl+t",)),
     ("plate-transient", "plate", "plate-table2", (120, 32), ("ctrl+t",)),
+    ("camshaft-torque", "camshaft", "four-cylinder-intake", (120, 40), ()),
 )
 
 #: screens quoted in the docs, as generated blocks (file relative to the repository, block name)
@@ -75,6 +76,7 @@ DOC_BLOCKS = {
     "valvetrain-animation": (("docs/tui.md", "tui-animation"),),
     "boom-limits": (("docs/tui.md", "tui-boom"),),
     "plate-transient": (("docs/tui.md", "tui-plate"),),
+    "camshaft-torque": (("docs/tui.md", "tui-camshaft"),),
 }
 
 
