@@ -111,6 +111,11 @@ def main(argv: list[str]) -> None:
     print(f"the {len(common)} test names both suites hold (of {len(old_each[0])} in {ref}, {len(new_each[0])} in HEAD): "
           f"summed test durations {summed_old / pairs:.1f} s in {ref}, {summed_new / pairs:.1f} s in HEAD; "
           f"ratio {summed_new / summed_old:.2f}")
+    change = sorted(((sum(sum(run[key]) for run in new_each) - sum(sum(run[key]) for run in old_each)) / pairs, key)
+                    for key in common)
+    print("the common tests that changed most (seconds a run, HEAD minus REF):")
+    for seconds, key in change[::-1][:12] + change[:3]:
+        print(f"  {seconds:+8.2f}  {key}")
 
 
 if __name__ == "__main__":
