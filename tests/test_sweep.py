@@ -328,3 +328,28 @@ def test_cancel_stops_the_check_of_the_points() -> None:
         plan_sweep("gnilka-1a", ["run.rpm=1000:30999:1", "damping.factor=0.5,1,2"],
                    cancel=lambda: asked.append(1) or len(asked) > 2)
     assert len(asked) == 3
+
+
+def test_a_pool_starts_every_worker_while_other_threads_hold_the_interpreter() -> None:
+    """The pool's start tasks meet at a barrier, so no worker is idle before the last is submitted: each
+    submission starts its own process. With plain os.getpid tasks a worker that finished while the starting
+    thread waited for the GIL took the next task, fewer processes started than workers, and start() waited
+    for the missing ones until its deadline (the TUI monkey's seed 148, sweeps started from several threads)."""
+    import threading
+
+    stop = threading.Event()
+
+    def spin() -> None:
+        while not stop.is_set():
+            sum(range(1000))
+
+    spinners = [threading.Thread(target=spin, daemon=True) for _ in range(4)]
+    for thread in spinners:
+        thread.start()
+    runner = ProcessRunner(3)
+    try:
+        runner.start(timeout=60.0)
+        assert len(runner.pids) == 3
+    finally:
+        stop.set()
+        runner.close()

@@ -242,10 +242,17 @@ IN_FLIGHT_PER_WORKER = 4
 
 # ----- execution -----
 
-def _ignore_interrupt(ready: Any = None, stderr: str | None = None) -> None:
+#: The pool's start barrier in a worker process (set by :func:`_ignore_interrupt`, see :meth:`ProcessRunner.start`).
+_START_BARRIER: Any = None
+
+
+def _ignore_interrupt(ready: Any = None, stderr: str | None = None, barrier: Any = None) -> None:
     """Worker initializer: Ctrl+C is handled by the parent, which stops the pool cleanly; with
     ``stderr`` (a file path), the worker's standard error (descriptor 2) is that file; ``ready`` (a
-    semaphore) is released once the worker runs (see :meth:`ProcessRunner.start`)."""
+    semaphore) is released once the worker runs; ``barrier`` is kept for :func:`_started` (see
+    :meth:`ProcessRunner.start`)."""
+    global _START_BARRIER
+    _START_BARRIER = barrier
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if stderr is not None:
         target = os.open(stderr, os.O_WRONLY | os.O_APPEND)
@@ -253,6 +260,14 @@ def _ignore_interrupt(ready: Any = None, stderr: str | None = None) -> None:
         os.close(target)
     if ready is not None:
         ready.release()
+
+
+def _started(timeout: float) -> int:
+    """A start task: it returns (its worker's pid) only when as many start tasks run at once as the pool
+    has workers, so that no worker is idle while the others are submitted (see :meth:`ProcessRunner.start`)."""
+    if _START_BARRIER is not None:
+        _START_BARRIER.wait(timeout)
+    return os.getpid()
 
 
 #: Most local Dask workers (processes or threads) per core: ``local:N`` above this is refused.
@@ -448,10 +463,12 @@ class ProcessRunner:
         context.set_forkserver_preload(["vtool.solvers.studies.sweep", backends.module_of(backends.DEFAULT)])
         self.workers = workers
         self.started = False
+        self.pids: set[int] = set()  # the worker processes, once started
         with descriptor_stderr():  # the pool's first semaphore starts multiprocessing's resource tracker
             self.ready = context.Semaphore(0)
+            self.barrier = context.Barrier(workers)
             self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_ignore_interrupt,
-                                            initargs=(self.ready, stderr))
+                                            initargs=(self.ready, stderr, self.barrier))
 
     def start(self, timeout: float = 300.0) -> None:
         """Start every worker and wait until each runs (inside :func:`_pool_start`).
@@ -463,8 +480,12 @@ class ProcessRunner:
         if self.started:
             return
         with _pool_start(), descriptor_stderr():
-            # each submission to a pool without an idle worker starts one
-            futures = [self.pool.submit(os.getpid) for _ in range(self.workers)]
+            # each submission to a pool without an idle worker starts one; a start task returns only when
+            # all run at once (a barrier), so none has made its worker idle before the last is submitted (with
+            # os.getpid, a worker that finished while this thread waited for the GIL took the next one: fewer
+            # processes than workers, and this loop waited for the rest until its deadline: the TUI monkey's
+            # seed 148 after 147 sequences, sweeps started by several threads at once)
+            futures = [self.pool.submit(_started, timeout) for _ in range(self.workers)]
             deadline = time.perf_counter() + timeout
             running = 0
             while running < self.workers:
@@ -477,6 +498,7 @@ class ProcessRunner:
                                    f"{str(failed)[:120]})")
                 if time.perf_counter() > deadline:
                     raise RunError(f"the sweep's {self.workers} worker processes did not start within {timeout:g} s")
+            self.pids = {future.result(timeout) for future in futures}  # one start task a worker process
         self.started = True
 
     def run(self, batches: Iterable[list[Point]], every_step: bool,
