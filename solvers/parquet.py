@@ -10,10 +10,11 @@ float64, and for a run ``configuration`` (the thesis' number, null when it
 has none) and ``closed`` (the closed clearances). The file's key-value
 metadata carries ``vtool_version`` and ``title``.
 
-Memory stays bounded: rows are buffered up to :data:`ROW_GROUP` and then
-written as one row group, so a writer holds at most one group whatever the
-length of the run or the number of points (benchmarks/bench_parquet.py
-measures the peak against a ten times smaller output). The bytes go to the
+Memory stays bounded: rows are buffered up to :data:`ROW_GROUP` (a sweep's:
+:func:`group_rows`, about :data:`GROUP_BYTES` of numbers) and then written as
+one row group, so a writer holds at most one group whatever the length of the
+run or the number of points (benchmarks/bench_parquet.py measures the peak at
+10^4, 10^5 and 2*10^5 points). The bytes go to the
 handle of :func:`vtool.files.open_atomic_binary` (a temporary file renamed
 over the target when the run succeeds), so a failed run leaves nothing.
 """
@@ -66,10 +67,11 @@ def output_format(path: Any, given: str | None, field: str = "--format") -> str:
 
 
 class _GroupWriter:
-    """Columns buffered up to :data:`ROW_GROUP` rows, then written as one row group."""
+    """Columns buffered up to ``rows`` rows (default :data:`ROW_GROUP`), then written as one row group."""
 
-    def __init__(self, handle: BinaryIO, metadata: dict[str, str]) -> None:
+    def __init__(self, handle: BinaryIO, metadata: dict[str, str], rows: int | None = None) -> None:
         self.pq = require_pyarrow()
+        self.rows = rows or ROW_GROUP
         self.handle = handle
         self.metadata = {k.encode(): v.encode() for k, v in metadata.items()}
         self.writer: Any = None
@@ -81,7 +83,7 @@ class _GroupWriter:
         for name, values in columns.items():
             self.buffer.setdefault(name, []).append(values)
         self.buffered += rows
-        if self.buffered >= ROW_GROUP:
+        if self.buffered >= self.rows:
             self.flush()
 
     def write(self, arrays: dict[str, Any]) -> None:
@@ -183,7 +185,6 @@ class SweepParquet:
         self.metrics = report_columns(spec, timing)
         self.names = ["point", *self.field_titles, "status", *(column_title(n, u) for n, u in self.metrics)]
         self.spec = spec
-        self.groups = _GroupWriter(handle, {"vtool_version": __version__, "title": spec.title})
         from vtool.solvers.studies.sweep import IndexSet
 
         self.finished = IndexSet()  # a resumed file's points (one bit a point)
@@ -191,6 +192,7 @@ class SweepParquet:
         # the points of the group being filled: the index and the metrics in arrays (8 bytes a number, a
         # metric's numbers contiguous: pyarrow takes them without a copy), the fields and statuses as lists
         self.size = group_rows(len(self.names))
+        self.groups = _GroupWriter(handle, {"vtool_version": __version__, "title": spec.title}, self.size)
         self.index = np.empty(self.size, dtype=np.int64)
         self.block = np.empty((len(self.metrics), self.size))
         self.cells: dict[str, list[Any]] = {title: [] for title in [*self.field_titles, "status"]}
