@@ -101,8 +101,8 @@ def locate_event(prob, C, W, k, t, h, hertz):
     open at t until the chattering stop. Each trial
     factors S(tau) by Cholesky. The trials are :func:`step_to`'s step written
     with the shared inline helpers on arrays taken out of the records once (a
-    call handed records takes and drops a reference count of each of their
-    arrays: in this loop, most of an event's cost).
+    call handed records takes and drops a count of each of their arrays: a
+    call each, even on :func:`run_chunk`'s borrowed views).
     """
     fp, ip = prob.fp, prob.ip
     beta, gamma, omega, tol, gap_noise = fp[FP_BETA], fp[FP_GAMMA], fp[FP_OMEGA], fp[FP_TTOL], fp[FP_GAPNOISE]

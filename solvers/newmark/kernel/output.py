@@ -66,7 +66,7 @@ def step_rows(prob, C, t, h, y, zdd1, W, O, S, hertz):
     """The output rows inside (t, t + h] of a step from y whose end acceleration is z̈1, by the
     linear-acceleration interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); False when the buffer
     filled first (the rows before are written). :func:`record_row`'s row, on arrays taken out of the
-    records once (a call handed records takes and drops a reference count of each of their arrays)."""
+    records once (a call handed records takes and drops a count of each of their arrays)."""
     dt, t_end, out_dt, omega = prob.fp[FP_DT], prob.fp[FP_TEND], prob.fp[FP_OUTDT], prob.fp[FP_OMEGA]
     n, ns, ncl = prob.ip[IP_N], prob.ip[IP_NS], prob.cl.shape[0]
     sc, sa, sb = prob.sc, prob.sa, prob.sb
