@@ -28,11 +28,38 @@ from vtool import numba_cache
 
 numba_cache.configure()
 
-from numba import njit  # noqa: E402 (after the cache folder is chosen)
+from cffi import FFI  # noqa: E402
+from numba import carray, config, njit  # noqa: E402 (after the cache folder is chosen)
 
 _OPTIONS: dict[str, Any] = {"cache": numba_cache.CACHE_ENABLED, "nogil": True, "error_model": "numpy"}
 jit = njit(**_OPTIONS)
 jit_inline = njit(**_OPTIONS, inline="always")
+
+_FFI = FFI()
+
+if config.DISABLE_JIT:  # plain Python: the arrays themselves (carray takes a ctypes pointer there)
+
+    def borrowed(a):  # noqa: ANN001, ANN201
+        return a
+
+else:
+
+    @jit_inline
+    def borrowed(a):  # noqa: ANN001, ANN201
+        """A view of C-contiguous array ``a`` that numba does not reference-count, for the length of a call.
+
+        numba counts references to every array it passes: a compiled function
+        takes (an atomic increment) and drops (an atomic decrement) a count of
+        each array in its arguments, records included, and its optimiser removes
+        few of these pairs in a function with branches. The kernel's entry point
+        hands its callees views made by numba's documented ``carray`` over the
+        arrays' data pointers (cffi's ``ffi.from_buffer``, supported in nopython
+        mode): such a view has no owner to count, so each count is a null check.
+        It is valid while ``a`` lives: the Python caller holds every array for
+        the whole call, and no view outlives it.
+        """
+        return carray(_FFI.from_buffer(a), a.shape)
+
 
 #: A first compile's length when none was measured yet on this machine (s; the 2-core development
 #: machine took 9-14 s for 1A's kernel with other work running).

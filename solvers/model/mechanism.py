@@ -168,14 +168,6 @@ class Mechanism:
         """[M, M⁻¹] stacked (2 x n x n)."""
         return self.kept("mass and inverse", lambda: np.stack([self.M, np.linalg.inv(self.M)]))
 
-    def cam_position(self, t: np.ndarray | float) -> np.ndarray | float:
-        from vtool.solvers.model.cam import derivatives, lift_series
-
-        c0, a, b = lift_series(self.spec.cam)
-        lift = derivatives(c0, a, b, self.omega * np.atleast_1d(np.asarray(t, dtype=float)))[0]
-        position = self.start.cam_offset - c0 + lift
-        return position if np.ndim(t) else float(position[0])
-
 
 def assemble(spec: MechanismSpec) -> Mechanism:
     """Build the mechanism model for a spec (full matrices; layers on demand)."""

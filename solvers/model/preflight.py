@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from vtool.solvers.model.cam import derivatives, lift_series
 from vtool.solvers.model.mechanism import Mechanism
 from vtool.solvers.model.spec import ENABLED, EXTERNAL, MOMENTUM, MechanismSpec
 
@@ -35,12 +36,23 @@ LOW_DAMPING = 0.01
 LONG_RUN_DEG = 360.0
 
 
+def lift_range(mechanism: Mechanism) -> tuple[float, float, float]:
+    """(L(0), lowest, highest L) of the cam's lift law, relative to its mean c0, at SAMPLES angles over
+    a revolution: the cam's alone, so kept with the mechanism for every run of it (100 µs a run)."""
+
+    def make() -> tuple[float, float, float]:
+        c0, a, b = lift_series(mechanism.spec.cam)
+        lift = derivatives(c0, a, b, np.arange(SAMPLES) * (2.0 * np.pi / SAMPLES))[0] - c0
+        return float(lift[0]), float(lift.min()), float(lift.max())
+
+    return mechanism.shared("cam lift range", make)
+
+
 def cam_travel(mechanism: Mechanism) -> tuple[float, float, float]:
     """(q_cam(0), lowest, highest q_cam) over a revolution of the cam's lift law (length units)."""
-    omega = mechanism.omega
-    period = 2.0 * np.pi / omega if omega > 0.0 else 1.0
-    positions = np.asarray(mechanism.cam_position(np.arange(SAMPLES) * (period / SAMPLES)), dtype=float)
-    return float(positions[0]), float(positions.min()), float(positions.max())
+    offset = mechanism.start.cam_offset
+    start, lowest, highest = lift_range(mechanism)
+    return offset + start, offset + lowest, offset + highest
 
 
 def seat_reach_warning(mechanism: Mechanism) -> str | None:

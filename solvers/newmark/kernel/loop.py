@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from vtool.jit import jit, jit_inline
+from vtool.jit import borrowed, jit, jit_inline
 from vtool.solvers.newmark.kernel.algebra import apply_operator, cholesky_solve, factor_effective
 from vtool.solvers.newmark.kernel.forces import (
     hertz_correction,
@@ -82,6 +82,7 @@ from vtool.solvers.newmark.layout import (
     OUTPUT_FULL,
     PEAK_ALL,
 )
+from vtool.solvers.newmark.records import Motion, Output, Problem, Scratch, State, Tables
 
 
 @jit
@@ -136,7 +137,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
         prescribed(ci, n, src1, z1, zd1, zdd1)
         apply_operator(cp, ci, CP_RAW, nf, coupled, src1, z1, zd1, zdd1, rhs)
         cholesky_solve(nf, L, rhs, sol)
-        correct(nf, tau, beta, gamma, sol, z1, zd1, zdd1)
+        correct(nf, tau, beta, gamma, sol, z1, zd1, zdd1, math.inf)
         if hertz is not None:
             if closed_hertz:
                 hertz_correction(prob, C, W, tau, CHOLESKY)
@@ -346,6 +347,24 @@ def steps(prob, C, W, S, O, hertz):
             return 0, True, h
 
 
+@jit_inline
+def motion_borrowed(y):
+    return Motion(borrowed(y.z), borrowed(y.zd), borrowed(y.zdd))
+
+
+@jit_inline
+def borrow(prob, T, W, S, O):
+    """The records with every array :func:`~vtool.jit.borrowed` (not reference-counted in the calls)."""
+    b = borrowed
+    prob = Problem(b(prob.ip), b(prob.fp), b(prob.cl), b(prob.clf), b(prob.sc), b(prob.sa), b(prob.sb), b(prob.mass))
+    T = Tables(b(T.index), b(T.ci), b(T.cm), b(T.cp), b(T.mk), b(T.mon))
+    W = Scratch(motion_borrowed(W.now), motion_borrowed(W.end), motion_borrowed(W.out), b(W.src0), b(W.src1),
+                b(W.srco), b(W.rhs), b(W.sol), b(W.L), b(W.phi), b(W.phi_start), b(W.tau), b(W.closing))
+    S = State(b(S.x), b(S.v), b(S.a), b(S.ist), b(S.fst))
+    O = Output(b(O.t), b(O.q), b(O.F), b(O.c), b(O.ev_f), b(O.ev_i), b(O.peak))  # noqa: E741
+    return prob, T, W, S, O
+
+
 @jit
 def run_chunk(prob, T, W, S, O, hertz, momentum):
     """Integrate from S.fst[F_T] until t_end, the chunk end, or something Python must do.
@@ -362,6 +381,7 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
     Only the momentum law's impacts and the Hertz iteration allocate their
     small systems.
     """
+    prob, T, W, S, O = borrow(prob, T, W, S, O)  # noqa: E741
     ist, fst = S.ist, S.fst
     n, ncl = prob.ip[IP_N], prob.cl.shape[0]
     clear(W)

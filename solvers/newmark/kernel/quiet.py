@@ -84,8 +84,9 @@ def advance(prob, C, W, S, O, hertz):
     ip, fp, ist, fst = prob.ip, prob.fp, S.ist, S.fst
     sc, sa, sb, cl, clf = prob.sc, prob.sa, prob.sb, prob.cl, prob.clf
     ci, cp, mk, mon = C.ci, C.cp, C.mk, C.mon
-    z, zd, zdd = W.now.z, W.now.zd, W.now.zdd
-    z1, zd1, zdd1 = W.end.z, W.end.zd, W.end.zdd
+    now, end = W.now, W.end
+    z, zd, zdd = now.z, now.zd, now.zdd
+    z1, zd1, zdd1 = end.z, end.zd, end.zdd
     rhs, phi, src1, peak = W.rhs, W.phi, W.src1, O.peak
     n, ns, ncl = ip[IP_N], ip[IP_NS], cl.shape[0]
     beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
@@ -137,15 +138,11 @@ def advance(prob, C, W, S, O, hertz):
         predict(m, h, beta, gamma, z, zd, zdd, z1, zd1)
         prescribed(ci, n, src1, z1, zd1, zdd1)
         apply_operator(cp, ci, plane, nrows, coupled, src1, z1, zd1, zdd1, rhs)
-        correct(nf, h, beta, gamma, rhs, z1, zd1, zdd1)
-        stop = False
-        for f in range(nf):
-            if not (abs(z1[f]) <= x_limit):  # the divergence limit
-                stop = True
-        if stop:
+        within = correct(nf, h, beta, gamma, rhs, z1, zd1, zdd1, x_limit)
+        if not within:  # past the divergence limit
             break
-        # monitors (see forces.monitors): stop before a sign change
-        for k in range(ncl):
+        stop = False
+        for k in range(ncl):  # monitors (see forces.monitors): stop before a sign change
             kind = mk[k, MK_KIND]
             value = 0.0
             if kind == MK_GAP or kind == MK_OVERLAP:
@@ -153,20 +150,16 @@ def advance(prob, C, W, S, O, hertz):
                 other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
                 value = signed_gap(kind, clf[k, CLF_SIGN] * (z1[mk[k, MK_AHEAD]] - other) + clf[k, CLF_OPEN],
                                    gap_noise)
-                if value < 0.0:
-                    stop = True
-                    break
+                stop |= value < 0.0
             elif kind == MK_FORCE:  # its force row of the step's product, and the row's constant
                 value = mon[k, constant] + rhs[mk[k, MK_ROW]]
-                if value < 0.0 and cl[k, CL_MON]:
-                    stop = True
-                    break
+                stop |= value < 0.0 and cl[k, CL_MON] != 0
             phi[k] = value
         if stop:
             break
         t_out = ist[I_NEXT_OUT] * out_dt  # output rows inside (t, t1]: a call only when one is due
         if (t_out <= t1 + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
-                and not step_rows(prob, C, t, h, W.now, zdd1, W, O, S, hertz)):
+                and not step_rows(prob, C, t, h, now, zdd1, W, O, S, hertz)):
             break
         # accept: peaks (output.track_peaks, the forces from the step's product), state, time
         after = t1 >= t_rev
@@ -177,7 +170,7 @@ def advance(prob, C, W, S, O, hertz):
                 if after:
                     peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], phi[k])
             elif kind == MK_OVERLAP:
-                force = contact_force(prob, C, k, W.end, src1)
+                force = contact_force(prob, C, k, end, src1)
                 peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
                 peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], force)
                 if after:
