@@ -11,8 +11,10 @@ memory pool, measured and shown as ``setup``) do not count as growth. Two cases:
     :func:`vtool.files.open_atomic_binary`), fed N synthetic points with the
     metric columns of gnilka-1d: what ``--format parquet`` adds.
 ``sweep``
-    ``vtool sweep gnilka-1d --set run.rpm=START:STOP:0.05 --set run.degrees=0.5
-    --workers 1 --out f.parquet`` in one process: real points, the cheapest a
+    What ``vtool sweep gnilka-1d --set run.rpm=START:STOP:0.05 --set run.degrees=0.5
+    --workers 1 --out f.parquet`` calls (the plan, its axes, the runner and
+    app/cli/sweep.py's Parquet writing; the command refuses more than 10^5
+    points, so the plan's limit is raised to N here) in one process: real points, the cheapest a
     sweep allows (half a cam degree each, about 1.4 ms a point on an idle
     development machine), planned and run: the range is kept as (start, step,
     count) and each point's spec made when it runs (presets/paths.py), the
@@ -37,7 +39,6 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
 DOC = ROOT / "docs" / "sweep.md"
@@ -82,17 +83,20 @@ def run_writer(n: int, out: Path) -> dict:
 
 
 def run_sweep(n: int, out: Path) -> dict:
-    from click.testing import CliRunner
+    from vtool.app.cli.sweep import _run_to_parquet
+    from vtool.presets.paths import plan_sweep
+    from vtool.solvers.studies.sweep import make_runner
 
-    from vtool.app.cli.main import cli
-
-    def sweep(count: int) -> Any:
+    def sweep(count: int) -> None:
+        """``vtool sweep``'s own calls for a Parquet file (app/cli/sweep.py), with the 10^5-point limit raised."""
         stop = f"{1000 + 0.05 * (count - 1):.12g}"
-        result = CliRunner().invoke(cli, ["sweep", "gnilka-1d", "--set", f"run.rpm=1000:{stop}:0.05", "--set",
-                                          "run.degrees=0.5", "--workers", "1", "--out", str(out)])
-        if result.exit_code != 0:
-            raise SystemExit(result.output)
-        return result
+        plan = plan_sweep("gnilka-1d", [f"run.rpm=1000:{stop}:0.05", "run.degrees=0.5"], max_points=count)
+        plan.points.axes()  # the command's check of the axes
+        runner = make_runner(1)  # --workers 1
+        try:
+            _run_to_parquet(plan, runner, out, False, False, False, None, False, [0])
+        finally:
+            runner.close()
 
     start = peak_kb()
     sweep(2)  # warm-up: the imports, the compiled kernel and the Parquet writer's setup are in the baseline
@@ -113,6 +117,7 @@ def case(kind: str, n: int) -> dict:
     data = json.loads(done.stdout.strip().splitlines()[-1])
     data["growth_mb"] = (data["peak_kb"] - data["before_kb"]) / 1024.0
     data["setup_mb"] = data["setup_kb"] / 1024.0
+    print(f"{kind} {n:,}: {data['growth_mb']:.2f} MB added, {data['seconds']:.1f} s", file=sys.stderr, flush=True)
     return data
 
 

@@ -17,8 +17,9 @@ a swept value is validated by the loader itself and its error is the loader's
 own. Only the tables and array entries on the way must already exist.
 
 :func:`parse_values` turns a sweep's ``VALUES`` text (``start:stop:step`` or
-``a,b,c``) into the list of values, with one-line errors for an empty range
-or a step of the wrong sign.
+``a,b,c``) into its values (a range as a :class:`ValueRange`: three numbers,
+each value made when asked for; a typed list as a list), with one-line errors
+for an empty range or a step of the wrong sign.
 """
 
 from __future__ import annotations

@@ -7,6 +7,7 @@ import tracemalloc
 from decimal import Decimal
 from typing import Any
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -131,3 +132,28 @@ def test_planning_a_100000_point_range_allocates_what_a_10_point_one_does() -> N
     plan_sweep("gnilka-1a", ["run.rpm=1000:1001:1"])  # the loader's imports and caches
     small, large = peak_bytes("1000:1000.45:0.05"), peak_bytes("1000:5999.95:0.05")
     assert large - small < 50_000, (small, large)
+
+
+def test_the_model_is_kept_from_chunk_to_chunk(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A sweep over run settings assembles its model once, not once a chunk (in this process and in a worker's
+    evaluate_chunk); another model is assembled when its points come."""
+    import vtool.solvers.studies.sweep as sweep
+
+    assembled = []
+    real = sweep.assemble
+    monkeypatch.setattr(sweep, "assemble", lambda spec: assembled.append(spec) or real(spec))
+    monkeypatch.setattr(sweep._LAST, "mechanism", None, raising=False)
+    points = plan_sweep("gnilka-1a", ["run.rpm=10000:10300:100", "damping.factor=1,2", "run.degrees=30"]).points
+    first, second = [points.lazy(i) for i in range(4)], [points.lazy(i) for i in range(4, 8)]
+    results = sweep.evaluate_chunk(first[:2]) + sweep.evaluate_chunk(first[2:])
+    assert len(assembled) == 1 and all(r.ok for r in results)
+    sweep.evaluate_chunk(second)
+    assert len(assembled) == 2
+    assembled.clear()
+    got: list[sweep.PointResult] = []
+    assert sweep.SerialRunner().run([first[:2], first[2:], second], False, got.extend, lambda: False)
+    assert len(assembled) == 2 and [r.index for r in got] == list(range(8))
+    def numbers(rs: list[sweep.PointResult]) -> str:  # NaN equal to NaN; the wall time left out
+        return repr([{k: v for k, v in r.metrics.items() if k != "wall_time"} for r in rs])
+
+    assert numbers(got[:4]) == numbers(results)

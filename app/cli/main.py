@@ -101,11 +101,17 @@ def _interrupt(signum: int, frame: Any) -> None:
     """SIGINT and SIGTERM: KeyboardInterrupt (:class:`Terminated`) where the program is, or the same signal
     again :data:`RETRY_SECONDS` later when it is where the interrupt cannot unwind (:func:`_held_back`)."""
     if frame is not None and _held_back(frame):
-        again = threading.Timer(RETRY_SECONDS, os.kill, (os.getpid(), signum))
-        again.daemon = True
-        again.start()
+        deliver_again(signum)
         return
     raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
+
+
+def deliver_again(signum: int, seconds: float = RETRY_SECONDS) -> None:
+    """Send this process ``signum`` again after ``seconds`` (from a daemon thread): a handler that cannot
+    raise its interrupt where the program is leaves it to the next delivery."""
+    again = threading.Timer(seconds, os.kill, (os.getpid(), signum))
+    again.daemon = True
+    again.start()
 
 
 def _interrupted(exc: BaseException | None) -> tuple[str, int]:
