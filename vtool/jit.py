@@ -28,40 +28,40 @@ from vtool import numba_cache
 
 numba_cache.configure()
 
-from llvmlite import ir  # noqa: E402
-from numba import config, njit  # noqa: E402 (after the cache folder is chosen)
-from numba.extending import intrinsic  # noqa: E402
+from cffi import FFI  # noqa: E402
+from numba import carray, config, njit  # noqa: E402 (after the cache folder is chosen)
 
 _OPTIONS: dict[str, Any] = {"cache": numba_cache.CACHE_ENABLED, "nogil": True, "error_model": "numpy"}
 jit = njit(**_OPTIONS)
 jit_inline = njit(**_OPTIONS, inline="always")
 
+#: cffi's FFI, whose ``from_buffer`` numba supports in nopython mode. With cffi installed, numba
+#: imports it (and pycparser) itself during a solve's first compiled call (its cffi typing support;
+#: seen with ``python -X importtime``), so this costs a solve no import of its own.
+_FFI = FFI()
 
-@intrinsic
-def _unowned(typingctx, a):  # noqa: ANN001, ANN202, ARG001
-    def codegen(context, builder, signature, args):  # noqa: ANN001, ANN202, ARG001
-        (value,) = args
-        return builder.insert_value(value, ir.Constant(value.type.elements[0], None), 0)
+if config.DISABLE_JIT:  # plain Python: the arrays themselves (carray takes a ctypes pointer there)
 
-    return a(a), codegen
+    def borrowed(a):  # noqa: ANN001, ANN201
+        return a
 
+else:
 
-def _same(a: Any) -> Any:
-    return a
+    @jit_inline
+    def borrowed(a):  # noqa: ANN001, ANN201
+        """A view of C-contiguous array ``a`` that numba does not reference-count, for the length of a call.
 
-
-#: ``borrowed(a)``: a view of array ``a`` that numba does not reference-count, for the length of a call.
-#:
-#: numba counts references to every array it passes: a compiled function takes (an atomic
-#: increment) and drops (an atomic decrement) a count of each array in its arguments, records
-#: included, and its optimiser removes few of these pairs in a function with branches. The
-#: kernel's entry point hands its callees these views instead: the same array value with no owner
-#: (numba's array value leads with its owner, the meminfo pointer, which this sets to null:
-#: numba's documented low-level extension API, ``numba.extending.intrinsic``, with llvmlite's IR
-#: builder), so that each count is a null check. A view is valid while ``a`` lives: the Python
-#: caller holds every array for the whole call, and no view outlives it. Plain Python
-#: (``NUMBA_DISABLE_JIT=1``): the array itself.
-borrowed: Any = _same if config.DISABLE_JIT else _unowned
+        numba counts references to every array it passes: a compiled function
+        takes (an atomic increment) and drops (an atomic decrement) a count of
+        each array in its arguments, records included, and its optimiser removes
+        few of these pairs in a function with branches. The kernel's entry point
+        hands its callees views made by numba's documented ``carray`` over the
+        arrays' data pointers (cffi's ``ffi.from_buffer``, supported in nopython
+        mode): such a view has no owner to count, so each count is a null check.
+        It is valid while ``a`` lives: the Python caller holds every array for
+        the whole call, and no view outlives it.
+        """
+        return carray(_FFI.from_buffer(a), a.shape)
 
 
 #: A first compile's length when none was measured yet on this machine (s; the 2-core development
