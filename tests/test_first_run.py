@@ -126,6 +126,20 @@ def test_a_cache_folder_not_the_users_own_is_not_used_and_nothing_is_loaded(tmp_
     assert str(base) in warning and ("another user" in warning if how.startswith("owned") else "writable" in warning)
 
 
+def test_a_child_process_shares_its_parents_cache_folder(tmp_path: Path) -> None:
+    """configure() exports BASE/kernels-DIGEST; a child (a sweep worker, a subprocess) inherits it and
+    must cache in the same folder, not in BASE/kernels-DIGEST/kernels-DIGEST (empty: a whole compile
+    again, 140 s for 1A measured at load 6.5)."""
+    report = "from vtool import numba_cache; print(numba_cache.configure())"
+    child = f"subprocess.run([sys.executable, '-c', {report!r}], capture_output=True, text=True).stdout"
+    parent = f"{report}; import subprocess, sys; print({child})"
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    lines = subprocess.run([sys.executable, "-c", parent], capture_output=True, text=True, env=env,
+                           check=True).stdout.split()
+    name = f"kernels-{numba_cache.digest(numba_cache.kernel_sources())}"
+    assert lines == [f"NUMBA_CACHE_DIR={tmp_path / 'cache' / name}"] * 2
+
+
 @needs_jit
 def test_a_safe_folder_is_used_with_the_kernels_digest_in_its_name(tmp_path: Path) -> None:
     base = tmp_path / "cache"

@@ -4,7 +4,9 @@
 first) and sets ``NUMBA_CACHE_DIR`` (numba's documented setting) to
 ``BASE/kernels-DIGEST``, where BASE is the first folder of
 
-1. ``NUMBA_CACHE_DIR`` when the user set it (then only that one);
+1. ``NUMBA_CACHE_DIR`` when the user set it (then only that one; a ``kernels-DIGEST`` folder
+   there is what :func:`configure` exported to a parent process, whose children, sweep workers
+   and subprocesses, inherit it: its parent is the base, so that they share the parent's cache);
 2. ``$XDG_CACHE_HOME/vtool/numba``, ``~/.cache/vtool/numba``,
    ``<tempdir>/vtool-numba-<uid>``
 
@@ -31,6 +33,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import stat
 import sys
 import tempfile
@@ -43,13 +46,16 @@ CACHE_ENABLED = True
 FOLDER: Path | None = None
 BASE: Path | None = None
 TIMES = "compile-seconds.json"
+#: The name of a cache folder in its base (see :func:`configure`).
+KERNELS = re.compile(r"kernels-[0-9a-f]{16}")
 _configured: list[str] = []
 
 
 def candidates() -> list[Path]:
     """Base folders tried in order (the user's ``NUMBA_CACHE_DIR`` alone when set)."""
     if os.environ.get("NUMBA_CACHE_DIR"):
-        return [Path(os.environ["NUMBA_CACHE_DIR"])]
+        given = Path(os.environ["NUMBA_CACHE_DIR"])
+        return [given.parent if KERNELS.fullmatch(given.name) else given]
     xdg = os.environ.get("XDG_CACHE_HOME")
     folders = [Path(xdg) / "vtool" / "numba"] if xdg else []
     folders.append(Path.home() / ".cache" / "vtool" / "numba")
