@@ -15,10 +15,17 @@ and first on ``PYTHONPATH``: numba's cache and mypy's cache start
 empty, as in CI's fresh clone. Both run under the pytest and the libraries installed here (CI's
 fresh install may pick other versions: pyproject pins pytest below 9.2 for that reason). ``-k``
 passes a selection to pytest (to try the script on a few tests).
+
+``--top N`` prints the N tests that got slowest (12). ``--save FILE`` writes each suite's wall seconds, last line and per-test durations to FILE (JSON);
+``--old FILE`` takes REF's runs from such a file instead of running REF's suite again (while one
+works on the suite's speed: REF does not change, and a run of it takes 1.5-2 min). The figures are
+fair only when FILE was written on the same machine under the same load: quote a run without
+``--old`` (one invocation, alternating) as the result.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -87,22 +94,36 @@ def run_suite(ref: str, select: str | None) -> tuple[float, str, dict[str, list[
 
 def main(argv: list[str]) -> None:
     if not argv or argv[0].startswith("-"):
-        raise SystemExit("usage: REF [--pairs N] [-k EXPRESSION]")
+        raise SystemExit("usage: REF [--pairs N] [-k EXPRESSION] [--top N] [--save FILE] [--old FILE]")
     ref = argv[0]
     pairs = int(argv[argv.index("--pairs") + 1]) if "--pairs" in argv else 2
     select = argv[argv.index("-k") + 1] if "-k" in argv else None
+    top = int(argv[argv.index("--top") + 1]) if "--top" in argv else 12
+    save = Path(argv[argv.index("--save") + 1]) if "--save" in argv else None
+    saved = json.loads(Path(argv[argv.index("--old") + 1]).read_text()) if "--old" in argv else None
     head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
                           check=True).stdout.strip()
     old: list[float] = []
     new: list[float] = []
     old_each: list[dict[str, list[float]]] = []
     new_each: list[dict[str, list[float]]] = []
-    for _ in range(pairs):
+    runs: dict[str, list[dict[str, object]]] = {ref: [], head: []}
+    for number in range(pairs):
         for label, commit, times, each in ((ref, ref, old, old_each), (f"HEAD {head}", head, new, new_each)):
-            seconds, last, tests = run_suite(commit, select)
+            if saved is not None and commit == ref:
+                if saved["ref"] != ref or number >= len(saved["runs"][ref]):
+                    raise SystemExit(f"--old: the file holds {len(saved['runs'].get(ref, []))} run(s) of "
+                                     f"{saved['ref']}, not run {number + 1} of {ref}")
+                kept = saved["runs"][ref][number]
+                seconds, last, tests = kept["seconds"], kept["last"] + " (saved)", kept["each"]
+            else:
+                seconds, last, tests = run_suite(commit, select)
+            runs[commit].append({"seconds": seconds, "last": last, "each": tests})
             times.append(seconds)
             each.append(tests)
             print(f"  {label}: {seconds:.1f} s ({last})", flush=True)
+    if save is not None:
+        save.write_text(json.dumps({"ref": ref, "head": head, "runs": runs}))
     print(f"the suite, {pairs} alternating pair(s): {ref} {min(old):.1f}-{max(old):.1f} s, HEAD {head} "
           f"{min(new):.1f}-{max(new):.1f} s; ratio of the sums {sum(new) / sum(old):.2f}")
     common = [key for key in old_each[0] if key in new_each[0] and len(old_each[0][key]) == len(new_each[0][key])]
@@ -114,7 +135,7 @@ def main(argv: list[str]) -> None:
     change = sorted(((sum(sum(run[key]) for run in new_each) - sum(sum(run[key]) for run in old_each)) / pairs, key)
                     for key in common)
     print("the common tests that changed most (seconds a run, HEAD minus REF):")
-    for seconds, key in change[::-1][:12] + change[:3]:
+    for seconds, key in change[::-1][:top] + change[:3]:
         print(f"  {seconds:+8.2f}  {key}")
 
 
