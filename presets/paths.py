@@ -24,10 +24,12 @@ or a step of the wrong sign.
 from __future__ import annotations
 
 import copy
+import functools
 import math
 import re
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from decimal import Decimal, InvalidOperation
 from pathlib import Path
 from typing import Any
 
@@ -122,8 +124,64 @@ def _scalar(text: str) -> Any:
     return text
 
 
-def parse_values(field: str, text: str, max_points: int = 100_000) -> list[Any]:
-    """Values of ``start:stop:step`` (stop included when reached) or ``a,b,c``."""
+@dataclass(frozen=True)
+class ValueRange(Sequence[Any]):
+    """The values of ``start:stop:step``, made on demand: three numbers whatever the count.
+
+    Value ``i`` is ``start + i * step`` when start and step are both integers, else that sum rounded to 12
+    significant digits (``float(f"{start + i * step:.12g}")``, so that ``0.1:0.3:0.1`` gives 0.3 and not
+    0.30000000000000004). The values are monotonic in ``i`` (the sum, the rounding and the decimal text of
+    each are), which :meth:`index_of` uses to find a value from its text by bisection.
+    """
+
+    start: int | float
+    step: int | float
+    size: int  # how many values
+
+    def __len__(self) -> int:
+        return self.size
+
+    def _value(self, i: int) -> Any:
+        if isinstance(self.start, int) and isinstance(self.step, int):
+            return self.start + i * self.step
+        return float(f"{self.start + i * self.step:.12g}")
+
+    def __getitem__(self, index: Any) -> Any:
+        if isinstance(index, slice):
+            return [self._value(i) for i in range(*index.indices(self.size))]
+        if not -self.size <= index < self.size:
+            raise IndexError(index)
+        return self._value(index % self.size)
+
+    def __iter__(self) -> Iterator[Any]:
+        return (self._value(i) for i in range(self.size))
+
+    def extremes(self) -> tuple[Any, Any]:
+        """(first, last): also the smallest and largest, in some order (the values are monotonic)."""
+        return self._value(0), self._value(self.size - 1)
+
+    def index_of(self, text: str, shown: Callable[[Any], str]) -> int | None:
+        """The first ``i`` whose value ``shown`` writes as ``text`` (None: no such value).
+
+        ``shown`` (a sweep file's number format) must be monotonic as the values are: the number it writes
+        is found by bisection, then its text compared."""
+        try:
+            wanted = float(text)
+        except ValueError:
+            return None
+        sign = 1 if self.step > 0 else -1
+        low, high = 0, self.size  # the first i whose shown number is >= wanted (<= for a falling range)
+        while low < high:
+            mid = (low + high) // 2
+            if sign * float(shown(self._value(mid))) < sign * wanted:
+                low = mid + 1
+            else:
+                high = mid
+        return low if low < self.size and shown(self._value(low)) == text else None
+
+
+def parse_values(field: str, text: str, max_points: int = 100_000) -> Sequence[Any]:
+    """Values of ``start:stop:step`` (stop included when reached: a :class:`ValueRange`) or ``a,b,c`` (a list)."""
     where = f"--set {field}"
     if ":" in text:
         parts = text.split(":")
@@ -137,12 +195,15 @@ def parse_values(field: str, text: str, max_points: int = 100_000) -> list[Any]:
             raise InputError(where, text, "a step other than 0")
         if (stop - start) * step < 0:
             raise InputError(where, text, f"a step with the sign of stop - start ({'+' if stop > start else '-'})")
-        count = int(math.floor((stop - start) / step * (1 + 1e-12) + 1e-9)) + 1
+        # counted on the typed decimals: in floats, 10935.322:10935.326:0.001 lost its stop to round-off
+        try:
+            exact = [Decimal(p.strip()) for p in parts]
+        except InvalidOperation:
+            raise InputError(where, text, "start:stop:step with three numbers") from None
+        count = int(math.floor((exact[1] - exact[0]) / exact[2] * (1 + Decimal("1e-12")) + Decimal("1e-9"))) + 1
         if count > max_points:
             raise InputError(where, text, f"at most {max_points} values (this range has {count})")
-        if all(isinstance(n, int) for n in numbers):
-            return [start + i * step for i in range(count)]
-        return [float(f"{start + i * step:.12g}") for i in range(count)]
+        return ValueRange(start, step, count)
     values = [_scalar(p) for p in text.split(",") if p.strip()]
     if not values:
         raise InputError(where, text, "a non-empty list a,b,c or a range start:stop:step")
@@ -165,10 +226,11 @@ class SweepCancelled(Exception):
     """:func:`plan_sweep` stopped because its ``cancel`` said so (nothing was planned)."""
 
 
-def parse_assignments(sets: list[str] | tuple[str, ...], max_points: int = 100_000) -> list[tuple[str, list[Any]]]:
+def parse_assignments(sets: list[str] | tuple[str, ...],
+                      max_points: int = 100_000) -> list[tuple[str, Sequence[Any]]]:
     """``FIELD=VALUES`` texts (``--set`` of ``vtool sweep`` and ``vtool solve``) -> (path, values), in order;
     each field once."""
-    fields: list[tuple[str, list[Any]]] = []
+    fields: list[tuple[str, Sequence[Any]]] = []
     for text in sets:
         path, sep, values = text.partition("=")
         path = path.strip()
@@ -242,12 +304,13 @@ class PointGrid(Sequence[Any]):
     """
 
     def __init__(self, fields: Sequence[tuple[str, Sequence[Any]]], maker: SpecMaker) -> None:
-        self.fields = [(path, list(values)) for path, values in fields]
+        self.fields: list[tuple[str, Sequence[Any]]] = [
+            (path, values if isinstance(values, ValueRange) else list(values)) for path, values in fields]
         self.maker = maker
         self.sizes = [len(values) for _, values in self.fields]
         self.strides = [math.prod(self.sizes[:k]) for k in range(len(self.sizes))]
         self.total = math.prod(self.sizes)
-        self._positions: list[dict[str, int]] | None = None
+        self._positions: list[Callable[[str], int | None]] | None = None
 
     def __len__(self) -> int:
         return self.total
@@ -291,21 +354,26 @@ class PointGrid(Sequence[Any]):
         """The index of the point whose values a sweep file writes as ``texts`` (None: not in this grid)."""
         from vtool.solvers.studies.sweep import format_value
 
-        if self._positions is None:
-            self._positions = [{format_value(v): i for i, v in reversed(list(enumerate(values)))}
+        if self._positions is None:  # a range finds its value by bisection; a typed list has a table
+            self._positions = [functools.partial(values.index_of, shown=format_value)
+                               if isinstance(values, ValueRange)
+                               else {format_value(v): i for i, v in reversed(list(enumerate(values)))}.get
                                for _, values in self.fields]
         if len(texts) != len(self.fields):
             return None
         index = 0
-        for text, positions, stride in zip(texts, self._positions, self.strides, strict=True):
-            if text not in positions:
+        for text, position, stride in zip(texts, self._positions, self.strides, strict=True):
+            found = position(text)
+            if found is None:
                 return None
-            index += positions[text] * stride
+            index += found * stride
         return index
 
     def axes(self) -> list[str]:
         """The swept fields with more than one distinct value."""
-        return [path for path, values in self.fields if len(set(map(repr, values))) > 1]
+        return [path for path, values in self.fields
+                if (len(set(map(repr, values))) if not isinstance(values, ValueRange)
+                    else 1 + (repr(values[0]) != repr(values[-1]))) > 1]  # a range is monotonic
 
     def checked_values(self) -> Iterator[tuple[tuple[str, Any], ...]]:
         """The points checked before a sweep runs: each field's values (a long range: its ends and extremes)
@@ -338,6 +406,8 @@ def _checked(values: Sequence[Any]) -> list[Any]:
     """A field's values checked up front (see :data:`CHECK_ALL_VALUES`)."""
     if len(values) <= CHECK_ALL_VALUES:
         return list(values)
+    if isinstance(values, ValueRange):  # monotonic: its ends are its extremes
+        return list(values.extremes())
     chosen = [values[0], values[-1]]
     if all(isinstance(v, int | float) and not isinstance(v, bool) for v in (values[0], values[-1])):
         numbers = [v for v in values if isinstance(v, int | float) and not isinstance(v, bool)]
@@ -392,7 +462,7 @@ def plan_sweep(preset: str, sets: list[str], max_points: int = 100_000, *,
     return plan_document(doc, fields, max_points, folder, progress=progress, cancel=cancel)
 
 
-def plan_document(doc: dict[str, Any], fields: list[tuple[str, list[Any]]], max_points: int = 100_000,
+def plan_document(doc: dict[str, Any], fields: Sequence[tuple[str, Sequence[Any]]], max_points: int = 100_000,
                   folder: Path | None = None, *, progress: Callable[[int, int], None] | None = None,
                   cancel: Callable[[], bool] | None = None) -> SweepPlan:
     """:func:`plan_sweep` for a parsed valvetrain document and (path, values) pairs (the Python API's sweep).

@@ -10,10 +10,11 @@ float64, and for a run ``configuration`` (the thesis' number, null when it
 has none) and ``closed`` (the closed clearances). The file's key-value
 metadata carries ``vtool_version`` and ``title``.
 
-Memory stays bounded: rows are buffered up to :data:`ROW_GROUP` and then
-written as one row group, so a writer holds at most one group whatever the
-length of the run or the number of points (benchmarks/bench_parquet.py
-measures the peak against a ten times smaller output). The bytes go to the
+Memory stays bounded: rows are buffered up to :data:`ROW_GROUP` (a sweep's:
+:func:`group_rows`, about :data:`GROUP_BYTES` of numbers) and then written as
+one row group, so a writer holds at most one group whatever the length of the
+run or the number of points (benchmarks/bench_parquet.py measures the peak at
+10^4, 10^5 and 2*10^5 points). The bytes go to the
 handle of :func:`vtool.files.open_atomic_binary` (a temporary file renamed
 over the target when the run succeeds), so a failed run leaves nothing.
 """
@@ -32,6 +33,16 @@ from vtool.solvers.trace import CsvStream, Trace
 
 #: rows per row group (and the most rows a writer buffers)
 ROW_GROUP = 16_384
+#: a sweep's row group holds about this many bytes of numbers (8 a value): fewer rows than ROW_GROUP when a
+#: point has many columns (see :func:`group_rows`)
+GROUP_BYTES = 1 << 20
+
+
+def group_rows(columns: int) -> int:
+    """Rows of a sweep's row group with ``columns`` columns: :data:`GROUP_BYTES` of values, at most
+    :data:`ROW_GROUP` rows (and at least 1,024). The writer's memory grows with the rows of one group (its
+    buffers and the Parquet encoder's: benchmarks/bench_parquet.py), not with the points of the sweep."""
+    return min(ROW_GROUP, max(1024, GROUP_BYTES // (8 * max(1, columns))))
 FORMATS = ("csv", "parquet")
 
 
@@ -56,10 +67,11 @@ def output_format(path: Any, given: str | None, field: str = "--format") -> str:
 
 
 class _GroupWriter:
-    """Columns buffered up to :data:`ROW_GROUP` rows, then written as one row group."""
+    """Columns buffered up to ``rows`` rows (default :data:`ROW_GROUP`), then written as one row group."""
 
-    def __init__(self, handle: BinaryIO, metadata: dict[str, str]) -> None:
+    def __init__(self, handle: BinaryIO, metadata: dict[str, str], rows: int | None = None) -> None:
         self.pq = require_pyarrow()
+        self.rows = rows or ROW_GROUP
         self.handle = handle
         self.metadata = {k.encode(): v.encode() for k, v in metadata.items()}
         self.writer: Any = None
@@ -71,8 +83,21 @@ class _GroupWriter:
         for name, values in columns.items():
             self.buffer.setdefault(name, []).append(values)
         self.buffered += rows
-        if self.buffered >= ROW_GROUP:
+        if self.buffered >= self.rows:
             self.flush()
+
+    def write(self, arrays: dict[str, Any]) -> None:
+        """Columns (pyarrow arrays of one length) written now as one row group, after what is buffered."""
+        import pyarrow as pa
+
+        self.flush()
+        self._write(pa.table(arrays), len(next(iter(arrays.values()))))
+
+    def _write(self, table: Any, rows: int) -> None:
+        if self.writer is None:
+            self.writer = self.pq.ParquetWriter(self.handle, table.schema.with_metadata(self.metadata))
+        self.writer.write_table(table.replace_schema_metadata(self.metadata), row_group_size=rows)
+        self.groups += 1
 
     def flush(self) -> None:
         if not self.buffered:
@@ -88,11 +113,7 @@ class _GroupWriter:
                 arrays[name] = pa.array([v for part in parts for v in part], type=pa.float64())
             else:
                 arrays[name] = pa.array([v for part in parts for v in part])
-        table = pa.table(arrays)
-        if self.writer is None:
-            self.writer = self.pq.ParquetWriter(self.handle, table.schema.with_metadata(self.metadata))
-        self.writer.write_table(table.replace_schema_metadata(self.metadata), row_group_size=self.buffered)
-        self.groups += 1
+        self._write(pa.table(arrays), self.buffered)
         self.buffer = {}
         self.buffered = 0
 
@@ -164,13 +185,16 @@ class SweepParquet:
         self.metrics = report_columns(spec, timing)
         self.names = ["point", *self.field_titles, "status", *(column_title(n, u) for n, u in self.metrics)]
         self.spec = spec
-        self.groups = _GroupWriter(handle, {"vtool_version": __version__, "title": spec.title})
-        self.finished: set[int] = set()
+        from vtool.solvers.studies.sweep import IndexSet
+
+        self.finished = IndexSet()  # a resumed file's points (one bit a point)
         self.rows = 0
-        # the points of the group being filled: the index and the metrics in arrays (8 bytes a number; a
-        # list of one-number lists a point cost about ten times that), the fields and statuses as lists
-        self.index = np.empty(ROW_GROUP, dtype=np.int64)
-        self.block = np.empty((ROW_GROUP, len(self.metrics)))
+        # the points of the group being filled: the index and the metrics in arrays (8 bytes a number, a
+        # metric's numbers contiguous: pyarrow takes them without a copy), the fields and statuses as lists
+        self.size = group_rows(len(self.names))
+        self.groups = _GroupWriter(handle, {"vtool_version": __version__, "title": spec.title}, self.size)
+        self.index = np.empty(self.size, dtype=np.int64)
+        self.block = np.empty((len(self.metrics), self.size))
         self.cells: dict[str, list[Any]] = {title: [] for title in [*self.field_titles, "status"]}
         self.held = 0
         self.resume = resume
@@ -241,22 +265,27 @@ class SweepParquet:
             self.cells[title].append(float(value) if isinstance(value, int | float) and not isinstance(value, bool)
                                      else value)
         self.cells["status"].append(result.status)
-        self.block[row] = [float(result.metrics.get(name, math.nan)) for name, _ in self.metrics]
+        self.block[:, row] = [float(result.metrics.get(name, math.nan)) for name, _ in self.metrics]
         self.held += 1
         self.rows += 1
-        if self.held == ROW_GROUP:
+        if self.held == self.size:
             self._hand_over()
 
     def _hand_over(self) -> None:
-        """The points held so far to the group writer (which writes a group once it has ROW_GROUP rows)."""
+        """The points held so far written as one row group (after the resumed rows the group writer holds)."""
         if not self.held:
             return
+        import pyarrow as pa
+
         n = self.held
-        data: dict[str, Any] = {"point": self.index[:n].copy()}
-        data |= {title: self.cells[title] for title in self.field_titles}
-        data["status"] = self.cells["status"]
-        data |= {title: self.block[:n, k].copy() for k, title in enumerate(self.names[len(self.fields) + 2:])}
-        self.groups.add(data, n)
+        data: dict[str, Any] = {"point": pa.array(self.index[:n])}
+        for title in self.field_titles:
+            cells = self.cells[title]
+            numbers = all(isinstance(v, float) for v in cells)
+            data[title] = pa.array(cells, type=pa.float64() if numbers else None)
+        data["status"] = pa.array(self.cells["status"], type=pa.string())
+        data |= {title: pa.array(self.block[k, :n]) for k, title in enumerate(self.names[len(self.fields) + 2:])}
+        self.groups.write(data)
         self.cells = {title: [] for title in self.cells}
         self.held = 0
 

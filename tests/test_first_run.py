@@ -192,9 +192,9 @@ def test_a_first_run_announces_its_compile_and_ctrl_c_leaves_a_usable_cache(tmp_
     time.sleep(4.0)  # the imports, then the compile
     process.send_signal(signal.SIGINT)
     stdout, stderr = process.communicate(timeout=120)
-    # 130, or killed by the SIGINT itself after the message (seen twice under heavy load, cause not found): a
-    # shell reports both as $? = 130, and the message, the missing traceback and the clean cache are checked below
-    assert process.returncode in (130, -signal.SIGINT), stderr
+    # (130 only: an interrupt inside exec'd source or llvmlite's callback ended it by SIGINT, -2, or lost it,
+    # now held back until it can unwind: tests/test_cli_signals.py)
+    assert process.returncode == 130, stderr
     assert stderr.splitlines()[-1] == "interrupted: nothing was written" and "Traceback" not in stderr
     assert not [p for p in tmp_path.rglob("*") if ".tmp" in p.name or p.suffix == ".done"]
     first = subprocess.run(command, env=env, capture_output=True, text=True, check=True)

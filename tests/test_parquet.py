@@ -95,6 +95,37 @@ def test_sweep_writer_holds_at_most_one_row_group(tmp_path: Path, monkeypatch: p
     assert file.read().column("run.rpm (rev/min)").to_pylist() == [1000.0 + i for i in range(1050)]
 
 
+def test_a_sweeps_row_groups_hold_about_group_bytes_of_numbers(tmp_path: Path) -> None:
+    """The writer's memory grows with a group's rows: a sweep's groups hold GROUP_BYTES of numbers (8 bytes a
+    value), fewer rows for more columns, between 1,024 and ROW_GROUP rows."""
+    from vtool.files import open_atomic_binary
+    from vtool.presets import load_preset
+    from vtool.solvers.parquet import GROUP_BYTES, ROW_GROUP, SweepParquet, group_rows
+    from vtool.solvers.studies.metrics import metric_columns
+    from vtool.solvers.studies.sweep import PointResult, column_title, report_columns
+
+    assert group_rows(1) == ROW_GROUP and group_rows(10**6) == 1024 and group_rows(64) == GROUP_BYTES // 512
+    spec = load_preset("gnilka-1d")
+    names = [name for name, _ in metric_columns(spec)]
+    with open_atomic_binary(tmp_path / "s.parquet") as handle:
+        sink = SweepParquet(handle, (("run.rpm", "rev/min"), ("run.degrees", "deg")), spec)
+        columns = 1 + 2 + 1 + len(report_columns(spec, timing=False))  # point, the fields, status, the metrics
+        assert sink.size == GROUP_BYTES // (8 * columns) < ROW_GROUP
+        count = 2 * sink.size + 7
+        for i in range(count):
+            sink.append(PointResult(i, (("run.rpm", 1000 + i), ("run.degrees", 0.5)), dict.fromkeys(names, i / 3)))
+            assert sink.held < sink.size
+        sink.finish()
+    file = pq.ParquetFile(tmp_path / "s.parquet")
+    assert [file.metadata.row_group(g).num_rows for g in range(file.metadata.num_row_groups)] == \
+        [sink.size, sink.size, 7]
+    table = file.read()
+    assert table.column("run.rpm (rev/min)").to_pylist() == [1000.0 + i for i in range(count)]
+    assert table.column("point").to_pylist() == list(range(count))
+    assert table.column(column_title(names[0], dict(metric_columns(spec))[names[0]])).to_pylist() == \
+        [i / 3 for i in range(count)]
+
+
 def _points(path: Path) -> dict[int, dict]:
     """Each point's row, NaN as None (to compare files)."""
     table = pq.read_table(path).to_pylist()

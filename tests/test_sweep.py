@@ -44,9 +44,9 @@ def run(*args: str):
 # ----- values and paths -----
 
 def test_ranges_include_stop_and_lists_keep_types() -> None:
-    assert parse_values("run.rpm", "2000:3000:250") == [2000, 2250, 2500, 2750, 3000]
-    assert parse_values("f", "0.1:0.3:0.1") == [0.1, 0.2, 0.3]
-    assert parse_values("f", "3:1:-1") == [3, 2, 1]
+    assert list(parse_values("run.rpm", "2000:3000:250")) == [2000, 2250, 2500, 2750, 3000]
+    assert list(parse_values("f", "0.1:0.3:0.1")) == [0.1, 0.2, 0.3]
+    assert list(parse_values("f", "3:1:-1")) == [3, 2, 1]
     assert parse_values("f", "1,2.5,newmark") == [1, 2.5, "newmark"]
 
 

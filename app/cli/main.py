@@ -24,7 +24,9 @@ Signals: SIGTERM (what ``timeout``, ``kill`` and a cancelled CI job send) is
 handled like Ctrl+C (:class:`Terminated`, a KeyboardInterrupt): every file
 being written is cleaned up the same way (no hidden temporary is left, an
 existing output is kept), the message is ``terminated: ...`` and the exit
-code 143 (128 + 15).
+code 143 (128 + 15). Both signals raise their interrupt where Python is, except inside code
+that cannot unwind it (:func:`_held_back`), where it is delivered again 20 ms later: Ctrl+C
+always ends with the one line and 130 (143), never with a traceback or a lost interrupt.
 """
 
 from __future__ import annotations
@@ -32,8 +34,10 @@ from __future__ import annotations
 import gc
 import importlib
 import importlib.util
+import os
 import signal
 import sys
+import threading
 import warnings
 from typing import Any
 
@@ -62,12 +66,46 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
+#: Seconds after which an interrupt that arrived inside code that cannot take it is delivered again.
+RETRY_SECONDS = 0.02
+#: The file name of code run by exec or eval from a string; llvmlite's bindings, whose Python callbacks
+#: LLVM calls from C through ctypes (numba's compile hands it its object-code cache).
+_STRING_SOURCE = "<string>"
+_CALLBACKS = f"{os.sep}llvmlite{os.sep}binding{os.sep}"
+
+
 class Terminated(KeyboardInterrupt):
     """SIGTERM, raised where the program is, so that it unwinds exactly as Ctrl+C does."""
 
 
-def _terminate(signum: int, frame: object) -> None:
-    raise Terminated()
+def _held_back(frame: Any) -> bool:
+    """Whether the frame, or one that called it up to :func:`main`, cannot take an interrupt.
+
+    * Source run by ``exec`` or ``eval`` from a string (dataclasses, namedtuple, scipy's imports do it):
+      an interrupt leaving such code makes CPython remember it as unhandled even when it is handled
+      later, and ``python -m vtool`` then ends by SIGINT itself (returncode -2) after the clean
+      message and exit 130.
+    * llvmlite's bindings: ctypes prints an exception raised in a callback from C ("Exception ignored
+      on calling ctypes callback function") and drops it, so Ctrl+C during the compile was lost (the
+      run went on and exited 0) or left numba without its object code (RuntimeError, exit 1).
+    """
+    while frame is not None and frame.f_code is not main.__code__:
+        name = frame.f_code.co_filename
+        if name == _STRING_SOURCE or _CALLBACKS in name:
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _interrupt(signum: int, frame: Any) -> None:
+    """SIGINT and SIGTERM: KeyboardInterrupt (:class:`Terminated`) where the program is, or the same signal
+    again :data:`RETRY_SECONDS` later when it is where the interrupt cannot unwind (:func:`_held_back`)."""
+    if frame is not None and _held_back(frame):
+        again = threading.Timer(RETRY_SECONDS, os.kill, (os.getpid(), signum))
+        again.daemon = True
+        again.start()
+        return
+    raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
 
 
 def _interrupted(exc: BaseException | None) -> tuple[str, int]:
@@ -150,9 +188,16 @@ def cli() -> None:
     """
 
 
+def install_signal_handlers() -> None:
+    """SIGINT and SIGTERM raise their interrupt through :func:`_interrupt` (SIGTERM cleaned up like Ctrl+C:
+    see the module doc). Main thread only (Python's rule for signal handlers)."""
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _interrupt)
+
+
 def main() -> None:
     gc.set_threshold(*GC_THRESHOLDS)
-    signal.signal(signal.SIGTERM, _terminate)  # cleaned up like Ctrl+C (see the module doc)
+    install_signal_handlers()
     try:
         cli(prog_name="vtool")
     finally:

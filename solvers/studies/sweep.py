@@ -172,14 +172,69 @@ def evaluate_point(spec: MechanismSpec, *, every_step: bool = False, previous: M
     return run_metrics(trace), OK, mechanism
 
 
+#: The last mechanism each thread evaluated (:func:`evaluate_chunk`): a worker's next chunk of the same model
+#: reuses it rather than assembling it again.
+_LAST = threading.local()
+
+
 def evaluate_chunk(chunk: Sequence[Point], every_step: bool = False) -> list[PointResult]:
-    """Evaluate points in order, reusing the model across points that differ only in [run]."""
+    """Evaluate points in order, reusing the model across points that differ only in [run] (also from the
+    worker's previous chunk: :func:`_mechanism` reuses it only for an equal model).
+
+    Memory: a sweep over run settings assembled its model again at every chunk, and a process that assembles
+    a model every few points grew by a few hundred bytes a point (measured on ``vtool sweep --workers 1``,
+    benchmarks/bench_parquet.py: 11.9 MB after 4*10^4 points of a null sink, 0.4 MB with the model kept)."""
     results = []
-    previous: Mechanism | None = None
+    previous: Mechanism | None = getattr(_LAST, "mechanism", None)
     for point in chunk:
         result, previous = evaluate(point, every_step=every_step, previous=previous)
         results.append(result)
+    _LAST.mechanism = previous
     return results
+
+
+class IndexSet:
+    """A set of point indices (``add``, ``update``, ``in``, ``len``, iteration) in one bit a possible index.
+
+    A resumed sweep's finished points: a set of Python ints costs about 60 bytes a point, this an eighth of a
+    byte an index up to the largest added (a 10^5-point grid: 12.5 kB).
+    """
+
+    def __init__(self, indices: Iterable[int] = ()) -> None:
+        self.bits = bytearray()
+        self.count = 0
+        self.update(indices)
+
+    def add(self, index: int) -> None:
+        byte, bit = divmod(index, 8)
+        if byte >= len(self.bits):
+            self.bits.extend(bytes(max(byte + 1 - len(self.bits), len(self.bits))))  # doubled: amortised
+        if not self.bits[byte] >> bit & 1:
+            self.bits[byte] |= 1 << bit
+            self.count += 1
+
+    def update(self, indices: Iterable[int]) -> None:
+        for index in indices:
+            self.add(index)
+
+    def __contains__(self, index: object) -> bool:
+        if not isinstance(index, int) or index < 0:
+            return False
+        byte, bit = divmod(index, 8)
+        return byte < len(self.bits) and bool(self.bits[byte] >> bit & 1)
+
+    def __len__(self) -> int:
+        return self.count
+
+    def __iter__(self) -> Iterator[int]:
+        for byte, value in enumerate(self.bits):
+            if value:
+                yield from (8 * byte + bit for bit in range(8) if value >> bit & 1)
+
+    def copy(self) -> IndexSet:
+        copied = IndexSet()
+        copied.bits, copied.count = bytearray(self.bits), self.count
+        return copied
 
 
 def batched(points: Iterable[Point], size: int) -> Iterator[list[Point]]:
@@ -202,7 +257,7 @@ class Batches:
     without specs; nothing per point is held. A plain sequence of points is grouped by model (:func:`chunks`).
     """
 
-    def __init__(self, points: Sequence[Point], skip: set[int], workers: int, per_worker: int = 4,
+    def __init__(self, points: Sequence[Point], skip: IndexSet | set[int], workers: int, per_worker: int = 4,
                  largest: int = 25) -> None:
         self.points = points
         self.skip = skip
@@ -544,8 +599,8 @@ class SerialRunner:
 
     def run(self, batches: Iterable[Iterable[Point]], every_step: bool,
             on_results: Callable[[list[PointResult]], None], cancel: Callable[[], bool]) -> bool:
+        previous = None  # kept from chunk to chunk (see evaluate_chunk)
         for batch in batches:
-            previous = None
             for point in batch:
                 if cancel():
                     return False
@@ -713,7 +768,7 @@ def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False
     started = time.perf_counter()
     if sink is not None:
         sink.open(points)
-    finished = sink.finished if sink is not None else set()
+    finished = sink.finished if sink is not None else IndexSet()
     total = len(points)
     results: dict[int, PointResult] = {}
     skipped = len(finished)
@@ -733,7 +788,7 @@ def run_points(points: Sequence[Point], runner: Any, *, every_step: bool = False
     if progress is not None:
         progress(done, total)
     complete = False
-    batches = Batches(points, set(finished), runner.workers)
+    batches = Batches(points, finished.copy(), runner.workers)
     try:
         complete = runner.run(batches, every_step, collect, cancel)
     finally:
@@ -843,7 +898,7 @@ class SweepFile:
             self._check_partial()
         elif resume:
             raise InputError("--resume", str(self.path), "an existing partial sweep file (none found)")
-        self.finished: set[int] = set()
+        self.finished = IndexSet()
         self.locate: Callable[[Sequence[str]], int | None] = lambda texts: None
         self.handle: io.TextIOWrapper | None = None
         self.written = False
@@ -898,7 +953,7 @@ class SweepFile:
 
     def _start(self) -> None:
         """The file with its header and the kept rows, then a no-follow append descriptor on it."""
-        kept: set[int] = set()
+        kept = IndexSet()
         with open_atomic(self.path, "--csv") as out:
             self._write(out, self.header_text(), -1)
             if self.resumed:

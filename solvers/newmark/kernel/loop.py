@@ -92,7 +92,12 @@ def locate_event(prob, C, W, k, t, h, hertz):
     step of length tau, bracketed by phi(0) = W.phi_start[k] >= 0 > phi(h) =
     W.phi[k], with a bisection whenever two iterations have not halved the
     bracket; returns the left end of the final bracket (the monitor still
-    non-negative), within the time tolerance of the crossing. Each trial
+    non-negative), within the time tolerance of the crossing, or its right end
+    when the left is the step's start (a bracket narrower than the tolerance
+    from the start: a step shorter than it, or a crossing within it): an
+    event at tau = 0 would make no progress, and a contact released at t
+    whose gap the round-off closes again within the tolerance would close and
+    open at t until the chattering stop. Each trial
     factors S(tau) by Cholesky. The trials are :func:`step_to`'s step written
     with the shared inline helpers on arrays taken out of the records once (a
     call handed records takes and drops a reference count of each of their
@@ -154,7 +159,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
             if side == 1:
                 fhi *= 0.5
             side = 1
-    return lo
+    return lo if lo > 0.0 else hi
 
 
 @jit_inline
@@ -257,7 +262,7 @@ def event_step(prob, C, W, t, h, hertz):
     monitors(prob, C, W.now, W.src0, prob.fp[FP_GAPNOISE], W.phi_start, hertz)
     tau_min = 2.0 * h
     for k in range(ncl):
-        W.tau[k] = 2.0 * h
+        W.tau[k] = math.inf  # no crossing: never an event (take_events takes tau <= h + tol, also for h < tol)
         if prob.cl[k, CL_MON] and W.phi[k] < 0.0:
             W.tau[k] = 0.0 if W.phi_start[k] < 0.0 else locate_event(prob, C, W, k, t, h, hertz)
             tau_min = min(tau_min, W.tau[k])
