@@ -15,10 +15,18 @@ and first on ``PYTHONPATH``: numba's cache and mypy's cache start
 empty, as in CI's fresh clone. Both run under the pytest and the libraries installed here (CI's
 fresh install may pick other versions: pyproject pins pytest below 9.2 for that reason). ``-k``
 passes a selection to pytest (to try the script on a few tests).
+
+``--top N`` prints the N tests that got slowest (12). ``--save FILE`` writes each suite's wall seconds, last line and per-test durations to FILE (JSON);
+``--old FILE`` takes REF's runs from such a file instead of running REF's suite again (while one
+works on the suite's speed: REF does not change, and a run of it takes 1.5-2 min). The figures are
+fair only when FILE was written on the same machine under the same load: quote a run without
+``--old`` (one invocation, alternating) as the result. A test that HEAD skips (one moved behind an
+environment variable) is not among the common tests; the script names those with REF's seconds.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -36,11 +44,13 @@ PROBE = "import vtool.app, vtool.assessments, vtool.presets, vtool.solvers as s,
         "print(*(m.__file__ for m in (vtool.app, vtool.assessments, vtool.presets, s, e)))"
 
 
-def durations(report: Path) -> dict[str, list[float]]:
-    """Seconds of each passed test in a junit XML report, by test name with its class (not its file)."""
+def durations(report: Path, skipped: bool = False) -> dict[str, list[float]]:
+    """Seconds of each passed test in a junit XML report, by test name with its class (not its file); with
+    ``skipped``, of each skipped test instead."""
     seconds: dict[str, list[float]] = defaultdict(list)
     for case in ET.parse(report).getroot().iter("testcase"):
-        if any(child.tag in ("skipped", "failure", "error") for child in case):
+        tags = {child.tag for child in case}
+        if tags & {"failure", "error"} or ("skipped" in tags) != skipped:
             continue
         owner = case.get("classname", "").rsplit(".", 1)[-1]
         key = f"{owner}::{case.get('name')}" if owner[:1].isupper() else str(case.get("name"))
@@ -48,9 +58,9 @@ def durations(report: Path) -> dict[str, list[float]]:
     return seconds
 
 
-def run_suite(ref: str, select: str | None) -> tuple[float, str, dict[str, list[float]]]:
-    """Wall seconds of ``python3 -m pytest -q`` in a fresh tree of ``ref``, pytest's last line and the
-    per-test durations."""
+def run_suite(ref: str, select: str | None) -> tuple[float, str, dict[str, list[float]], list[str]]:
+    """Wall seconds of ``python3 -m pytest -q`` in a fresh tree of ``ref``, pytest's last line, the
+    per-test durations and the skipped tests' names."""
     with tempfile.TemporaryDirectory() as folder:
         entry = layout(ref, Path(folder))
         env = dict(os.environ)
@@ -76,33 +86,49 @@ def run_suite(ref: str, select: str | None) -> tuple[float, str, dict[str, list[
         seconds = time.perf_counter() - started
         report = Path(folder) / "report.xml"
         each = durations(report) if report.exists() else {}
+        skipped = sorted(durations(report, skipped=True)) if report.exists() else []
     last = out.stdout.strip().splitlines()[-1] if out.stdout.strip() else out.stderr[-300:]
     if not each:
         raise SystemExit(f"the suite of {ref} did not run ({last}):\n{out.stdout[-3000:]}")
     if out.returncode != 0:  # a failed test is left out of the durations; its name is printed
         failed = [line for line in out.stdout.splitlines() if line.startswith(("FAILED", "ERROR"))]
         print(f"  {ref}: " + "\n  ".join(failed), flush=True)
-    return seconds, last, each
+    return seconds, last, each, skipped
 
 
 def main(argv: list[str]) -> None:
     if not argv or argv[0].startswith("-"):
-        raise SystemExit("usage: REF [--pairs N] [-k EXPRESSION]")
+        raise SystemExit("usage: REF [--pairs N] [-k EXPRESSION] [--top N] [--save FILE] [--old FILE]")
     ref = argv[0]
     pairs = int(argv[argv.index("--pairs") + 1]) if "--pairs" in argv else 2
     select = argv[argv.index("-k") + 1] if "-k" in argv else None
+    top = int(argv[argv.index("--top") + 1]) if "--top" in argv else 12
+    save = Path(argv[argv.index("--save") + 1]) if "--save" in argv else None
+    saved = json.loads(Path(argv[argv.index("--old") + 1]).read_text()) if "--old" in argv else None
     head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
                           check=True).stdout.strip()
     old: list[float] = []
     new: list[float] = []
     old_each: list[dict[str, list[float]]] = []
     new_each: list[dict[str, list[float]]] = []
-    for _ in range(pairs):
+    runs: dict[str, list[dict[str, object]]] = {ref: [], head: []}
+    for number in range(pairs):
         for label, commit, times, each in ((ref, ref, old, old_each), (f"HEAD {head}", head, new, new_each)):
-            seconds, last, tests = run_suite(commit, select)
+            if saved is not None and commit == ref:
+                if saved["ref"] != ref or number >= len(saved["runs"][ref]):
+                    raise SystemExit(f"--old: the file holds {len(saved['runs'].get(ref, []))} run(s) of "
+                                     f"{saved['ref']}, not run {number + 1} of {ref}")
+                kept = saved["runs"][ref][number]
+                seconds, last, tests, skipped = (kept["seconds"], kept["last"] + " (saved)", kept["each"],
+                                                 kept.get("skipped", []))
+            else:
+                seconds, last, tests, skipped = run_suite(commit, select)
+            runs[commit].append({"seconds": seconds, "last": last, "each": tests, "skipped": skipped})
             times.append(seconds)
             each.append(tests)
             print(f"  {label}: {seconds:.1f} s ({last})", flush=True)
+    if save is not None:
+        save.write_text(json.dumps({"ref": ref, "head": head, "runs": runs}))
     print(f"the suite, {pairs} alternating pair(s): {ref} {min(old):.1f}-{max(old):.1f} s, HEAD {head} "
           f"{min(new):.1f}-{max(new):.1f} s; ratio of the sums {sum(new) / sum(old):.2f}")
     common = [key for key in old_each[0] if key in new_each[0] and len(old_each[0][key]) == len(new_each[0][key])]
@@ -114,8 +140,14 @@ def main(argv: list[str]) -> None:
     change = sorted(((sum(sum(run[key]) for run in new_each) - sum(sum(run[key]) for run in old_each)) / pairs, key)
                     for key in common)
     print("the common tests that changed most (seconds a run, HEAD minus REF):")
-    for seconds, key in change[::-1][:12] + change[:3]:
+    for seconds, key in change[::-1][:top] + change[:3]:
         print(f"  {seconds:+8.2f}  {key}")
+    # a test HEAD skips (moved behind an environment variable) is not a common test: name it with REF's time
+    skipped_now = [key for key in runs[head][0]["skipped"] if key in old_each[0]]
+    if skipped_now:
+        print(f"left out: {len(skipped_now)} test(s) {ref} ran and HEAD skips (seconds a run in {ref}):")
+        for key in skipped_now:
+            print(f"  {sum(sum(run[key]) for run in old_each) / pairs:8.2f}  {key}")
 
 
 if __name__ == "__main__":

@@ -139,9 +139,21 @@ def _event_counts(trace: Trace) -> dict[str, int]:
     return counts
 
 
-def cycle_change(before: Trace, after: Trace) -> tuple[float, str, str]:
+def _cycle_metrics(trace: Trace, measured: dict[int, dict[str, float]] | None) -> dict[str, float]:
+    """``run_metrics`` of one cycle's run, kept in ``measured`` (by the trace's id) when given: a run of
+    cycles compares each cycle with up to MAX_PERIOD earlier ones."""
+    if measured is None:
+        return run_metrics(trace, (0.0, REVOLUTION))
+    if id(trace) not in measured:
+        measured[id(trace)] = run_metrics(trace, (0.0, REVOLUTION))
+    return measured[id(trace)]
+
+
+def cycle_change(before: Trace, after: Trace,
+                 measured: dict[int, dict[str, float]] | None = None) -> tuple[float, str, str]:
     """The largest relative change of the continuous measures from one cycle's run to another (see the
-    module doc), what it is, and how the events per clearance differ ("" when they are the same)."""
+    module doc), what it is, and how the events per clearance differ ("" when they are the same).
+    ``measured`` keeps each run's metrics (see :func:`_cycle_metrics`; its traces must stay alive)."""
     spec = after.spec
     n = spec.n_coordinates
     changes: dict[str, float] = {}
@@ -149,7 +161,7 @@ def cycle_change(before: Trace, after: Trace) -> tuple[float, str, str]:
         x, y = getattr(before, data)[:, :n], getattr(after, data)[:, :n]
         scale = max(float(np.abs(x).max()), float(np.abs(y).max()), 1e-300)
         changes[name] = float(np.abs(y[0] - x[0]).max()) / scale
-    m0, m1 = run_metrics(before, (0.0, REVOLUTION)), run_metrics(after, (0.0, REVOLUTION))
+    m0, m1 = _cycle_metrics(before, measured), _cycle_metrics(after, measured)
     peaks = [k for k in m1 if k.startswith("peak_")]
     force_scale = max([abs(m1[k]) for k in peaks if not math.isnan(m1[k])] + [1e-300])
     for k in peaks:
@@ -164,13 +176,14 @@ def cycle_change(before: Trace, after: Trace) -> tuple[float, str, str]:
     return changes[what], what, events
 
 
-def _periodic(traces: list[Trace], tolerance: float) -> tuple[int, float, str, str] | None:
+def _periodic(traces: list[Trace], tolerance: float,
+              measured: dict[int, dict[str, float]] | None = None) -> tuple[int, float, str, str] | None:
     """(period, change, what, events) of the shortest period p = 2 .. MAX_PERIOD over which the last cycle
     repeats the one p cycles before it (the first cycle, the start-up, left out), or None."""
     for period in range(2, MAX_PERIOD + 1):
         if len(traces) - 1 - period < 1:
             break
-        change, what, events = cycle_change(traces[-1 - period], traces[-1])
+        change, what, events = cycle_change(traces[-1 - period], traces[-1], measured)
         if not events and change <= tolerance:
             return period, change, what, events
     return None
@@ -229,6 +242,7 @@ def simulate_cycles(backend: Any, mechanism: Mechanism, *, every_step: bool = Fa
     options = backend.options_from_run(one, every_step)
     current = base if start is None else start.start(base)
     traces: list[Trace] = []
+    measured: dict[int, dict[str, float]] = {}  # each cycle's metrics, by id (traces holds them)
     changes = [math.nan]
     change, changed, events = math.nan, "", ""
     settled: bool | None = None if fixed else False
@@ -239,12 +253,12 @@ def simulate_cycles(backend: Any, mechanism: Mechanism, *, every_step: bool = Fa
                                  cancel=cancel if backend.supports_cancel else None)
         traces.append(trace)
         if k > 0:
-            change, changed, events = cycle_change(traces[-2], trace)
+            change, changed, events = cycle_change(traces[-2], trace, measured)
             changes.append(math.inf if events else change)
             if not fixed and not events and change <= tolerance:
                 settled = True
                 break
-            repeating = None if fixed else _periodic(traces, tolerance)
+            repeating = None if fixed else _periodic(traces, tolerance, measured)
             if repeating is not None:
                 period, change, changed, events = repeating
                 settled = True
