@@ -81,17 +81,27 @@ from vtool.solvers.newmark.layout import (
     NEED_CONFIG,
     OUTPUT_FULL,
     PEAK_ALL,
+    PHI,
+    PHI_START,
+    SRC_END,
+    SRC_NOW,
+    TAU,
+    Y_END,
+    Y_NOW,
+    ZD,
+    ZDD,
+    Z,
 )
-from vtool.solvers.newmark.records import Motion, Output, Problem, Scratch, State, Tables
+from vtool.solvers.newmark.records import Output, Problem, Scratch, State, Tables
 
 
 @jit
 def locate_event(prob, C, W, k, t, h, hertz):
-    """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from W.now at t.
+    """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from W.y[Y_NOW] at t.
 
     Illinois (modified regula falsi) on phi(tau) = monitor after a Newmark
-    step of length tau, bracketed by phi(0) = W.phi_start[k] >= 0 > phi(h) =
-    W.phi[k], with a bisection whenever two iterations have not halved the
+    step of length tau, bracketed by phi(0) = W.cross[PHI_START, k] >= 0 > phi(h) =
+    W.cross[PHI, k], with a bisection whenever two iterations have not halved the
     bracket; returns the left end of the final bracket (the monitor still
     non-negative), within the time tolerance of the crossing, or its right end
     when the left is the step's start (a bracket narrower than the tolerance
@@ -109,12 +119,13 @@ def locate_event(prob, C, W, k, t, h, hertz):
     n, ns = ip[IP_N], ip[IP_NS]
     sc, sa, sb, clf = prob.sc, prob.sa, prob.sb, prob.clf
     ci, cm, cp, mk, mon = C.ci, C.cm, C.cp, C.mk, C.mon
-    z, zd, zdd, z1, zd1, zdd1 = W.now.z, W.now.zd, W.now.zdd, W.end.z, W.end.zd, W.end.zdd
-    src1, rhs, sol, L = W.src1, W.rhs, W.sol, W.L
+    now, end = W.y[Y_NOW], W.y[Y_END]
+    z, zd, zdd, z1, zd1, zdd1 = now[Z], now[ZD], now[ZDD], end[Z], end[ZD], end[ZDD]
+    src1, rhs, sol, L = W.src[SRC_END], W.rhs, W.sol, W.L
     m, nf, coupled, closed_hertz = ci[CI_M], ci[CI_NF], ci[CI_SRC], ci[CI_HERTZ]
     kind = mk[k, MK_KIND]
     lo, hi = 0.0, h
-    flo, fhi = W.phi_start[k], W.phi[k]
+    flo, fhi = W.cross[PHI_START, k], W.cross[PHI, k]
     side = 0
     width_before = 2.0 * h
     for iteration in range(200):
@@ -149,7 +160,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
         elif hertz is None:  # a closed rigid contact's force: the linear row alone
             f = linear_force(mon, k, n, ns, mk[k, MK_M], z1, zd1, zdd1, src1)
         else:
-            f = rigid_force(prob, C, k, W.end, src1, hertz)
+            f = rigid_force(prob, C, k, end, src1, hertz)
         if f < 0.0:
             hi, fhi = tau, f
             if side == -1:
@@ -165,8 +176,8 @@ def locate_event(prob, C, W, k, t, h, hertz):
 
 @jit_inline
 def step_to(prob, C, W, t, h, hertz):
-    """A step of any length h from W.now at t into W.end: sources at t + h, S(h) factored by Cholesky."""
-    sources(prob, t + h, W.src1)
+    """A step of any length h from W.y[Y_NOW] at t into W.y[Y_END]: sources at t + h, S(h) factored by Cholesky."""
+    sources(prob, t + h, W.src[SRC_END])
     factor_effective(C.cm, C.ci[CI_NF], prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
     layer_step(prob, C, W, h, CHOLESKY, hertz)
 
@@ -175,9 +186,9 @@ def step_to(prob, C, W, t, h, hertz):
 def copy_state(m, y, src, y_to, src_to):
     """The first m entries of y, and the sources, into y_to and src_to."""
     for j in range(m):
-        y_to.z[j] = y.z[j]
-        y_to.zd[j] = y.zd[j]
-        y_to.zdd[j] = y.zdd[j]
+        y_to[Z, j] = y[Z, j]
+        y_to[ZD, j] = y[ZD, j]
+        y_to[ZDD, j] = y[ZDD, j]
     for j in range(src.shape[0]):
         src_to[j] = src[j]
 
@@ -197,12 +208,11 @@ def arrive(S, target, grid_next, k_grid, j_target):
 @jit_inline
 def clear(W):
     """The scratch zeroed, as fresh arrays would be (each call of :func:`run_chunk` starts so)."""
-    for y in (W.now, W.end, W.out):
-        y.z[:] = 0.0
-        y.zd[:] = 0.0
-        y.zdd[:] = 0.0
-    for vector in (W.src0, W.src1, W.srco, W.rhs, W.sol, W.phi, W.phi_start, W.tau):
-        vector[:] = 0.0
+    W.y[:, :, :] = 0.0
+    W.src[:, :] = 0.0
+    W.cross[:, :] = 0.0
+    W.rhs[:] = 0.0
+    W.sol[:] = 0.0
     W.L[:, :] = 0.0
     W.closing[:] = 0
 
@@ -214,8 +224,8 @@ def start(prob, C, W, S, O, hertz):
     ist = S.ist
     if ist[I_NOUT] >= O.t.shape[0]:
         return False
-    gather(C, prob.ip[IP_N], S, W.now)
-    record_row(prob, C, S.fst[F_T], W.now, W.src0, O, ist[I_NOUT], hertz)
+    gather(C, prob.ip[IP_N], S, W.y[Y_NOW])
+    record_row(prob, C, S.fst[F_T], W.y[Y_NOW], W.src[SRC_NOW], O, ist[I_NOUT], hertz)
     for k in range(prob.cl.shape[0]):
         O.peak[PEAK_ALL, k] = max(O.peak[PEAK_ALL, k], O.F[ist[I_NOUT], k])
     ist[I_NOUT] += 1
@@ -257,23 +267,23 @@ def step_length(prob, S, t, c_hertz):
 
 @jit_inline
 def event_step(prob, C, W, t, h, hertz):
-    """After a step of length h whose monitors W.phi changed sign: locate every sign change, take the
-    earliest (tau in W.tau) and redo the step to it. Returns the step taken."""
+    """After a step of length h whose monitors W.cross[PHI] changed sign: locate every sign change, take the
+    earliest (tau in W.cross[TAU]) and redo the step to it. Returns the step taken."""
     ncl = prob.cl.shape[0]
-    monitors(prob, C, W.now, W.src0, prob.fp[FP_GAPNOISE], W.phi_start, hertz)
+    monitors(prob, C, W.y[Y_NOW], W.src[SRC_NOW], prob.fp[FP_GAPNOISE], W.cross[PHI_START], hertz)
     tau_min = 2.0 * h
     for k in range(ncl):
-        W.tau[k] = math.inf  # no crossing: never an event (take_events takes tau <= h + tol, also for h < tol)
-        if prob.cl[k, CL_MON] and W.phi[k] < 0.0:
-            W.tau[k] = 0.0 if W.phi_start[k] < 0.0 else locate_event(prob, C, W, k, t, h, hertz)
-            tau_min = min(tau_min, W.tau[k])
+        W.cross[TAU, k] = math.inf  # no crossing: never an event (take_events takes tau <= h + tol, also for h < tol)
+        if prob.cl[k, CL_MON] and W.cross[PHI, k] < 0.0:
+            W.cross[TAU, k] = 0.0 if W.cross[PHI_START, k] < 0.0 else locate_event(prob, C, W, k, t, h, hertz)
+            tau_min = min(tau_min, W.cross[TAU, k])
     h = tau_min
     if h > 0.0:
         step_to(prob, C, W, t, h, hertz)
         # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
-        monitors(prob, C, W.end, W.src1, prob.fp[FP_GAPNOISE], W.phi, hertz)
+        monitors(prob, C, W.y[Y_END], W.src[SRC_END], prob.fp[FP_GAPNOISE], W.cross[PHI], hertz)
     else:
-        copy_state(prob.ip[IP_N], W.now, W.src0, W.end, W.src1)
+        copy_state(prob.ip[IP_N], W.y[Y_NOW], W.src[SRC_NOW], W.y[Y_END], W.src[SRC_END])
     return h
 
 
@@ -284,7 +294,7 @@ def steps(prob, C, W, S, O, hertz):
     event), h the event's located step."""
     fp, ist, fst = prob.fp, S.ist, S.fst
     dt, t_end, out_dt, x_limit, t_rev = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_XLIM], fp[FP_TREV]
-    omega, sc, sa, sb, src0, src1 = fp[FP_OMEGA], prob.sc, prob.sa, prob.sb, W.src0, W.src1
+    omega, sc, sa, sb, src0, src1 = fp[FP_OMEGA], prob.sc, prob.sa, prob.sb, W.src[SRC_NOW], W.src[SRC_END]
     n = prob.ip[IP_N]
     t = fst[F_T]
     h = 0.0
@@ -312,33 +322,33 @@ def steps(prob, C, W, S, O, hertz):
                 which = CHOLESKY
                 factor_effective(C.cm, C.ci[CI_NF], fp[FP_BETA], fp[FP_GAMMA], h, W.L)
         layer_step(prob, C, W, h, which, hertz)
-        monitors(prob, C, W.end, W.src1, fp[FP_GAPNOISE], W.phi, hertz)
+        monitors(prob, C, W.y[Y_END], W.src[SRC_END], fp[FP_GAPNOISE], W.cross[PHI], hertz)
         fired = False
         for k in range(prob.cl.shape[0]):
-            if prob.cl[k, CL_MON] and W.phi[k] < 0.0:
+            if prob.cl[k, CL_MON] and W.cross[PHI, k] < 0.0:
                 fired = True
         if fired:  # locate every sign change; the earliest is taken
             h = event_step(prob, C, W, t, h, hertz)
         if h > 0.0:
             for j in range(C.ci[CI_NF]):
-                if not (abs(W.end.z[j]) <= x_limit):
-                    scatter(C, n, W.end, S)
+                if not (abs(W.y[Y_END, Z, j]) <= x_limit):
+                    scatter(C, n, W.y[Y_END], S)
                     fst[F_T] = t + h
                     return DIVERGED, False, h
             # outputs inside (t, t + h]
             if prob.ip[IP_EVERY]:
                 if ist[I_NOUT] >= O.t.shape[0]:
                     return OUTPUT_FULL, False, h
-                record_row(prob, C, t + h, W.end, W.src1, O, ist[I_NOUT], hertz)
+                record_row(prob, C, t + h, W.y[Y_END], W.src[SRC_END], O, ist[I_NOUT], hertz)
                 ist[I_NOUT] += 1
             else:
                 t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant: a call only when one is due
                 if (t_out <= t + h + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
-                        and not step_rows(prob, C, t, h, W.now, W.end.zdd, W, O, S, hertz)):
+                        and not step_rows(prob, C, t, h, W.y[Y_NOW], W.y[Y_END, ZDD], W, O, S, hertz)):
                     return OUTPUT_FULL, False, h
-            track_peaks(prob, C, t + h >= t_rev, W.phi, W.end, W.src1, O.peak, hertz)
+            track_peaks(prob, C, t + h >= t_rev, W.cross[PHI], W.y[Y_END], W.src[SRC_END], O.peak, hertz)
             ist[I_STEPS] += 1
-            copy_state(n, W.end, W.src1, W.now, W.src0)
+            copy_state(n, W.y[Y_END], W.src[SRC_END], W.y[Y_NOW], W.src[SRC_NOW])
             t = t + h
             fst[F_T] = t
             if abs(t - target) <= 1e-9 * dt:
@@ -348,18 +358,12 @@ def steps(prob, C, W, S, O, hertz):
 
 
 @jit_inline
-def motion_borrowed(y):
-    return Motion(borrowed(y.z), borrowed(y.zd), borrowed(y.zdd))
-
-
-@jit_inline
 def borrow(prob, T, W, S, O):
     """The records with every array :func:`~vtool.jit.borrowed` (not reference-counted in the calls)."""
     b = borrowed
     prob = Problem(b(prob.ip), b(prob.fp), b(prob.cl), b(prob.clf), b(prob.sc), b(prob.sa), b(prob.sb), b(prob.mass))
     T = Tables(b(T.index), b(T.ci), b(T.cm), b(T.cp), b(T.mk), b(T.mon))
-    W = Scratch(motion_borrowed(W.now), motion_borrowed(W.end), motion_borrowed(W.out), b(W.src0), b(W.src1),
-                b(W.srco), b(W.rhs), b(W.sol), b(W.L), b(W.phi), b(W.phi_start), b(W.tau), b(W.closing))
+    W = Scratch(b(W.y), b(W.src), b(W.cross), b(W.rhs), b(W.sol), b(W.L), b(W.closing))
     S = State(b(S.x), b(S.v), b(S.a), b(S.ist), b(S.fst))
     O = Output(b(O.t), b(O.q), b(O.F), b(O.c), b(O.ev_f), b(O.ev_i), b(O.peak))  # noqa: E741
     return prob, T, W, S, O
@@ -394,9 +398,9 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
             return NEED_CONFIG
         if ist[I_NEV] + 3 * ncl + 2 >= O.ev_f.shape[0]:
             return OUTPUT_FULL
-        sources(prob, t, W.src0)
+        sources(prob, t, W.src[SRC_NOW])
         if ist[I_NEED_SETTLE]:
-            settled = release_pulling(prob, T, c, t, S, W.src0, O, W.now, W.rhs, hertz)
+            settled = release_pulling(prob, T, c, t, S, W.src[SRC_NOW], O, W.y[Y_NOW], W.rhs, hertz)
             if settled < 0:
                 ist[I_CFG] = -1 - settled
                 ist[I_WANT_CFG] = -1 - settled
@@ -408,11 +412,11 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
             if not ist[I_STARTED] and not start(prob, configuration(T, c, slot), W, S, O, hertz):
                 return OUTPUT_FULL
         C = configuration(T, c, slot)
-        gather(C, n, S, W.now)
+        gather(C, n, S, W.y[Y_NOW])
         status, event, h = steps(prob, C, W, S, O, hertz)
         if status == DIVERGED:  # (the state at the divergence is in S already)
             return status
-        scatter(C, n, W.now, S)
+        scatter(C, n, W.y[Y_NOW], S)
         if not event:
             return status
         # ---- the events at t (within the tolerance) ----
