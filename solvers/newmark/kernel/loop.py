@@ -85,6 +85,7 @@ from vtool.solvers.newmark.layout import (
     PHI_START,
     SRC_END,
     SRC_NOW,
+    SRC_OUT,
     TAU,
     Y_END,
     Y_NOW,
@@ -344,7 +345,7 @@ def steps(prob, C, W, S, O, hertz):
             else:
                 t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant: a call only when one is due
                 if (t_out <= t + h + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
-                        and not step_rows(prob, C, t, h, W.y[Y_NOW], W.y[Y_END, ZDD], W, O, S, hertz)):
+                        and not step_rows(prob, C, t, h, W.y, W.src[SRC_OUT], O, ist, hertz)):
                     return OUTPUT_FULL, False, h
             track_peaks(prob, C, t + h >= t_rev, W.cross[PHI], W.y[Y_END], W.src[SRC_END], O.peak, hertz)
             ist[I_STEPS] += 1

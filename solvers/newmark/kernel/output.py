@@ -26,7 +26,8 @@ from vtool.solvers.newmark.layout import (
     PEAK_ALL,
     PEAK_LATE,
     PEAK_OVERLAP,
-    SRC_OUT,
+    Y_END,
+    Y_NOW,
     Y_OUT,
     ZD,
     ZDD,
@@ -67,20 +68,21 @@ def record_row(prob, C, t, y, src, O, row, hertz):
 
 
 @jit
-def step_rows(prob, C, t, h, y, zdd1, W, O, S, hertz):
-    """The output rows inside (t, t + h] of a step from y whose end acceleration is z̈1, by the
-    linear-acceleration interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); False when the buffer
-    filled first (the rows before are written). :func:`record_row`'s row, on arrays taken out of the
-    records once (a call handed records takes and drops a count of each of their arrays)."""
+def step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
+    """The output rows inside (t, t + h] of a step from the layer state Y[Y_NOW] whose end acceleration
+    is Y[Y_END, ZDD] (Y: the scratch's layer states), by the linear-acceleration interpolant (exact for
+    beta = 1/6; thesis eqs. B.3–B.5), each row's state in Y[Y_OUT] and its sources in srco; False when
+    the buffer filled first (the rows before are written). :func:`record_row`'s row, on arrays taken
+    out of the records once. It is handed only what it uses, not the scratch and state records: a
+    non-inline call passes every array of its records, field by field (less code to compile)."""
     dt, t_end, out_dt, omega = prob.fp[FP_DT], prob.fp[FP_TEND], prob.fp[FP_OUTDT], prob.fp[FP_OMEGA]
     n, ns, ncl = prob.ip[IP_N], prob.ip[IP_NS], prob.cl.shape[0]
     sc, sa, sb = prob.sc, prob.sa, prob.sb
     ci, mk, mon = C.ci, C.mk, C.mon
+    y, out, zdd1 = Y[Y_NOW], Y[Y_OUT], Y[Y_END, ZDD]
     z, zd, zdd = y[Z], y[ZD], y[ZDD]
-    out, srco = W.y[Y_OUT], W.src[SRC_OUT]
     zo, zdo, zddo = out[Z], out[ZD], out[ZDD]
     out_t, out_q, out_F, out_c = O.t, O.q, O.F, O.c
-    ist = S.ist
     nf = ci[CI_NF]
     while True:
         j_out = ist[I_NEXT_OUT]

@@ -60,6 +60,7 @@ from vtool.solvers.newmark.layout import (
     PEAK_OVERLAP,
     PHI,
     SRC_END,
+    SRC_OUT,
     Y_END,
     Y_NOW,
     ZD,
@@ -95,6 +96,7 @@ def advance(prob, C, W, S, O, hertz):
     z, zd, zdd = now[Z], now[ZD], now[ZDD]
     z1, zd1, zdd1 = end[Z], end[ZD], end[ZDD]
     rhs, phi, src1, peak = W.rhs, W.cross[PHI], W.src[SRC_END], O.peak
+    Y, srco = W.y, W.src[SRC_OUT]
     n, ns, ncl = ip[IP_N], ip[IP_NS], cl.shape[0]
     beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
     omega, gap_noise, x_limit, t_rev = fp[FP_OMEGA], fp[FP_GAPNOISE], fp[FP_XLIM], fp[FP_TREV]
@@ -166,7 +168,7 @@ def advance(prob, C, W, S, O, hertz):
             break
         t_out = ist[I_NEXT_OUT] * out_dt  # output rows inside (t, t1]: a call only when one is due
         if (t_out <= t1 + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
-                and not step_rows(prob, C, t, h, now, zdd1, W, O, S, hertz)):
+                and not step_rows(prob, C, t, h, Y, srco, O, ist, hertz)):
             break
         # accept: peaks (output.track_peaks, the forces from the step's product), state, time
         after = t1 >= t_rev
