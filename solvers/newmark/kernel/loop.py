@@ -289,76 +289,6 @@ def event_step(prob, C, W, t, h, hertz):
 
 
 @jit_inline
-def steps(prob, C, W, S, O, hertz):
-    """Steps in configuration C from S.fst[F_T] until an event, the chunk end, the run's end or a full
-    buffer. Returns (status, event, h): status FINISHED, CHUNK_END, OUTPUT_FULL or DIVERGED (0 after an
-    event), h the event's located step."""
-    fp, ist, fst = prob.fp, S.ist, S.fst
-    dt, t_end, out_dt, x_limit, t_rev = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_XLIM], fp[FP_TREV]
-    omega, sc, sa, sb, src0, src1 = fp[FP_OMEGA], prob.sc, prob.sa, prob.sb, W.src[SRC_NOW], W.src[SRC_END]
-    n = prob.ip[IP_N]
-    t = fst[F_T]
-    h = 0.0
-    while True:
-        if t >= t_end - 1e-9 * dt:
-            return FINISHED, False, h
-        if t >= fst[F_CHUNK_END]:
-            return CHUNK_END, False, h
-        h, target, grid_next, j_target, quiet = step_length(prob, S, t, C.ci[CI_HERTZ])
-        if quiet:  # quiet steps may follow; off the grid, after an event, the call would return at once
-            t_quiet = advance(prob, C, W, S, O, hertz)
-            if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
-                t = t_quiet
-                harmonics(sc, sa, sb, omega, math.cos(omega * t), math.sin(omega * t), src0)
-                continue
-        if h <= 1e-9 * dt:  # at a grid point but for round-off
-            t = arrive(S, target, grid_next, ist[I_GRID], j_target)
-            continue
-        harmonics(sc, sa, sb, omega, math.cos(omega * (t + h)), math.sin(omega * (t + h)), src1)
-        which = STANDARD
-        if h != dt:
-            if h == dt / int(fp[FP_REFINE] + 0.5):
-                which = REFINED
-            else:
-                which = CHOLESKY
-                factor_effective(C.cm, C.ci[CI_NF], fp[FP_BETA], fp[FP_GAMMA], h, W.L)
-        layer_step(prob, C, W, h, which, hertz)
-        monitors(prob, C, W.y[Y_END], W.src[SRC_END], fp[FP_GAPNOISE], W.cross[PHI], hertz)
-        fired = False
-        for k in range(prob.cl.shape[0]):
-            if prob.cl[k, CL_MON] and W.cross[PHI, k] < 0.0:
-                fired = True
-        if fired:  # locate every sign change; the earliest is taken
-            h = event_step(prob, C, W, t, h, hertz)
-        if h > 0.0:
-            for j in range(C.ci[CI_NF]):
-                if not (abs(W.y[Y_END, Z, j]) <= x_limit):
-                    scatter(C, n, W.y[Y_END], S)
-                    fst[F_T] = t + h
-                    return DIVERGED, False, h
-            # outputs inside (t, t + h]
-            if prob.ip[IP_EVERY]:
-                if ist[I_NOUT] >= O.t.shape[0]:
-                    return OUTPUT_FULL, False, h
-                record_row(prob, C, t + h, W.y[Y_END], W.src[SRC_END], O, ist[I_NOUT], hertz)
-                ist[I_NOUT] += 1
-            else:
-                t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant: a call only when one is due
-                if (t_out <= t + h + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
-                        and not step_rows(prob, C, t, h, W.y, W.src[SRC_OUT], O, ist, hertz)):
-                    return OUTPUT_FULL, False, h
-            track_peaks(prob, C, t + h >= t_rev, W.cross[PHI], W.y[Y_END], W.src[SRC_END], O.peak, hertz)
-            ist[I_STEPS] += 1
-            copy_state(n, W.y[Y_END], W.src[SRC_END], W.y[Y_NOW], W.src[SRC_NOW])
-            t = t + h
-            fst[F_T] = t
-            if abs(t - target) <= 1e-9 * dt:
-                t = arrive(S, target, grid_next, ist[I_GRID], j_target)
-        if fired:
-            return 0, True, h
-
-
-@jit_inline
 def borrow(prob, T, W, S, O):
     """The records with every array :func:`~vtool.jit.borrowed` (not reference-counted in the calls)."""
     b = borrowed
@@ -387,8 +317,11 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
     small systems.
     """
     prob, T, W, S, O = borrow(prob, T, W, S, O)  # noqa: E741
-    ist, fst = S.ist, S.fst
+    fp, ist, fst = prob.fp, S.ist, S.fst
     n, ncl = prob.ip[IP_N], prob.cl.shape[0]
+    dt, t_end, out_dt, x_limit, t_rev = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_XLIM], fp[FP_TREV]
+    omega, sc, sa, sb = fp[FP_OMEGA], prob.sc, prob.sa, prob.sb
+    now, end, src0, src1, phi = W.y[Y_NOW], W.y[Y_END], W.src[SRC_NOW], W.src[SRC_END], W.cross[PHI]
     clear(W)
     while True:
         t = fst[F_T]
@@ -399,9 +332,9 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
             return NEED_CONFIG
         if ist[I_NEV] + 3 * ncl + 2 >= O.ev_f.shape[0]:
             return OUTPUT_FULL
-        sources(prob, t, W.src[SRC_NOW])
+        sources(prob, t, src0)
         if ist[I_NEED_SETTLE]:
-            settled = release_pulling(prob, T, c, t, S, W.src[SRC_NOW], O, W.y[Y_NOW], W.rhs, hertz)
+            settled = release_pulling(prob, T, c, t, S, src0, O, now, W.rhs, hertz)
             if settled < 0:
                 ist[I_CFG] = -1 - settled
                 ist[I_WANT_CFG] = -1 - settled
@@ -410,15 +343,78 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
             ist[I_CFG] = c
             ist[I_NEED_SETTLE] = 0
             slot = find_slot(T.index, c)
-            if not ist[I_STARTED] and not start(prob, configuration(T, c, slot), W, S, O, hertz):
-                return OUTPUT_FULL
         C = configuration(T, c, slot)
-        gather(C, n, S, W.y[Y_NOW])
-        status, event, h = steps(prob, C, W, S, O, hertz)
-        if status == DIVERGED:  # (the state at the divergence is in S already)
-            return status
-        scatter(C, n, W.y[Y_NOW], S)
-        if not event:
+        if not ist[I_STARTED] and not start(prob, C, W, S, O, hertz):
+            return OUTPUT_FULL
+        gather(C, n, S, now)
+        # ---- steps in configuration C until an event (status 0), the chunk end, the run's end or a full
+        # buffer (written here, not as an inline function: numba copies an inline function's whole IR
+        # at its call, a cost that grows with its blocks times its variables) ----
+        h = 0.0
+        status = 0
+        while True:
+            if t >= t_end - 1e-9 * dt:
+                status = FINISHED
+                break
+            if t >= fst[F_CHUNK_END]:
+                status = CHUNK_END
+                break
+            h, target, grid_next, j_target, quiet = step_length(prob, S, t, C.ci[CI_HERTZ])
+            if quiet:  # quiet steps may follow; off the grid, after an event, the call would return at once
+                t_quiet = advance(prob, C, W, S, O, hertz)
+                if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
+                    t = t_quiet
+                    harmonics(sc, sa, sb, omega, math.cos(omega * t), math.sin(omega * t), src0)
+                    continue
+            if h <= 1e-9 * dt:  # at a grid point but for round-off
+                t = arrive(S, target, grid_next, ist[I_GRID], j_target)
+                continue
+            harmonics(sc, sa, sb, omega, math.cos(omega * (t + h)), math.sin(omega * (t + h)), src1)
+            which = STANDARD
+            if h != dt:
+                if h == dt / int(fp[FP_REFINE] + 0.5):
+                    which = REFINED
+                else:
+                    which = CHOLESKY
+                    factor_effective(C.cm, C.ci[CI_NF], fp[FP_BETA], fp[FP_GAMMA], h, W.L)
+            layer_step(prob, C, W, h, which, hertz)
+            monitors(prob, C, end, src1, fp[FP_GAPNOISE], phi, hertz)
+            fired = False
+            for k in range(ncl):
+                if prob.cl[k, CL_MON] and phi[k] < 0.0:
+                    fired = True
+            if fired:  # locate every sign change; the earliest is taken
+                h = event_step(prob, C, W, t, h, hertz)
+            if h > 0.0:
+                for j in range(C.ci[CI_NF]):
+                    if not (abs(end[Z, j]) <= x_limit):  # the state at the divergence into S
+                        scatter(C, n, end, S)
+                        fst[F_T] = t + h
+                        return DIVERGED
+                # outputs inside (t, t + h]
+                if prob.ip[IP_EVERY]:
+                    if ist[I_NOUT] >= O.t.shape[0]:
+                        status = OUTPUT_FULL
+                        break
+                    record_row(prob, C, t + h, end, src1, O, ist[I_NOUT], hertz)
+                    ist[I_NOUT] += 1
+                else:
+                    t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant: a call only when one is due
+                    if (t_out <= t + h + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
+                            and not step_rows(prob, C, t, h, W.y, W.src[SRC_OUT], O, ist, hertz)):
+                        status = OUTPUT_FULL
+                        break
+                track_peaks(prob, C, t + h >= t_rev, phi, end, src1, O.peak, hertz)
+                ist[I_STEPS] += 1
+                copy_state(n, end, src1, now, src0)
+                t = t + h
+                fst[F_T] = t
+                if abs(t - target) <= 1e-9 * dt:
+                    t = arrive(S, target, grid_next, ist[I_GRID], j_target)
+            if fired:
+                break
+        scatter(C, n, now, S)
+        if status != 0:
             return status
         # ---- the events at t (within the tolerance) ----
         t = fst[F_T]
