@@ -5,9 +5,8 @@ from __future__ import annotations
 import math
 
 from vtool.jit import borrowed, jit, jit_inline
-from vtool.solvers.newmark.kernel.algebra import apply_operator, cholesky_solve, factor_effective
+from vtool.solvers.newmark.kernel.algebra import factor_effective
 from vtool.solvers.newmark.kernel.forces import (
-    hertz_correction,
     linear_force,
     monitors,
     rigid_force,
@@ -21,13 +20,10 @@ from vtool.solvers.newmark.kernel.step import (
     REFINED,
     STANDARD,
     configuration,
-    correct,
     find_slot,
     gather,
     harmonics,
     layer_step,
-    predict,
-    prescribed,
     scatter,
     sources,
 )
@@ -35,13 +31,10 @@ from vtool.solvers.newmark.layout import (
     CHATTER,
     CHUNK_END,
     CI_HERTZ,
-    CI_M,
     CI_NF,
-    CI_SRC,
     CL_MON,
     CLF_OPEN,
     CLF_SIGN,
-    CP_RAW,
     DIVERGED,
     F_CHUNK_END,
     F_FINE_UNTIL,
@@ -96,6 +89,14 @@ from vtool.solvers.newmark.layout import (
 from vtool.solvers.newmark.records import Output, Problem, Scratch, State, Tables
 
 
+@jit_inline
+def step_to(prob, C, W, t, h, hertz):
+    """A step of any length h from W.y[Y_NOW] at t into W.y[Y_END]: sources at t + h, S(h) factored by Cholesky."""
+    sources(prob, t + h, W.src[SRC_END])
+    factor_effective(C.cm, C.ci[CI_NF], prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
+    layer_step(prob, C, W, h, CHOLESKY, hertz)
+
+
 @jit
 def locate_event(prob, C, W, k, t, h, hertz):
     """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from W.y[Y_NOW] at t.
@@ -109,21 +110,18 @@ def locate_event(prob, C, W, k, t, h, hertz):
     from the start: a step shorter than it, or a crossing within it): an
     event at tau = 0 would make no progress, and a contact released at t
     whose gap the round-off closes again within the tolerance would close and
-    open at t until the chattering stop. Each trial
-    factors S(tau) by Cholesky. The trials are :func:`step_to`'s step written
-    with the shared inline helpers on arrays taken out of the records once (a
-    call handed records takes and drops a count of each of their arrays: a
-    call each, even on :func:`run_chunk`'s borrowed views).
+    open at t until the chattering stop. Each trial is :func:`step_to`'s step
+    (S(tau) factored by Cholesky): the same code as the event's step, compiled
+    once in :func:`~vtool.solvers.newmark.kernel.step.layer_step` (a copy of it
+    here cost about 0.6 s of first compile; the call costs about 1 % of a run).
     """
     fp, ip = prob.fp, prob.ip
-    beta, gamma, omega, tol, gap_noise = fp[FP_BETA], fp[FP_GAMMA], fp[FP_OMEGA], fp[FP_TTOL], fp[FP_GAPNOISE]
+    tol, gap_noise = fp[FP_TTOL], fp[FP_GAPNOISE]
     n, ns = ip[IP_N], ip[IP_NS]
-    sc, sa, sb, clf = prob.sc, prob.sa, prob.sb, prob.clf
-    ci, cm, cp, mk, mon = C.ci, C.cm, C.cp, C.mk, C.mon
-    now, end = W.y[Y_NOW], W.y[Y_END]
-    z, zd, zdd, z1, zd1, zdd1 = now[Z], now[ZD], now[ZDD], end[Z], end[ZD], end[ZDD]
-    src1, rhs, sol, L = W.src[SRC_END], W.rhs, W.sol, W.L
-    m, nf, coupled, closed_hertz = ci[CI_M], ci[CI_NF], ci[CI_SRC], ci[CI_HERTZ]
+    clf, mk, mon = prob.clf, C.mk, C.mon
+    end = W.y[Y_END]
+    z1, zd1, zdd1 = end[Z], end[ZD], end[ZDD]
+    src1 = W.src[SRC_END]
     kind = mk[k, MK_KIND]
     lo, hi = 0.0, h
     flo, fhi = W.cross[PHI_START, k], W.cross[PHI, k]
@@ -142,17 +140,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
         else:
             tau = (lo * fhi - hi * flo) / (fhi - flo)
         tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
-        # step_to(prob, C, W, t, tau, hertz), on the arrays
-        harmonics(sc, sa, sb, omega, math.cos(omega * (t + tau)), math.sin(omega * (t + tau)), src1)
-        factor_effective(cm, nf, beta, gamma, tau, L)
-        predict(m, tau, beta, gamma, z, zd, zdd, z1, zd1)
-        prescribed(ci, n, src1, z1, zd1, zdd1)
-        apply_operator(cp, ci, CP_RAW, nf, coupled, src1, z1, zd1, zdd1, rhs)
-        cholesky_solve(nf, L, rhs, sol)
-        correct(nf, tau, beta, gamma, sol, z1, zd1, zdd1, math.inf)
-        if hertz is not None:
-            if closed_hertz:
-                hertz_correction(prob, C, W, tau, CHOLESKY)
+        step_to(prob, C, W, t, tau, hertz)
         # monitor k (see forces.monitors), on the arrays
         if kind == MK_GAP or kind == MK_OVERLAP:
             behind = mk[k, MK_BEHIND]
@@ -173,14 +161,6 @@ def locate_event(prob, C, W, k, t, h, hertz):
                 fhi *= 0.5
             side = 1
     return lo if lo > 0.0 else hi
-
-
-@jit_inline
-def step_to(prob, C, W, t, h, hertz):
-    """A step of any length h from W.y[Y_NOW] at t into W.y[Y_END]: sources at t + h, S(h) factored by Cholesky."""
-    sources(prob, t + h, W.src[SRC_END])
-    factor_effective(C.cm, C.ci[CI_NF], prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
-    layer_step(prob, C, W, h, CHOLESKY, hertz)
 
 
 @jit_inline
