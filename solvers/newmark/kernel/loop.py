@@ -22,7 +22,6 @@ from vtool.solvers.newmark.kernel.step import (
     configuration,
     find_slot,
     gather,
-    harmonics,
     layer_step,
     scatter,
     sources,
@@ -44,7 +43,6 @@ from vtool.solvers.newmark.layout import (
     FP_DT,
     FP_GAMMA,
     FP_GAPNOISE,
-    FP_OMEGA,
     FP_OUTDT,
     FP_REFINE,
     FP_REFWIN,
@@ -189,13 +187,13 @@ def arrive(S, target, grid_next, k_grid, j_target):
 @jit_inline
 def clear(W):
     """The scratch zeroed, as fresh arrays would be (each call of :func:`run_chunk` starts so)."""
-    W.y[:, :, :] = 0.0
-    W.src[:, :] = 0.0
-    W.cross[:, :] = 0.0
-    W.rhs[:] = 0.0
-    W.sol[:] = 0.0
-    W.L[:, :] = 0.0
-    W.closing[:] = 0
+    W.y.fill(0.0)
+    W.src.fill(0.0)
+    W.cross.fill(0.0)
+    W.rhs.fill(0.0)
+    W.sol.fill(0.0)
+    W.L.fill(0.0)
+    W.closing.fill(0)
 
 
 @jit_inline
@@ -300,7 +298,6 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
     fp, ist, fst = prob.fp, S.ist, S.fst
     n, ncl = prob.ip[IP_N], prob.cl.shape[0]
     dt, t_end, out_dt, x_limit, t_rev = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_XLIM], fp[FP_TREV]
-    omega, sc, sa, sb = fp[FP_OMEGA], prob.sc, prob.sa, prob.sb
     now, end, src0, src1, phi = W.y[Y_NOW], W.y[Y_END], W.src[SRC_NOW], W.src[SRC_END], W.cross[PHI]
     clear(W)
     while True:
@@ -344,12 +341,12 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
                 t_quiet = advance(prob, C, W, S, O, hertz)
                 if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
                     t = t_quiet
-                    harmonics(sc, sa, sb, omega, math.cos(omega * t), math.sin(omega * t), src0)
+                    sources(prob, t, src0)
                     continue
             if h <= 1e-9 * dt:  # at a grid point but for round-off
                 t = arrive(S, target, grid_next, ist[I_GRID], j_target)
                 continue
-            harmonics(sc, sa, sb, omega, math.cos(omega * (t + h)), math.sin(omega * (t + h)), src1)
+            sources(prob, t + h, src1)
             which = STANDARD
             if h != dt:
                 if h == dt / int(fp[FP_REFINE] + 0.5):

@@ -179,16 +179,17 @@ def layer_step(prob, C, W, h, which, hertz):
     are added by Newton iteration (:func:`~vtool.solvers.newmark.kernel.forces.hertz_correction`).
     """
     beta, gamma = prob.fp[FP_BETA], prob.fp[FP_GAMMA]
-    ci, y, y1 = C.ci, W.y[Y_NOW], W.y[Y_END]
+    ci, y, y1, src1 = C.ci, W.y[Y_NOW], W.y[Y_END], W.src[SRC_END]
     nf = ci[CI_NF]
     predict(ci[CI_M], h, beta, gamma, y[Z], y[ZD], y[ZDD], y1[Z], y1[ZD])
-    prescribed(ci, prob.ip[IP_N], W.src[SRC_END], y1[Z], y1[ZD], y1[ZDD])
+    prescribed(ci, prob.ip[IP_N], src1, y1[Z], y1[ZD], y1[ZDD])
+    # CHOLESKY: ΔP (free_rhs's product) into W.rhs, then solved; else z̈_F = S⁻¹ ΔP as one product with the
+    # stored G = S⁻¹R into W.sol. One product written for both (each row sums in the same order either way).
+    plane = CP_RAW if which == CHOLESKY else (CP_STD if which == STANDARD else CP_FINE)
+    out = W.rhs if which == CHOLESKY else W.sol
+    apply_operator(C.cp, ci, plane, nf, ci[CI_SRC], src1, y1[Z], y1[ZD], y1[ZDD], out)
     if which == CHOLESKY:
-        free_rhs(C, W.src[SRC_END], y1, W.rhs)
         cholesky_solve(nf, W.L, W.rhs, W.sol)
-    else:  # z̈_F = S⁻¹ ΔP as one product with the stored G = S⁻¹R
-        apply_operator(C.cp, ci, CP_STD if which == STANDARD else CP_FINE, nf, ci[CI_SRC], W.src[SRC_END], y1[Z], y1[ZD],
-                       y1[ZDD], W.sol)
     correct(nf, h, beta, gamma, W.sol, y1[Z], y1[ZD], y1[ZDD], math.inf)
     if hertz is not None:
         if C.ci[CI_HERTZ]:
