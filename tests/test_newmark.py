@@ -193,7 +193,8 @@ def test_a_quiet_steps_force_rows_give_the_contact_force_at_the_steps_end(preset
             for _ in range(10):
                 z, zd, zdd = rng.normal(size=n) * 1e-2, rng.normal(size=n) * 10, rng.normal(size=n) * 1e4
                 src = rng.normal(size=3 * ns) * np.tile([1e-2, 10, 1e4], ns)
-                end = np.array([z + h * zd + h * h * (0.5 - beta) * zdd, zd + h * (1 - gamma) * zdd, zdd])  # (z, ż, z̈) rows
+                # a layer state: rows (z, ż, z̈)
+                end = np.array([z + h * zd + h * h * (0.5 - beta) * zdd, zd + h * (1 - gamma) * zdd, zdd])
                 plain(step.prescribed)(C.ci, n, src, end[0], end[1], end[2])
                 out = np.zeros(n + ncl)
                 plain(algebra.apply_operator)(C.cp, C.ci, plane, C.ci[layout.CI_ROWS], C.ci[layout.CI_SRCSTEP], src,

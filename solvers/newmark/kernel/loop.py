@@ -252,7 +252,8 @@ def event_step(prob, C, W, t, h, hertz):
     monitors(prob, C, W.y[Y_NOW], W.src[SRC_NOW], prob.fp[FP_GAPNOISE], W.cross[PHI_START], hertz)
     tau_min = 2.0 * h
     for k in range(ncl):
-        W.cross[TAU, k] = math.inf  # no crossing: never an event (take_events takes tau <= h + tol, also for h < tol)
+        # no crossing: never an event (take_events takes tau <= h + tol, also for h < tol)
+        W.cross[TAU, k] = math.inf
         if prob.cl[k, CL_MON] and W.cross[PHI, k] < 0.0:
             W.cross[TAU, k] = 0.0 if W.cross[PHI_START, k] < 0.0 else locate_event(prob, C, W, k, t, h, hertz)
             tau_min = min(tau_min, W.cross[TAU, k])

@@ -172,7 +172,8 @@ def free_rhs(C, src, y, rhs):
 
 @jit
 def layer_step(prob, C, W, h, which, hertz):
-    """One Newmark step of length h from layer state W.y[Y_NOW] into W.y[Y_END], the sources at t + h in W.src[SRC_END].
+    """One Newmark step of length h from layer state W.y[Y_NOW] into W.y[Y_END], the sources at t + h
+    in W.src[SRC_END].
 
     ``which``: STANDARD the stored S⁻¹ of the standard step (as one product with G = S⁻¹R),
     REFINED of the refined step, CHOLESKY a Cholesky factor already in W.L. Closed Hertz contacts
