@@ -22,12 +22,25 @@ works on the suite's speed: REF does not change, and a run of it takes 1.5-2 min
 fair only when FILE was written on the same machine under the same load: quote a run without
 ``--old`` (one invocation, alternating) as the result. A test that HEAD skips (one moved behind an
 environment variable) is not among the common tests; the script names those with REF's seconds.
+
+``--same`` then runs the common tests alone in both trees (each tree's own node ids, the same pytest
+options and workers, alternating, ``--pairs`` times) and compares the wall times: the same suite
+measured as a suite, with what a run costs besides its tests (collection, the workers' start, the
+kernels compiled into the empty cache) that the summed durations leave out or spread over the tests.
+A saved REF run must hold the node ids (a file this version wrote).
+
+The tests run with ``PYTHONSAFEPATH=1`` and ``.`` after the tree's package on ``PYTHONPATH``: every
+process then finds the complete ``vtool`` first, and its own current folder after it (a test's child
+``python -m module`` in its folder, ``-p tests.conftest`` in the tree). One test still fails in such a
+tree only: tests/test_outputs.py's helper-process test asserts that a plain child has ``''`` on its
+path, which PYTHONSAFEPATH removes.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -44,6 +57,15 @@ PROBE = "import vtool.app, vtool.assessments, vtool.presets, vtool.solvers as s,
         "print(*(m.__file__ for m in (vtool.app, vtool.assessments, vtool.presets, s, e)))"
 
 
+#: pytest-xdist's ``--dist loadgroup`` suffix of a grouped test's name (``test_x[id]@group``): not the test's
+#: identity (a test put into a group is the same test) and not part of its node id on the command line
+GROUP = re.compile(r"@[^@\[\]]*$")
+
+
+def test_name(case: ET.Element) -> str:
+    return GROUP.sub("", str(case.get("name")))
+
+
 def durations(report: Path, skipped: bool = False) -> dict[str, list[float]]:
     """Seconds of each passed test in a junit XML report, by test name with its class (not its file); with
     ``skipped``, of each skipped test instead."""
@@ -53,7 +75,7 @@ def durations(report: Path, skipped: bool = False) -> dict[str, list[float]]:
         if tags & {"failure", "error"} or ("skipped" in tags) != skipped:
             continue
         owner = case.get("classname", "").rsplit(".", 1)[-1]
-        key = f"{owner}::{case.get('name')}" if owner[:1].isupper() else str(case.get("name"))
+        key = f"{owner}::{test_name(case)}" if owner[:1].isupper() else test_name(case)
         seconds[key].append(float(case.get("time", "0")))
     return seconds
 
@@ -67,8 +89,8 @@ def node_ids(report: Path) -> dict[str, list[str]]:
         parts = case.get("classname", "").split(".")
         owner = parts[-1] if parts[-1][:1].isupper() else ""
         module = parts[:-1] if owner else parts
-        key = f"{owner}::{case.get('name')}" if owner else str(case.get("name"))
-        ids[key].append("::".join(["/".join(module) + ".py", *([owner] if owner else []), str(case.get("name"))]))
+        key = f"{owner}::{test_name(case)}" if owner else test_name(case)
+        ids[key].append("::".join(["/".join(module) + ".py", *([owner] if owner else []), test_name(case)]))
     return ids
 
 
