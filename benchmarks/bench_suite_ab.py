@@ -22,12 +22,25 @@ works on the suite's speed: REF does not change, and a run of it takes 1.5-2 min
 fair only when FILE was written on the same machine under the same load: quote a run without
 ``--old`` (one invocation, alternating) as the result. A test that HEAD skips (one moved behind an
 environment variable) is not among the common tests; the script names those with REF's seconds.
+
+``--same`` then runs the common tests alone in both trees (each tree's own node ids, the same pytest
+options and workers, alternating, ``--pairs`` times) and compares the wall times: the same suite
+measured as a suite, with what a run costs besides its tests (collection, the workers' start, the
+kernels compiled into the empty cache) that the summed durations leave out or spread over the tests.
+A saved REF run must hold the node ids (a file this version wrote).
+
+The tests run with ``PYTHONSAFEPATH=1`` and ``.`` after the tree's package on ``PYTHONPATH``: every
+process then finds the complete ``vtool`` first, and its own current folder after it (a test's child
+``python -m module`` in its folder, ``-p tests.conftest`` in the tree). One test still fails in such a
+tree only: tests/test_outputs.py's helper-process test asserts that a plain child has ``''`` on its
+path, which PYTHONSAFEPATH removes.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -44,6 +57,15 @@ PROBE = "import vtool.app, vtool.assessments, vtool.presets, vtool.solvers as s,
         "print(*(m.__file__ for m in (vtool.app, vtool.assessments, vtool.presets, s, e)))"
 
 
+#: pytest-xdist's ``--dist loadgroup`` suffix of a grouped test's name (``test_x[id]@group``): not the test's
+#: identity (a test put into a group is the same test) and not part of its node id on the command line
+GROUP = re.compile(r"@[^@\[\]]*$")
+
+
+def test_name(case: ET.Element) -> str:
+    return GROUP.sub("", str(case.get("name")))
+
+
 def durations(report: Path, skipped: bool = False) -> dict[str, list[float]]:
     """Seconds of each passed test in a junit XML report, by test name with its class (not its file); with
     ``skipped``, of each skipped test instead."""
@@ -53,18 +75,37 @@ def durations(report: Path, skipped: bool = False) -> dict[str, list[float]]:
         if tags & {"failure", "error"} or ("skipped" in tags) != skipped:
             continue
         owner = case.get("classname", "").rsplit(".", 1)[-1]
-        key = f"{owner}::{case.get('name')}" if owner[:1].isupper() else str(case.get("name"))
+        key = f"{owner}::{test_name(case)}" if owner[:1].isupper() else test_name(case)
         seconds[key].append(float(case.get("time", "0")))
     return seconds
 
 
-def run_suite(ref: str, select: str | None) -> tuple[float, str, dict[str, list[float]], list[str]]:
+def node_ids(report: Path) -> dict[str, list[str]]:
+    """pytest's node ids of the passed tests in a junit XML report, by the key of :func:`durations`."""
+    ids: dict[str, list[str]] = defaultdict(list)
+    for case in ET.parse(report).getroot().iter("testcase"):
+        if {child.tag for child in case} & {"failure", "error", "skipped"}:
+            continue
+        parts = case.get("classname", "").split(".")
+        owner = parts[-1] if parts[-1][:1].isupper() else ""
+        module = parts[:-1] if owner else parts
+        key = f"{owner}::{test_name(case)}" if owner else test_name(case)
+        ids[key].append("::".join(["/".join(module) + ".py", *([owner] if owner else []), test_name(case)]))
+    return ids
+
+
+def run_suite(ref: str, select: str | None, only: list[str] | None = None
+              ) -> tuple[float, str, dict[str, list[float]], list[str], dict[str, list[str]]]:
     """Wall seconds of ``python3 -m pytest -q`` in a fresh tree of ``ref``, pytest's last line, the
-    per-test durations and the skipped tests' names."""
+    per-test durations, the skipped tests' names and the passed tests' node ids; ``only``: just these
+    node ids (the tree's own)."""
     with tempfile.TemporaryDirectory() as folder:
         entry = layout(ref, Path(folder))
         env = dict(os.environ)
-        env["PYTHONPATH"] = os.pathsep.join([str(entry), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+        # "." after the tree's package: every process's own current folder, resolved when it starts (site
+        # makes sys.path absolute), as Python's '' would be without PYTHONSAFEPATH (below) but behind the
+        # complete package: `-p tests.conftest` in the tree and `python -m module` in a test's folder import
+        env["PYTHONPATH"] = os.pathsep.join([str(entry), ".", env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
         env.pop("NUMBA_CACHE_DIR", None)  # numba's cache beside the tree's sources: empty
         # the tree's own folder never first on sys.path (PYTHONSAFEPATH for pytest and every process a test
         # starts in the tree; pytest appends it, for tests/): its vtool/ holds the core alone, and its
@@ -81,24 +122,27 @@ def run_suite(ref: str, select: str | None) -> tuple[float, str, dict[str, list[
                    f"--junitxml={Path(folder) / 'report.xml'}"]
         if select:
             command += ["-k", select]
+        if only is not None:
+            command += only
         started = time.perf_counter()
         out = subprocess.run(command, cwd=Path(folder) / "tree", env=env, capture_output=True, text=True)
         seconds = time.perf_counter() - started
         report = Path(folder) / "report.xml"
         each = durations(report) if report.exists() else {}
         skipped = sorted(durations(report, skipped=True)) if report.exists() else []
+        ids = node_ids(report) if report.exists() else {}
     last = out.stdout.strip().splitlines()[-1] if out.stdout.strip() else out.stderr[-300:]
     if not each:
         raise SystemExit(f"the suite of {ref} did not run ({last}):\n{out.stdout[-3000:]}")
     if out.returncode != 0:  # a failed test is left out of the durations; its name is printed
         failed = [line for line in out.stdout.splitlines() if line.startswith(("FAILED", "ERROR"))]
         print(f"  {ref}: " + "\n  ".join(failed), flush=True)
-    return seconds, last, each, skipped
+    return seconds, last, each, skipped, ids
 
 
 def main(argv: list[str]) -> None:
     if not argv or argv[0].startswith("-"):
-        raise SystemExit("usage: REF [--pairs N] [-k EXPRESSION] [--top N] [--save FILE] [--old FILE]")
+        raise SystemExit("usage: REF [--pairs N] [-k EXPRESSION] [--top N] [--save FILE] [--old FILE] [--same]")
     ref = argv[0]
     pairs = int(argv[argv.index("--pairs") + 1]) if "--pairs" in argv else 2
     select = argv[argv.index("-k") + 1] if "-k" in argv else None
@@ -119,11 +163,11 @@ def main(argv: list[str]) -> None:
                     raise SystemExit(f"--old: the file holds {len(saved['runs'].get(ref, []))} run(s) of "
                                      f"{saved['ref']}, not run {number + 1} of {ref}")
                 kept = saved["runs"][ref][number]
-                seconds, last, tests, skipped = (kept["seconds"], kept["last"] + " (saved)", kept["each"],
-                                                 kept.get("skipped", []))
+                seconds, last, tests, skipped, ids = (kept["seconds"], kept["last"] + " (saved)", kept["each"],
+                                                      kept.get("skipped", []), kept.get("ids", {}))
             else:
-                seconds, last, tests, skipped = run_suite(commit, select)
-            runs[commit].append({"seconds": seconds, "last": last, "each": tests, "skipped": skipped})
+                seconds, last, tests, skipped, ids = run_suite(commit, select)
+            runs[commit].append({"seconds": seconds, "last": last, "each": tests, "skipped": skipped, "ids": ids})
             times.append(seconds)
             each.append(tests)
             print(f"  {label}: {seconds:.1f} s ({last})", flush=True)
@@ -148,6 +192,27 @@ def main(argv: list[str]) -> None:
         print(f"left out: {len(skipped_now)} test(s) {ref} ran and HEAD skips (seconds a run in {ref}):")
         for key in skipped_now:
             print(f"  {sum(sum(run[key]) for run in old_each) / pairs:8.2f}  {key}")
+    if "--same" in argv:
+        same_suite(ref, head, runs, common, pairs)
+
+
+def same_suite(ref: str, head: str, runs: dict[str, list[dict[str, object]]], common: list[str],
+               pairs: int) -> None:
+    """The wall time of the same suite in both trees: only the common tests, by each tree's own node ids
+    (a test moved between files keeps its name), under the same pytest options, alternating."""
+    ids = {commit: runs[commit][0]["ids"] for commit in (ref, head)}
+    if not all(ids.values()):
+        raise SystemExit("--same: the saved REF run holds no node ids (save it again with this script)")
+    only = {commit: sorted(node for key in common for node in ids[commit][key]) for commit in (ref, head)}  # type: ignore[index]
+    wall: dict[str, list[float]] = {ref: [], head: []}
+    for _ in range(pairs):
+        for commit in (ref, head):
+            seconds, last, _each, _skipped, _ids = run_suite(commit, None, only[commit])
+            wall[commit].append(seconds)
+            print(f"  the {len(common)} common tests alone, {commit}: {seconds:.1f} s ({last})", flush=True)
+    print(f"the same {len(common)} tests in both trees, {pairs} alternating pair(s): {ref} "
+          f"{min(wall[ref]):.1f}-{max(wall[ref]):.1f} s, HEAD {head} {min(wall[head]):.1f}-{max(wall[head]):.1f} s; "
+          f"wall ratio {sum(wall[head]) / sum(wall[ref]):.2f}")
 
 
 if __name__ == "__main__":

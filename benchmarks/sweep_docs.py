@@ -9,6 +9,7 @@ the deterministic tables and compares them with the committed page.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import sys
 from pathlib import Path
@@ -19,7 +20,7 @@ from vtool.presets.paths import plan_sweep
 from vtool.presets.valvetrain import with_run_overrides
 from vtool.solvers.studies.metrics import metric_columns, seat_index
 from vtool.solvers.studies.steady import with_steady
-from vtool.solvers.studies.sweep import SerialRunner, find_speed, make_runner, run_points
+from vtool.solvers.studies.sweep import SerialRunner, chunks, find_speed, make_runner, run_points
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "sweep.md"
 PRESETS = (("gnilka-1a", "1A: three clearances, valve seat"),
@@ -38,7 +39,47 @@ SPRING = "members.valve_spring.stiffness=150:350:50"
 MAP_RPM = "run.rpm=8000:14000:250"
 
 
+class Remembered:
+    """A runner that runs each distinct point (its spec) once and hands out the kept result again.
+
+    The speeds table's jump-speed and bounce-speed searches of a preset scan the same speeds of the same
+    spec, and where both criteria change between the same scanned speeds their bisections try the same
+    speeds too: the second search took the first one's runs again (a quarter of the page's regeneration).
+    A point's result depends on its spec alone (:func:`vtool.solvers.studies.sweep.evaluate_point`), so the
+    kept one is the result the run would give; only the index and the swept values are the asking point's.
+    """
+
+    def __init__(self, runner, kept: dict | None = None) -> None:  # type: ignore[no-untyped-def]
+        self.runner = runner
+        self.workers = runner.workers
+        self.kept = {} if kept is None else kept  # (spec, every_step) -> its PointResult
+        self.runs = 0  # points actually run
+
+    def run(self, batches, every_step, on_results, cancel) -> bool:  # type: ignore[no-untyped-def]
+        fresh = []
+        for point in (p for batch in batches for p in batch):
+            kept = self.kept.get((point.spec, every_step))
+            if kept is None:
+                fresh.append(point)
+            else:
+                on_results([dataclasses.replace(kept, index=point.index, values=point.values)])
+        specs = {point.index: point.spec for point in fresh}
+        self.runs += len(fresh)
+
+        def keep(results) -> None:  # type: ignore[no-untyped-def]
+            for result in results:
+                self.kept[(specs[result.index], every_step)] = result
+            on_results(results)
+
+        return self.runner.run(chunks(fresh, self.workers), every_step, keep, cancel)
+
+    def close(self) -> None:
+        self.runner.close()
+
+
 def speeds_table(runner) -> str:  # type: ignore[no-untyped-def]
+    runner = Remembered(runner)
+    bisector = Remembered(SerialRunner(), runner.kept)  # find_speed's default: one point at a time, here
     rows = []
     for name, words in PRESETS:
         spec = load_preset(name)
@@ -48,7 +89,7 @@ def speeds_table(runner) -> str:  # type: ignore[no-untyped-def]
                 cells.append("no seat")
                 continue
             result = find_speed(criterion, lambda rpm, spec=spec: with_steady(with_run_overrides(spec, rpm=rpm)),
-                                SCAN, runner)
+                                SCAN, runner, bisector=bisector)
             steps = len(result.history)
             intervals = "; ".join(f"{i.low:,.0f}-{i.high:,.0f}" + ("" if i.above is not None else "+")
                                   for i in result.intervals)

@@ -417,12 +417,14 @@ def _startup(trace: Trace, seat: int | None) -> dict[str, float]:
             "startup_seating_velocity": float(max(speeds)) if speeds else NAN}
 
 
-def run_metrics(trace: Trace, window: tuple[float, float] | None = None) -> dict[str, float]:
+def run_metrics(trace: Trace, window: tuple[float, float] | None = None,
+                criteria: Criteria | None = None) -> dict[str, float]:
     """The metrics of one run over ``window`` (default :func:`evaluation_window`), keyed as
-    :func:`metric_columns`."""
+    :func:`metric_columns`; ``criteria``: ``Criteria.of(trace.spec)`` made once by a caller that measures
+    many runs of one spec (a run's cycles: :mod:`vtool.solvers.studies.steady`)."""
     spec = trace.spec
     window = evaluation_window(trace) if window is None else window
-    criteria = Criteria.of(spec)
+    criteria = Criteria.of(spec) if criteria is None else criteria
     cam = cam_index(spec)
     seat = seat_index(spec)
     metrics: dict[str, float] = {}
