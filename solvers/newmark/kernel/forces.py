@@ -95,7 +95,7 @@ def contact_force(prob, C, k, y, src):
 def rigid_force(prob, C, k, y, src, hertz):
     """Contact force of closed rigid clearance k: its linear row, plus the closed Hertz contacts' pull
     on it (``mon[k, 3n + 3ns + 1 + j]`` per unit Hertz force F_j)."""
-    f = contact_force(prob, C, k, y, src)
+    f = linear_force(C.mon, k, prob.ip[IP_N], prob.ip[IP_NS], C.mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
     if hertz is not None:
         head = 3 * prob.ip[IP_N] + 3 * prob.ip[IP_NS] + 1
         for j in range(prob.cl.shape[0]):
@@ -112,7 +112,7 @@ def compliant_force(prob, C, k, y, src, hertz):
         if prob.cl[k, CL_SOFT] == SOFT_HERTZ:
             delta, rate = overlap_and_rate(prob, C, k, y, src)
             return hertz_force(prob.clf, k, delta, rate)[0]
-    return contact_force(prob, C, k, y, src)
+    return linear_force(C.mon, k, prob.ip[IP_N], prob.ip[IP_NS], C.mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
 
 
 @jit_inline

@@ -14,7 +14,7 @@ import numpy as np
 
 from vtool.jit import jit, jit_inline
 from vtool.solvers.newmark.kernel.algebra import solve_dense
-from vtool.solvers.newmark.kernel.forces import rigid_force
+from vtool.solvers.newmark.kernel.forces import linear_force, rigid_force
 from vtool.solvers.newmark.kernel.step import (
     configuration,
     consistent_acceleration,
@@ -48,14 +48,19 @@ from vtool.solvers.newmark.layout import (
     I_RAPID,
     IP_N,
     IP_NCL,
+    IP_NS,
     IP_ZSTICK,
     IP_ZSTOP,
     LAW_MOMENTUM,
     LAW_THESIS,
     MK_FORCE,
     MK_KIND,
+    MK_M,
     SRC_NOW,
     TAU,
+    ZD,
+    ZDD,
+    Z,
 )
 
 
@@ -349,7 +354,10 @@ def release_pulling(prob, T, c, t, S, src, O, y, rhs, hertz):
         worst_f = -fp[FP_FTOL]
         for k in range(ncl):
             if C.mk[k, MK_KIND] == MK_FORCE and cl[k, CL_MON]:
-                f = rigid_force(prob, C, k, y, src, hertz)
+                if hertz is None:  # the linear row alone (rigid_force's, with no Hertz contact)
+                    f = linear_force(C.mon, k, n, ip[IP_NS], C.mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
+                else:
+                    f = rigid_force(prob, C, k, y, src, hertz)
                 if f < worst_f:
                     worst = k
                     worst_f = f

@@ -59,12 +59,16 @@ def record_row(prob, C, t, y, src, O, row, hertz):
     O.c[row] = C.mask
     put_state(C.ci, n, ns, row, y[Z], y[ZD], y[ZDD], src, O.q)
     for k in range(prob.cl.shape[0]):
-        if C.mk[k, MK_KIND] == MK_FORCE:
-            O.F[row, k] = rigid_force(prob, C, k, y, src, hertz)
-        elif C.mk[k, MK_KIND] == MK_OVERLAP:
-            O.F[row, k] = compliant_force(prob, C, k, y, src, hertz)
-        else:
-            O.F[row, k] = 0.0
+        kind = C.mk[k, MK_KIND]
+        force = 0.0
+        if hertz is None:  # (with no Hertz contact, a closed contact's force is its linear row)
+            if kind == MK_FORCE or kind == MK_OVERLAP:
+                force = linear_force(C.mon, k, n, ns, C.mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
+        elif kind == MK_FORCE:
+            force = rigid_force(prob, C, k, y, src, hertz)
+        elif kind == MK_OVERLAP:
+            force = compliant_force(prob, C, k, y, src, hertz)
+        O.F[row, k] = force
 
 
 @jit
@@ -101,8 +105,9 @@ def step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
         for k in range(ncl):
             kind = mk[k, MK_KIND]
             force = 0.0
-            if (kind == MK_FORCE or kind == MK_OVERLAP) and hertz is None:
-                force = linear_force(mon, k, n, ns, mk[k, MK_M], zo, zdo, zddo, srco)
+            if hertz is None:  # (the branches below are pruned before typing: see layout.laws)
+                if kind == MK_FORCE or kind == MK_OVERLAP:
+                    force = linear_force(mon, k, n, ns, mk[k, MK_M], zo, zdo, zddo, srco)
             elif kind == MK_FORCE:
                 force = rigid_force(prob, C, k, out, srco, hertz)
             elif kind == MK_OVERLAP:

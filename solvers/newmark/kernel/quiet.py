@@ -16,7 +16,7 @@ import math
 
 from vtool.jit import jit
 from vtool.solvers.newmark.kernel.algebra import apply_operator
-from vtool.solvers.newmark.kernel.forces import contact_force, signed_gap
+from vtool.solvers.newmark.kernel.forces import linear_force, signed_gap
 from vtool.solvers.newmark.kernel.output import step_rows
 from vtool.solvers.newmark.kernel.step import correct, harmonics, predict, prescribed
 from vtool.solvers.newmark.layout import (
@@ -53,6 +53,7 @@ from vtool.solvers.newmark.layout import (
     MK_FORCE,
     MK_GAP,
     MK_KIND,
+    MK_M,
     MK_OVERLAP,
     MK_ROW,
     PEAK_ALL,
@@ -179,7 +180,7 @@ def advance(prob, C, W, S, O, hertz):
                 if after:
                     peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], phi[k])
             elif kind == MK_OVERLAP:
-                force = contact_force(prob, C, k, end, src1)
+                force = linear_force(mon, k, n, ns, mk[k, MK_M], z1, zd1, zdd1, src1)
                 peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
                 peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], force)
                 if after:
