@@ -172,7 +172,7 @@ def test_a_quiet_steps_force_rows_give_the_contact_force_at_the_steps_end(preset
     random states, to round-off. (The kernel's functions as plain Python: ``py_func``.)"""
     from vtool.solvers.newmark import layout
     from vtool.solvers.newmark.kernel import algebra, forces, step
-    from vtool.solvers.newmark.records import Config, Motion
+    from vtool.solvers.newmark.records import Config
 
     def plain(function):  # noqa: ANN001, ANN202
         return getattr(function, "py_func", function)
@@ -193,14 +193,14 @@ def test_a_quiet_steps_force_rows_give_the_contact_force_at_the_steps_end(preset
             for _ in range(10):
                 z, zd, zdd = rng.normal(size=n) * 1e-2, rng.normal(size=n) * 10, rng.normal(size=n) * 1e4
                 src = rng.normal(size=3 * ns) * np.tile([1e-2, 10, 1e4], ns)
-                end = Motion(z + h * zd + h * h * (0.5 - beta) * zdd, zd + h * (1 - gamma) * zdd, zdd.copy())
-                plain(step.prescribed)(C.ci, n, src, end.z, end.zd, end.zdd)
+                end = np.array([z + h * zd + h * h * (0.5 - beta) * zdd, zd + h * (1 - gamma) * zdd, zdd])  # (z, ż, z̈) rows
+                plain(step.prescribed)(C.ci, n, src, end[0], end[1], end[2])
                 out = np.zeros(n + ncl)
                 plain(algebra.apply_operator)(C.cp, C.ci, plane, C.ci[layout.CI_ROWS], C.ci[layout.CI_SRCSTEP], src,
-                                              end.z, end.zd, end.zdd, out)
-                end.zdd[:nf] = out[:nf]
-                end.z[:nf] += beta * h * h * out[:nf]
-                end.zd[:nf] += gamma * h * out[:nf]
+                                              end[0], end[1], end[2], out)
+                end[2, :nf] = out[:nf]
+                end[0, :nf] += beta * h * h * out[:nf]
+                end[1, :nf] += gamma * h * out[:nf]
                 for k in range(ncl):
                     if C.mk[k, layout.MK_KIND] != layout.MK_FORCE:
                         continue

@@ -61,7 +61,7 @@ from vtool.solvers.model.spec import (
     THESIS,
 )
 from vtool.solvers.newmark import layout
-from vtool.solvers.newmark.records import Motion, Output, Problem, State, Tables, mask_hash
+from vtool.solvers.newmark.records import Output, Problem, State, Tables, mask_hash
 from vtool.solvers.trace import EVENT_KINDS, OPENED, TraceBuilder
 
 LAW_CODES = {MOMENTUM: layout.LAW_MOMENTUM, LOCAL: layout.LAW_LOCAL, THESIS: layout.LAW_THESIS}
@@ -665,7 +665,7 @@ class Transitions:
             self.ist[layout.I_NEV] = 0
             result = int(self.rules.release_pulling(
                 self.record, tables.record(), mask, t, State(x, v, a, self.ist, self.fst), problem.sources_at(t),
-                self.events, Motion(np.zeros(m), np.zeros(m), np.zeros(m)), np.zeros(m), problem.hertz))
+                self.events, np.zeros((3, m)), np.zeros(m), problem.hertz))
             self.take_events()
             if result >= 0:
                 return result

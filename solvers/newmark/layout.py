@@ -69,6 +69,12 @@ I_CFG, I_NOUT, I_NEV, I_STEPS, I_RAPID, I_GRID, I_NEXT_OUT, I_NEED_SETTLE, I_WAN
 I_SIZE = 11  # I_SUB: refined steps taken since the grid point I_GRID (the refined steps' own grid)
 F_T, F_LAST_EVENT, F_CHUNK_END, F_FINE_UNTIL = range(4)
 F_SIZE = 4
+# the run loop's scratch (records.scratch): a layer state's rows (z, ż, z̈), the layer states and the
+# sources' instants (a step's start and end, an output row), the per-clearance rows
+Z, ZD, ZDD = range(3)
+Y_NOW, Y_END, Y_OUT = range(3)
+SRC_NOW, SRC_END, SRC_OUT = range(3)
+PHI, PHI_START, TAU = range(3)
 
 
 def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:

@@ -17,8 +17,12 @@ The slot numbers inside the arrays are in :mod:`vtool.solvers.newmark.layout`.
 * :class:`State`: the run's full state and counters (x, v, a, the integer and
   float state slots);
 * :class:`Output`: the output buffers (rows, events, peaks);
-* :class:`Motion`: a layer state (z, ż, z̈);
-* :class:`Scratch`: the run loop's work vectors.
+* :class:`Scratch`: the run loop's work arrays.
+
+A layer state is one (3, m) array, rows ``Z``, ``ZD``, ``ZDD`` (z, ż, z̈; layout):
+a few arrays with named rows instead of many vectors, since numba copies each
+array of a record at every variable and call that holds the record (about
+0.15 s of first compile per array in :class:`Scratch`).
 """
 
 from __future__ import annotations
@@ -32,8 +36,7 @@ Tables = namedtuple("Tables", "index ci cm cp mk mon")
 Config = namedtuple("Config", "mask ci cm cp mk mon")
 State = namedtuple("State", "x v a ist fst")
 Output = namedtuple("Output", "t q F c ev_f ev_i peak")
-Motion = namedtuple("Motion", "z zd zdd")
-Scratch = namedtuple("Scratch", "now end out src0 src1 srco rhs sol L phi phi_start tau closing")
+Scratch = namedtuple("Scratch", "y src cross rhs sol L closing")
 
 
 def mask_hash(mask: int, capacity: int) -> int:
@@ -42,12 +45,12 @@ def mask_hash(mask: int, capacity: int) -> int:
     return (mask ^ (mask >> 7) ^ (mask >> 17)) & (capacity - 1)
 
 
-def motion(n: int) -> Motion:
-    return Motion(np.zeros(n), np.zeros(n), np.zeros(n))
-
-
 def scratch(n: int, ns: int, ncl: int) -> Scratch:
-    """The run loop's work vectors for n coordinates, ns sources and ncl clearances."""
-    return Scratch(motion(n), motion(n), motion(n), np.zeros(3 * ns), np.zeros(3 * ns), np.zeros(3 * ns),
-                   np.zeros(n + ncl), np.zeros(n), np.zeros((n, n)), np.zeros(ncl), np.zeros(ncl),
-                   np.zeros(ncl), np.zeros(ncl, dtype=np.int64))
+    """The run loop's work arrays for n coordinates, ns sources and ncl clearances: the layer states
+    ``y[Y_NOW]`` (the step's start), ``y[Y_END]`` (its end), ``y[Y_OUT]`` (an output row's), each a
+    layer state (rows Z, ZD, ZDD); the sources' (x, v, a) at those instants ``src[SRC_NOW]``,
+    ``src[SRC_END]``, ``src[SRC_OUT]``; per clearance ``cross[PHI]`` (the monitors at the step's end),
+    ``cross[PHI_START]`` (at its start), ``cross[TAU]`` (a located crossing); the right side and
+    solution of a step's system, a Cholesky factor, and the closing clearances of an event."""
+    return Scratch(np.zeros((3, 3, n)), np.zeros((3, 3 * ns)), np.zeros((3, ncl)), np.zeros(n + ncl), np.zeros(n),
+                   np.zeros((n, n)), np.zeros(ncl, dtype=np.int64))

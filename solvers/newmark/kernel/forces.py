@@ -27,6 +27,11 @@ from vtool.solvers.newmark.layout import (
     MK_M,
     MK_OVERLAP,
     SOFT_HERTZ,
+    SRC_END,
+    Y_END,
+    ZD,
+    ZDD,
+    Z,
 )
 
 
@@ -56,8 +61,8 @@ def overlap_and_rate(prob, C, k, y, src):
     delta = 0.0
     rate = 0.0
     for j in range(n):
-        delta += row[j] * y.z[j]
-        rate += row[n + j] * y.zd[j]
+        delta += row[j] * y[Z, j]
+        rate += row[n + j] * y[ZD, j]
     for s in range(ns):
         delta += row[3 * n + 3 * s] * src[3 * s]
         rate += row[3 * n + 3 * s + 1] * src[3 * s + 1]
@@ -83,7 +88,7 @@ def linear_force(mon, k, n, ns, count, z, zd, zdd, src):
 @jit
 def contact_force(prob, C, k, y, src):
     """:func:`linear_force` of closed clearance k in configuration C, layer state y."""
-    return linear_force(C.mon, k, prob.ip[IP_N], prob.ip[IP_NS], C.mk[k, MK_M], y.z, y.zd, y.zdd, src)
+    return linear_force(C.mon, k, prob.ip[IP_N], prob.ip[IP_NS], C.mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
 
 
 @jit
@@ -126,7 +131,7 @@ def monitors(prob, C, y, src, gap_noise, phi, hertz):
     allowance (the contact ends when the parts part). Gaps and linear forces on arrays taken out of
     the records once; with no Hertz contact (``hertz`` None) nothing else is called."""
     n, ns = prob.ip[IP_N], prob.ip[IP_NS]
-    mk, mon, z, zd, zdd, clf = C.mk, C.mon, y.z, y.zd, y.zdd, prob.clf
+    mk, mon, z, zd, zdd, clf = C.mk, C.mon, y[Z], y[ZD], y[ZDD], prob.clf
     for k in range(prob.cl.shape[0]):
         kind = mk[k, MK_KIND]
         if kind == MK_GAP or kind == MK_OVERLAP:
@@ -144,7 +149,7 @@ def monitors(prob, C, y, src, gap_noise, phi, hertz):
 
 @jit
 def hertz_correction(prob, C, W, h, which):
-    """Add the closed Hertz contacts' forces to the Newmark step into W.end whose linear part is done.
+    """Add the closed Hertz contacts' forces to the Newmark step into W.y[Y_END] whose linear part is done.
 
     With the linear accelerations u (in z̈1) and V_j = S⁻¹ w_j (w_j: contact
     j's direction on the free rows), z̈_F = u + Σ V_j F_j, and each overlap is
@@ -153,7 +158,7 @@ def hertz_correction(prob, C, W, h, which):
     closed Hertz contacts' size); then the state takes the forces.
     """
     beta, gamma = prob.fp[FP_BETA], prob.fp[FP_GAMMA]
-    end = W.end
+    end = W.y[Y_END]
     nf = C.ci[CI_NF]
     ncl = prob.cl.shape[0]
     idx = np.empty(ncl, dtype=np.int64)
@@ -177,7 +182,7 @@ def hertz_correction(prob, C, W, h, which):
     d0 = np.zeros(nc)
     r0 = np.zeros(nc)
     for i in range(nc):
-        d0[i], r0[i] = overlap_and_rate(prob, C, idx[i], end, W.src1)
+        d0[i], r0[i] = overlap_and_rate(prob, C, idx[i], end, W.src[SRC_END])
         for j in range(nc):
             acc = 0.0
             for f in range(nf):
@@ -211,6 +216,6 @@ def hertz_correction(prob, C, W, h, which):
         acc = 0.0
         for j in range(nc):
             acc += V[f, j] * F[j]
-        end.zdd[f] += acc
-        end.z[f] += beta * h * h * acc
-        end.zd[f] += gamma * h * acc
+        end[ZDD, f] += acc
+        end[Z, f] += beta * h * h * acc
+        end[ZD, f] += gamma * h * acc

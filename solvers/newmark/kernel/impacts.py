@@ -54,6 +54,8 @@ from vtool.solvers.newmark.layout import (
     LAW_THESIS,
     MK_FORCE,
     MK_KIND,
+    SRC_NOW,
+    TAU,
 )
 
 
@@ -366,7 +368,7 @@ def take_events(prob, c, t, h, W, S, O, momentum):
     the configuration after them, or -1 when the contacts chatter (``IP_ZSTOP`` rapid events)."""
     ip, fp, cl = prob.ip, prob.fp, prob.cl
     x, v, ist, fst = S.x, S.v, S.ist, S.fst
-    tau, closing, src0 = W.tau, W.closing, W.src0
+    tau, closing, src0 = W.cross[TAU], W.closing, W.src[SRC_NOW]
     ncl = ip[IP_NCL]
     tol = fp[FP_TTOL]
     new_c = c
@@ -393,7 +395,7 @@ def take_events(prob, c, t, h, W, S, O, momentum):
                 u = gap_velocity(cl, prob.clf, k, v, src0)
             add_event(O, S, t, k, EV_OPENED, u, c, new_c)
     if any_closing:
-        new_c = apply_impacts(prob, new_c, W.closing, W.src0, S, stick, O, t, momentum)
+        new_c = apply_impacts(prob, new_c, W.closing, W.src[SRC_NOW], S, stick, O, t, momentum)
     return new_c
 
 

@@ -5,9 +5,8 @@ from __future__ import annotations
 import math
 
 from vtool.jit import borrowed, jit, jit_inline
-from vtool.solvers.newmark.kernel.algebra import apply_operator, cholesky_solve, factor_effective
+from vtool.solvers.newmark.kernel.algebra import factor_effective
 from vtool.solvers.newmark.kernel.forces import (
-    hertz_correction,
     linear_force,
     monitors,
     rigid_force,
@@ -21,13 +20,9 @@ from vtool.solvers.newmark.kernel.step import (
     REFINED,
     STANDARD,
     configuration,
-    correct,
     find_slot,
     gather,
-    harmonics,
     layer_step,
-    predict,
-    prescribed,
     scatter,
     sources,
 )
@@ -35,13 +30,10 @@ from vtool.solvers.newmark.layout import (
     CHATTER,
     CHUNK_END,
     CI_HERTZ,
-    CI_M,
     CI_NF,
-    CI_SRC,
     CL_MON,
     CLF_OPEN,
     CLF_SIGN,
-    CP_RAW,
     DIVERGED,
     F_CHUNK_END,
     F_FINE_UNTIL,
@@ -51,7 +43,6 @@ from vtool.solvers.newmark.layout import (
     FP_DT,
     FP_GAMMA,
     FP_GAPNOISE,
-    FP_OMEGA,
     FP_OUTDT,
     FP_REFINE,
     FP_REFWIN,
@@ -81,40 +72,57 @@ from vtool.solvers.newmark.layout import (
     NEED_CONFIG,
     OUTPUT_FULL,
     PEAK_ALL,
+    PHI,
+    PHI_START,
+    SRC_END,
+    SRC_NOW,
+    SRC_OUT,
+    TAU,
+    Y_END,
+    Y_NOW,
+    ZD,
+    ZDD,
+    Z,
 )
-from vtool.solvers.newmark.records import Motion, Output, Problem, Scratch, State, Tables
+from vtool.solvers.newmark.records import Output, Problem, Scratch, State, Tables
+
+
+@jit_inline
+def step_to(prob, C, W, t, h, hertz):
+    """A step of any length h from W.y[Y_NOW] at t into W.y[Y_END]: sources at t + h, S(h) factored by Cholesky."""
+    sources(prob, t + h, W.src[SRC_END])
+    factor_effective(C.cm, C.ci[CI_NF], prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
+    layer_step(prob, C, W, h, CHOLESKY, hertz)
 
 
 @jit
 def locate_event(prob, C, W, k, t, h, hertz):
-    """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from W.now at t.
+    """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from W.y[Y_NOW] at t.
 
     Illinois (modified regula falsi) on phi(tau) = monitor after a Newmark
-    step of length tau, bracketed by phi(0) = W.phi_start[k] >= 0 > phi(h) =
-    W.phi[k], with a bisection whenever two iterations have not halved the
+    step of length tau, bracketed by phi(0) = W.cross[PHI_START, k] >= 0 > phi(h) =
+    W.cross[PHI, k], with a bisection whenever two iterations have not halved the
     bracket; returns the left end of the final bracket (the monitor still
     non-negative), within the time tolerance of the crossing, or its right end
     when the left is the step's start (a bracket narrower than the tolerance
     from the start: a step shorter than it, or a crossing within it): an
     event at tau = 0 would make no progress, and a contact released at t
     whose gap the round-off closes again within the tolerance would close and
-    open at t until the chattering stop. Each trial
-    factors S(tau) by Cholesky. The trials are :func:`step_to`'s step written
-    with the shared inline helpers on arrays taken out of the records once (a
-    call handed records takes and drops a count of each of their arrays: a
-    call each, even on :func:`run_chunk`'s borrowed views).
+    open at t until the chattering stop. Each trial is :func:`step_to`'s step
+    (S(tau) factored by Cholesky): the same code as the event's step, compiled
+    once in :func:`~vtool.solvers.newmark.kernel.step.layer_step` (a copy of it
+    here cost about 0.6 s of first compile; the call costs about 1 % of a run).
     """
     fp, ip = prob.fp, prob.ip
-    beta, gamma, omega, tol, gap_noise = fp[FP_BETA], fp[FP_GAMMA], fp[FP_OMEGA], fp[FP_TTOL], fp[FP_GAPNOISE]
+    tol, gap_noise = fp[FP_TTOL], fp[FP_GAPNOISE]
     n, ns = ip[IP_N], ip[IP_NS]
-    sc, sa, sb, clf = prob.sc, prob.sa, prob.sb, prob.clf
-    ci, cm, cp, mk, mon = C.ci, C.cm, C.cp, C.mk, C.mon
-    z, zd, zdd, z1, zd1, zdd1 = W.now.z, W.now.zd, W.now.zdd, W.end.z, W.end.zd, W.end.zdd
-    src1, rhs, sol, L = W.src1, W.rhs, W.sol, W.L
-    m, nf, coupled, closed_hertz = ci[CI_M], ci[CI_NF], ci[CI_SRC], ci[CI_HERTZ]
+    clf, mk, mon = prob.clf, C.mk, C.mon
+    end = W.y[Y_END]
+    z1, zd1, zdd1 = end[Z], end[ZD], end[ZDD]
+    src1 = W.src[SRC_END]
     kind = mk[k, MK_KIND]
     lo, hi = 0.0, h
-    flo, fhi = W.phi_start[k], W.phi[k]
+    flo, fhi = W.cross[PHI_START, k], W.cross[PHI, k]
     side = 0
     width_before = 2.0 * h
     for iteration in range(200):
@@ -130,17 +138,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
         else:
             tau = (lo * fhi - hi * flo) / (fhi - flo)
         tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
-        # step_to(prob, C, W, t, tau, hertz), on the arrays
-        harmonics(sc, sa, sb, omega, math.cos(omega * (t + tau)), math.sin(omega * (t + tau)), src1)
-        factor_effective(cm, nf, beta, gamma, tau, L)
-        predict(m, tau, beta, gamma, z, zd, zdd, z1, zd1)
-        prescribed(ci, n, src1, z1, zd1, zdd1)
-        apply_operator(cp, ci, CP_RAW, nf, coupled, src1, z1, zd1, zdd1, rhs)
-        cholesky_solve(nf, L, rhs, sol)
-        correct(nf, tau, beta, gamma, sol, z1, zd1, zdd1, math.inf)
-        if hertz is not None:
-            if closed_hertz:
-                hertz_correction(prob, C, W, tau, CHOLESKY)
+        step_to(prob, C, W, t, tau, hertz)
         # monitor k (see forces.monitors), on the arrays
         if kind == MK_GAP or kind == MK_OVERLAP:
             behind = mk[k, MK_BEHIND]
@@ -149,7 +147,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
         elif hertz is None:  # a closed rigid contact's force: the linear row alone
             f = linear_force(mon, k, n, ns, mk[k, MK_M], z1, zd1, zdd1, src1)
         else:
-            f = rigid_force(prob, C, k, W.end, src1, hertz)
+            f = rigid_force(prob, C, k, end, src1, hertz)
         if f < 0.0:
             hi, fhi = tau, f
             if side == -1:
@@ -164,20 +162,12 @@ def locate_event(prob, C, W, k, t, h, hertz):
 
 
 @jit_inline
-def step_to(prob, C, W, t, h, hertz):
-    """A step of any length h from W.now at t into W.end: sources at t + h, S(h) factored by Cholesky."""
-    sources(prob, t + h, W.src1)
-    factor_effective(C.cm, C.ci[CI_NF], prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
-    layer_step(prob, C, W, h, CHOLESKY, hertz)
-
-
-@jit_inline
 def copy_state(m, y, src, y_to, src_to):
     """The first m entries of y, and the sources, into y_to and src_to."""
     for j in range(m):
-        y_to.z[j] = y.z[j]
-        y_to.zd[j] = y.zd[j]
-        y_to.zdd[j] = y.zdd[j]
+        y_to[Z, j] = y[Z, j]
+        y_to[ZD, j] = y[ZD, j]
+        y_to[ZDD, j] = y[ZDD, j]
     for j in range(src.shape[0]):
         src_to[j] = src[j]
 
@@ -197,14 +187,13 @@ def arrive(S, target, grid_next, k_grid, j_target):
 @jit_inline
 def clear(W):
     """The scratch zeroed, as fresh arrays would be (each call of :func:`run_chunk` starts so)."""
-    for y in (W.now, W.end, W.out):
-        y.z[:] = 0.0
-        y.zd[:] = 0.0
-        y.zdd[:] = 0.0
-    for vector in (W.src0, W.src1, W.srco, W.rhs, W.sol, W.phi, W.phi_start, W.tau):
-        vector[:] = 0.0
-    W.L[:, :] = 0.0
-    W.closing[:] = 0
+    W.y.fill(0.0)
+    W.src.fill(0.0)
+    W.cross.fill(0.0)
+    W.rhs.fill(0.0)
+    W.sol.fill(0.0)
+    W.L.fill(0.0)
+    W.closing.fill(0)
 
 
 @jit_inline
@@ -214,8 +203,8 @@ def start(prob, C, W, S, O, hertz):
     ist = S.ist
     if ist[I_NOUT] >= O.t.shape[0]:
         return False
-    gather(C, prob.ip[IP_N], S, W.now)
-    record_row(prob, C, S.fst[F_T], W.now, W.src0, O, ist[I_NOUT], hertz)
+    gather(C, prob.ip[IP_N], S, W.y[Y_NOW])
+    record_row(prob, C, S.fst[F_T], W.y[Y_NOW], W.src[SRC_NOW], O, ist[I_NOUT], hertz)
     for k in range(prob.cl.shape[0]):
         O.peak[PEAK_ALL, k] = max(O.peak[PEAK_ALL, k], O.F[ist[I_NOUT], k])
     ist[I_NOUT] += 1
@@ -257,99 +246,24 @@ def step_length(prob, S, t, c_hertz):
 
 @jit_inline
 def event_step(prob, C, W, t, h, hertz):
-    """After a step of length h whose monitors W.phi changed sign: locate every sign change, take the
-    earliest (tau in W.tau) and redo the step to it. Returns the step taken."""
+    """After a step of length h whose monitors W.cross[PHI] changed sign: locate every sign change, take the
+    earliest (tau in W.cross[TAU]) and redo the step to it. Returns the step taken."""
     ncl = prob.cl.shape[0]
-    monitors(prob, C, W.now, W.src0, prob.fp[FP_GAPNOISE], W.phi_start, hertz)
+    monitors(prob, C, W.y[Y_NOW], W.src[SRC_NOW], prob.fp[FP_GAPNOISE], W.cross[PHI_START], hertz)
     tau_min = 2.0 * h
     for k in range(ncl):
-        W.tau[k] = math.inf  # no crossing: never an event (take_events takes tau <= h + tol, also for h < tol)
-        if prob.cl[k, CL_MON] and W.phi[k] < 0.0:
-            W.tau[k] = 0.0 if W.phi_start[k] < 0.0 else locate_event(prob, C, W, k, t, h, hertz)
-            tau_min = min(tau_min, W.tau[k])
+        W.cross[TAU, k] = math.inf  # no crossing: never an event (take_events takes tau <= h + tol, also for h < tol)
+        if prob.cl[k, CL_MON] and W.cross[PHI, k] < 0.0:
+            W.cross[TAU, k] = 0.0 if W.cross[PHI_START, k] < 0.0 else locate_event(prob, C, W, k, t, h, hertz)
+            tau_min = min(tau_min, W.cross[TAU, k])
     h = tau_min
     if h > 0.0:
         step_to(prob, C, W, t, h, hertz)
         # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
-        monitors(prob, C, W.end, W.src1, prob.fp[FP_GAPNOISE], W.phi, hertz)
+        monitors(prob, C, W.y[Y_END], W.src[SRC_END], prob.fp[FP_GAPNOISE], W.cross[PHI], hertz)
     else:
-        copy_state(prob.ip[IP_N], W.now, W.src0, W.end, W.src1)
+        copy_state(prob.ip[IP_N], W.y[Y_NOW], W.src[SRC_NOW], W.y[Y_END], W.src[SRC_END])
     return h
-
-
-@jit_inline
-def steps(prob, C, W, S, O, hertz):
-    """Steps in configuration C from S.fst[F_T] until an event, the chunk end, the run's end or a full
-    buffer. Returns (status, event, h): status FINISHED, CHUNK_END, OUTPUT_FULL or DIVERGED (0 after an
-    event), h the event's located step."""
-    fp, ist, fst = prob.fp, S.ist, S.fst
-    dt, t_end, out_dt, x_limit, t_rev = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_XLIM], fp[FP_TREV]
-    omega, sc, sa, sb, src0, src1 = fp[FP_OMEGA], prob.sc, prob.sa, prob.sb, W.src0, W.src1
-    n = prob.ip[IP_N]
-    t = fst[F_T]
-    h = 0.0
-    while True:
-        if t >= t_end - 1e-9 * dt:
-            return FINISHED, False, h
-        if t >= fst[F_CHUNK_END]:
-            return CHUNK_END, False, h
-        h, target, grid_next, j_target, quiet = step_length(prob, S, t, C.ci[CI_HERTZ])
-        if quiet:  # quiet steps may follow; off the grid, after an event, the call would return at once
-            t_quiet = advance(prob, C, W, S, O, hertz)
-            if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
-                t = t_quiet
-                harmonics(sc, sa, sb, omega, math.cos(omega * t), math.sin(omega * t), src0)
-                continue
-        if h <= 1e-9 * dt:  # at a grid point but for round-off
-            t = arrive(S, target, grid_next, ist[I_GRID], j_target)
-            continue
-        harmonics(sc, sa, sb, omega, math.cos(omega * (t + h)), math.sin(omega * (t + h)), src1)
-        which = STANDARD
-        if h != dt:
-            if h == dt / int(fp[FP_REFINE] + 0.5):
-                which = REFINED
-            else:
-                which = CHOLESKY
-                factor_effective(C.cm, C.ci[CI_NF], fp[FP_BETA], fp[FP_GAMMA], h, W.L)
-        layer_step(prob, C, W, h, which, hertz)
-        monitors(prob, C, W.end, W.src1, fp[FP_GAPNOISE], W.phi, hertz)
-        fired = False
-        for k in range(prob.cl.shape[0]):
-            if prob.cl[k, CL_MON] and W.phi[k] < 0.0:
-                fired = True
-        if fired:  # locate every sign change; the earliest is taken
-            h = event_step(prob, C, W, t, h, hertz)
-        if h > 0.0:
-            for j in range(C.ci[CI_NF]):
-                if not (abs(W.end.z[j]) <= x_limit):
-                    scatter(C, n, W.end, S)
-                    fst[F_T] = t + h
-                    return DIVERGED, False, h
-            # outputs inside (t, t + h]
-            if prob.ip[IP_EVERY]:
-                if ist[I_NOUT] >= O.t.shape[0]:
-                    return OUTPUT_FULL, False, h
-                record_row(prob, C, t + h, W.end, W.src1, O, ist[I_NOUT], hertz)
-                ist[I_NOUT] += 1
-            else:
-                t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant: a call only when one is due
-                if (t_out <= t + h + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
-                        and not step_rows(prob, C, t, h, W.now, W.end.zdd, W, O, S, hertz)):
-                    return OUTPUT_FULL, False, h
-            track_peaks(prob, C, t + h >= t_rev, W.phi, W.end, W.src1, O.peak, hertz)
-            ist[I_STEPS] += 1
-            copy_state(n, W.end, W.src1, W.now, W.src0)
-            t = t + h
-            fst[F_T] = t
-            if abs(t - target) <= 1e-9 * dt:
-                t = arrive(S, target, grid_next, ist[I_GRID], j_target)
-        if fired:
-            return 0, True, h
-
-
-@jit_inline
-def motion_borrowed(y):
-    return Motion(borrowed(y.z), borrowed(y.zd), borrowed(y.zdd))
 
 
 @jit_inline
@@ -358,8 +272,7 @@ def borrow(prob, T, W, S, O):
     b = borrowed
     prob = Problem(b(prob.ip), b(prob.fp), b(prob.cl), b(prob.clf), b(prob.sc), b(prob.sa), b(prob.sb), b(prob.mass))
     T = Tables(b(T.index), b(T.ci), b(T.cm), b(T.cp), b(T.mk), b(T.mon))
-    W = Scratch(motion_borrowed(W.now), motion_borrowed(W.end), motion_borrowed(W.out), b(W.src0), b(W.src1),
-                b(W.srco), b(W.rhs), b(W.sol), b(W.L), b(W.phi), b(W.phi_start), b(W.tau), b(W.closing))
+    W = Scratch(b(W.y), b(W.src), b(W.cross), b(W.rhs), b(W.sol), b(W.L), b(W.closing))
     S = State(b(S.x), b(S.v), b(S.a), b(S.ist), b(S.fst))
     O = Output(b(O.t), b(O.q), b(O.F), b(O.c), b(O.ev_f), b(O.ev_i), b(O.peak))  # noqa: E741
     return prob, T, W, S, O
@@ -382,8 +295,10 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
     small systems.
     """
     prob, T, W, S, O = borrow(prob, T, W, S, O)  # noqa: E741
-    ist, fst = S.ist, S.fst
+    fp, ist, fst = prob.fp, S.ist, S.fst
     n, ncl = prob.ip[IP_N], prob.cl.shape[0]
+    dt, t_end, out_dt, x_limit, t_rev = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_XLIM], fp[FP_TREV]
+    now, end, src0, src1, phi = W.y[Y_NOW], W.y[Y_END], W.src[SRC_NOW], W.src[SRC_END], W.cross[PHI]
     clear(W)
     while True:
         t = fst[F_T]
@@ -394,9 +309,9 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
             return NEED_CONFIG
         if ist[I_NEV] + 3 * ncl + 2 >= O.ev_f.shape[0]:
             return OUTPUT_FULL
-        sources(prob, t, W.src0)
+        sources(prob, t, src0)
         if ist[I_NEED_SETTLE]:
-            settled = release_pulling(prob, T, c, t, S, W.src0, O, W.now, W.rhs, hertz)
+            settled = release_pulling(prob, T, c, t, S, src0, O, now, W.rhs, hertz)
             if settled < 0:
                 ist[I_CFG] = -1 - settled
                 ist[I_WANT_CFG] = -1 - settled
@@ -405,15 +320,78 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
             ist[I_CFG] = c
             ist[I_NEED_SETTLE] = 0
             slot = find_slot(T.index, c)
-            if not ist[I_STARTED] and not start(prob, configuration(T, c, slot), W, S, O, hertz):
-                return OUTPUT_FULL
         C = configuration(T, c, slot)
-        gather(C, n, S, W.now)
-        status, event, h = steps(prob, C, W, S, O, hertz)
-        if status == DIVERGED:  # (the state at the divergence is in S already)
-            return status
-        scatter(C, n, W.now, S)
-        if not event:
+        if not ist[I_STARTED] and not start(prob, C, W, S, O, hertz):
+            return OUTPUT_FULL
+        gather(C, n, S, now)
+        # ---- steps in configuration C until an event (status 0), the chunk end, the run's end or a full
+        # buffer (written here, not as an inline function: numba copies an inline function's whole IR
+        # at its call, a cost that grows with its blocks times its variables) ----
+        h = 0.0
+        status = 0
+        while True:
+            if t >= t_end - 1e-9 * dt:
+                status = FINISHED
+                break
+            if t >= fst[F_CHUNK_END]:
+                status = CHUNK_END
+                break
+            h, target, grid_next, j_target, quiet = step_length(prob, S, t, C.ci[CI_HERTZ])
+            if quiet:  # quiet steps may follow; off the grid, after an event, the call would return at once
+                t_quiet = advance(prob, C, W, S, O, hertz)
+                if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
+                    t = t_quiet
+                    sources(prob, t, src0)
+                    continue
+            if h <= 1e-9 * dt:  # at a grid point but for round-off
+                t = arrive(S, target, grid_next, ist[I_GRID], j_target)
+                continue
+            sources(prob, t + h, src1)
+            which = STANDARD
+            if h != dt:
+                if h == dt / int(fp[FP_REFINE] + 0.5):
+                    which = REFINED
+                else:
+                    which = CHOLESKY
+                    factor_effective(C.cm, C.ci[CI_NF], fp[FP_BETA], fp[FP_GAMMA], h, W.L)
+            layer_step(prob, C, W, h, which, hertz)
+            monitors(prob, C, end, src1, fp[FP_GAPNOISE], phi, hertz)
+            fired = False
+            for k in range(ncl):
+                if prob.cl[k, CL_MON] and phi[k] < 0.0:
+                    fired = True
+            if fired:  # locate every sign change; the earliest is taken
+                h = event_step(prob, C, W, t, h, hertz)
+            if h > 0.0:
+                for j in range(C.ci[CI_NF]):
+                    if not (abs(end[Z, j]) <= x_limit):  # the state at the divergence into S
+                        scatter(C, n, end, S)
+                        fst[F_T] = t + h
+                        return DIVERGED
+                # outputs inside (t, t + h]
+                if prob.ip[IP_EVERY]:
+                    if ist[I_NOUT] >= O.t.shape[0]:
+                        status = OUTPUT_FULL
+                        break
+                    record_row(prob, C, t + h, end, src1, O, ist[I_NOUT], hertz)
+                    ist[I_NOUT] += 1
+                else:
+                    t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant: a call only when one is due
+                    if (t_out <= t + h + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
+                            and not step_rows(prob, C, t, h, W.y, W.src[SRC_OUT], O, ist, hertz)):
+                        status = OUTPUT_FULL
+                        break
+                track_peaks(prob, C, t + h >= t_rev, phi, end, src1, O.peak, hertz)
+                ist[I_STEPS] += 1
+                copy_state(n, end, src1, now, src0)
+                t = t + h
+                fst[F_T] = t
+                if abs(t - target) <= 1e-9 * dt:
+                    t = arrive(S, target, grid_next, ist[I_GRID], j_target)
+            if fired:
+                break
+        scatter(C, n, now, S)
+        if status != 0:
             return status
         # ---- the events at t (within the tolerance) ----
         t = fst[F_T]

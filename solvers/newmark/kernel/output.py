@@ -26,6 +26,12 @@ from vtool.solvers.newmark.layout import (
     PEAK_ALL,
     PEAK_LATE,
     PEAK_OVERLAP,
+    Y_END,
+    Y_NOW,
+    Y_OUT,
+    ZD,
+    ZDD,
+    Z,
 )
 
 
@@ -51,7 +57,7 @@ def record_row(prob, C, t, y, src, O, row, hertz):
     n, ns = prob.ip[IP_N], prob.ip[IP_NS]
     O.t[row] = t
     O.c[row] = C.mask
-    put_state(C.ci, n, ns, row, y.z, y.zd, y.zdd, src, O.q)
+    put_state(C.ci, n, ns, row, y[Z], y[ZD], y[ZDD], src, O.q)
     for k in range(prob.cl.shape[0]):
         if C.mk[k, MK_KIND] == MK_FORCE:
             O.F[row, k] = rigid_force(prob, C, k, y, src, hertz)
@@ -62,19 +68,21 @@ def record_row(prob, C, t, y, src, O, row, hertz):
 
 
 @jit
-def step_rows(prob, C, t, h, y, zdd1, W, O, S, hertz):
-    """The output rows inside (t, t + h] of a step from y whose end acceleration is z̈1, by the
-    linear-acceleration interpolant (exact for beta = 1/6; thesis eqs. B.3–B.5); False when the buffer
-    filled first (the rows before are written). :func:`record_row`'s row, on arrays taken out of the
-    records once (a call handed records takes and drops a count of each of their arrays)."""
+def step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
+    """The output rows inside (t, t + h] of a step from the layer state Y[Y_NOW] whose end acceleration
+    is Y[Y_END, ZDD] (Y: the scratch's layer states), by the linear-acceleration interpolant (exact for
+    beta = 1/6; thesis eqs. B.3–B.5), each row's state in Y[Y_OUT] and its sources in srco; False when
+    the buffer filled first (the rows before are written). :func:`record_row`'s row, on arrays taken
+    out of the records once. It is handed only what it uses, not the scratch and state records: a
+    non-inline call passes every array of its records, field by field (less code to compile)."""
     dt, t_end, out_dt, omega = prob.fp[FP_DT], prob.fp[FP_TEND], prob.fp[FP_OUTDT], prob.fp[FP_OMEGA]
     n, ns, ncl = prob.ip[IP_N], prob.ip[IP_NS], prob.cl.shape[0]
     sc, sa, sb = prob.sc, prob.sa, prob.sb
     ci, mk, mon = C.ci, C.mk, C.mon
-    z, zd, zdd = y.z, y.zd, y.zdd
-    zo, zdo, zddo, srco = W.out.z, W.out.zd, W.out.zdd, W.srco
+    y, out, zdd1 = Y[Y_NOW], Y[Y_OUT], Y[Y_END, ZDD]
+    z, zd, zdd = y[Z], y[ZD], y[ZDD]
+    zo, zdo, zddo = out[Z], out[ZD], out[ZDD]
     out_t, out_q, out_F, out_c = O.t, O.q, O.F, O.c
-    ist = S.ist
     nf = ci[CI_NF]
     while True:
         j_out = ist[I_NEXT_OUT]
@@ -84,7 +92,7 @@ def step_rows(prob, C, t, h, y, zdd1, W, O, S, hertz):
         row = ist[I_NOUT]
         if row >= out_t.shape[0]:
             return False
-        interpolate(nf, t_out - t, h, z, zd, zdd, zdd1, W.out)
+        interpolate(nf, t_out - t, h, z, zd, zdd, zdd1, out)
         harmonics(sc, sa, sb, omega, math.cos(omega * t_out), math.sin(omega * t_out), srco)
         prescribed(ci, n, srco, zo, zdo, zddo)
         out_t[row] = t_out
@@ -96,9 +104,9 @@ def step_rows(prob, C, t, h, y, zdd1, W, O, S, hertz):
             if (kind == MK_FORCE or kind == MK_OVERLAP) and hertz is None:
                 force = linear_force(mon, k, n, ns, mk[k, MK_M], zo, zdo, zddo, srco)
             elif kind == MK_FORCE:
-                force = rigid_force(prob, C, k, W.out, srco, hertz)
+                force = rigid_force(prob, C, k, out, srco, hertz)
             elif kind == MK_OVERLAP:
-                force = compliant_force(prob, C, k, W.out, srco, hertz)
+                force = compliant_force(prob, C, k, out, srco, hertz)
             out_F[row, k] = force
         ist[I_NOUT] = row + 1
         ist[I_NEXT_OUT] = j_out + 1
@@ -116,7 +124,7 @@ def track_peaks(prob, C, after, phi, y, src, peak, hertz):
         force = phi[k]
         if kind == MK_OVERLAP:
             if hertz is None:
-                force = linear_force(mon, k, n, ns, mk[k, MK_M], y.z, y.zd, y.zdd, src)
+                force = linear_force(mon, k, n, ns, mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
             else:
                 force = compliant_force(prob, C, k, y, src, hertz)
             peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)

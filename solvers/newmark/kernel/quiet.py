@@ -58,6 +58,14 @@ from vtool.solvers.newmark.layout import (
     PEAK_ALL,
     PEAK_LATE,
     PEAK_OVERLAP,
+    PHI,
+    SRC_END,
+    SRC_OUT,
+    Y_END,
+    Y_NOW,
+    ZD,
+    ZDD,
+    Z,
 )
 
 #: Quiet steps between fresh evaluations of cos and sin of the cam angle (see :func:`advance`).
@@ -66,8 +74,8 @@ ANCHOR_STEPS = 64
 
 @jit
 def advance(prob, C, W, S, O, hertz):
-    """Standard and refined steps in configuration C from W.now while nothing happens; returns the time
-    reached (the state there in W.now).
+    """Standard and refined steps in configuration C from W.y[Y_NOW] while nothing happens; returns the time
+    reached (the state there in W.y[Y_NOW]).
 
     It stops, without taking it, at the first step that is neither a
     standard step on the grid nor a refined one, that would end past the
@@ -79,15 +87,16 @@ def advance(prob, C, W, S, O, hertz):
 
     Every array is taken out of its record once, before the loop: numba counts references, and a
     record's field read inside the loop would take and drop one at every step. The step's end is
-    computed into W.end and copied back into W.now (m values), cheaper than swapping the two.
+    computed into W.y[Y_END] and copied back into W.y[Y_NOW] (m values), cheaper than swapping the two.
     """
     ip, fp, ist, fst = prob.ip, prob.fp, S.ist, S.fst
     sc, sa, sb, cl, clf = prob.sc, prob.sa, prob.sb, prob.cl, prob.clf
     ci, cp, mk, mon = C.ci, C.cp, C.mk, C.mon
-    now, end = W.now, W.end
-    z, zd, zdd = now.z, now.zd, now.zdd
-    z1, zd1, zdd1 = end.z, end.zd, end.zdd
-    rhs, phi, src1, peak = W.rhs, W.phi, W.src1, O.peak
+    now, end = W.y[Y_NOW], W.y[Y_END]
+    z, zd, zdd = now[Z], now[ZD], now[ZDD]
+    z1, zd1, zdd1 = end[Z], end[ZD], end[ZDD]
+    rhs, phi, src1, peak = W.rhs, W.cross[PHI], W.src[SRC_END], O.peak
+    Y, srco = W.y, W.src[SRC_OUT]
     n, ns, ncl = ip[IP_N], ip[IP_NS], cl.shape[0]
     beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
     omega, gap_noise, x_limit, t_rev = fp[FP_OMEGA], fp[FP_GAPNOISE], fp[FP_XLIM], fp[FP_TREV]
@@ -159,7 +168,7 @@ def advance(prob, C, W, S, O, hertz):
             break
         t_out = ist[I_NEXT_OUT] * out_dt  # output rows inside (t, t1]: a call only when one is due
         if (t_out <= t1 + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
-                and not step_rows(prob, C, t, h, now, zdd1, W, O, S, hertz)):
+                and not step_rows(prob, C, t, h, Y, srco, O, ist, hertz)):
             break
         # accept: peaks (output.track_peaks, the forces from the step's product), state, time
         after = t1 >= t_rev

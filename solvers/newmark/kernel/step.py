@@ -36,6 +36,12 @@ from vtool.solvers.newmark.layout import (
     MK_KIND,
     MK_OVERLAP,
     SOFT_HERTZ,
+    SRC_END,
+    Y_END,
+    Y_NOW,
+    ZD,
+    ZDD,
+    Z,
 )
 from vtool.solvers.newmark.records import Config
 
@@ -101,9 +107,9 @@ def gather(C, n, S, y):
     """The layer state y of the full state (S.x, S.v, S.a)."""
     for j in range(C.ci[CI_M]):
         i = C.ci[CI_HEAD + j]
-        y.z[j] = S.x[i]
-        y.zd[j] = S.v[i]
-        y.zdd[j] = S.a[i]
+        y[Z, j] = S.x[i]
+        y[ZD, j] = S.v[i]
+        y[ZDD, j] = S.a[i]
 
 
 @jit_inline
@@ -111,9 +117,9 @@ def scatter(C, n, y, S):
     """The full state (S.x, S.v, S.a) of the layer state y."""
     for i in range(n):
         j = C.ci[CI_HEAD + n + i]
-        S.x[i] = y.z[j]
-        S.v[i] = y.zd[j]
-        S.a[i] = y.zdd[j]
+        S.x[i] = y[Z, j]
+        S.v[i] = y[ZD, j]
+        S.a[i] = y[ZDD, j]
 
 
 @jit_inline
@@ -161,29 +167,30 @@ def correct(nf, h, beta, gamma, acc, z1, zd1, zdd1, limit):
 def free_rhs(C, src, y, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
     right, and the sources' pull through closed compliant contacts (``layout.CP_RAW``)."""
-    apply_operator(C.cp, C.ci, CP_RAW, C.ci[CI_NF], C.ci[CI_SRC], src, y.z, y.zd, y.zdd, rhs)
+    apply_operator(C.cp, C.ci, CP_RAW, C.ci[CI_NF], C.ci[CI_SRC], src, y[Z], y[ZD], y[ZDD], rhs)
 
 
 @jit
 def layer_step(prob, C, W, h, which, hertz):
-    """One Newmark step of length h from layer state W.now into W.end, the sources at t + h in W.src1.
+    """One Newmark step of length h from layer state W.y[Y_NOW] into W.y[Y_END], the sources at t + h in W.src[SRC_END].
 
     ``which``: STANDARD the stored S⁻¹ of the standard step (as one product with G = S⁻¹R),
     REFINED of the refined step, CHOLESKY a Cholesky factor already in W.L. Closed Hertz contacts
     are added by Newton iteration (:func:`~vtool.solvers.newmark.kernel.forces.hertz_correction`).
     """
     beta, gamma = prob.fp[FP_BETA], prob.fp[FP_GAMMA]
-    ci, y, y1 = C.ci, W.now, W.end
+    ci, y, y1, src1 = C.ci, W.y[Y_NOW], W.y[Y_END], W.src[SRC_END]
     nf = ci[CI_NF]
-    predict(ci[CI_M], h, beta, gamma, y.z, y.zd, y.zdd, y1.z, y1.zd)
-    prescribed(ci, prob.ip[IP_N], W.src1, y1.z, y1.zd, y1.zdd)
+    predict(ci[CI_M], h, beta, gamma, y[Z], y[ZD], y[ZDD], y1[Z], y1[ZD])
+    prescribed(ci, prob.ip[IP_N], src1, y1[Z], y1[ZD], y1[ZDD])
+    # CHOLESKY: ΔP (free_rhs's product) into W.rhs, then solved; else z̈_F = S⁻¹ ΔP as one product with the
+    # stored G = S⁻¹R into W.sol. One product written for both (each row sums in the same order either way).
+    plane = CP_RAW if which == CHOLESKY else (CP_STD if which == STANDARD else CP_FINE)
+    out = W.rhs if which == CHOLESKY else W.sol
+    apply_operator(C.cp, ci, plane, nf, ci[CI_SRC], src1, y1[Z], y1[ZD], y1[ZDD], out)
     if which == CHOLESKY:
-        free_rhs(C, W.src1, y1, W.rhs)
         cholesky_solve(nf, W.L, W.rhs, W.sol)
-    else:  # z̈_F = S⁻¹ ΔP as one product with the stored G = S⁻¹R
-        apply_operator(C.cp, ci, CP_STD if which == STANDARD else CP_FINE, nf, ci[CI_SRC], W.src1, y1.z, y1.zd,
-                       y1.zdd, W.sol)
-    correct(nf, h, beta, gamma, W.sol, y1.z, y1.zd, y1.zdd, math.inf)
+    correct(nf, h, beta, gamma, W.sol, y1[Z], y1[ZD], y1[ZDD], math.inf)
     if hertz is not None:
         if C.ci[CI_HERTZ]:
             hertz_correction(prob, C, W, h, which)
@@ -192,7 +199,7 @@ def layer_step(prob, C, W, h, which, hertz):
 @jit
 def consistent_acceleration(prob, C, src, y, rhs, hertz):
     """Free accelerations of configuration C from its equations of motion (prescribed set from src)."""
-    prescribed(C.ci, prob.ip[IP_N], src, y.z, y.zd, y.zdd)
+    prescribed(C.ci, prob.ip[IP_N], src, y[Z], y[ZD], y[ZDD])
     free_rhs(C, src, y, rhs)
     nf = C.ci[CI_NF]
     if hertz is not None:
@@ -207,7 +214,7 @@ def consistent_acceleration(prob, C, src, y, rhs, hertz):
         s = 0.0
         for g in range(nf):
             s += C.cm[CM_MINVFF, f, g] * rhs[g]
-        y.zdd[f] = s
+        y[ZDD, f] = s
 
 
 @jit_inline
@@ -215,7 +222,7 @@ def interpolate(nf, s_out, h, z, zd, zdd, zdd1, out):
     """The free coordinates at s_out into a step of length h from (z, ż, z̈) whose end acceleration is
     z̈1, into the layer state ``out``: the linear-acceleration interpolant (exact for beta = 1/6;
     thesis eqs. B.3-B.5)."""
-    zo, zdo, zddo = out.z, out.zd, out.zdd
+    zo, zdo, zddo = out[Z], out[ZD], out[ZDD]
     r = s_out / h
     for j in range(nf):
         da = zdd1[j] - zdd[j]
