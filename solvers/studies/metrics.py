@@ -361,8 +361,21 @@ def _seatings(trace: Trace, index: int, window: tuple[float, float]) -> list[flo
 
 def _seat_metrics(trace: Trace, index: int | None, window: tuple[float, float], criteria: Criteria) -> dict[str, float]:
     spec = trace.spec
-    result = {"lift_loss": NAN, "seating_velocity_max": NAN, "seating_velocity_mean": NAN,
-              "seat_bounces": 0, "bounce_height": NAN}
+    result = _seat_motion(trace, index, window) | {"seat_bounces": 0, "bounce_height": NAN}
+    if index is None or spec.seat is None:
+        return result
+    clearance = spec.clearances[index]
+    bounces = [b for b in trace.seat_bounces(clearance.name)
+               if window[0] <= b[1] <= window[1] and b[2] > criteria.bounce_lift]
+    result["seat_bounces"] = _per_revolution([landing for _, landing, _ in bounces])
+    result["bounce_height"] = max((height for _, _, height in bounces), default=0.0)
+    return result
+
+
+def _seat_motion(trace: Trace, index: int | None, window: tuple[float, float]) -> dict[str, float]:
+    """The lift loss and the seating velocities in the window (NaN without a seat or a seating)."""
+    spec = trace.spec
+    result = {"lift_loss": NAN, "seating_velocity_max": NAN, "seating_velocity_mean": NAN}
     if index is None or spec.seat is None:
         return result
     clearance = spec.clearances[index]
@@ -379,10 +392,6 @@ def _seat_metrics(trace: Trace, index: int | None, window: tuple[float, float], 
     if speeds:
         result["seating_velocity_max"] = float(max(speeds))
         result["seating_velocity_mean"] = float(np.mean(speeds))
-    bounces = [b for b in trace.seat_bounces(clearance.name)
-               if window[0] <= b[1] <= window[1] and b[2] > criteria.bounce_lift]
-    result["seat_bounces"] = _per_revolution([landing for _, landing, _ in bounces])
-    result["bounce_height"] = max((height for _, _, height in bounces), default=0.0)
     return result
 
 
@@ -417,22 +426,34 @@ def _startup(trace: Trace, seat: int | None) -> dict[str, float]:
             "startup_seating_velocity": float(max(speeds)) if speeds else NAN}
 
 
-def run_metrics(trace: Trace, window: tuple[float, float] | None = None,
-                criteria: Criteria | None = None) -> dict[str, float]:
+def _peak_metrics(trace: Trace, peaks: np.ndarray) -> dict[str, float]:
+    spec = trace.spec
+    return {f"peak_{force_label(spec, i)}": NAN if c.state == REMOVED else float(peaks[i])
+            for i, c in enumerate(spec.clearances)}
+
+
+def settling_metrics(trace: Trace, window: tuple[float, float]) -> dict[str, float]:
+    """The metrics by which a run's cycle is compared with another (:func:`vtool.solvers.studies.steady.cycle_change`):
+    the peak forces, the lift loss and the largest seating velocity, each as :func:`run_metrics` gives it (the
+    same functions), without the rest of its work (the cam separations, the coil-bind margin, a spectrum)."""
+    seat = _seat_motion(trace, seat_index(trace.spec), window)
+    return _peak_metrics(trace, _peaks(trace, window)) | {"lift_loss": seat["lift_loss"],
+                                                          "seating_velocity_max": seat["seating_velocity_max"]}
+
+
+def run_metrics(trace: Trace, window: tuple[float, float] | None = None) -> dict[str, float]:
     """The metrics of one run over ``window`` (default :func:`evaluation_window`), keyed as
-    :func:`metric_columns`; ``criteria``: ``Criteria.of(trace.spec)`` made once by a caller that measures
-    many runs of one spec (a run's cycles: :mod:`vtool.solvers.studies.steady`)."""
+    :func:`metric_columns`."""
     spec = trace.spec
     window = evaluation_window(trace) if window is None else window
-    criteria = Criteria.of(spec) if criteria is None else criteria
+    criteria = Criteria.of(spec)
     cam = cam_index(spec)
     seat = seat_index(spec)
     metrics: dict[str, float] = {}
     metrics.update(_cam_separation(trace, window, criteria))
     metrics.update(_seat_metrics(trace, seat, window, criteria))
     peaks = _peaks(trace, window)
-    for i, c in enumerate(spec.clearances):
-        metrics[f"peak_{force_label(spec, i)}"] = NAN if c.state == REMOVED else float(peaks[i])
+    metrics.update(_peak_metrics(trace, peaks))
     rows = (trace.cam_angle >= window[0]) & (trace.cam_angle <= window[1])
     during = rows & _during_lift(trace, criteria.bins)
     in_contact = during & ((trace.configuration & clearance_bit(spec, cam)) != 0)

@@ -56,7 +56,7 @@ from typing import Any
 import numpy as np
 
 from vtool.solvers.model.mechanism import Mechanism
-from vtool.solvers.studies.metrics import Criteria, run_metrics, total_lift
+from vtool.solvers.studies.metrics import settling_metrics, total_lift
 from vtool.solvers.trace import MAX_PERIOD, Cycles, Event, RunStatistics, Trace
 
 #: run.steady's defaults
@@ -141,8 +141,8 @@ def _event_counts(trace: Trace) -> dict[str, int]:
 
 @dataclass(frozen=True)
 class _Measures:
-    """What :func:`cycle_change` compares of one cycle's run: its metrics over the cycle, its elastic
-    coordinates' and velocities' largest magnitudes and start values, its events per clearance."""
+    """What :func:`cycle_change` compares of one cycle's run: its :func:`settling_metrics` over the cycle,
+    its elastic coordinates' and velocities' largest magnitudes and start values, its events per clearance."""
 
     metrics: dict[str, float]
     largest: dict[str, float]  # "q", "qd": the largest magnitude over the run
@@ -150,30 +150,26 @@ class _Measures:
     events: dict[str, int]
 
     @classmethod
-    def of(cls, trace: Trace, criteria: Criteria | None = None) -> _Measures:
+    def of(cls, trace: Trace) -> _Measures:
         n = trace.spec.n_coordinates
         largest, start = {}, {}
         for data in ("q", "qd"):
             values = getattr(trace, data)[:, :n]
             largest[data] = float(np.abs(values).max())
             start[data] = values[0]
-        return cls(run_metrics(trace, (0.0, REVOLUTION), criteria), largest, start, _event_counts(trace))
+        return cls(settling_metrics(trace, (0.0, REVOLUTION)), largest, start, _event_counts(trace))
 
 
 class Measured:
-    """Each cycle's :class:`_Measures`, made once (by the trace's id: the caller keeps the traces alive),
-    and the spec's criteria, made once: a run of cycles compares each cycle with the one before and up to
-    MAX_PERIOD more (10,522 -> 1,549 run_metrics calls for 56 finger-follower points)."""
+    """Each cycle's :class:`_Measures`, made once (by the trace's id: the caller keeps the traces alive): a
+    run of cycles compares each cycle with the one before and up to MAX_PERIOD more."""
 
     def __init__(self) -> None:
         self.kept: dict[int, _Measures] = {}
-        self.criteria: tuple[Any, Criteria] | None = None  # (the spec, its criteria)
 
     def __call__(self, trace: Trace) -> _Measures:
         if id(trace) not in self.kept:
-            if self.criteria is None or self.criteria[0] is not trace.spec:
-                self.criteria = (trace.spec, Criteria.of(trace.spec))
-            self.kept[id(trace)] = _Measures.of(trace, self.criteria[1])
+            self.kept[id(trace)] = _Measures.of(trace)
         return self.kept[id(trace)]
 
 
