@@ -299,7 +299,7 @@ class KernelRun:
         self.ist[layout.I_CFG] = problem.start_mask
         self.ist[layout.I_NEED_SETTLE] = 1
         self.fst[layout.F_LAST_EVENT] = -1.0
-        self.scratch = scratch(n, ns, ncl)  # (zeroed by the kernel at each call)
+        self.scratch, self.scratch_buffer = scratch(n, ns, ncl)  # (zeroed before each call: chunk)
         self.compile_time = 0.0
 
     def flush(self, final: bool = False) -> None:
@@ -323,6 +323,8 @@ class KernelRun:
         args = (self.record, problem.tables.record(), self.scratch, self.state, self.out, problem.hertz,
                 problem.momentum)
         key = jit.law_key(problem.hertz, problem.momentum)
+        self.scratch_buffer.fill(0.0)  # every call starts with a zeroed scratch, as with fresh arrays
+        self.scratch.closing.fill(0)
         if jit.is_compiled(kernel.run_chunk, "run_chunk", key):
             return int(kernel.run_chunk(*args))
         started = wallclock.perf_counter()

@@ -13,7 +13,7 @@ from vtool.solvers.newmark.kernel.forces import (
     signed_gap,
 )
 from vtool.solvers.newmark.kernel.impacts import release_pulling, take_events
-from vtool.solvers.newmark.kernel.output import record_row, step_rows, track_peaks
+from vtool.solvers.newmark.kernel.output import raise_peaks, record_row, step_rows, track_peaks
 from vtool.solvers.newmark.kernel.quiet import advance
 from vtool.solvers.newmark.kernel.step import (
     CHOLESKY,
@@ -185,18 +185,6 @@ def arrive(S, target, grid_next, k_grid, j_target):
 
 
 @jit_inline
-def clear(W):
-    """The scratch zeroed, as fresh arrays would be (each call of :func:`run_chunk` starts so)."""
-    W.y.fill(0.0)
-    W.src.fill(0.0)
-    W.cross.fill(0.0)
-    W.rhs.fill(0.0)
-    W.sol.fill(0.0)
-    W.L.fill(0.0)
-    W.closing.fill(0)
-
-
-@jit_inline
 def start(prob, C, W, S, O, hertz):
     """The run's first row (the start is an output row and counts for the peaks); False when the
     output buffer is full."""
@@ -295,7 +283,7 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
     interpolated inside the step; ``O.peak[PEAK_ALL]`` holds the peak contact
     forces over every step, ``[PEAK_LATE]`` those after the first cam
     revolution, ``[PEAK_OVERLAP]`` the largest overlap of each compliant
-    contact. The scratch W is zeroed at each call, as fresh arrays would be.
+    contact. The caller zeroes the scratch W before each call, as fresh arrays would be.
     Only the momentum law's impacts and the Hertz iteration allocate their
     small systems.
     """
@@ -304,7 +292,6 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
     n, ncl = prob.ip[IP_N], prob.cl.shape[0]
     dt, t_end, out_dt, x_limit, t_rev = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_XLIM], fp[FP_TREV]
     now, end, src0, src1, phi = W.y[Y_NOW], W.y[Y_END], W.src[SRC_NOW], W.src[SRC_END], W.cross[PHI]
-    clear(W)
     while True:
         t = fst[F_T]
         c = ist[I_CFG]
@@ -386,7 +373,11 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
                             and not step_rows(prob, C, t, h, W.y, W.src[SRC_OUT], O, ist, hertz)):
                         status = OUTPUT_FULL
                         break
-                track_peaks(prob, C, t + h >= t_rev, phi, end, src1, O.peak, hertz)
+                if hertz is None:  # linear contacts: the quiet loop's peaks (no call to compile)
+                    raise_peaks(C.mk, C.mon, n, prob.ip[IP_NS], t + h >= t_rev, fp[FP_GAPNOISE], phi, end[Z], end[ZD],
+                                end[ZDD], src1, O.peak)
+                else:
+                    track_peaks(prob, C, t + h >= t_rev, phi, end, src1, O.peak, hertz)
                 ist[I_STEPS] += 1
                 copy_state(n, end, src1, now, src0)
                 t = t + h

@@ -117,6 +117,24 @@ def step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
         ist[I_NEXT_OUT] = j_out + 1
 
 
+@jit_inline
+def raise_peaks(mk, mon, n, ns, after, gap_noise, phi, z, zd, zdd, src, peak):
+    """:func:`track_peaks` with linear contacts only (no Hertz law): a closed rigid contact's force is
+    its monitor phi[k], a compliant one's its linear row at the step's end (z, ż, z̈, sources src)."""
+    for k in range(phi.shape[0]):
+        kind = mk[k, MK_KIND]
+        if kind == MK_FORCE:
+            force = phi[k]
+        elif kind == MK_OVERLAP:
+            force = linear_force(mon, k, n, ns, mk[k, MK_M], z, zd, zdd, src)
+            peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
+        else:
+            continue
+        peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], force)
+        if after:
+            peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], force)
+
+
 @jit
 def track_peaks(prob, C, after, phi, y, src, peak, hertz):
     """Raise the peak contact forces (and compliant overlaps) with the monitors ``phi`` at a step's end

@@ -16,8 +16,8 @@ import math
 
 from vtool.jit import jit
 from vtool.solvers.newmark.kernel.algebra import apply_operator
-from vtool.solvers.newmark.kernel.forces import linear_force, signed_gap
-from vtool.solvers.newmark.kernel.output import step_rows
+from vtool.solvers.newmark.kernel.forces import signed_gap
+from vtool.solvers.newmark.kernel.output import raise_peaks, step_rows
 from vtool.solvers.newmark.kernel.step import correct, harmonics, predict, prescribed
 from vtool.solvers.newmark.layout import (
     CI_M,
@@ -53,12 +53,8 @@ from vtool.solvers.newmark.layout import (
     MK_FORCE,
     MK_GAP,
     MK_KIND,
-    MK_M,
     MK_OVERLAP,
     MK_ROW,
-    PEAK_ALL,
-    PEAK_LATE,
-    PEAK_OVERLAP,
     PHI,
     SRC_END,
     SRC_OUT,
@@ -171,20 +167,8 @@ def advance(prob, C, W, S, O, hertz):
         if (t_out <= t1 + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
                 and not step_rows(prob, C, t, h, Y, srco, O, ist, hertz)):
             break
-        # accept: peaks (output.track_peaks, the forces from the step's product), state, time
-        after = t1 >= t_rev
-        for k in range(ncl):
-            kind = mk[k, MK_KIND]
-            if kind == MK_FORCE:
-                peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], phi[k])
-                if after:
-                    peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], phi[k])
-            elif kind == MK_OVERLAP:
-                force = linear_force(mon, k, n, ns, mk[k, MK_M], z1, zd1, zdd1, src1)
-                peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
-                peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], force)
-                if after:
-                    peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], force)
+        # accept: peaks (the rigid contacts' forces from the step's product), state, time
+        raise_peaks(mk, mon, n, ns, t1 >= t_rev, gap_noise, phi, z1, zd1, zdd1, src1, peak)
         for j in range(m):
             z[j] = z1[j]
             zd[j] = zd1[j]
