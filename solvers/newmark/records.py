@@ -55,7 +55,7 @@ def scratch(n: int, ns: int, ncl: int) -> tuple[Scratch, np.ndarray]:
 
     Returns the record and the one buffer its float arrays are views of: the caller zeroes the
     buffer and ``closing`` before each kernel call (two fills), so that every call starts as with fresh
-    arrays (the kernel's own zeroing was about 0.3 s of its first compile)."""
+    arrays (zeroing them in the kernel compiled four ``fill`` specialisations into its first compile)."""
     sizes = (9 * n, 9 * ns, 3 * ncl, n + ncl, n, n * n)
     buffer = np.zeros(sum(sizes))
     y, src, cross, rhs, sol, L = np.split(buffer, np.cumsum(sizes)[:-1])
