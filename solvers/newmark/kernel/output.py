@@ -138,18 +138,16 @@ def raise_peaks(mk, mon, n, ns, after, gap_noise, phi, z, zd, zdd, src, peak):
 @jit
 def track_peaks(prob, C, after, phi, y, src, peak, hertz):
     """Raise the peak contact forces (and compliant overlaps) with the monitors ``phi`` at a step's end
-    (state y, sources src); ``after``: the step ends after the first cam revolution."""
+    (state y, sources src); ``after``: the step ends after the first cam revolution. A compliant
+    contact's force by its own law (:func:`compliant_force`): the run loop calls this with Hertz
+    contacts, :func:`raise_peaks` with linear ones."""
     gap_noise = prob.fp[FP_GAPNOISE]
-    n, ns = prob.ip[IP_N], prob.ip[IP_NS]
-    mk, mon = C.mk, C.mon
+    mk = C.mk
     for k in range(prob.cl.shape[0]):
         kind = mk[k, MK_KIND]
         force = phi[k]
         if kind == MK_OVERLAP:
-            if hertz is None:
-                force = linear_force(mon, k, n, ns, mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
-            else:
-                force = compliant_force(prob, C, k, y, src, hertz)
+            force = compliant_force(prob, C, k, y, src, hertz)
             peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
         elif kind != MK_FORCE:
             continue
