@@ -34,9 +34,7 @@ from __future__ import annotations
 import csv
 import io
 import sys
-import time
 from collections.abc import Callable, Iterable, Sequence
-from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -83,19 +81,13 @@ def repeated_columns(values: np.ndarray) -> np.ndarray:
 Formatter = Callable[..., int]
 
 
-def kernel() -> ModuleType:
-    """The numba kernel's module (imported when first needed: it imports numba)."""
-    from vtool import csvrows_kernel
-
-    return csvrows_kernel
-
-
 def ready() -> bool:
     """True when numba's kernel needs no compiling: plain Python, loaded in this process, or compiled into
-    numba's cache before (:func:`vtool.jit.is_compiled`)."""
+    numba's cache before (:func:`vtool.jit.is_compiled`). Imports numba."""
     from vtool import jit
+    from vtool.csvrows_kernel import put_rows
 
-    return jit.is_compiled(kernel().put_rows, "put_rows", "csv")
+    return jit.is_compiled(put_rows, "put_rows", "csv")
 
 
 def choose(rows: int, compiled: bool | None) -> Formatter | None:
@@ -110,7 +102,9 @@ def choose(rows: int, compiled: bool | None) -> Formatter | None:
     if compiled is False:
         return None
     if compiled or rows >= WORTH_COMPILING_ROWS or ("numba" in sys.modules and ready()):
-        return kernel().put_rows
+        from vtool.csvrows_kernel import put_rows
+
+        return put_rows
     return None
 
 
@@ -145,15 +139,10 @@ def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
     if put_rows is None:
         text = "".join(python_row(values[r], labels[int(label_of_row[r])]) for r in range(rows))
         return [text.encode("utf-8")]
-    args = arguments(values, labels, label_of_row)
-    if ready():
-        end = put_rows(*args)
-    else:  # numba compiles it first: timed, and marked compiled (vtool.jit)
-        from vtool import jit
+    from vtool import jit
 
-        started = time.perf_counter()
-        end = put_rows(*args)
-        jit.compiled("put_rows", "csv", time.perf_counter() - started)
+    args = arguments(values, labels, label_of_row)
+    end, _ = jit.timed_call(put_rows, "put_rows", "csv", *args)  # the first call compiles it: timed, marked
     label_of_row, out, offsets, fallback = args[6:]
     pieces, done = [], 0
     for r in np.flatnonzero(fallback).tolist():

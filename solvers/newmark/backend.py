@@ -6,59 +6,18 @@ validates the settings, builds configurations lazily (the first time the
 kernel reaches one), calls the kernel in chunks (progress, cancel), and hands
 rows and events to the :class:`~vtool.solvers.trace.TraceBuilder`.
 
-Method (see the kernel's docstring for the equations):
-
-* Newmark with general beta, gamma; the thesis' linear acceleration
-  (beta = 1/6, gamma = 1/2) is the default. The effective matrix inverse
-  (thesis BMIV) of a configuration is computed when the configuration is first
-  visited and reused for every standard step.
-* Events: after each step the contact force of every closed clearance and
-  the gap of every open one are checked. A sign change is located by
-  re-stepping from the start of the step (Illinois root finding on the
-  Newmark solution itself, not on an interpolant) to within
-  ``time_tolerance`` (default 1e-6 of the time step: 1e-12 s at 1 µs); when
-  several monitors change sign in one step the earliest event is taken first
-  and the rest of the step is integrated in the new configuration. A gap that
-  starts at zero (a contact just released) has a round-off sign, so a gap
-  closes when it falls below -1e-13 of the mechanism's size.
-* Impacts: the clearance's impact law (``local``, ``thesis``, ``momentum``;
-  see :func:`vtool.solvers.newmark.kernel.apply_impacts`) with Newton's restitution
-  coefficient. After every transition the contact forces of the new
-  configuration are evaluated and any contact that would pull is released
-  at once (:func:`vtool.solvers.newmark.kernel.release_pulling`). Separations and
-  bounces slower than ``rest_velocity`` (default 1e-5 of the cam amplitude
-  times the larger of the cam speed and the lowest natural frequency) are
-  resting contacts that stay closed until their contact force says
-  otherwise.
-* Chattering: ``zeno_stick`` (20) events each within 1e-3 of the shortest
-  natural period of the previous one (events piling up) make
-  every contact involved stick (restitution zero, held shut; their forces
-  then decide separation); ``zeno_stop`` (400) such events stop the run with
-  a message naming the time and configuration. A run never loops forever.
-* Refinement after events: an impact excites the highest modes, which the
-  step resolves poorly (omega_max dt = 1.37 at 1 µs in the thesis examples),
-  and their error moves the events that follow. For four periods of the
-  highest natural frequency after every event the step is divided by
-  ``refine`` (10); the rest of the run keeps the user's step. Four periods,
-  not two: with two, a grazing rocker re-contact of example 3 (7 lbf just
-  after the impact) came out as an extra separation; with four, all six
-  thesis presets give the exact back end's event sequence (the accuracy
-  tables give the figures). ``refine = 1`` is the plain thesis scheme.
-* First run: the kernel is compiled by numba on the first call and kept in
-  numba's cache (:mod:`vtool.numba_cache`); :func:`compile_notice` gives the
-  line to show before it, and :class:`KernelRun` times it and marks it done
-  (:mod:`vtool.jit`).
-* Stability: for gamma = 1/2 and beta < 1/4 the step must satisfy
-  omega_max dt <= 1 / sqrt(gamma/2 - beta) (2 sqrt 3 for linear acceleration:
-  dt <= sqrt(3)/pi T_min), with omega_max the highest natural frequency of
-  the unconstrained system, which bounds every configuration's.
+The method (configurations, event location by re-stepping, the impact laws,
+resting contacts and chattering, the refinement after events, the stability
+limit omega_max dt <= 1 / sqrt(gamma/2 - beta)) is in docs/valvetrain.md, "The
+method"; its equations in :mod:`vtool.solvers.newmark.kernel`; the first run's
+compile (:func:`compile_notice`, :class:`KernelRun`) in docs/developer.md,
+"Compile".
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import time as wallclock
 from dataclasses import dataclass
 from typing import Any
 
@@ -159,8 +118,6 @@ def compile_solver(spec: Any) -> None:
     """Compile the kernel for valve-train ``spec``'s contact laws, or load it from numba's cache: a run
     of ten time steps (the TUI starts it when a preset opens). Nothing when its back end is not newmark
     or its settings are refused (the real run says why)."""
-    import dataclasses
-
     from vtool.solvers.model.mechanism import assemble
 
     if spec.run.backend != "newmark":
@@ -322,16 +279,12 @@ class KernelRun:
         problem = self.problem
         args = (self.record, problem.tables.record(), self.scratch, self.state, self.out, problem.hertz,
                 problem.momentum)
-        key = jit.law_key(problem.hertz, problem.momentum)
         self.scratch_buffer.fill(0.0)  # every call starts with a zeroed scratch, as with fresh arrays
         self.scratch.closing.fill(0)
-        if jit.is_compiled(kernel.run_chunk, "run_chunk", key):
-            return int(kernel.run_chunk(*args))
-        started = wallclock.perf_counter()
-        status = int(kernel.run_chunk(*args))  # numba compiles it (or loads it from its cache) first
-        self.compile_time = wallclock.perf_counter() - started
-        jit.compiled("run_chunk", key, self.compile_time)
-        return status
+        status, seconds = jit.timed_call(kernel.run_chunk, "run_chunk", jit.law_key(problem.hertz, problem.momentum),
+                                         *args)
+        self.compile_time = self.compile_time or seconds
+        return int(status)
 
     def execute(self, progress: Progress | None, cancel: Cancel | None) -> None:
         problem = self.problem

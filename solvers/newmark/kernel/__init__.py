@@ -52,10 +52,8 @@ times the ahead coordinate's velocity (Gnilka eq. 3.54). After every
 transition :func:`release_pulling` computes the consistent accelerations of
 the new configuration and releases at once any contact whose force would pull.
 
-Law switches: the ``hertz`` and ``momentum`` arguments
-(:func:`~vtool.solvers.newmark.layout.laws`) are None when no clearance uses
-that law: numba prunes the branches under them before typing, so the Hertz
-iteration and the momentum-law LCP are compiled only for mechanisms that use them.
+Law switches: the ``hertz`` and ``momentum`` arguments are None when no
+clearance uses that law (:func:`~vtool.solvers.newmark.layout.laws`).
 """
 
 from vtool.solvers.newmark.kernel.forces import hertz_force
@@ -68,9 +66,4 @@ from vtool.solvers.newmark.kernel.impacts import (
 from vtool.solvers.newmark.kernel.loop import run_chunk
 from vtool.solvers.newmark.kernel.step import sources
 
-#: The functions the back ends call from Python.
-ENTRY_POINTS = ("run_chunk", "apply_impacts", "release_pulling", "sources", "shut_gap", "gap_velocity",
-                "hertz_force")
-
-__all__ = ["ENTRY_POINTS", "apply_impacts", "gap_velocity", "hertz_force", "release_pulling", "run_chunk",
-           "shut_gap", "sources"]
+__all__ = ["apply_impacts", "gap_velocity", "hertz_force", "release_pulling", "run_chunk", "shut_gap", "sources"]
