@@ -1,9 +1,10 @@
-"""CSV rows of numbers formatted by a compiled kernel: the text of Python's ``'%.10g' % x``, 10-20x faster.
+"""CSV rows of numbers formatted by a compiled kernel: the text of Python's ``'%.10g' % x``, faster.
 
 A row is the values of one row of a float array, each as ``'%.10g' % x``,
 separated by commas, then a comma, the row's label (a preset-dependent text
-such as ``VI,cam+seat``) and a newline. Python's own formatting costs about
-30 µs per row of 46 values; a long ``--every-step`` run has a million rows.
+such as ``VI,cam+seat``) and a newline. A long ``--every-step`` run has a
+million rows; ``python3 benchmarks/bench_output.py`` times the kernel against
+Python's formatting (the same text).
 
 How the kernel writes ``x`` with 10 significant digits (C's ``%.10g``):
 
@@ -42,7 +43,7 @@ import numpy as np
 #: Characters one value can take at most (``-1.234567891e-100``) plus its comma.
 VALUE_WIDTH = 18
 #: Outputs of at least this many rows compile the kernel when it is not cached yet (smaller ones
-#: are written by Python: about 25 µs per row of 46 values, under a second for 20,000 rows).
+#: are written by Python, in well under a second).
 WORTH_COMPILING_ROWS = 20_000
 #: Decimal shifts 10^k, |k| <= MAX_SHIFT, are one multiplication by the nearest double.
 MAX_SHIFT = 44
@@ -97,7 +98,7 @@ def choose(rows: int, compiled: bool | None) -> Formatter | None:
     is True, when the output is large enough to pay for the kernel's compile
     (a few seconds, once; a per-degree CSV does not wait for it), or when
     numba is loaded in this process already and the kernel is cached (not
-    worth importing numba for: Python writes 20,000 rows in about 0.5 s).
+    worth importing numba for).
     """
     if compiled is False:
         return None

@@ -79,10 +79,6 @@ class NewmarkOptions:
     refine: int = 10  # after each event, steps of time_step / refine ...
     refine_periods: float = 4.0  # ... for this many periods of the highest natural frequency
 
-    @classmethod
-    def from_run(cls, run: RunSpec, every_step: bool = False) -> NewmarkOptions:
-        return cls(run.time_step, run.beta, run.gamma, run.output_interval, every_step)
-
 
 def kernel_laws(spec: Any, impacts: tuple[str, ...] = ()) -> tuple[bool | None, bool | None]:
     """The kernel's (hertz, momentum) switches for a valve-train spec, and for its runs under the impact
@@ -114,23 +110,6 @@ def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | Non
     return jit.compile_notice("the solver" if backend == "newmark" else "the event rules", name)
 
 
-def compile_solver(spec: Any) -> None:
-    """Compile the kernel for valve-train ``spec``'s contact laws, or load it from numba's cache: a run
-    of ten time steps (the TUI starts it when a preset opens). Nothing when its back end is not newmark
-    or its settings are refused (the real run says why)."""
-    from vtool.solvers.model.mechanism import assemble
-
-    if spec.run.backend != "newmark":
-        return
-    run = spec.run
-    short = dataclasses.replace(spec, run=dataclasses.replace(run, degrees=10.0 * run.time_step * 6.0 * run.rpm))
-    backend = NewmarkBackend()
-    try:
-        backend.simulate(assemble(short), backend.options_from_run(short.run))
-    except (InputError, RunError):
-        return
-
-
 def stability_limit(beta: float, gamma: float, omega_max: float) -> float:
     """Largest stable step (s) of Newmark(beta, gamma) for omega_max; inf if unconditional."""
     if 2.0 * beta >= gamma >= 0.5:
@@ -144,32 +123,6 @@ def round_down(value: float, digits: int) -> float:
     return math.floor(value / unit) * unit
 
 
-def highest_frequency(mechanism: Mechanism) -> float:
-    """omega_max of the unconstrained system: no configuration is stiffer."""
-    return mechanism.highest_frequency
-
-
-def check_settings(mechanism: Mechanism, options: NewmarkOptions) -> None:
-    """Refuse a step that is not positive or beyond the stability limit."""
-    dt = options.time_step
-    if not dt > 0.0:
-        raise InputError("run.time_step", dt, "> 0", "s")
-    (beta_low, beta_high), (gamma_low, gamma_high) = BETA_RANGE, GAMMA_RANGE  # the loader's bounds
-    if not beta_low < options.beta <= beta_high:
-        raise InputError("run.beta", options.beta, f"> {beta_low:g} and <= {beta_high:g}")
-    if not gamma_low <= options.gamma <= gamma_high:
-        raise InputError("run.gamma", options.gamma, f">= {gamma_low:g} and <= {gamma_high:g}")
-    if not options.refine >= 1:
-        raise InputError("refine", options.refine, ">= 1")
-    limit = stability_limit(options.beta, options.gamma, highest_frequency(mechanism))
-    if dt > limit and options.enforce_stability_limit:
-        raise InputError(
-            "run.time_step", dt,
-            f"<= {round_down(limit, 6):.6g} (stability limit of Newmark beta={options.beta:.4g}, gamma={options.gamma:.4g} "
-            f"for the stiffest configuration; use beta=1/4 for no limit)", "s",
-        )
-
-
 class NewmarkBackend(Backend[NewmarkOptions]):
     """Newmark back end (see module doc). Registered as ``newmark``."""
 
@@ -179,12 +132,12 @@ class NewmarkBackend(Backend[NewmarkOptions]):
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> NewmarkOptions:
-        return NewmarkOptions.from_run(run, every_step)
+        return NewmarkOptions(run.time_step, run.beta, run.gamma, run.output_interval, every_step)
 
     @classmethod
     def stable_step(cls, mechanism: Mechanism) -> float:
         run = mechanism.spec.run
-        return stability_limit(run.beta, run.gamma, highest_frequency(mechanism))
+        return stability_limit(run.beta, run.gamma, mechanism.highest_frequency)
 
     @classmethod
     def compile_notice(cls, spec: MechanismSpec, impacts: tuple[str, ...] = ()) -> str | None:
@@ -192,7 +145,17 @@ class NewmarkBackend(Backend[NewmarkOptions]):
 
     @classmethod
     def warm_up(cls, spec: MechanismSpec) -> None:
-        compile_solver(spec)
+        """Compile the kernel for valve-train ``spec``'s contact laws, or load it from numba's cache: a run
+        of ten time steps (the TUI starts it when a preset opens). Nothing when its settings are refused
+        (the real run says why)."""
+        from vtool.solvers.model.mechanism import assemble
+
+        run = spec.run
+        short = dataclasses.replace(spec, run=dataclasses.replace(run, degrees=10.0 * run.time_step * 6.0 * run.rpm))
+        try:
+            cls().simulate(assemble(short), cls.options_from_run(short.run))
+        except (InputError, RunError):
+            return
 
     @classmethod
     def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:
@@ -204,7 +167,24 @@ class NewmarkBackend(Backend[NewmarkOptions]):
         return [*settings, AccuracySetting(PLAIN_SETTING, run, NewmarkOptions(1e-6, refine=1))]
 
     def check(self, mechanism: Mechanism, options: NewmarkOptions) -> None:
-        check_settings(mechanism, options)
+        """Refuse a step that is not positive or beyond the stability limit."""
+        dt = options.time_step
+        if not dt > 0.0:
+            raise InputError("run.time_step", dt, "> 0", "s")
+        (beta_low, beta_high), (gamma_low, gamma_high) = BETA_RANGE, GAMMA_RANGE  # the loader's bounds
+        if not beta_low < options.beta <= beta_high:
+            raise InputError("run.beta", options.beta, f"> {beta_low:g} and <= {beta_high:g}")
+        if not gamma_low <= options.gamma <= gamma_high:
+            raise InputError("run.gamma", options.gamma, f">= {gamma_low:g} and <= {gamma_high:g}")
+        if not options.refine >= 1:
+            raise InputError("refine", options.refine, ">= 1")
+        limit = stability_limit(options.beta, options.gamma, mechanism.highest_frequency)
+        if dt > limit and options.enforce_stability_limit:
+            raise InputError(
+                "run.time_step", dt,
+                f"<= {round_down(limit, 6):.6g} (stability limit of Newmark beta={options.beta:.4g}, gamma={options.gamma:.4g} "
+                f"for the stiffest configuration; use beta=1/4 for no limit)", "s",
+            )
 
     def event_rules(self, options: NewmarkOptions) -> EventRules:
         return EventRules(options.rest_velocity, options.zeno_stick, options.zeno_stop)
