@@ -58,26 +58,6 @@ def python_row(values: np.ndarray, label: str) -> str:
     return ",".join("%.10g" % value for value in values.tolist()) + "," + label + "\n"  # noqa: UP031
 
 
-def repeated_columns(values: np.ndarray) -> np.ndarray:
-    """For each column, the first earlier column with the same values (bit for bit), or -1.
-
-    A trace's CSV repeats some columns (the preset's quantities ``q9``, ``F1``
-    ... beside the coordinates and forces): their text is copied."""
-    same = np.full(values.shape[1], -1, dtype=np.int64)
-    first: dict[bytes, list[int]] = {}
-    for c in range(values.shape[1]):
-        column = np.ascontiguousarray(values[:, c])
-        with np.errstate(all="ignore"):  # inf - inf in the sum is only a key
-            key = column.tobytes()[:64] + column.sum(dtype=np.float64).tobytes()
-        for j in first.get(key, []):
-            if np.array_equal(column.view(np.int64), values[:, j].view(np.int64)):
-                same[c] = j
-                break
-        else:
-            first.setdefault(key, []).append(c)
-    return same
-
-
 #: A compiled ``put_rows`` (:mod:`vtool.csvrows_kernel`'s signature).
 Formatter = Callable[..., int]
 
@@ -123,8 +103,7 @@ def arguments(values: np.ndarray, labels: list[str], label_of_row: np.ndarray) -
     out = np.empty(rows * (values.shape[1] * VALUE_WIDTH + width + 2), dtype=np.uint8)
     offsets = np.zeros(rows + 1, dtype=np.int64)
     fallback = np.zeros(rows, dtype=np.bool_)
-    return (values, values.view(np.int64), repeated_columns(values), POWERS, label_text, label_start,
-            label_of_row, out, offsets, fallback)
+    return values, values.view(np.int64), POWERS, label_text, label_start, label_of_row, out, offsets, fallback
 
 
 def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
@@ -144,7 +123,7 @@ def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
 
     args = arguments(values, labels, label_of_row)
     end, _ = jit.timed_call(put_rows, "put_rows", "csv", *args)  # the first call compiles it: timed, marked
-    label_of_row, out, offsets, fallback = args[6:]
+    label_of_row, out, offsets, fallback = args[5:]
     pieces, done = [], 0
     for r in np.flatnonzero(fallback).tolist():
         pieces.append(out[offsets[done]:offsets[r]])

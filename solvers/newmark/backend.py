@@ -182,8 +182,8 @@ class NewmarkBackend(Backend[NewmarkOptions]):
         if dt > limit and options.enforce_stability_limit:
             raise InputError(
                 "run.time_step", dt,
-                f"<= {round_down(limit, 6):.6g} (stability limit of Newmark beta={options.beta:.4g}, gamma={options.gamma:.4g} "
-                f"for the stiffest configuration; use beta=1/4 for no limit)", "s",
+                f"<= {round_down(limit, 6):.6g} (stability limit of Newmark beta={options.beta:.4g}, "
+                f"gamma={options.gamma:.4g} for the stiffest configuration; use beta=1/4 for no limit)", "s",
             )
 
     def event_rules(self, options: NewmarkOptions) -> EventRules:
