@@ -58,10 +58,6 @@ def python_row(values: np.ndarray, label: str) -> str:
     return ",".join("%.10g" % value for value in values.tolist()) + "," + label + "\n"  # noqa: UP031
 
 
-#: A compiled ``put_rows`` (:mod:`vtool.csvrows_kernel`'s signature).
-Formatter = Callable[..., int]
-
-
 def ready() -> bool:
     """True when numba's kernel needs no compiling: plain Python, loaded in this process, or compiled into
     numba's cache before (:func:`vtool.jit.is_compiled`). Imports numba."""
@@ -71,8 +67,9 @@ def ready() -> bool:
     return jit.is_compiled(put_rows, "put_rows", "csv")
 
 
-def choose(rows: int, compiled: bool | None) -> Formatter | None:
-    """The formatter for ``rows`` rows, or None for Python's formatting.
+def choose(rows: int, compiled: bool | None) -> Callable[..., int] | None:
+    """The formatter for ``rows`` rows (:mod:`vtool.csvrows_kernel`'s ``put_rows``), or None for Python's
+    formatting.
 
     ``compiled`` False: Python's; otherwise numba's kernel when ``compiled``
     is True, when the output is large enough to pay for the kernel's compile

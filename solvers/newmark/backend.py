@@ -261,8 +261,8 @@ class KernelRun:
                 problem.momentum)
         self.scratch_buffer.fill(0.0)  # every call starts with a zeroed scratch, as with fresh arrays
         self.scratch.closing.fill(0)
-        status, seconds = jit.timed_call(kernel.run_chunk, "run_chunk", jit.law_key(problem.hertz, problem.momentum),
-                                         *args)
+        key = jit.law_key(problem.hertz, problem.momentum)
+        status, seconds = jit.timed_call(kernel.run_chunk, "run_chunk", key, *args)
         self.compile_time = self.compile_time or seconds
         return int(status)
 
