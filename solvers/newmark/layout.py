@@ -78,15 +78,10 @@ PHI, PHI_START, TAU = range(3)
 
 
 def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:
-    """The ``hertz`` and ``momentum`` switches of the kernel's entry points for clearance table ``cl``.
-
-    Each is True when some clearance uses that law and None when none does.
-    numba prunes the branches under ``if hertz is not None`` (``momentum``)
-    before typing when the switch is None, so a mechanism without Hertz
-    contacts (momentum-law impacts) compiles and caches a kernel without
-    that code, and one with them compiles its own. The plain-Python
-    reference takes the same branches.
-    """
+    """The ``hertz`` and ``momentum`` switches of the kernel's entry points for clearance table ``cl``:
+    True when some clearance uses that law, None when none does. numba prunes the branches under a
+    None switch before typing, so each law pair compiles and caches a kernel of its own (and the
+    plain-Python reference takes the same branches)."""
     hertz = bool(np.any(cl[:, CL_SOFT] == SOFT_HERTZ))
     momentum = bool(np.any((cl[:, CL_LAW] == LAW_MOMENTUM) & (cl[:, CL_SOFT] == 0)))
     return (True if hertz else None), (True if momentum else None)
