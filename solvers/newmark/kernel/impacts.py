@@ -150,39 +150,27 @@ def impact_momentum(prob, c, closing, src, S, stick, O, t):
         if ((c & cl[k, CL_BIT]) and not cl[k, CL_SOFT]) or closing[k]:
             idx[nc] = k
             nc += 1
-    G = np.zeros((nc, n))
     u = np.zeros(nc)
     b = np.zeros(nc)
     eq = np.zeros(nc, dtype=np.int64)
+    MG = np.zeros((n, nc))  # M⁻¹ Gᵀ
     for r in range(nc):
         k = idx[r]
-        G[r, cl[k, CL_AHEAD]] = 1.0
-        wsrc = 0.0
-        if cl[k, CL_BEHIND] >= 0:
-            G[r, cl[k, CL_BEHIND]] -= 1.0
-        else:
-            wsrc = src[3 * cl[k, CL_SRC] + 1]
+        ahead, behind = cl[k, CL_AHEAD], cl[k, CL_BEHIND]
+        # G's row is e_ahead - e_behind, or e_ahead with w the source's velocity: u = G v - w and M⁻¹ Gᵀ by
+        # their entries, each sum begun at 0.0 as a dot product with G's row (the same bits, zeros' signs too)
+        u[r] = 0.0 + v[ahead] - (v[behind] if behind >= 0 else src[3 * cl[k, CL_SRC] + 1])
         for i in range(n):
-            u[r] += G[r, i] * v[i]
-        u[r] -= wsrc
+            MG[i, r] = 0.0 + mass[1, i, ahead] - (mass[1, i, behind] if behind >= 0 else 0.0)
         if closing[k]:
             e = 0.0 if (stick or abs(u[r]) < fp[FP_VREST]) else clf[k, CLF_E]
             b[r] = -e * u[r]
         eq[r] = cl[k, CL_PIN] or stick
-    MG = np.zeros((n, nc))  # M⁻¹ Gᵀ
-    for i in range(n):
-        for r in range(nc):
-            s = 0.0
-            for j in range(n):
-                s += mass[1, i, j] * G[r, j]
-            MG[i, r] = s
-    W = np.zeros((nc, nc))
+    W = np.zeros((nc, nc))  # G M⁻¹ Gᵀ
     for r in range(nc):
+        ahead, behind = cl[idx[r], CL_AHEAD], cl[idx[r], CL_BEHIND]
         for q in range(nc):
-            s = 0.0
-            for i in range(n):
-                s += G[r, i] * MG[i, q]
-            W[r, q] = s
+            W[r, q] = 0.0 + MG[ahead, q] - (MG[behind, q] if behind >= 0 else 0.0)
     umax = 0.0
     for r in range(nc):
         umax = max(umax, abs(u[r]))
