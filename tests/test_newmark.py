@@ -168,7 +168,7 @@ def test_quiet_steps_cam_angle_by_rotation_equals_libm_every_step() -> None:
 def test_a_quiet_steps_force_rows_give_the_contact_force_at_the_steps_end(preset: str) -> None:
     """A quiet step reads each closed rigid contact's force off its own product (the step operators'
     force rows, ``ConfigurationTables._force_rows``); that number is the force row of the step's end
-    state (``contact_force``, term by term), in every configuration, standard and refined step, from
+    state (``linear_force``, term by term), in every configuration, standard and refined step, from
     random states, to round-off. (The kernel's functions as plain Python: ``py_func``.)"""
     from vtool.solvers.newmark import layout
     from vtool.solvers.newmark.kernel import algebra, forces, step
@@ -182,7 +182,6 @@ def test_a_quiet_steps_force_rows_give_the_contact_force_at_the_steps_end(preset
     dt, beta, gamma, fine = 1e-6, 0.25, 0.5, 1e-7
     tables.use_step(dt, beta, gamma, fine)
     n, ns, ncl = problem.n, problem.ns, problem.ncl
-    record = problem.record()
     rng = np.random.default_rng(7)
     checked = 0
     for c in range(2**ncl):
@@ -205,7 +204,7 @@ def test_a_quiet_steps_force_rows_give_the_contact_force_at_the_steps_end(preset
                 for k in range(ncl):
                     if C.mk[k, layout.MK_KIND] != layout.MK_FORCE:
                         continue
-                    expected = plain(forces.contact_force)(record, C, k, end, src)
+                    expected = plain(forces.linear_force)(C.mon, k, n, ns, C.mk[k, layout.MK_M], *end, src)
                     row = C.mk[k, layout.MK_ROW]
                     assert nf <= row < C.ci[layout.CI_ROWS]
                     scale = np.abs(C.mon[k, :3 * n + 3 * ns]).max() * 1e4

@@ -1,9 +1,10 @@
-"""CSV rows of numbers formatted by a compiled kernel: the text of Python's ``'%.10g' % x``, 10-20x faster.
+"""CSV rows of numbers formatted by a compiled kernel: the text of Python's ``'%.10g' % x``, faster.
 
 A row is the values of one row of a float array, each as ``'%.10g' % x``,
 separated by commas, then a comma, the row's label (a preset-dependent text
-such as ``VI,cam+seat``) and a newline. Python's own formatting costs about
-30 µs per row of 46 values; a long ``--every-step`` run has a million rows.
+such as ``VI,cam+seat``) and a newline. A long ``--every-step`` run has a
+million rows; ``python3 benchmarks/bench_output.py`` times the kernel against
+Python's formatting (the same text).
 
 How the kernel writes ``x`` with 10 significant digits (C's ``%.10g``):
 
@@ -34,9 +35,7 @@ from __future__ import annotations
 import csv
 import io
 import sys
-import time
 from collections.abc import Callable, Iterable, Sequence
-from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -44,7 +43,7 @@ import numpy as np
 #: Characters one value can take at most (``-1.234567891e-100``) plus its comma.
 VALUE_WIDTH = 18
 #: Outputs of at least this many rows compile the kernel when it is not cached yet (smaller ones
-#: are written by Python: about 25 µs per row of 46 values, under a second for 20,000 rows).
+#: are written by Python, in well under a second).
 WORTH_COMPILING_ROWS = 20_000
 #: Decimal shifts 10^k, |k| <= MAX_SHIFT, are one multiplication by the nearest double.
 MAX_SHIFT = 44
@@ -59,58 +58,31 @@ def python_row(values: np.ndarray, label: str) -> str:
     return ",".join("%.10g" % value for value in values.tolist()) + "," + label + "\n"  # noqa: UP031
 
 
-def repeated_columns(values: np.ndarray) -> np.ndarray:
-    """For each column, the first earlier column with the same values (bit for bit), or -1.
-
-    A trace's CSV repeats some columns (the preset's quantities ``q9``, ``F1``
-    ... beside the coordinates and forces): their text is copied."""
-    same = np.full(values.shape[1], -1, dtype=np.int64)
-    first: dict[bytes, list[int]] = {}
-    for c in range(values.shape[1]):
-        column = np.ascontiguousarray(values[:, c])
-        with np.errstate(all="ignore"):  # inf - inf in the sum is only a key
-            key = column.tobytes()[:64] + column.sum(dtype=np.float64).tobytes()
-        for j in first.get(key, []):
-            if np.array_equal(column.view(np.int64), values[:, j].view(np.int64)):
-                same[c] = j
-                break
-        else:
-            first.setdefault(key, []).append(c)
-    return same
-
-
-#: A compiled ``put_rows`` (:mod:`vtool.csvrows_kernel`'s signature).
-Formatter = Callable[..., int]
-
-
-def kernel() -> ModuleType:
-    """The numba kernel's module (imported when first needed: it imports numba)."""
-    from vtool import csvrows_kernel
-
-    return csvrows_kernel
-
-
 def ready() -> bool:
     """True when numba's kernel needs no compiling: plain Python, loaded in this process, or compiled into
-    numba's cache before (:func:`vtool.jit.is_compiled`)."""
+    numba's cache before (:func:`vtool.jit.is_compiled`). Imports numba."""
     from vtool import jit
+    from vtool.csvrows_kernel import put_rows
 
-    return jit.is_compiled(kernel().put_rows, "put_rows", "csv")
+    return jit.is_compiled(put_rows, "put_rows", "csv")
 
 
-def choose(rows: int, compiled: bool | None) -> Formatter | None:
-    """The formatter for ``rows`` rows, or None for Python's formatting.
+def choose(rows: int, compiled: bool | None) -> Callable[..., int] | None:
+    """The formatter for ``rows`` rows (:mod:`vtool.csvrows_kernel`'s ``put_rows``), or None for Python's
+    formatting.
 
     ``compiled`` False: Python's; otherwise numba's kernel when ``compiled``
     is True, when the output is large enough to pay for the kernel's compile
     (a few seconds, once; a per-degree CSV does not wait for it), or when
     numba is loaded in this process already and the kernel is cached (not
-    worth importing numba for: Python writes 20,000 rows in about 0.5 s).
+    worth importing numba for).
     """
     if compiled is False:
         return None
     if compiled or rows >= WORTH_COMPILING_ROWS or ("numba" in sys.modules and ready()):
-        return kernel().put_rows
+        from vtool.csvrows_kernel import put_rows
+
+        return put_rows
     return None
 
 
@@ -128,8 +100,7 @@ def arguments(values: np.ndarray, labels: list[str], label_of_row: np.ndarray) -
     out = np.empty(rows * (values.shape[1] * VALUE_WIDTH + width + 2), dtype=np.uint8)
     offsets = np.zeros(rows + 1, dtype=np.int64)
     fallback = np.zeros(rows, dtype=np.bool_)
-    return (values, values.view(np.int64), repeated_columns(values), POWERS, label_text, label_start,
-            label_of_row, out, offsets, fallback)
+    return values, values.view(np.int64), POWERS, label_text, label_start, label_of_row, out, offsets, fallback
 
 
 def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
@@ -145,16 +116,11 @@ def _encode(values: np.ndarray, labels: list[str], label_of_row: np.ndarray,
     if put_rows is None:
         text = "".join(python_row(values[r], labels[int(label_of_row[r])]) for r in range(rows))
         return [text.encode("utf-8")]
-    args = arguments(values, labels, label_of_row)
-    if ready():
-        end = put_rows(*args)
-    else:  # numba compiles it first: timed, and marked compiled (vtool.jit)
-        from vtool import jit
+    from vtool import jit
 
-        started = time.perf_counter()
-        end = put_rows(*args)
-        jit.compiled("put_rows", "csv", time.perf_counter() - started)
-    label_of_row, out, offsets, fallback = args[6:]
+    args = arguments(values, labels, label_of_row)
+    end, _ = jit.timed_call(put_rows, "put_rows", "csv", *args)  # the first call compiles it: timed, marked
+    label_of_row, out, offsets, fallback = args[5:]
     pieces, done = [], 0
     for r in np.flatnonzero(fallback).tolist():
         pieces.append(out[offsets[done]:offsets[r]])

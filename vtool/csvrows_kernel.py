@@ -104,35 +104,24 @@ def put_value(x, bits, powers, out, pos):  # noqa: ANN001, ANN201 (a numba kerne
 
 
 @jit
-def put_rows(values, bits, same, powers, label_text, label_start, label_of_row, out, offsets,  # noqa: ANN001, ANN201
+def put_rows(values, bits, powers, label_text, label_start, label_of_row, out, offsets,  # noqa: ANN001, ANN201
              fallback):
     """Rows of ``values`` with their labels into ``out`` (see the module doc); returns the bytes written.
 
     ``label_text[label_start[i]:label_start[i + 1]]`` is label i (UTF-8);
     row r ends with label ``label_of_row[r]``. ``offsets[r]`` is where row r
     starts (``offsets[rows]`` the end); ``fallback[r]`` is set for a row that
-    Python must write (its bytes here are incomplete). A column c with
-    ``same[c] = j >= 0`` holds the values of the earlier column j: its text is
-    copied, not formatted again.
+    Python must write (its bytes here are incomplete).
     """
     rows, cols = values.shape
-    starts = np.zeros(cols, dtype=np.int64)
-    ends = np.zeros(cols, dtype=np.int64)
     pos = 0
     for r in range(rows):
         offsets[r] = pos
         for c in range(cols):
-            j = same[c]
-            if j >= 0:
-                end = pos + ends[j] - starts[j]
-                out[pos:end] = out[starts[j]:ends[j]]
-            else:
-                end = put_value(values[r, c], bits[r, c], powers, out, pos)
-                if end < 0:
-                    fallback[r] = True
-                    end = pos
-            starts[c] = pos
-            ends[c] = end
+            end = put_value(values[r, c], bits[r, c], powers, out, pos)
+            if end < 0:
+                fallback[r] = True
+                end = pos
             out[end] = COMMA
             pos = end + 1
         label = label_of_row[r]

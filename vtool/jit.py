@@ -1,26 +1,18 @@
-"""The one decorator of vtool's compiled kernels, their cache folder, and what a first run says.
+"""The one decorator of vtool's compiled kernels, and what a first run says about their compile.
 
-Every compiled function (the Newmark kernel's files under ``solvers/newmark/``,
-the CSV formatter :mod:`vtool.csvrows_kernel`) is ``@jit``: numba's ``njit`` with
-``cache=True`` (when :mod:`vtool.numba_cache` found a safe folder),
-``nogil=True`` (threads of a sweep run in parallel) and numpy's error model
-(a division by zero gives inf, as the plain-NumPy reference does). The few
-small helpers of the quiet step are ``@jit_inline``: the same, copied into
-their callers as numba IR (``inline="always"``) so that LLVM vectorizes them
-in place. ``NUMBA_DISABLE_JIT=1`` runs the same source as plain Python, the
-reference the tests compare the compiled kernel with.
-
-The cache folder's name carries a digest of all of the kernels' files
-(:func:`vtool.numba_cache.kernel_sources`): an edit of any of them starts an empty cache.
-
-First run: :func:`compile_notice` says whether an entry point still has to be
-compiled for a law pair (a ``.done`` mark in the cache folder, written by
-:func:`compiled`, or a compile in this process already) and how long it took
-last time on this machine.
+``jit`` is numba's ``njit`` with ``cache=True`` (when :mod:`vtool.numba_cache`
+found a safe folder), ``nogil=True`` (a sweep's threads run in parallel) and
+numpy's error model (a division by zero gives inf, as the plain-NumPy
+reference does); ``jit_inline`` is the same, copied into its callers
+(``inline="always"``). ``NUMBA_DISABLE_JIT=1`` runs the same source as plain
+Python, the reference of the tests. The cache, the borrowed views and the
+first run's notice (a ``.done`` mark per entry point and law pair, written by
+:func:`compiled`): docs/developer.md, "Compile".
 """
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 from typing import Any
 
@@ -35,9 +27,7 @@ _OPTIONS: dict[str, Any] = {"cache": numba_cache.CACHE_ENABLED, "nogil": True, "
 jit = njit(**_OPTIONS)
 jit_inline = njit(**_OPTIONS, inline="always")
 
-#: cffi's FFI, whose ``from_buffer`` numba supports in nopython mode. With cffi installed, numba
-#: imports it (and pycparser) itself during a solve's first compiled call (its cffi typing support;
-#: seen with ``python -X importtime``), so this costs a solve no import of its own.
+#: cffi's FFI, whose ``from_buffer`` numba supports in nopython mode (numba imports cffi itself).
 _FFI = FFI()
 
 if config.DISABLE_JIT:  # plain Python: the arrays themselves (carray takes a ctypes pointer there)
@@ -49,23 +39,12 @@ else:
 
     @jit_inline
     def borrowed(a):  # noqa: ANN001, ANN201
-        """A view of C-contiguous array ``a`` that numba does not reference-count, for the length of a call.
-
-        numba counts references to every array it passes: a compiled function
-        takes (an atomic increment) and drops (an atomic decrement) a count of
-        each array in its arguments, records included, and its optimiser removes
-        few of these pairs in a function with branches. The kernel's entry point
-        hands its callees views made by numba's documented ``carray`` over the
-        arrays' data pointers (cffi's ``ffi.from_buffer``, supported in nopython
-        mode): such a view has no owner to count, so each count is a null check.
-        It is valid while ``a`` lives: the Python caller holds every array for
-        the whole call, and no view outlives it.
-        """
+        """A view of C-contiguous array ``a`` that numba does not reference-count: numba's ``carray`` over
+        its data pointer. Valid while ``a`` lives (the Python caller holds it for the whole call)."""
         return carray(_FFI.from_buffer(a), a.shape)
 
 
-#: A first compile's length when none was measured yet on this machine (s; the 2-core development
-#: machine took 9-14 s for 1A's kernel with other work running).
+#: A first compile's length (s) when none was measured yet on this machine.
 FIRST_GUESS = "5-20"
 
 
@@ -112,3 +91,15 @@ def compile_notice(what: str, name: str) -> str:
     about = f"{last:.0f}" if last is not None else FIRST_GUESS
     later = "later runs load it from the cache" if numba_cache.CACHE_ENABLED else "no cache: every process compiles it"
     return f"compiling {what} once, about {about} s on this machine; {later}"
+
+
+def timed_call(function: Any, name: str, key: str, *args: Any) -> tuple[Any, float]:
+    """``function(*args)`` and the seconds of its compile: timed and marked :func:`compiled` when it had
+    to be compiled (or loaded from numba's cache) first, else 0."""
+    if is_compiled(function, name, key):
+        return function(*args), 0.0
+    started = time.perf_counter()
+    result = function(*args)
+    seconds = time.perf_counter() - started
+    compiled(name, key, seconds)
+    return result, seconds

@@ -1,31 +1,16 @@
 """Where numba caches vtool's compiled kernels: a private per-user folder, named by the kernels' source.
 
-:func:`configure` runs before numba is imported (the kernel modules call it
-first) and sets ``NUMBA_CACHE_DIR`` (numba's documented setting) to
-``BASE/kernels-DIGEST``, where BASE is the first folder of
-
-1. ``NUMBA_CACHE_DIR`` when the user set it (then only that one; a ``kernels-DIGEST`` folder
-   there is what :func:`configure` exported to a parent process, whose children, sweep workers
-   and subprocesses, inherit it: its parent is the base, so that they share the parent's cache);
-2. ``$XDG_CACHE_HOME/vtool/numba``, ``~/.cache/vtool/numba``,
-   ``<tempdir>/vtool-numba-<uid>``
-
-that can be created, and DIGEST is the SHA-256 of the kernels' source files
-(content, size and modification time), numba's version and Python's. numba
-stamps a cached function by its own file only, while the machine code of a
-kernel function holds every compiled callee it calls, from other files: a
-new digest (an edit of any kernel file, another numba) is a new, empty
-folder, so stale machine code is never loaded.
-
-Safety: numba's index files are pickles, loaded as code. A folder is used
-only when it is a real directory owned by the user and not writable by group
-or others (new ones are made 0700); otherwise, or when no folder can be made,
-nothing is cached (every process compiles again) and one warning says why.
-No lock files: numba writes each cache file whole and renames it into place.
-
-Beside the cache (in BASE) ``compile-seconds.json`` keeps the last measured
-compile time of each kernel (:func:`last_compile`), for the notice before
-the next compile.
+:func:`configure` runs before numba is imported and sets ``NUMBA_CACHE_DIR``
+to ``BASE/kernels-DIGEST``. BASE is the user's ``NUMBA_CACHE_DIR`` when set (a
+``kernels-DIGEST`` folder there was exported by a parent process: its parent is
+the base, so that sweep workers and subprocesses share the parent's cache), else
+the first of ``$XDG_CACHE_HOME/vtool/numba``, ``~/.cache/vtool/numba``,
+``<tempdir>/vtool-numba-<uid>`` that can be created; DIGEST is :func:`digest` of
+:func:`kernel_sources`. A folder is used only when it is the user's own and not
+writable by group or others (:func:`unsafe`; new ones are made 0700), else
+nothing is cached, with one warning. Why (numba's index files are pickles; a
+cached function holds its callees' code): docs/developer.md, "Compile".
+``BASE/compile-seconds.json`` keeps each kernel's last compile time (:func:`last_compile`).
 """
 
 from __future__ import annotations
@@ -149,14 +134,18 @@ def configure(sources: Iterable[Path] | None = None) -> str:
     return _configured[0]
 
 
+def _times() -> dict:
+    """The kept compile times by kernel ({} without a cache, or when the file is missing or damaged)."""
+    try:
+        times = json.loads((BASE / TIMES).read_text()) if BASE is not None else {}
+    except (OSError, ValueError):
+        return {}
+    return times if isinstance(times, dict) else {}
+
+
 def last_compile(name: str) -> float | None:
     """Seconds the last compile of kernel ``name`` took on this machine (any kernel source), or None."""
-    if BASE is None:
-        return None
-    try:
-        value = json.loads((BASE / TIMES).read_text()).get(name)
-    except (OSError, ValueError, AttributeError):
-        return None
+    value = _times().get(name)
     return float(value) if isinstance(value, int | float) and value > 0 else None
 
 
@@ -164,17 +153,10 @@ def record_compile(name: str, seconds: float) -> None:
     """Keep ``seconds`` as the last compile time of kernel ``name`` (written whole, then renamed)."""
     if BASE is None:
         return
-    path = BASE / TIMES
+    times = {**_times(), name: round(seconds, 2)}
     try:
-        times = json.loads(path.read_text())
-        if not isinstance(times, dict):
-            times = {}
-    except (OSError, ValueError):
-        times = {}
-    times[name] = round(seconds, 2)
-    try:
-        partial = path.with_name(f"{TIMES}.{os.getpid()}")
+        partial = BASE / f"{TIMES}.{os.getpid()}"
         partial.write_text(json.dumps(times))
-        partial.replace(path)
+        partial.replace(BASE / TIMES)
     except OSError:
         pass

@@ -90,7 +90,7 @@ def state_space(problem: ContactProblem, layer: OrderedLayer) -> StateSpace:
     for s in range(ns):
         src[3 * s:3 * s + 3] = source_coefficients(series, s)
     G, H = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # monitors (kernel.monitors)
-    GF, HF = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # contact forces (kernel.contact_force)
+    GF, HF = np.zeros((ncl, n2)), np.zeros((ncl, nb))  # contact forces (kernel.forces.linear_force)
     for k in range(ncl):
         kind, ahead, behind = (int(v) for v in mk[k, :layout.MK_M])
         if kind in (layout.MK_GAP, layout.MK_OVERLAP):

@@ -240,7 +240,7 @@ class ConfigurationTables:
         source that a prescribed index follows are moved onto that index's columns (the same values), so
         that the step reads the source columns only where a term is left (``CI_SRCSTEP``): on 1A the
         quiet step was 0.91 of one that read them (``bench_step_ab.py``). The same number as
-        :func:`vtool.solvers.newmark.kernel.contact_force` of the step's end, up to round-off.
+        :func:`vtool.solvers.newmark.kernel.forces.linear_force` of the step's end, up to round-off.
         """
         n, ns = self.n, self.ns
         ci, _, cp, mk, mon = self.of(mask)

@@ -6,59 +6,18 @@ validates the settings, builds configurations lazily (the first time the
 kernel reaches one), calls the kernel in chunks (progress, cancel), and hands
 rows and events to the :class:`~vtool.solvers.trace.TraceBuilder`.
 
-Method (see the kernel's docstring for the equations):
-
-* Newmark with general beta, gamma; the thesis' linear acceleration
-  (beta = 1/6, gamma = 1/2) is the default. The effective matrix inverse
-  (thesis BMIV) of a configuration is computed when the configuration is first
-  visited and reused for every standard step.
-* Events: after each step the contact force of every closed clearance and
-  the gap of every open one are checked. A sign change is located by
-  re-stepping from the start of the step (Illinois root finding on the
-  Newmark solution itself, not on an interpolant) to within
-  ``time_tolerance`` (default 1e-6 of the time step: 1e-12 s at 1 µs); when
-  several monitors change sign in one step the earliest event is taken first
-  and the rest of the step is integrated in the new configuration. A gap that
-  starts at zero (a contact just released) has a round-off sign, so a gap
-  closes when it falls below -1e-13 of the mechanism's size.
-* Impacts: the clearance's impact law (``local``, ``thesis``, ``momentum``;
-  see :func:`vtool.solvers.newmark.kernel.apply_impacts`) with Newton's restitution
-  coefficient. After every transition the contact forces of the new
-  configuration are evaluated and any contact that would pull is released
-  at once (:func:`vtool.solvers.newmark.kernel.release_pulling`). Separations and
-  bounces slower than ``rest_velocity`` (default 1e-5 of the cam amplitude
-  times the larger of the cam speed and the lowest natural frequency) are
-  resting contacts that stay closed until their contact force says
-  otherwise.
-* Chattering: ``zeno_stick`` (20) events each within 1e-3 of the shortest
-  natural period of the previous one (events piling up) make
-  every contact involved stick (restitution zero, held shut; their forces
-  then decide separation); ``zeno_stop`` (400) such events stop the run with
-  a message naming the time and configuration. A run never loops forever.
-* Refinement after events: an impact excites the highest modes, which the
-  step resolves poorly (omega_max dt = 1.37 at 1 µs in the thesis examples),
-  and their error moves the events that follow. For four periods of the
-  highest natural frequency after every event the step is divided by
-  ``refine`` (10); the rest of the run keeps the user's step. Four periods,
-  not two: with two, a grazing rocker re-contact of example 3 (7 lbf just
-  after the impact) came out as an extra separation; with four, all six
-  thesis presets give the exact back end's event sequence (the accuracy
-  tables give the figures). ``refine = 1`` is the plain thesis scheme.
-* First run: the kernel is compiled by numba on the first call and kept in
-  numba's cache (:mod:`vtool.numba_cache`); :func:`compile_notice` gives the
-  line to show before it, and :class:`KernelRun` times it and marks it done
-  (:mod:`vtool.jit`).
-* Stability: for gamma = 1/2 and beta < 1/4 the step must satisfy
-  omega_max dt <= 1 / sqrt(gamma/2 - beta) (2 sqrt 3 for linear acceleration:
-  dt <= sqrt(3)/pi T_min), with omega_max the highest natural frequency of
-  the unconstrained system, which bounds every configuration's.
+The method (configurations, event location by re-stepping, the impact laws,
+resting contacts and chattering, the refinement after events, the stability
+limit omega_max dt <= 1 / sqrt(gamma/2 - beta)) is in docs/valvetrain.md, "The
+method"; its equations in :mod:`vtool.solvers.newmark.kernel`; the first run's
+compile (:func:`compile_notice`, :class:`KernelRun`) in docs/developer.md,
+"Compile".
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import time as wallclock
 from dataclasses import dataclass
 from typing import Any
 
@@ -120,10 +79,6 @@ class NewmarkOptions:
     refine: int = 10  # after each event, steps of time_step / refine ...
     refine_periods: float = 4.0  # ... for this many periods of the highest natural frequency
 
-    @classmethod
-    def from_run(cls, run: RunSpec, every_step: bool = False) -> NewmarkOptions:
-        return cls(run.time_step, run.beta, run.gamma, run.output_interval, every_step)
-
 
 def kernel_laws(spec: Any, impacts: tuple[str, ...] = ()) -> tuple[bool | None, bool | None]:
     """The kernel's (hertz, momentum) switches for a valve-train spec, and for its runs under the impact
@@ -155,25 +110,6 @@ def compile_notice(backend: str = "newmark", laws: tuple[bool | None, bool | Non
     return jit.compile_notice("the solver" if backend == "newmark" else "the event rules", name)
 
 
-def compile_solver(spec: Any) -> None:
-    """Compile the kernel for valve-train ``spec``'s contact laws, or load it from numba's cache: a run
-    of ten time steps (the TUI starts it when a preset opens). Nothing when its back end is not newmark
-    or its settings are refused (the real run says why)."""
-    import dataclasses
-
-    from vtool.solvers.model.mechanism import assemble
-
-    if spec.run.backend != "newmark":
-        return
-    run = spec.run
-    short = dataclasses.replace(spec, run=dataclasses.replace(run, degrees=10.0 * run.time_step * 6.0 * run.rpm))
-    backend = NewmarkBackend()
-    try:
-        backend.simulate(assemble(short), backend.options_from_run(short.run))
-    except (InputError, RunError):
-        return
-
-
 def stability_limit(beta: float, gamma: float, omega_max: float) -> float:
     """Largest stable step (s) of Newmark(beta, gamma) for omega_max; inf if unconditional."""
     if 2.0 * beta >= gamma >= 0.5:
@@ -187,32 +123,6 @@ def round_down(value: float, digits: int) -> float:
     return math.floor(value / unit) * unit
 
 
-def highest_frequency(mechanism: Mechanism) -> float:
-    """omega_max of the unconstrained system: no configuration is stiffer."""
-    return mechanism.highest_frequency
-
-
-def check_settings(mechanism: Mechanism, options: NewmarkOptions) -> None:
-    """Refuse a step that is not positive or beyond the stability limit."""
-    dt = options.time_step
-    if not dt > 0.0:
-        raise InputError("run.time_step", dt, "> 0", "s")
-    (beta_low, beta_high), (gamma_low, gamma_high) = BETA_RANGE, GAMMA_RANGE  # the loader's bounds
-    if not beta_low < options.beta <= beta_high:
-        raise InputError("run.beta", options.beta, f"> {beta_low:g} and <= {beta_high:g}")
-    if not gamma_low <= options.gamma <= gamma_high:
-        raise InputError("run.gamma", options.gamma, f">= {gamma_low:g} and <= {gamma_high:g}")
-    if not options.refine >= 1:
-        raise InputError("refine", options.refine, ">= 1")
-    limit = stability_limit(options.beta, options.gamma, highest_frequency(mechanism))
-    if dt > limit and options.enforce_stability_limit:
-        raise InputError(
-            "run.time_step", dt,
-            f"<= {round_down(limit, 6):.6g} (stability limit of Newmark beta={options.beta:.4g}, gamma={options.gamma:.4g} "
-            f"for the stiffest configuration; use beta=1/4 for no limit)", "s",
-        )
-
-
 class NewmarkBackend(Backend[NewmarkOptions]):
     """Newmark back end (see module doc). Registered as ``newmark``."""
 
@@ -222,12 +132,12 @@ class NewmarkBackend(Backend[NewmarkOptions]):
 
     @staticmethod
     def options_from_run(run: RunSpec, every_step: bool = False) -> NewmarkOptions:
-        return NewmarkOptions.from_run(run, every_step)
+        return NewmarkOptions(run.time_step, run.beta, run.gamma, run.output_interval, every_step)
 
     @classmethod
     def stable_step(cls, mechanism: Mechanism) -> float:
         run = mechanism.spec.run
-        return stability_limit(run.beta, run.gamma, highest_frequency(mechanism))
+        return stability_limit(run.beta, run.gamma, mechanism.highest_frequency)
 
     @classmethod
     def compile_notice(cls, spec: MechanismSpec, impacts: tuple[str, ...] = ()) -> str | None:
@@ -235,7 +145,17 @@ class NewmarkBackend(Backend[NewmarkOptions]):
 
     @classmethod
     def warm_up(cls, spec: MechanismSpec) -> None:
-        compile_solver(spec)
+        """Compile the kernel for valve-train ``spec``'s contact laws, or load it from numba's cache: a run
+        of ten time steps (the TUI starts it when a preset opens). Nothing when its settings are refused
+        (the real run says why)."""
+        from vtool.solvers.model.mechanism import assemble
+
+        run = spec.run
+        short = dataclasses.replace(spec, run=dataclasses.replace(run, degrees=10.0 * run.time_step * 6.0 * run.rpm))
+        try:
+            cls().simulate(assemble(short), cls.options_from_run(short.run))
+        except (InputError, RunError):
+            return
 
     @classmethod
     def accuracy_settings(cls, run: RunSpec, knobs: AccuracyKnobs) -> list[AccuracySetting]:
@@ -247,7 +167,24 @@ class NewmarkBackend(Backend[NewmarkOptions]):
         return [*settings, AccuracySetting(PLAIN_SETTING, run, NewmarkOptions(1e-6, refine=1))]
 
     def check(self, mechanism: Mechanism, options: NewmarkOptions) -> None:
-        check_settings(mechanism, options)
+        """Refuse a step that is not positive or beyond the stability limit."""
+        dt = options.time_step
+        if not dt > 0.0:
+            raise InputError("run.time_step", dt, "> 0", "s")
+        (beta_low, beta_high), (gamma_low, gamma_high) = BETA_RANGE, GAMMA_RANGE  # the loader's bounds
+        if not beta_low < options.beta <= beta_high:
+            raise InputError("run.beta", options.beta, f"> {beta_low:g} and <= {beta_high:g}")
+        if not gamma_low <= options.gamma <= gamma_high:
+            raise InputError("run.gamma", options.gamma, f">= {gamma_low:g} and <= {gamma_high:g}")
+        if not options.refine >= 1:
+            raise InputError("refine", options.refine, ">= 1")
+        limit = stability_limit(options.beta, options.gamma, mechanism.highest_frequency)
+        if dt > limit and options.enforce_stability_limit:
+            raise InputError(
+                "run.time_step", dt,
+                f"<= {round_down(limit, 6):.6g} (stability limit of Newmark beta={options.beta:.4g}, "
+                f"gamma={options.gamma:.4g} for the stiffest configuration; use beta=1/4 for no limit)", "s",
+            )
 
     def event_rules(self, options: NewmarkOptions) -> EventRules:
         return EventRules(options.rest_velocity, options.zeno_stick, options.zeno_stop)
@@ -322,16 +259,12 @@ class KernelRun:
         problem = self.problem
         args = (self.record, problem.tables.record(), self.scratch, self.state, self.out, problem.hertz,
                 problem.momentum)
-        key = jit.law_key(problem.hertz, problem.momentum)
         self.scratch_buffer.fill(0.0)  # every call starts with a zeroed scratch, as with fresh arrays
         self.scratch.closing.fill(0)
-        if jit.is_compiled(kernel.run_chunk, "run_chunk", key):
-            return int(kernel.run_chunk(*args))
-        started = wallclock.perf_counter()
-        status = int(kernel.run_chunk(*args))  # numba compiles it (or loads it from its cache) first
-        self.compile_time = wallclock.perf_counter() - started
-        jit.compiled("run_chunk", key, self.compile_time)
-        return status
+        key = jit.law_key(problem.hertz, problem.momentum)
+        status, seconds = jit.timed_call(kernel.run_chunk, "run_chunk", key, *args)
+        self.compile_time = self.compile_time or seconds
+        return int(status)
 
     def execute(self, progress: Progress | None, cancel: Cancel | None) -> None:
         problem = self.problem

@@ -1,28 +1,19 @@
 """The records the Newmark kernel computes on: named tuples of arrays (no numba here).
 
-numba takes a :func:`collections.namedtuple` of arrays as one argument and
-reads its fields by name, with no cost in the compiled code; Python builds
-them once per run (the arrays inside are the ones the kernel writes into).
-The slot numbers inside the arrays are in :mod:`vtool.solvers.newmark.layout`.
+numba takes a named tuple of arrays as one argument and reads its fields by
+name; Python builds them once per run. The slots inside the arrays are in
+:mod:`vtool.solvers.newmark.layout`.
 
-* :class:`Problem`: a mechanism's constant tables for one run (the integer and
-  float parameters, the clearance tables, the sources' Fourier series, the
-  mass matrix and its inverse);
-* :class:`Tables`: every built configuration's operators, one slot each, and
-  the open-addressing map from a configuration's mask to its slot
-  (``index[h] = (mask, slot)``, -1 where empty; :func:`mask_hash`), grown by
-  :class:`vtool.solvers.model.contact.ConfigurationTables` as the run visits
-  new configurations;
+* :class:`Problem`: a mechanism's constant tables (parameters, clearance tables,
+  the sources' Fourier series, the mass matrix and its inverse);
+* :class:`Tables`: every built configuration's operators, one slot each, and the
+  map ``index[h] = (mask, slot)`` (open addressing, -1 where empty:
+  :func:`mask_hash`), grown by :class:`vtool.solvers.model.contact.ConfigurationTables`;
 * :class:`Config`: one configuration's operators (views of its slot);
-* :class:`State`: the run's full state and counters (x, v, a, the integer and
-  float state slots);
+* :class:`State`: the full state x, v, a and the integer and float state slots;
 * :class:`Output`: the output buffers (rows, events, peaks);
-* :class:`Scratch`: the run loop's work arrays.
-
-A layer state is one (3, m) array, rows ``Z``, ``ZD``, ``ZDD`` (z, ż, z̈; layout):
-a few arrays with named rows instead of many vectors, since numba copies each
-array of a record at every variable and call that holds the record (about
-0.15 s of first compile per array in :class:`Scratch`).
+* :class:`Scratch`: the run loop's work arrays, few arrays with named rows
+  (every array of a record costs compile: docs/developer.md, "Records").
 """
 
 from __future__ import annotations

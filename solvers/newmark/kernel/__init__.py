@@ -38,24 +38,13 @@ other columns] (``CP_STD``, ``CP_FINE``): z̈_F = -G·(ż̃_F, z̃_F, …) is on
 product; other step lengths (event location, the return to the step grid)
 form ΔP and factor S by Cholesky.
 
-Monitors: a closed clearance's contact force (a row of coefficients on
-(z, ż, z̈, sources) per configuration, positive in compression), an open
-one's gap q[ahead] - q[behind] (+ the round-off allowance). A sign change
-is an event, located by re-stepping (Illinois).
+Monitors (:func:`~.forces.monitors`): a closed clearance's contact force, an
+open one's gap; a sign change is an event, located by re-stepping (Illinois).
+Impact laws (per clearance, ``CL_LAW``: momentum, local, thesis) and the
+release of pulling contacts after every transition: :mod:`.impacts`.
 
-Impact laws (per clearance, ``CL_LAW``): ``LAW_MOMENTUM`` one linear
-complementarity problem on the consistent mass matrix; ``LAW_LOCAL`` only the
-impacting coordinate's velocity changes (external), or the two tied
-coordinates take their common, momentum-conserving velocity (internal);
-``LAW_THESIS`` as local but an internal closing gives the tied pair SCALE
-times the ahead coordinate's velocity (Gnilka eq. 3.54). After every
-transition :func:`release_pulling` computes the consistent accelerations of
-the new configuration and releases at once any contact whose force would pull.
-
-Law switches: the ``hertz`` and ``momentum`` arguments
-(:func:`~vtool.solvers.newmark.layout.laws`) are None when no clearance uses
-that law: numba prunes the branches under them before typing, so the Hertz
-iteration and the momentum-law LCP are compiled only for mechanisms that use them.
+Law switches: the ``hertz`` and ``momentum`` arguments are None when no
+clearance uses that law (:func:`~vtool.solvers.newmark.layout.laws`).
 """
 
 from vtool.solvers.newmark.kernel.forces import hertz_force
@@ -68,9 +57,4 @@ from vtool.solvers.newmark.kernel.impacts import (
 from vtool.solvers.newmark.kernel.loop import run_chunk
 from vtool.solvers.newmark.kernel.step import sources
 
-#: The functions the back ends call from Python.
-ENTRY_POINTS = ("run_chunk", "apply_impacts", "release_pulling", "sources", "shut_gap", "gap_velocity",
-                "hertz_force")
-
-__all__ = ["ENTRY_POINTS", "apply_impacts", "gap_velocity", "hertz_force", "release_pulling", "run_chunk",
-           "shut_gap", "sources"]
+__all__ = ["apply_impacts", "gap_velocity", "hertz_force", "release_pulling", "run_chunk", "shut_gap", "sources"]

@@ -86,12 +86,6 @@ def linear_force(mon, k, n, ns, count, z, zd, zdd, src):
 
 
 @jit
-def contact_force(prob, C, k, y, src):
-    """:func:`linear_force` of closed clearance k in configuration C, layer state y."""
-    return linear_force(C.mon, k, prob.ip[IP_N], prob.ip[IP_NS], C.mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
-
-
-@jit
 def rigid_force(prob, C, k, y, src, hertz):
     """Contact force of closed rigid clearance k: its linear row, plus the closed Hertz contacts' pull
     on it (``mon[k, 3n + 3ns + 1 + j]`` per unit Hertz force F_j)."""
