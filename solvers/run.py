@@ -54,8 +54,9 @@ def run_cost(mechanism: Mechanism, every_step: bool = False, csv: bool = False,
 #: inverses (ConfigurationTables.use_step), which two threads must not share.
 ASSEMBLED_KEPT = 4
 _kept = threading.local()
-#: What a kept mechanism is found by: the spec's compared fields but its run settings.
-_KEY_FIELDS = tuple(f.name for f in dataclasses.fields(MechanismSpec) if f.compare and f.name != "run")
+#: What a kept mechanism is found by: the spec's compared fields but its run settings and title (a speed
+#: override names the speed in the title).
+_KEY_FIELDS = tuple(f.name for f in dataclasses.fields(MechanismSpec) if f.compare and f.name not in ("run", "title"))
 
 
 class _Key:

@@ -53,7 +53,8 @@ class Mechanism:
         return self.for_spec(dataclasses.replace(self.spec, run=run))
 
     def for_spec(self, spec: MechanismSpec) -> Mechanism:
-        """This mechanism for ``spec``, a spec equal to its own but for the run settings (not checked)."""
+        """This mechanism for ``spec``, a spec equal to its own but for the run settings and the title (not
+        checked)."""
         return Mechanism(spec, _shared=self)
 
     def shared(self, key: Hashable, make: Callable[[], T]) -> T:

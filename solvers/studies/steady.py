@@ -213,8 +213,8 @@ def _periodic(traces: list[Trace], tolerance: float,
 
 def _shifted(trace: Trace, k: int, period: float, skip_first: bool) -> tuple[slice, list[Event]]:
     rows = slice(1 if skip_first else 0, None)
-    events = [dataclasses.replace(e, time=e.time + k * period, cam_angle=e.cam_angle + k * REVOLUTION)
-              for e in trace.events]
+    seconds, degrees = k * period, k * REVOLUTION
+    events = [e.shifted(seconds, degrees) for e in trace.events]
     return rows, events
 
 

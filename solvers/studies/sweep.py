@@ -131,15 +131,17 @@ def grid(fields: Sequence[tuple[str, Sequence[Any]]]) -> list[tuple[tuple[str, A
 # ----- point evaluation -----
 
 def _model_key(spec: MechanismSpec) -> MechanismSpec:
-    """The spec without its run settings: points with equal keys share one assembled model."""
-    return replace(spec, run=None)  # type: ignore[arg-type]  # a cache key without run settings, never run
+    """The spec without its run settings and title (a speed override names the speed in the title): points with
+    equal keys share one assembled model."""
+    return replace(spec, run=None, title="")  # type: ignore[arg-type]  # a cache key, never run
 
 
 def _mechanism(spec: MechanismSpec, previous: Mechanism | None) -> Mechanism:
-    """An assembled mechanism for ``spec``, reusing ``previous``'s matrices and layers when only [run] differs."""
+    """An assembled mechanism for ``spec``, reusing ``previous``'s matrices and layers when only [run] (and the
+    title) differs."""
     if previous is None or _model_key(previous.spec) != _model_key(spec):
         return assemble(spec)
-    return previous.with_run(spec.run)  # shares M, K, the contact layers and configuration tables
+    return previous.for_spec(spec)  # shares M, K, the contact layers and configuration tables
 
 
 @functools.cache
@@ -599,16 +601,22 @@ class SerialRunner:
 
     def run(self, batches: Iterable[Iterable[Point]], every_step: bool,
             on_results: Callable[[list[PointResult]], None], cancel: Callable[[], bool]) -> bool:
-        previous = None  # kept from chunk to chunk (see evaluate_chunk)
-        for batch in batches:
-            for point in batch:
-                if cancel():
-                    return False
-                result, previous = evaluate(point, every_step=every_step, previous=previous, cancel=cancel)
-                if cancel() and not result.ok:
-                    return False
-                on_results([result])
-        return True
+        # the last mechanism, kept from chunk to chunk and from call to call as a worker keeps it (see
+        # evaluate_chunk): a speed search calls once per bisection step, and each call assembled the model and
+        # built its configurations again (548 assemblies for docs/sweep.md's 570 points, 8 models)
+        previous: Mechanism | None = getattr(_LAST, "mechanism", None)
+        try:
+            for batch in batches:
+                for point in batch:
+                    if cancel():
+                        return False
+                    result, previous = evaluate(point, every_step=every_step, previous=previous, cancel=cancel)
+                    if cancel() and not result.ok:
+                        return False
+                    on_results([result])
+            return True
+        finally:
+            _LAST.mechanism = previous
 
     def close(self) -> None:
         pass

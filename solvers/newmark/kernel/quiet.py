@@ -113,6 +113,7 @@ def advance(prob, C, W, S, O, hertz):
     c_fine = math.cos(omega * fine)
     s_fine = math.sin(omega * fine)
     rotated = 0
+    t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant (moved on only by step_rows)
     while True:
         k_grid = ist[I_GRID]
         sub = ist[I_SUB]
@@ -163,10 +164,10 @@ def advance(prob, C, W, S, O, hertz):
             phi[k] = value
         if stop:
             break
-        t_out = ist[I_NEXT_OUT] * out_dt  # output rows inside (t, t1]: a call only when one is due
-        if (t_out <= t1 + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
-                and not step_rows(prob, C, t, h, Y, srco, O, ist, hertz)):
-            break
+        if t_out <= t1 + 1e-9 * dt and t_out <= t_end + 1e-9 * dt:  # output rows inside (t, t1]
+            if not step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
+                break
+            t_out = ist[I_NEXT_OUT] * out_dt
         # accept: peaks (the rigid contacts' forces from the step's product), state, time
         raise_peaks(mk, mon, n, ns, t1 >= t_rev, gap_noise, phi, z1, zd1, zdd1, src1, peak)
         for j in range(m):
