@@ -22,12 +22,14 @@ from vtool.presets import find_preset, load_preset, read_document
 from vtool.presets.paths import get_field, parse_values, plan_sweep, set_field
 from vtool.presets.valvetrain import with_run_overrides
 from vtool.solvers.run import simulate
+from vtool.solvers.studies import sweep
 from vtool.solvers.studies.metrics import run_metrics
 from vtool.solvers.studies.sweep import (
     DaskRunner,
     ProcessRunner,
     SerialRunner,
     SweepFile,
+    evaluate,
     find_speed,
     grid,
     run_points,
@@ -122,9 +124,31 @@ def test_model_reuse_across_rpm_changes_nothing() -> None:
     """A chunk reuses the assembled model from one speed to the next: same numbers as fresh runs."""
     plan = plan_sweep("gnilka-1a", ["run.rpm=10000,10600", SHORT])
     chained = run_points(plan.points, SerialRunner()).results
-    fresh = [run_points([p], SerialRunner()).results[0] for p in plan.points]
+    fresh = [evaluate(p)[0] for p in plan.points]  # no model to reuse: each assembled afresh
     for a, b in zip(chained, fresh, strict=True):
         assert _same(_without_timing(a.metrics), _without_timing(b.metrics))
+
+
+def test_a_speed_search_assembles_its_model_once_and_each_point_keeps_its_own_title(monkeypatch) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
+    """The speed override rewrites the title, which is no part of the model: a serial search's scan and
+    its bisection steps (one runner call each) share one assembled model, and so its configurations."""
+    assembled = []
+    real = sweep.assemble
+
+    def counting(spec):  # type: ignore[no-untyped-def]  # noqa: ANN001, ANN202
+        assembled.append(spec.title)
+        return real(spec)
+
+    monkeypatch.setattr(sweep, "assemble", counting)
+    spec = load_preset("gnilka-1a")
+    monkeypatch.setattr(sweep._LAST, "mechanism", None, raising=False)  # nothing kept from an earlier test
+    result = find_speed("jump-speed", lambda rpm: with_run_overrides(with_run_overrides(spec, degrees=460), rpm=rpm),
+                        [9000, 12000], SerialRunner())
+    assert len(result.history) > 3 and len(assembled) == 1, assembled
+    first, second = (with_run_overrides(spec, rpm=rpm) for rpm in (9000, 12000))
+    assert first.title != second.title
+    _, mechanism = evaluate(sweep.Point(0, (("run.rpm", 12000),), second), previous=real(first))
+    assert mechanism is not None and mechanism.spec.title == second.title
 
 
 # ----- execution paths, files, resume -----
