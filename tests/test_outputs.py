@@ -15,6 +15,7 @@ import signal
 import stat
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -172,6 +173,37 @@ def long_preset(folder: Path) -> Path:
     text = (PRESET_DIR / "gnilka-1a.toml").read_text()
     preset.write_text(text.replace("output_interval = 1.0 #", "output_interval = 100.0 #"))
     return preset
+
+
+class _Terminated(Exception):
+    pass
+
+
+def test_a_signal_as_the_temporary_file_is_made_is_taken_where_the_file_is_removed(tmp_path: Path,
+                                                                                  monkeypatch) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
+    """SIGTERM delivered just after mkstemp made the file (as a signal can land): the handler raises
+    only once the block that removes the file on failure is entered, so nothing is left behind."""
+    made = tempfile.mkstemp
+
+    def made_then_signalled(*args, **kwargs):  # type: ignore[no-untyped-def]  # noqa: ANN002, ANN003, ANN202
+        result = made(*args, **kwargs)
+        os.kill(os.getpid(), signal.SIGTERM)
+        return result
+
+    def handler(signum, frame):  # type: ignore[no-untyped-def]  # noqa: ANN001, ANN202
+        raise _Terminated
+
+    out = tmp_path / "out.csv"
+    out.write_text("previous\n")
+    monkeypatch.setattr(tempfile, "mkstemp", made_then_signalled)
+    before = signal.signal(signal.SIGTERM, handler)
+    try:
+        with pytest.raises(_Terminated), open_atomic(out) as handle:
+            handle.write("new\n")
+    finally:
+        signal.signal(signal.SIGTERM, before)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv"]
+    assert out.read_text() == "previous\n"
 
 
 def test_sigterm_while_writing_leaves_no_temporary_and_the_old_file(tmp_path: Path) -> None:

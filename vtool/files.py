@@ -174,12 +174,13 @@ def open_atomic(path: str | os.PathLike[str], field: str = "output") -> Iterator
     target = check_output_path(path, field)
     directory = target.parent if str(target.parent) else Path(".")
     clean_stale_temporaries(target)
-    try:  # mkstemp opens with O_CREAT | O_EXCL: never through a link
-        fd, tmp = tempfile.mkstemp(prefix=f"{_tmp_prefix(target)}{os.getpid()}.", suffix=".tmp",
-                                   dir=directory)
-    except OSError as exc:
-        raise InputError(field, str(path), f"a file in a writable folder ({exc.strerror})") from None
+    prefix = f"{_tmp_prefix(target)}{os.getpid()}."
+    tmp: str | None = None  # known once mkstemp returns; an interrupt can come between its making and then
     try:
+        try:  # mkstemp opens with O_CREAT | O_EXCL: never through a link
+            fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=directory)
+        except OSError as exc:
+            raise InputError(field, str(path), f"a file in a writable folder ({exc.strerror})") from None
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
             yield handle
             handle.flush()
@@ -188,12 +189,25 @@ def open_atomic(path: str | os.PathLike[str], field: str = "output") -> Iterator
             raise InputError(field, str(path), "a file path that is not a symbolic link")
         os.replace(tmp, target)  # rename never follows a link at the target
     except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
+        _remove_temporary(directory, prefix, tmp)
         reason = "the disk is full" if exc.errno in (errno.ENOSPC, errno.EDQUOT) else exc.strerror
         raise RunError(f"could not write {path}: {reason}; nothing was written") from None
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        _remove_temporary(directory, prefix, tmp)
         raise
+
+
+def _remove_temporary(directory: Path, prefix: str, tmp: str | None) -> None:
+    """Remove :func:`open_atomic`'s temporary file ``tmp``; when the write failed before its name was known
+    (an interrupt just after mkstemp made it), every ``PREFIX*.tmp`` there: the prefix holds this process's
+    id and the target's name, so they are this write's (tests/test_outputs.py's SIGTERM test left one
+    behind about 1 run in 13)."""
+    if tmp is not None:
+        Path(tmp).unlink(missing_ok=True)
+        return
+    with contextlib.suppress(OSError):
+        for made in directory.glob(f"{glob.escape(prefix)}*.tmp"):
+            made.unlink(missing_ok=True)
 
 
 def finite_json(data: object) -> tuple[object, list[str]]:
