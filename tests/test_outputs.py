@@ -176,13 +176,13 @@ def long_preset(folder: Path) -> Path:
 
 
 class _Terminated(Exception):
-    pass
+    """What the test's SIGTERM handler raises."""
 
 
 def test_a_signal_as_the_temporary_file_is_made_is_taken_where_the_file_is_removed(tmp_path: Path,
                                                                                   monkeypatch) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
-    """SIGTERM delivered just after mkstemp made the file (as a signal can land): the handler raises
-    only once the block that removes the file on failure is entered, so nothing is left behind."""
+    """SIGTERM delivered just after mkstemp made the file, before open_atomic knows its name (as a signal
+    can land): the block that removes the file on failure finds it by its prefix, so nothing is left."""
     made = tempfile.mkstemp
 
     def made_then_signalled(*args, **kwargs):  # type: ignore[no-untyped-def]  # noqa: ANN002, ANN003, ANN202
