@@ -18,7 +18,7 @@ from vtool.jit import jit
 from vtool.solvers.newmark.kernel.algebra import apply_operator
 from vtool.solvers.newmark.kernel.forces import signed_gap
 from vtool.solvers.newmark.kernel.output import raise_peaks, step_rows
-from vtool.solvers.newmark.kernel.step import correct, harmonics, predict, prescribed
+from vtool.solvers.newmark.kernel.step import corrected, harmonics, predict, prescribed
 from vtool.solvers.newmark.layout import (
     CI_M,
     CI_NF,
@@ -145,7 +145,18 @@ def advance(prob, C, W, S, O, hertz):
         predict(m, h, beta, gamma, z, zd, zdd, z1, zd1)
         prescribed(ci, n, src1, z1, zd1, zdd1)
         apply_operator(cp, ci, plane, nrows, coupled, src1, z1, zd1, zdd1, rhs)
-        within = correct(nf, h, beta, gamma, rhs, z1, zd1, zdd1, x_limit)
+        # the corrector (step.correct's, on scalars: see step.corrected), the divergence limit checked on
+        # each corrected value as it is stored (a vector load of z1 after these scalar stores would wait)
+        bx = beta * h * h
+        gv = gamma * h
+        within = True
+        for f in range(nf):
+            a = rhs[f]
+            zdd1[f] = a
+            zf, zdf = corrected(a, z1[f], zd1[f], bx, gv)
+            z1[f] = zf
+            zd1[f] = zdf
+            within &= abs(zf) <= x_limit
         if not within:  # past the divergence limit
             break
         stop = False

@@ -4,7 +4,7 @@ A configuration's operators are found by its mask (:func:`find_slot`, the
 open-addressing map of :class:`~vtool.solvers.newmark.records.Tables`) and
 taken as a :class:`~vtool.solvers.newmark.records.Config` of views
 (:func:`configuration`). The predictor and corrector (:func:`predict`,
-:func:`correct`) and the sources' harmonics (:func:`harmonics`) are inline
+:func:`corrected`) and the sources' harmonics (:func:`harmonics`) are inline
 helpers shared by every step: :func:`layer_step` here and the quiet loop
 (:mod:`~vtool.solvers.newmark.kernel.quiet`).
 """
@@ -145,22 +145,24 @@ def predict(m, h, beta, gamma, z, zd, zdd, z1, zd1):
 
 
 @jit_inline
-def correct(nf, h, beta, gamma, acc, z1, zd1, zdd1, limit):
-    """Newmark's corrector: the free accelerations ``acc`` into z̈1, z1 += beta h² z̈, ż1 += gamma h z̈.
-    Returns whether every corrected z1 is within ``limit`` in magnitude (False for a NaN): checked on
-    the values as they are stored, since a vector load of z1 right after these scalar stores would
-    wait for them (a tenth of a quiet step)."""
+def corrected(a, z, zd, bx, gv):
+    """Newmark's corrector of one coordinate: (z + bx a, ż + gv a) from the predicted z, ż and the
+    new acceleration a (bx = beta h², gv = gamma h). Scalars only: the quiet loop calls it at every
+    step, and an inline helper handed arrays there left a reference count taken and dropped at every
+    step, an opaque call that also spilled the loop's registers (2-3 % of a quiet step)."""
+    return z + bx * a, zd + gv * a
+
+
+@jit_inline
+def correct(nf, h, beta, gamma, acc, z1, zd1, zdd1):
+    """Newmark's corrector of the nf free coordinates (:func:`corrected`): the accelerations ``acc``
+    into z̈1, the predicted z1, ż1 corrected in place."""
     bx = beta * h * h
     gv = gamma * h
-    within = True
     for f in range(nf):
         a = acc[f]
         zdd1[f] = a
-        z = z1[f] + bx * a
-        z1[f] = z
-        zd1[f] += gv * a
-        within &= abs(z) <= limit
-    return within
+        z1[f], zd1[f] = corrected(a, z1[f], zd1[f], bx, gv)
 
 
 @jit_inline
@@ -191,7 +193,7 @@ def layer_step(prob, C, W, h, which, hertz):
     apply_operator(C.cp, ci, plane, nf, ci[CI_SRC], src1, y1[Z], y1[ZD], y1[ZDD], out)
     if which == CHOLESKY:
         cholesky_solve(nf, W.L, W.rhs, W.sol)
-    correct(nf, h, beta, gamma, W.sol, y1[Z], y1[ZD], y1[ZDD], math.inf)
+    correct(nf, h, beta, gamma, W.sol, y1[Z], y1[ZD], y1[ZDD])
     if hertz is not None:
         if C.ci[CI_HERTZ]:
             hertz_correction(prob, C, W, h, which)
