@@ -34,9 +34,17 @@ def apply_operator(cp, ci, plane, nrows, coupled, src, z, zd, zdd, out):
     nf = ci[CI_NF]
     m = ci[CI_M]
     rows = min((nrows + 3) // 4 * 4, out.shape[0], cp.shape[3])
-    for f in range(rows):
-        out[f] = 0.0
-    for g in range(nf):
+    g0 = 0
+    if nf > 0:  # the first column's terms from 0.0 (the same bits as zeroing first; a zeroing loop alone
+        a = zd[0]  # became a call to memset at every quiet step, which spilled the loop's registers)
+        b = z[0]
+        for f in range(rows):
+            out[f] = 0.0 - (cp[plane, PART_C, 0, f] * a + cp[plane, PART_K, 0, f] * b)
+        g0 = 1
+    else:
+        for f in range(rows):
+            out[f] = 0.0
+    for g in range(g0, nf):
         a = zd[g]
         b = z[g]
         for f in range(rows):
