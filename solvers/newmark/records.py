@@ -49,6 +49,10 @@ def scratch(n: int, ns: int, ncl: int) -> tuple[Scratch, np.ndarray]:
     arrays (zeroing them in the kernel compiled four ``fill`` specialisations into its first compile)."""
     sizes = (9 * n, 9 * ns, 3 * ncl, n + ncl, n, n * n)
     buffer = np.zeros(sum(sizes))
-    y, src, cross, rhs, sol, L = np.split(buffer, np.cumsum(sizes)[:-1])
+    parts, start = [], 0
+    for size in sizes:  # (np.split's Python around the same slices took longer than the kernel's setup)
+        parts.append(buffer[start:start + size])
+        start += size
+    y, src, cross, rhs, sol, L = parts
     return Scratch(y.reshape(3, 3, n), src.reshape(3, 3 * ns), cross.reshape(3, ncl), rhs, sol, L.reshape(n, n),
                    np.zeros(ncl, dtype=np.int64)), buffer
