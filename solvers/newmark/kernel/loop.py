@@ -87,14 +87,6 @@ from vtool.solvers.newmark.layout import (
 from vtool.solvers.newmark.records import Output, Problem, Scratch, State, Tables
 
 
-@jit_inline
-def step_to(prob, C, W, t, h, hertz):
-    """A step of any length h from W.y[Y_NOW] at t into W.y[Y_END]: sources at t + h, S(h) factored by Cholesky."""
-    sources(prob, t + h, W.src[SRC_END])
-    factor_effective(C.cm, C.ci[CI_NF], prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
-    layer_step(prob, C, W, h, CHOLESKY, hertz)
-
-
 @jit
 def locate_event(prob, C, W, k, t, h, hertz):
     """Earliest tau in (0, h] where monitor k crosses zero, re-stepping from W.y[Y_NOW] at t.
@@ -108,7 +100,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
     from the start: a step shorter than it, or a crossing within it): an
     event at tau = 0 would make no progress, and a contact released at t
     whose gap the round-off closes again within the tolerance would close and
-    open at t until the chattering stop. Each trial is :func:`step_to`'s step
+    open at t until the chattering stop. Each trial is a step of length tau
     (S(tau) factored by Cholesky): the same code as the event's step, compiled
     once in :func:`~vtool.solvers.newmark.kernel.step.layer_step` (a copy of it
     here cost about 0.6 s of first compile; the call costs about 1 % of a run).
@@ -138,7 +130,11 @@ def locate_event(prob, C, W, k, t, h, hertz):
         else:
             tau = (lo * fhi - hi * flo) / (fhi - flo)
         tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
-        step_to(prob, C, W, t, tau, hertz)
+        # the trial step from t: sources at t + tau, S(tau) factored by Cholesky (written here, not as an
+        # inline helper of the records: its records' arrays were counted in and out at every trial)
+        sources(prob, t + tau, W.src[SRC_END])
+        factor_effective(C.cm, C.ci[CI_NF], fp[FP_BETA], fp[FP_GAMMA], tau, W.L)
+        layer_step(prob, C, W, tau, CHOLESKY, hertz)
         # monitor k (see forces.monitors), on the arrays
         if kind == MK_GAP or kind == MK_OVERLAP:
             behind = mk[k, MK_BEHIND]
@@ -247,7 +243,9 @@ def event_step(prob, C, W, t, h, hertz):
             tau_min = min(tau_min, W.cross[TAU, k])
     h = tau_min
     if h > 0.0:
-        step_to(prob, C, W, t, h, hertz)
+        sources(prob, t + h, W.src[SRC_END])  # the step to the earliest crossing (as locate_event's trials)
+        factor_effective(C.cm, C.ci[CI_NF], prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
+        layer_step(prob, C, W, h, CHOLESKY, hertz)
         # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
         monitors(prob, C, W.y[Y_END], W.src[SRC_END], prob.fp[FP_GAPNOISE], W.cross[PHI], hertz)
     else:
