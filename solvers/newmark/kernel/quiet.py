@@ -84,12 +84,16 @@ def advance(prob, C, W, S, O, hertz):
 
     Every array is taken out of its record once, before the loop: numba counts references, and a
     record's field read inside the loop would take and drop one at every step. The step's end is
-    computed into W.y[Y_END] and copied back into W.y[Y_NOW] (m values), cheaper than swapping the two.
+    computed into W.y[Y_END] and copied back into W.y[Y_NOW], cheaper than swapping the two: the
+    whole (3, n) block as one run of values, which compiles to vector copies (a loop over the m entries of
+    three rows did not: LLVM's vector loop for three arrays needs more entries than a layer has).
     """
     ip, fp, ist, fst = prob.ip, prob.fp, S.ist, S.fst
     sc, sa, sb, cl, clf = prob.sc, prob.sa, prob.sb, prob.cl, prob.clf
     ci, cp, mk, mon = C.ci, C.cp, C.mk, C.mon
     now, end = W.y[Y_NOW], W.y[Y_END]
+    now_values, end_values = now.reshape(now.size), end.reshape(end.size)  # (views: the rows are contiguous)
+    state_size = now.size
     z, zd, zdd = now[Z], now[ZD], now[ZDD]
     z1, zd1, zdd1 = end[Z], end[ZD], end[ZDD]
     rhs, phi, src1, peak = W.rhs, W.cross[PHI], W.src[SRC_END], O.peak
@@ -181,10 +185,8 @@ def advance(prob, C, W, S, O, hertz):
             t_out = ist[I_NEXT_OUT] * out_dt
         # accept: peaks (the rigid contacts' forces from the step's product), state, time
         raise_peaks(mk, mon, n, ns, t1 >= t_rev, gap_noise, phi, z1, zd1, zdd1, src1, peak)
-        for j in range(m):
-            z[j] = z1[j]
-            zd[j] = zd1[j]
-            zdd[j] = zdd1[j]
+        for j in range(state_size):  # the whole (3, n) block as one run of values (vector copies)
+            now_values[j] = end_values[j]
         ist[I_STEPS] += 1
         if plane == CP_STD or sub + 1 == refine:
             ist[I_GRID] = k_grid + 1
