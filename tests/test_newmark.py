@@ -331,6 +331,25 @@ def test_an_every_step_run_reports_progress_and_can_be_cancelled() -> None:
         simulate(spec, every_step=True, cancel=lambda: True)
 
 
+def test_a_run_told_of_its_progress_gives_the_bits_of_one_that_is_not() -> None:
+    """With nobody told of the progress, the kernel goes on past each chunk's end by itself
+    (``layout.FP_CHUNK``); told, it returns to Python there and is called again. The two give the same
+    bits: rows, forces, events and peaks (1A; 1A under the momentum law; a compliant Hertz cam)."""
+    from tests.test_compliant import hertz_doc
+    from vtool.solvers.studies.compare import with_model
+
+    for spec in (load_preset("gnilka-1a"), with_model(load_preset("gnilka-1a"), "momentum"), spec_from(hertz_doc())):
+        backend, mechanism = NewmarkBackend(), assemble(spec)
+        options = backend.options_from_run(spec.run)
+        seen: list[float] = []
+        told = backend.simulate(mechanism, options, progress=seen.append)
+        untold = backend.simulate(mechanism, options)
+        assert len(seen) >= 3, "the run did not return at its chunks' ends"
+        for name in ("time", "q", "qd", "qdd", "contact_force", "configuration", "peak_force"):
+            assert getattr(told, name).tobytes() == getattr(untold, name).tobytes(), name
+        assert told.events == untold.events
+
+
 def test_events_taken_whole_from_the_buffers_equal_events_made_one_by_one() -> None:
     """``TraceBuilder.add_events`` makes each Event without its dataclass __init__ (for speed): the events
     equal, and hash as, those :meth:`add_event` makes through Event(...), and stay frozen."""

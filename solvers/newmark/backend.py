@@ -251,16 +251,19 @@ class KernelRun:
         self.ist[layout.I_NOUT] = 0
         self.ist[layout.I_NEV] = 0
 
-    def chunk(self) -> int:
-        """One call of the kernel (the first one timed as the compile when the kernel was not compiled)."""
+    def chunk(self, fresh: bool = True) -> int:
+        """One call of the kernel (the first one timed as the compile when the kernel was not compiled);
+        ``fresh``: with a zeroed scratch, as every call but one that goes on after a chunk's end (which the
+        kernel does by itself when nobody is to be told of the progress: ``layout.FP_CHUNK``)."""
         from vtool import jit
         from vtool.solvers.newmark import kernel
 
         problem = self.problem
         args = (self.record, problem.tables.record(), self.scratch, self.state, self.out, problem.hertz,
                 problem.momentum)
-        self.scratch_buffer.fill(0.0)  # every call starts with a zeroed scratch, as with fresh arrays
-        self.scratch.closing.fill(0)
+        if fresh:
+            self.scratch_buffer.fill(0.0)
+            self.scratch.closing.fill(0)
         key = jit.law_key(problem.hertz, problem.momentum)
         status, seconds = jit.timed_call(kernel.run_chunk, "run_chunk", key, *args)
         self.compile_time = self.compile_time or seconds
@@ -270,8 +273,12 @@ class KernelRun:
         problem = self.problem
         chunk = self.options.chunk_steps * self.options.time_step
         self.fst[layout.F_CHUNK_END] = self.fst[layout.F_T] + chunk
+        # with no progress to report and no cancel to ask, the kernel goes on past a chunk's end itself
+        self.record.fp[layout.FP_CHUNK] = chunk if progress is None and cancel is None else 0.0
+        fresh = True
         while True:
-            status = self.chunk()
+            status = self.chunk(fresh)
+            fresh = status != layout.CHUNK_END
             t = float(self.fst[layout.F_T])
             if status == layout.NEED_CONFIG:
                 problem.build(int(self.ist[layout.I_WANT_CFG]))

@@ -17,8 +17,10 @@ import numpy as np
 IP_N, IP_NCL, IP_NS, IP_NH, IP_EVERY, IP_ZSTICK, IP_ZSTOP = range(7)
 IP_SIZE = 8
 (FP_BETA, FP_GAMMA, FP_DT, FP_TEND, FP_OUTDT, FP_OMEGA, FP_TTOL, FP_ZWIN, FP_XLIM, FP_VREST,
- FP_GAPNOISE, FP_REFINE, FP_REFWIN, FP_FTOL, FP_TREV) = range(15)
+ FP_GAPNOISE, FP_REFINE, FP_REFWIN, FP_FTOL, FP_TREV, FP_CHUNK) = range(16)
 FP_SIZE = 16
+# FP_CHUNK: a chunk's length (s) when the kernel goes on past a chunk's end by itself (nobody to report
+# progress to or to ask about a cancel), 0.0 when it returns CHUNK_END to its caller there
 # clearance table columns (int) and float columns
 CL_AHEAD, CL_BEHIND, CL_SRC, CL_MON, CL_PIN, CL_BIT, CL_LAW, CL_SOFT = range(8)
 CL_SIZE = 8  # CL_SOFT: SOFT_LINEAR or SOFT_HERTZ for a compliant clearance (no impact, no tie), else 0

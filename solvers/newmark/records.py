@@ -45,8 +45,9 @@ def scratch(n: int, ns: int, ncl: int) -> tuple[Scratch, np.ndarray]:
     solution of a step's system, a Cholesky factor, and the closing clearances of an event.
 
     Returns the record and the one buffer its float arrays are views of: the caller zeroes the
-    buffer and ``closing`` before each kernel call (two fills), so that every call starts as with fresh
-    arrays (zeroing them in the kernel compiled four ``fill`` specialisations into its first compile)."""
+    buffer and ``closing`` before each kernel call but one that goes on after a chunk's end (two
+    fills), so that such a call starts as with fresh arrays (zeroing them in the kernel compiled four
+    ``fill`` specialisations into its first compile)."""
     sizes = (9 * n, 9 * ns, 3 * ncl, n + ncl, n, n * n)
     buffer = np.zeros(sum(sizes))
     parts, start = [], 0

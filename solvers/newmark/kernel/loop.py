@@ -40,6 +40,7 @@ from vtool.solvers.newmark.layout import (
     F_T,
     FINISHED,
     FP_BETA,
+    FP_CHUNK,
     FP_DT,
     FP_GAMMA,
     FP_GAPNOISE,
@@ -281,7 +282,8 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
     interpolated inside the step; ``O.peak[PEAK_ALL]`` holds the peak contact
     forces over every step, ``[PEAK_LATE]`` those after the first cam
     revolution, ``[PEAK_OVERLAP]`` the largest overlap of each compliant
-    contact. The caller zeroes the scratch W before each call, as fresh arrays would be.
+    contact. The caller zeroes the scratch W before each call, as fresh arrays would be, but one that goes
+    on after a chunk's end (the kernel itself goes on there when ``prob.fp[FP_CHUNK]`` is set).
     Only the momentum law's impacts and the Hertz iteration allocate their
     small systems.
     """
@@ -385,6 +387,9 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
             if fired:
                 break
         scatter(C, n, now, S)
+        if status == CHUNK_END and fp[FP_CHUNK] > 0.0:  # no caller to report to: the next chunk as a new call
+            fst[F_CHUNK_END] = fst[F_T] + fp[FP_CHUNK]  # would start it (KernelRun.execute), without the call
+            continue
         if status != 0:
             return status
         # ---- the events at t (within the tolerance) ----
