@@ -5,19 +5,7 @@ from __future__ import annotations
 import math
 
 from vtool.jit import jit, jit_inline
-from vtool.solvers.newmark.layout import (
-    CI_M,
-    CI_NF,
-    CM_CFF,
-    CM_KFF,
-    CM_MFF,
-    CM_SINV,
-    CM_SINVF,
-    PART_C,
-    PART_K,
-    PART_P,
-    PART_S,
-)
+from vtool.solvers.newmark import layout
 
 
 @jit_inline
@@ -31,15 +19,15 @@ def apply_operator(cp, ci, plane, nrows, coupled, src, z, zd, zdd, out):
     on vectors of rows; each row is still summed in column order. The rows run on to a multiple of four
     where out and cp have room (nobody reads the rows past nrows). Plain arrays, no records: in the
     quiet loop a record's field read is a reference count taken and dropped at every step."""
-    nf = ci[CI_NF]
-    m = ci[CI_M]
+    nf = ci[layout.CI_NF]
+    m = ci[layout.CI_M]
     rows = min((nrows + 3) // 4 * 4, out.shape[0], cp.shape[3])
     g0 = 0
     if nf > 0:  # the first column's terms from 0.0 (the same bits as zeroing first; a zeroing loop alone
         a = zd[0]  # became a call to memset at every quiet step, which spilled the loop's registers)
         b = z[0]
         for f in range(rows):
-            out[f] = 0.0 - (cp[plane, PART_C, 0, f] * a + cp[plane, PART_K, 0, f] * b)
+            out[f] = 0.0 - (cp[plane, layout.PART_C, 0, f] * a + cp[plane, layout.PART_K, 0, f] * b)
         g0 = 1
     else:
         for f in range(rows):
@@ -48,20 +36,20 @@ def apply_operator(cp, ci, plane, nrows, coupled, src, z, zd, zdd, out):
         a = zd[g]
         b = z[g]
         for f in range(rows):
-            out[f] -= cp[plane, PART_C, g, f] * a + cp[plane, PART_K, g, f] * b
+            out[f] -= cp[plane, layout.PART_C, g, f] * a + cp[plane, layout.PART_K, g, f] * b
     for p in range(m - nf):
         j = nf + p
         a = zdd[j]
         b = zd[j]
         d = z[j]
         for f in range(rows):
-            out[f] -= (cp[plane, PART_P, 3 * p, f] * a + cp[plane, PART_P, 3 * p + 1, f] * b
-                       + cp[plane, PART_P, 3 * p + 2, f] * d)
+            out[f] -= (cp[plane, layout.PART_P, 3 * p, f] * a + cp[plane, layout.PART_P, 3 * p + 1, f] * b
+                       + cp[plane, layout.PART_P, 3 * p + 2, f] * d)
     if coupled:
         for j in range(src.shape[0]):
             a = src[j]
             for f in range(rows):
-                out[f] -= cp[plane, PART_S, j, f] * a
+                out[f] -= cp[plane, layout.PART_S, j, f] * a
 
 
 @jit_inline
@@ -70,7 +58,7 @@ def factor_effective(cm, nf, beta, gamma, h, L):
     rows of a configuration's matrices cm)."""
     for f in range(nf):
         for g in range(f + 1):
-            s = cm[CM_MFF, f, g] + gamma * h * cm[CM_CFF, f, g] + beta * h * h * cm[CM_KFF, f, g]
+            s = cm[layout.CM_MFF, f, g] + gamma * h * cm[layout.CM_CFF, f, g] + beta * h * h * cm[layout.CM_KFF, f, g]
             for k in range(g):
                 s -= L[f, k] * L[g, k]
             if f == g:
@@ -97,11 +85,11 @@ def cholesky_solve(nf, L, rhs, out):
 def effective_solve(C, which, L, b, out):
     """out = S⁻¹ b: the stored inverse of the standard (``which`` 0) or refined (1) step, or the
     Cholesky factor in L (2)."""
-    nf = C.ci[CI_NF]
+    nf = C.ci[layout.CI_NF]
     if which == 2:
         cholesky_solve(nf, L, b, out)
         return
-    slot = CM_SINV if which == 0 else CM_SINVF
+    slot = layout.CM_SINV if which == 0 else layout.CM_SINVF
     for f in range(nf):
         acc = 0.0
         for g in range(nf):

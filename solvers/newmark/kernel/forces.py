@@ -5,34 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from vtool.jit import jit, jit_inline
+from vtool.solvers.newmark import layout
 from vtool.solvers.newmark.kernel.algebra import effective_solve, solve_dense
-from vtool.solvers.newmark.layout import (
-    CI_NF,
-    CL_SOFT,
-    CLF_E,
-    CLF_HK,
-    CLF_HN,
-    CLF_HV,
-    CLF_OPEN,
-    CLF_SIGN,
-    FP_BETA,
-    FP_GAMMA,
-    IP_N,
-    IP_NS,
-    MK_AHEAD,
-    MK_BEHIND,
-    MK_FORCE,
-    MK_GAP,
-    MK_KIND,
-    MK_M,
-    MK_OVERLAP,
-    SOFT_HERTZ,
-    SRC_END,
-    Y_END,
-    ZD,
-    ZDD,
-    Z,
-)
 
 
 @jit
@@ -43,9 +17,9 @@ def hertz_force(clf, k, delta, rate):
     1975: the damping that gives restitution e at an impact at v⁻)."""
     if delta <= 0.0:
         return 0.0, 0.0, 0.0
-    stiffness = clf[k, CLF_HK]
-    exponent = clf[k, CLF_HN]
-    lam = 1.5 * (1.0 - clf[k, CLF_E]) / clf[k, CLF_HV]
+    stiffness = clf[k, layout.CLF_HK]
+    exponent = clf[k, layout.CLF_HN]
+    lam = 1.5 * (1.0 - clf[k, layout.CLF_E]) / clf[k, layout.CLF_HV]
     power = stiffness * delta**exponent
     force = power * (1.0 + lam * rate)
     if force <= 0.0:
@@ -56,13 +30,13 @@ def hertz_force(clf, k, delta, rate):
 @jit
 def overlap_and_rate(prob, C, k, y, src):
     """(δ, δ̇) of a closed Hertz contact: its monitor row holds -w on z and on ż, +1 on its source."""
-    n, ns = prob.ip[IP_N], prob.ip[IP_NS]
+    n, ns = prob.ip[layout.IP_N], prob.ip[layout.IP_NS]
     row = C.mon[k]
     delta = 0.0
     rate = 0.0
     for j in range(n):
-        delta += row[j] * y[Z, j]
-        rate += row[n + j] * y[ZD, j]
+        delta += row[j] * y[layout.Z, j]
+        rate += row[n + j] * y[layout.ZD, j]
     for s in range(ns):
         delta += row[3 * n + 3 * s] * src[3 * s]
         rate += row[3 * n + 3 * s + 1] * src[3 * s + 1]
@@ -89,9 +63,10 @@ def linear_force(mon, k, n, ns, count, z, zd, zdd, src):
 def rigid_force(prob, C, k, y, src, hertz):
     """Contact force of closed rigid clearance k: its linear row, plus the closed Hertz contacts' pull
     on it (``mon[k, 3n + 3ns + 1 + j]`` per unit Hertz force F_j)."""
-    f = linear_force(C.mon, k, prob.ip[IP_N], prob.ip[IP_NS], C.mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
+    f = linear_force(C.mon, k, prob.ip[layout.IP_N], prob.ip[layout.IP_NS], C.mk[k, layout.MK_M], y[layout.Z],
+                     y[layout.ZD], y[layout.ZDD], src)
     if hertz is not None:
-        head = 3 * prob.ip[IP_N] + 3 * prob.ip[IP_NS] + 1
+        head = 3 * prob.ip[layout.IP_N] + 3 * prob.ip[layout.IP_NS] + 1
         for j in range(prob.cl.shape[0]):
             if C.mon[k, head + j] != 0.0:
                 delta, rate = overlap_and_rate(prob, C, j, y, src)
@@ -103,10 +78,11 @@ def rigid_force(prob, C, k, y, src, hertz):
 def compliant_force(prob, C, k, y, src, hertz):
     """Contact force of closed compliant clearance k: the Hertz law, or its linear row."""
     if hertz is not None:
-        if prob.cl[k, CL_SOFT] == SOFT_HERTZ:
+        if prob.cl[k, layout.CL_SOFT] == layout.SOFT_HERTZ:
             delta, rate = overlap_and_rate(prob, C, k, y, src)
             return hertz_force(prob.clf, k, delta, rate)[0]
-    return linear_force(C.mon, k, prob.ip[IP_N], prob.ip[IP_NS], C.mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
+    return linear_force(C.mon, k, prob.ip[layout.IP_N], prob.ip[layout.IP_NS], C.mk[k, layout.MK_M], y[layout.Z],
+                        y[layout.ZD], y[layout.ZDD], src)
 
 
 @jit_inline
@@ -114,7 +90,7 @@ def signed_gap(kind, gap, gap_noise):
     """The monitor of an open clearance (its gap) or a closed compliant one (its overlap, -gap), plus
     the round-off allowance: negative past the event. Scalars only: an inline helper handed arrays
     takes and drops a reference count of each at every call, and this one runs per clearance and step."""
-    return (gap if kind == MK_GAP else -gap) + gap_noise
+    return (gap if kind == layout.MK_GAP else -gap) + gap_noise
 
 
 @jit
@@ -124,17 +100,18 @@ def monitors(prob, C, y, src, gap_noise, phi, hertz):
     Open: gap + allowance. Closed rigid: the contact force. Closed compliant: the overlap δ = -gap +
     allowance (the contact ends when the parts part). Gaps and linear forces on arrays taken out of
     the records once; with no Hertz contact (``hertz`` None) nothing else is called."""
-    n, ns = prob.ip[IP_N], prob.ip[IP_NS]
-    mk, mon, z, zd, zdd, clf = C.mk, C.mon, y[Z], y[ZD], y[ZDD], prob.clf
+    n, ns = prob.ip[layout.IP_N], prob.ip[layout.IP_NS]
+    mk, mon, z, zd, zdd, clf = C.mk, C.mon, y[layout.Z], y[layout.ZD], y[layout.ZDD], prob.clf
     for k in range(prob.cl.shape[0]):
-        kind = mk[k, MK_KIND]
-        if kind == MK_GAP or kind == MK_OVERLAP:
-            behind = mk[k, MK_BEHIND]
+        kind = mk[k, layout.MK_KIND]
+        if kind == layout.MK_GAP or kind == layout.MK_OVERLAP:
+            behind = mk[k, layout.MK_BEHIND]
             other = z[behind] if behind >= 0 else src[3 * (-1 - behind)]
-            phi[k] = signed_gap(kind, clf[k, CLF_SIGN] * (z[mk[k, MK_AHEAD]] - other) + clf[k, CLF_OPEN], gap_noise)
-        elif kind == MK_FORCE:
+            gap = clf[k, layout.CLF_SIGN] * (z[mk[k, layout.MK_AHEAD]] - other) + clf[k, layout.CLF_OPEN]
+            phi[k] = signed_gap(kind, gap, gap_noise)
+        elif kind == layout.MK_FORCE:
             if hertz is None:  # the linear row alone
-                phi[k] = linear_force(mon, k, n, ns, mk[k, MK_M], z, zd, zdd, src)
+                phi[k] = linear_force(mon, k, n, ns, mk[k, layout.MK_M], z, zd, zdd, src)
             else:
                 phi[k] = rigid_force(prob, C, k, y, src, hertz)
         else:
@@ -151,14 +128,14 @@ def hertz_correction(prob, C, W, h, which):
     Σ w_kᵀV_j F_j. Newton on F_k = H_k(δ_k(F), δ̇_k(F)) (a system of the
     closed Hertz contacts' size); then the state takes the forces.
     """
-    beta, gamma = prob.fp[FP_BETA], prob.fp[FP_GAMMA]
-    end = W.y[Y_END]
-    nf = C.ci[CI_NF]
+    beta, gamma = prob.fp[layout.FP_BETA], prob.fp[layout.FP_GAMMA]
+    end = W.y[layout.Y_END]
+    nf = C.ci[layout.CI_NF]
     ncl = prob.cl.shape[0]
     idx = np.empty(ncl, dtype=np.int64)
     nc = 0
     for k in range(ncl):
-        if C.mk[k, MK_KIND] == MK_OVERLAP and prob.cl[k, CL_SOFT] == SOFT_HERTZ:
+        if C.mk[k, layout.MK_KIND] == layout.MK_OVERLAP and prob.cl[k, layout.CL_SOFT] == layout.SOFT_HERTZ:
             idx[nc] = k
             nc += 1
     if nc == 0:
@@ -176,7 +153,7 @@ def hertz_correction(prob, C, W, h, which):
     d0 = np.zeros(nc)
     r0 = np.zeros(nc)
     for i in range(nc):
-        d0[i], r0[i] = overlap_and_rate(prob, C, idx[i], end, W.src[SRC_END])
+        d0[i], r0[i] = overlap_and_rate(prob, C, idx[i], end, W.src[layout.SRC_END])
         for j in range(nc):
             acc = 0.0
             for f in range(nf):
@@ -210,6 +187,6 @@ def hertz_correction(prob, C, W, h, which):
         acc = 0.0
         for j in range(nc):
             acc += V[f, j] * F[j]
-        end[ZDD, f] += acc
-        end[Z, f] += beta * h * h * acc
-        end[ZD, f] += gamma * h * acc
+        end[layout.ZDD, f] += acc
+        end[layout.Z, f] += beta * h * h * acc
+        end[layout.ZD, f] += gamma * h * acc

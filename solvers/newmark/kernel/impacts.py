@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from vtool.jit import jit, jit_inline
+from vtool.solvers.newmark import layout
 from vtool.solvers.newmark.kernel.algebra import solve_dense
 from vtool.solvers.newmark.kernel.forces import linear_force, rigid_force
 from vtool.solvers.newmark.kernel.step import (
@@ -22,52 +23,12 @@ from vtool.solvers.newmark.kernel.step import (
     gather,
     scatter,
 )
-from vtool.solvers.newmark.layout import (
-    CL_AHEAD,
-    CL_BEHIND,
-    CL_BIT,
-    CL_LAW,
-    CL_MON,
-    CL_PIN,
-    CL_SOFT,
-    CL_SRC,
-    CLF_E,
-    CLF_HV,
-    CLF_OPEN,
-    CLF_SCALE,
-    CLF_SIGN,
-    EV_CLOSED,
-    EV_OPENED,
-    EV_RELEASED,
-    F_LAST_EVENT,
-    FP_FTOL,
-    FP_TTOL,
-    FP_VREST,
-    FP_ZWIN,
-    I_NEV,
-    I_RAPID,
-    IP_N,
-    IP_NCL,
-    IP_NS,
-    IP_ZSTICK,
-    IP_ZSTOP,
-    LAW_MOMENTUM,
-    LAW_THESIS,
-    MK_FORCE,
-    MK_KIND,
-    MK_M,
-    SRC_NOW,
-    TAU,
-    ZD,
-    ZDD,
-    Z,
-)
 
 
 @jit_inline
 def add_event(O, S, t, k, kind, u, c_from, c_to):
     """Event row: time, relative velocity; clearance, kind, configuration before and after."""
-    row = S.ist[I_NEV]
+    row = S.ist[layout.I_NEV]
     if row < O.ev_f.shape[0]:
         O.ev_f[row, 0] = t
         O.ev_f[row, 1] = u
@@ -75,7 +36,7 @@ def add_event(O, S, t, k, kind, u, c_from, c_to):
         O.ev_i[row, 1] = kind
         O.ev_i[row, 2] = c_from
         O.ev_i[row, 3] = c_to
-    S.ist[I_NEV] = row + 1
+    S.ist[layout.I_NEV] = row + 1
 
 
 @jit
@@ -142,12 +103,12 @@ def impact_momentum(prob, c, closing, src, S, stick, O, t):
     """
     ip, fp, cl, clf, mass = prob.ip, prob.fp, prob.cl, prob.clf, prob.mass
     v = S.v
-    n = ip[IP_N]
-    ncl = ip[IP_NCL]
+    n = ip[layout.IP_N]
+    ncl = ip[layout.IP_NCL]
     idx = np.empty(ncl, dtype=np.int64)
     nc = 0
     for k in range(ncl):
-        if ((c & cl[k, CL_BIT]) and not cl[k, CL_SOFT]) or closing[k]:
+        if ((c & cl[k, layout.CL_BIT]) and not cl[k, layout.CL_SOFT]) or closing[k]:
             idx[nc] = k
             nc += 1
     u = np.zeros(nc)
@@ -156,19 +117,19 @@ def impact_momentum(prob, c, closing, src, S, stick, O, t):
     MG = np.zeros((n, nc))  # M⁻¹ Gᵀ
     for r in range(nc):
         k = idx[r]
-        ahead, behind = cl[k, CL_AHEAD], cl[k, CL_BEHIND]
+        ahead, behind = cl[k, layout.CL_AHEAD], cl[k, layout.CL_BEHIND]
         # G's row is e_ahead - e_behind, or e_ahead with w the source's velocity: u = G v - w and M⁻¹ Gᵀ by
         # their entries, each sum begun at 0.0 as a dot product with G's row (the same bits, zeros' signs too)
-        u[r] = 0.0 + v[ahead] - (v[behind] if behind >= 0 else src[3 * cl[k, CL_SRC] + 1])
+        u[r] = 0.0 + v[ahead] - (v[behind] if behind >= 0 else src[3 * cl[k, layout.CL_SRC] + 1])
         for i in range(n):
             MG[i, r] = 0.0 + mass[1, i, ahead] - (mass[1, i, behind] if behind >= 0 else 0.0)
         if closing[k]:
-            e = 0.0 if (stick or abs(u[r]) < fp[FP_VREST]) else clf[k, CLF_E]
+            e = 0.0 if (stick or abs(u[r]) < fp[layout.FP_VREST]) else clf[k, layout.CLF_E]
             b[r] = -e * u[r]
-        eq[r] = cl[k, CL_PIN] or stick
+        eq[r] = cl[k, layout.CL_PIN] or stick
     W = np.zeros((nc, nc))  # G M⁻¹ Gᵀ
     for r in range(nc):
-        ahead, behind = cl[idx[r], CL_AHEAD], cl[idx[r], CL_BEHIND]
+        ahead, behind = cl[idx[r], layout.CL_AHEAD], cl[idx[r], layout.CL_BEHIND]
         for q in range(nc):
             W[r, q] = 0.0 + MG[ahead, q] - (MG[behind, q] if behind >= 0 else 0.0)
     umax = 0.0
@@ -181,7 +142,7 @@ def impact_momentum(prob, c, closing, src, S, stick, O, t):
         solve_impulse_lcp(W, u, b, eq, scale, P, uplus)
         resting = False
         for r in range(nc):
-            if not eq[r] and 10.0 * scale < uplus[r] < fp[FP_VREST]:
+            if not eq[r] and 10.0 * scale < uplus[r] < fp[layout.FP_VREST]:
                 eq[r] = 1
                 b[r] = 0.0
                 resting = True
@@ -195,15 +156,15 @@ def impact_momentum(prob, c, closing, src, S, stick, O, t):
         k = idx[r]
         stays = eq[r] or uplus[r] <= 10.0 * scale
         if stays:
-            mask |= cl[k, CL_BIT]
+            mask |= cl[k, layout.CL_BIT]
         else:
-            mask &= ~cl[k, CL_BIT]
+            mask &= ~cl[k, layout.CL_BIT]
     for r in range(nc):
         k = idx[r]
         if closing[k]:
-            add_event(O, S, t, k, EV_CLOSED, u[r], c, mask)
-        elif not (mask & cl[k, CL_BIT]):
-            add_event(O, S, t, k, EV_RELEASED, uplus[r], c, mask)
+            add_event(O, S, t, k, layout.EV_CLOSED, u[r], c, mask)
+        elif not (mask & cl[k, layout.CL_BIT]):
+            add_event(O, S, t, k, layout.EV_RELEASED, uplus[r], c, mask)
     return mask
 
 
@@ -211,8 +172,9 @@ def impact_momentum(prob, c, closing, src, S, stick, O, t):
 def prescribed_velocity(cl, c, ncl, coordinate, src):
     """Velocity of the source a coordinate is tied to in configuration c, or nan if it is free."""
     for k in range(ncl):
-        if (c & cl[k, CL_BIT]) and not cl[k, CL_SOFT] and cl[k, CL_BEHIND] < 0 and cl[k, CL_AHEAD] == coordinate:
-            return src[3 * cl[k, CL_SRC] + 1]
+        if ((c & cl[k, layout.CL_BIT]) and not cl[k, layout.CL_SOFT] and cl[k, layout.CL_BEHIND] < 0
+                and cl[k, layout.CL_AHEAD] == coordinate):
+            return src[3 * cl[k, layout.CL_SRC] + 1]
     return math.nan
 
 
@@ -232,17 +194,17 @@ def impact_local(prob, c, k, src, S, stick, O, t):
     """
     ip, fp, cl, clf, mass = prob.ip, prob.fp, prob.cl, prob.clf, prob.mass
     v = S.v
-    ncl = ip[IP_NCL]
-    a = cl[k, CL_AHEAD]
-    behind = cl[k, CL_BEHIND]
+    ncl = ip[layout.IP_NCL]
+    a = cl[k, layout.CL_AHEAD]
+    behind = cl[k, layout.CL_BEHIND]
     if behind < 0:
-        w = src[3 * cl[k, CL_SRC] + 1]
+        w = src[3 * cl[k, layout.CL_SRC] + 1]
         u = v[a] - w
-        e = 0.0 if (stick or abs(u) < fp[FP_VREST]) else clf[k, CLF_E]
+        e = 0.0 if (stick or abs(u) < fp[layout.FP_VREST]) else clf[k, layout.CLF_E]
         v[a] = w - e * u
     else:
         u = v[a] - v[behind]
-        e = 0.0 if (stick or abs(u) < fp[FP_VREST]) else clf[k, CLF_E]
+        e = 0.0 if (stick or abs(u) < fp[layout.FP_VREST]) else clf[k, layout.CLF_E]
         wa = prescribed_velocity(cl, c, ncl, a, src)
         wb = prescribed_velocity(cl, c, ncl, behind, src)
         if not math.isnan(wa):  # a follows a source: b alone changes
@@ -252,8 +214,8 @@ def impact_local(prob, c, k, src, S, stick, O, t):
         else:
             ma = mass[0, a, a]
             mb = mass[0, behind, behind]
-            if cl[k, CL_LAW] == LAW_THESIS:
-                common = clf[k, CLF_SCALE] * v[a]
+            if cl[k, layout.CL_LAW] == layout.LAW_THESIS:
+                common = clf[k, layout.CLF_SCALE] * v[a]
             else:
                 common = (ma * v[a] + mb * v[behind]) / (ma + mb)
             uplus = -e * u
@@ -261,8 +223,8 @@ def impact_local(prob, c, k, src, S, stick, O, t):
             v[behind] = common - ma / (ma + mb) * uplus
     mask = c
     if e * abs(u) <= 0.0:
-        mask |= cl[k, CL_BIT]
-    add_event(O, S, t, k, EV_CLOSED, u, c, mask)
+        mask |= cl[k, layout.CL_BIT]
+    add_event(O, S, t, k, layout.EV_CLOSED, u, c, mask)
     return mask
 
 
@@ -270,15 +232,16 @@ def impact_local(prob, c, k, src, S, stick, O, t):
 def shut_gap(cl, clf, k, x, src):
     """Clearance k's gap (or overlap) set to exactly zero: it is within the time tolerance of zero
     (sense (x_ahead - x_behind) + opening = 0)."""
-    other = x[cl[k, CL_BEHIND]] if cl[k, CL_BEHIND] >= 0 else src[3 * cl[k, CL_SRC]]
-    x[cl[k, CL_AHEAD]] = other - clf[k, CLF_SIGN] * clf[k, CLF_OPEN]
+    other = x[cl[k, layout.CL_BEHIND]] if cl[k, layout.CL_BEHIND] >= 0 else src[3 * cl[k, layout.CL_SRC]]
+    x[cl[k, layout.CL_AHEAD]] = other - clf[k, layout.CLF_SIGN] * clf[k, layout.CLF_OPEN]
 
 
 @jit
 def gap_velocity(cl, clf, k, v, src):
     """Velocity of clearance k's gap: sense (v_ahead - v_behind (or the source's))."""
-    behind = cl[k, CL_BEHIND]
-    return clf[k, CLF_SIGN] * (v[cl[k, CL_AHEAD]] - (v[behind] if behind >= 0 else src[3 * cl[k, CL_SRC] + 1]))
+    behind = cl[k, layout.CL_BEHIND]
+    other = v[behind] if behind >= 0 else src[3 * cl[k, layout.CL_SRC] + 1]
+    return clf[k, layout.CLF_SIGN] * (v[cl[k, layout.CL_AHEAD]] - other)
 
 @jit
 def apply_impacts(prob, c, closing, src, S, stick, O, t, momentum):
@@ -292,19 +255,19 @@ def apply_impacts(prob, c, closing, src, S, stick, O, t, momentum):
     """
     ip, fp, cl, clf = prob.ip, prob.fp, prob.cl, prob.clf
     x, v = S.x, S.v
-    ncl = ip[IP_NCL]
+    ncl = ip[layout.IP_NCL]
     mask = c
     any_momentum = False
     for k in range(ncl):
         if not closing[k]:
             continue
         shut_gap(cl, clf, k, x, src)
-        if cl[k, CL_SOFT]:
-            mask |= cl[k, CL_BIT]
+        if cl[k, layout.CL_SOFT]:
+            mask |= cl[k, layout.CL_BIT]
             u = gap_velocity(cl, clf, k, v, src)
-            clf[k, CLF_HV] = max(-u, fp[FP_VREST], 1e-300)  # the Hertz contact's approach velocity
-            add_event(O, S, t, k, EV_CLOSED, u, c, mask)
-        elif cl[k, CL_LAW] == LAW_MOMENTUM:
+            clf[k, layout.CLF_HV] = max(-u, fp[layout.FP_VREST], 1e-300)  # the Hertz contact's approach velocity
+            add_event(O, S, t, k, layout.EV_CLOSED, u, c, mask)
+        elif cl[k, layout.CL_LAW] == layout.LAW_MOMENTUM:
             any_momentum = True
         else:
             mask = impact_local(prob, mask, k, src, S, stick, O, t)
@@ -312,7 +275,7 @@ def apply_impacts(prob, c, closing, src, S, stick, O, t, momentum):
         if any_momentum:
             joint = np.zeros(ncl, dtype=np.int64)  # the momentum-law closings, solved together
             for k in range(ncl):
-                if closing[k] and not cl[k, CL_SOFT] and cl[k, CL_LAW] == LAW_MOMENTUM:
+                if closing[k] and not cl[k, layout.CL_SOFT] and cl[k, layout.CL_LAW] == layout.LAW_MOMENTUM:
                     joint[k] = 1
             mask = impact_momentum(prob, mask, joint, src, S, stick, O, t)
     return mask
@@ -328,8 +291,8 @@ def release_pulling(prob, T, c, t, S, src, O, y, rhs, hertz):
     contact pushes (at most one release per clearance).
     """
     ip, fp, cl = prob.ip, prob.fp, prob.cl
-    n = ip[IP_N]
-    ncl = ip[IP_NCL]
+    n = ip[layout.IP_N]
+    ncl = ip[layout.IP_NCL]
     for _ in range(ncl + 1):
         slot = find_slot(T.index, c)
         if slot < 0:
@@ -339,11 +302,12 @@ def release_pulling(prob, T, c, t, S, src, O, y, rhs, hertz):
         consistent_acceleration(prob, C, src, y, rhs, hertz)
         scatter(C, n, y, S)
         worst = -1
-        worst_f = -fp[FP_FTOL]
+        worst_f = -fp[layout.FP_FTOL]
         for k in range(ncl):
-            if C.mk[k, MK_KIND] == MK_FORCE and cl[k, CL_MON]:
+            if C.mk[k, layout.MK_KIND] == layout.MK_FORCE and cl[k, layout.CL_MON]:
                 if hertz is None:  # the linear row alone (rigid_force's, with no Hertz contact)
-                    f = linear_force(C.mon, k, n, ip[IP_NS], C.mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
+                    f = linear_force(C.mon, k, n, ip[layout.IP_NS], C.mk[k, layout.MK_M], y[layout.Z], y[layout.ZD],
+                                     y[layout.ZDD], src)
                 else:
                     f = rigid_force(prob, C, k, y, src, hertz)
                 if f < worst_f:
@@ -351,8 +315,8 @@ def release_pulling(prob, T, c, t, S, src, O, y, rhs, hertz):
                     worst_f = f
         if worst < 0:
             return c
-        new_c = c & ~cl[worst, CL_BIT]
-        add_event(O, S, t, worst, EV_OPENED, 0.0, c, new_c)
+        new_c = c & ~cl[worst, layout.CL_BIT]
+        add_event(O, S, t, worst, layout.EV_OPENED, 0.0, c, new_c)
         c = new_c
     return c
 
@@ -364,34 +328,34 @@ def take_events(prob, c, t, h, W, S, O, momentum):
     the configuration after them, or -1 when the contacts chatter (``IP_ZSTOP`` rapid events)."""
     ip, fp, cl = prob.ip, prob.fp, prob.cl
     x, v, ist, fst = S.x, S.v, S.ist, S.fst
-    tau, closing, src0 = W.cross[TAU], W.closing, W.src[SRC_NOW]
-    ncl = ip[IP_NCL]
-    tol = fp[FP_TTOL]
+    tau, closing, src0 = W.cross[layout.TAU], W.closing, W.src[layout.SRC_NOW]
+    ncl = ip[layout.IP_NCL]
+    tol = fp[layout.FP_TTOL]
     new_c = c
     any_closing = False
     for k in range(ncl):
         closing[k] = 0
-        if cl[k, CL_MON] and tau[k] <= h + tol:
-            if c & cl[k, CL_BIT]:
-                new_c &= ~cl[k, CL_BIT]
+        if cl[k, layout.CL_MON] and tau[k] <= h + tol:
+            if c & cl[k, layout.CL_BIT]:
+                new_c &= ~cl[k, layout.CL_BIT]
             else:
                 closing[k] = 1
                 any_closing = True
-    rapid = t - fst[F_LAST_EVENT] <= fp[FP_ZWIN]
-    ist[I_RAPID] = ist[I_RAPID] + 1 if rapid else 0
-    fst[F_LAST_EVENT] = t
-    if ist[I_RAPID] >= ip[IP_ZSTOP]:
+    rapid = t - fst[layout.F_LAST_EVENT] <= fp[layout.FP_ZWIN]
+    ist[layout.I_RAPID] = ist[layout.I_RAPID] + 1 if rapid else 0
+    fst[layout.F_LAST_EVENT] = t
+    if ist[layout.I_RAPID] >= ip[layout.IP_ZSTOP]:
         return -1
-    stick = ist[I_RAPID] >= ip[IP_ZSTICK]
+    stick = ist[layout.I_RAPID] >= ip[layout.IP_ZSTICK]
     for k in range(ncl):
-        if (c & cl[k, CL_BIT]) and not (new_c & cl[k, CL_BIT]):
+        if (c & cl[k, layout.CL_BIT]) and not (new_c & cl[k, layout.CL_BIT]):
             u = 0.0
-            if cl[k, CL_SOFT]:  # the parts leave with their relative velocity; the overlap is shut
+            if cl[k, layout.CL_SOFT]:  # the parts leave with their relative velocity; the overlap is shut
                 shut_gap(cl, prob.clf, k, x, src0)
                 u = gap_velocity(cl, prob.clf, k, v, src0)
-            add_event(O, S, t, k, EV_OPENED, u, c, new_c)
+            add_event(O, S, t, k, layout.EV_OPENED, u, c, new_c)
     if any_closing:
-        new_c = apply_impacts(prob, new_c, W.closing, W.src[SRC_NOW], S, stick, O, t, momentum)
+        new_c = apply_impacts(prob, new_c, W.closing, W.src[layout.SRC_NOW], S, stick, O, t, momentum)
     return new_c
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from vtool.jit import borrowed, jit, jit_inline
+from vtool.solvers.newmark import layout
 from vtool.solvers.newmark.kernel.algebra import factor_effective
 from vtool.solvers.newmark.kernel.forces import (
     linear_force,
@@ -25,65 +26,6 @@ from vtool.solvers.newmark.kernel.step import (
     layer_step,
     scatter,
     sources,
-)
-from vtool.solvers.newmark.layout import (
-    CHATTER,
-    CHUNK_END,
-    CI_HERTZ,
-    CI_NF,
-    CL_MON,
-    CLF_OPEN,
-    CLF_SIGN,
-    DIVERGED,
-    F_CHUNK_END,
-    F_FINE_UNTIL,
-    F_T,
-    FINISHED,
-    FP_BETA,
-    FP_CHUNK,
-    FP_DT,
-    FP_GAMMA,
-    FP_GAPNOISE,
-    FP_OUTDT,
-    FP_REFINE,
-    FP_REFWIN,
-    FP_TEND,
-    FP_TREV,
-    FP_TTOL,
-    FP_XLIM,
-    I_CFG,
-    I_GRID,
-    I_NEED_SETTLE,
-    I_NEV,
-    I_NEXT_OUT,
-    I_NOUT,
-    I_STARTED,
-    I_STEPS,
-    I_SUB,
-    I_WANT_CFG,
-    IP_EVERY,
-    IP_N,
-    IP_NS,
-    MK_AHEAD,
-    MK_BEHIND,
-    MK_GAP,
-    MK_KIND,
-    MK_M,
-    MK_OVERLAP,
-    NEED_CONFIG,
-    OUTPUT_FULL,
-    PEAK_ALL,
-    PHI,
-    PHI_START,
-    SRC_END,
-    SRC_NOW,
-    SRC_OUT,
-    TAU,
-    Y_END,
-    Y_NOW,
-    ZD,
-    ZDD,
-    Z,
 )
 from vtool.solvers.newmark.records import Output, Problem, Scratch, State, Tables
 
@@ -107,15 +49,15 @@ def locate_event(prob, C, W, k, t, h, hertz):
     here cost about 0.6 s of first compile; the call costs about 1 % of a run).
     """
     fp, ip = prob.fp, prob.ip
-    tol, gap_noise = fp[FP_TTOL], fp[FP_GAPNOISE]
-    n, ns = ip[IP_N], ip[IP_NS]
+    tol, gap_noise = fp[layout.FP_TTOL], fp[layout.FP_GAPNOISE]
+    n, ns = ip[layout.IP_N], ip[layout.IP_NS]
     clf, mk, mon = prob.clf, C.mk, C.mon
-    end = W.y[Y_END]
-    z1, zd1, zdd1 = end[Z], end[ZD], end[ZDD]
-    src1 = W.src[SRC_END]
-    kind = mk[k, MK_KIND]
+    end = W.y[layout.Y_END]
+    z1, zd1, zdd1 = end[layout.Z], end[layout.ZD], end[layout.ZDD]
+    src1 = W.src[layout.SRC_END]
+    kind = mk[k, layout.MK_KIND]
     lo, hi = 0.0, h
-    flo, fhi = W.cross[PHI_START, k], W.cross[PHI, k]
+    flo, fhi = W.cross[layout.PHI_START, k], W.cross[layout.PHI, k]
     side = 0
     width_before = 2.0 * h
     for iteration in range(200):
@@ -133,16 +75,17 @@ def locate_event(prob, C, W, k, t, h, hertz):
         tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
         # the trial step from t: sources at t + tau, S(tau) factored by Cholesky (written here, not as an
         # inline helper of the records: its records' arrays were counted in and out at every trial)
-        sources(prob, t + tau, W.src[SRC_END])
-        factor_effective(C.cm, C.ci[CI_NF], fp[FP_BETA], fp[FP_GAMMA], tau, W.L)
+        sources(prob, t + tau, W.src[layout.SRC_END])
+        factor_effective(C.cm, C.ci[layout.CI_NF], fp[layout.FP_BETA], fp[layout.FP_GAMMA], tau, W.L)
         layer_step(prob, C, W, tau, CHOLESKY, hertz)
         # monitor k (see forces.monitors), on the arrays
-        if kind == MK_GAP or kind == MK_OVERLAP:
-            behind = mk[k, MK_BEHIND]
+        if kind == layout.MK_GAP or kind == layout.MK_OVERLAP:
+            behind = mk[k, layout.MK_BEHIND]
             other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
-            f = signed_gap(kind, clf[k, CLF_SIGN] * (z1[mk[k, MK_AHEAD]] - other) + clf[k, CLF_OPEN], gap_noise)
+            gap = clf[k, layout.CLF_SIGN] * (z1[mk[k, layout.MK_AHEAD]] - other) + clf[k, layout.CLF_OPEN]
+            f = signed_gap(kind, gap, gap_noise)
         elif hertz is None:  # a closed rigid contact's force: the linear row alone
-            f = linear_force(mon, k, n, ns, mk[k, MK_M], z1, zd1, zdd1, src1)
+            f = linear_force(mon, k, n, ns, mk[k, layout.MK_M], z1, zd1, zdd1, src1)
         else:
             f = rigid_force(prob, C, k, end, src1, hertz)
         if f < 0.0:
@@ -162,9 +105,9 @@ def locate_event(prob, C, W, k, t, h, hertz):
 def copy_state(m, y, src, y_to, src_to):
     """The first m entries of y, and the sources, into y_to and src_to."""
     for j in range(m):
-        y_to[Z, j] = y[Z, j]
-        y_to[ZD, j] = y[ZD, j]
-        y_to[ZDD, j] = y[ZDD, j]
+        y_to[layout.Z, j] = y[layout.Z, j]
+        y_to[layout.ZD, j] = y[layout.ZD, j]
+        y_to[layout.ZDD, j] = y[layout.ZDD, j]
     for j in range(src.shape[0]):
         src_to[j] = src[j]
 
@@ -173,11 +116,11 @@ def copy_state(m, y, src, y_to, src_to):
 def arrive(S, target, grid_next, k_grid, j_target):
     """Now at ``target``: the next standard grid point, or point ``j_target`` of the refined grid."""
     if target == grid_next:
-        S.ist[I_GRID] = k_grid + 1
-        S.ist[I_SUB] = 0
+        S.ist[layout.I_GRID] = k_grid + 1
+        S.ist[layout.I_SUB] = 0
     else:
-        S.ist[I_SUB] = j_target
-    S.fst[F_T] = target
+        S.ist[layout.I_SUB] = j_target
+    S.fst[layout.F_T] = target
     return target
 
 
@@ -186,15 +129,15 @@ def start(prob, C, W, S, O, hertz):
     """The run's first row (the start is an output row and counts for the peaks); False when the
     output buffer is full."""
     ist = S.ist
-    if ist[I_NOUT] >= O.t.shape[0]:
+    if ist[layout.I_NOUT] >= O.t.shape[0]:
         return False
-    gather(C, prob.ip[IP_N], S, W.y[Y_NOW])
-    record_row(prob, C, S.fst[F_T], W.y[Y_NOW], W.src[SRC_NOW], O, ist[I_NOUT], hertz)
+    gather(C, prob.ip[layout.IP_N], S, W.y[layout.Y_NOW])
+    record_row(prob, C, S.fst[layout.F_T], W.y[layout.Y_NOW], W.src[layout.SRC_NOW], O, ist[layout.I_NOUT], hertz)
     for k in range(prob.cl.shape[0]):
-        O.peak[PEAK_ALL, k] = max(O.peak[PEAK_ALL, k], O.F[ist[I_NOUT], k])
-    ist[I_NOUT] += 1
-    ist[I_NEXT_OUT] = 1
-    ist[I_STARTED] = 1
+        O.peak[layout.PEAK_ALL, k] = max(O.peak[layout.PEAK_ALL, k], O.F[ist[layout.I_NOUT], k])
+    ist[layout.I_NOUT] += 1
+    ist[layout.I_NEXT_OUT] = 1
+    ist[layout.I_STARTED] = 1
     return True
 
 
@@ -203,13 +146,13 @@ def step_length(prob, S, t, c_hertz):
     """The next step from t: (h, target, grid_next, j_target, quiet), quiet when the quiet loop may take it
     (on a point of the step grid, not every-step mode, no closed Hertz contact)."""
     fp, ist = prob.fp, S.ist
-    dt, t_end = fp[FP_DT], fp[FP_TEND]
-    refine = int(fp[FP_REFINE] + 0.5)
+    dt, t_end = fp[layout.FP_DT], fp[layout.FP_TEND]
+    refine = int(fp[layout.FP_REFINE] + 0.5)
     fine = dt / refine
-    k_grid = ist[I_GRID]
-    sub = ist[I_SUB]
-    refined = sub > 0 or t < S.fst[F_FINE_UNTIL]
-    quiet = t == (k_grid * dt + sub * fine if refined else k_grid * dt) and not (prob.ip[IP_EVERY] or c_hertz)
+    k_grid = ist[layout.I_GRID]
+    sub = ist[layout.I_SUB]
+    refined = sub > 0 or t < S.fst[layout.F_FINE_UNTIL]
+    quiet = t == (k_grid * dt + sub * fine if refined else k_grid * dt) and not (prob.ip[layout.IP_EVERY] or c_hertz)
     grid_next = (k_grid + 1) * dt
     j_target = -1  # refined steps: the index of the refined grid point this step reaches
     target = grid_next
@@ -234,23 +177,26 @@ def event_step(prob, C, W, t, h, hertz):
     """After a step of length h whose monitors W.cross[PHI] changed sign: locate every sign change, take the
     earliest (tau in W.cross[TAU]) and redo the step to it. Returns the step taken."""
     ncl = prob.cl.shape[0]
-    monitors(prob, C, W.y[Y_NOW], W.src[SRC_NOW], prob.fp[FP_GAPNOISE], W.cross[PHI_START], hertz)
+    gap_noise = prob.fp[layout.FP_GAPNOISE]
+    monitors(prob, C, W.y[layout.Y_NOW], W.src[layout.SRC_NOW], gap_noise, W.cross[layout.PHI_START], hertz)
     tau_min = 2.0 * h
     for k in range(ncl):
         # no crossing: never an event (take_events takes tau <= h + tol, also for h < tol)
-        W.cross[TAU, k] = math.inf
-        if prob.cl[k, CL_MON] and W.cross[PHI, k] < 0.0:
-            W.cross[TAU, k] = 0.0 if W.cross[PHI_START, k] < 0.0 else locate_event(prob, C, W, k, t, h, hertz)
-            tau_min = min(tau_min, W.cross[TAU, k])
+        W.cross[layout.TAU, k] = math.inf
+        if prob.cl[k, layout.CL_MON] and W.cross[layout.PHI, k] < 0.0:
+            started_past = W.cross[layout.PHI_START, k] < 0.0
+            W.cross[layout.TAU, k] = 0.0 if started_past else locate_event(prob, C, W, k, t, h, hertz)
+            tau_min = min(tau_min, W.cross[layout.TAU, k])
     h = tau_min
     if h > 0.0:
-        sources(prob, t + h, W.src[SRC_END])  # the step to the earliest crossing (as locate_event's trials)
-        factor_effective(C.cm, C.ci[CI_NF], prob.fp[FP_BETA], prob.fp[FP_GAMMA], h, W.L)
+        sources(prob, t + h, W.src[layout.SRC_END])  # the step to the earliest crossing (as locate_event's trials)
+        factor_effective(C.cm, C.ci[layout.CI_NF], prob.fp[layout.FP_BETA], prob.fp[layout.FP_GAMMA], h, W.L)
         layer_step(prob, C, W, h, CHOLESKY, hertz)
         # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
-        monitors(prob, C, W.y[Y_END], W.src[SRC_END], prob.fp[FP_GAPNOISE], W.cross[PHI], hertz)
+        monitors(prob, C, W.y[layout.Y_END], W.src[layout.SRC_END], gap_noise, W.cross[layout.PHI], hertz)
     else:
-        copy_state(prob.ip[IP_N], W.y[Y_NOW], W.src[SRC_NOW], W.y[Y_END], W.src[SRC_END])
+        copy_state(prob.ip[layout.IP_N], W.y[layout.Y_NOW], W.src[layout.SRC_NOW], W.y[layout.Y_END],
+                   W.src[layout.SRC_END])
     return h
 
 
@@ -289,32 +235,34 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
     """
     prob, T, W, S, O = borrow(prob, T, W, S, O)  # noqa: E741
     fp, ist, fst = prob.fp, S.ist, S.fst
-    n, ncl = prob.ip[IP_N], prob.cl.shape[0]
-    dt, t_end, out_dt, x_limit, t_rev = fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT], fp[FP_XLIM], fp[FP_TREV]
-    now, end, src0, src1, phi = W.y[Y_NOW], W.y[Y_END], W.src[SRC_NOW], W.src[SRC_END], W.cross[PHI]
+    n, ncl = prob.ip[layout.IP_N], prob.cl.shape[0]
+    dt, t_end, out_dt = fp[layout.FP_DT], fp[layout.FP_TEND], fp[layout.FP_OUTDT]
+    x_limit, t_rev = fp[layout.FP_XLIM], fp[layout.FP_TREV]
+    now, end, src0, src1 = W.y[layout.Y_NOW], W.y[layout.Y_END], W.src[layout.SRC_NOW], W.src[layout.SRC_END]
+    phi = W.cross[layout.PHI]
     while True:
-        t = fst[F_T]
-        c = ist[I_CFG]
+        t = fst[layout.F_T]
+        c = ist[layout.I_CFG]
         slot = find_slot(T.index, c)
         if slot < 0:
-            ist[I_WANT_CFG] = c
-            return NEED_CONFIG
-        if ist[I_NEV] + 3 * ncl + 2 >= O.ev_f.shape[0]:
-            return OUTPUT_FULL
+            ist[layout.I_WANT_CFG] = c
+            return layout.NEED_CONFIG
+        if ist[layout.I_NEV] + 3 * ncl + 2 >= O.ev_f.shape[0]:
+            return layout.OUTPUT_FULL
         sources(prob, t, src0)
-        if ist[I_NEED_SETTLE]:
+        if ist[layout.I_NEED_SETTLE]:
             settled = release_pulling(prob, T, c, t, S, src0, O, now, W.rhs, hertz)
             if settled < 0:
-                ist[I_CFG] = -1 - settled
-                ist[I_WANT_CFG] = -1 - settled
-                return NEED_CONFIG
+                ist[layout.I_CFG] = -1 - settled
+                ist[layout.I_WANT_CFG] = -1 - settled
+                return layout.NEED_CONFIG
             c = settled
-            ist[I_CFG] = c
-            ist[I_NEED_SETTLE] = 0
+            ist[layout.I_CFG] = c
+            ist[layout.I_NEED_SETTLE] = 0
             slot = find_slot(T.index, c)
         C = configuration(T, c, slot)
-        if not ist[I_STARTED] and not start(prob, C, W, S, O, hertz):
-            return OUTPUT_FULL
+        if not ist[layout.I_STARTED] and not start(prob, C, W, S, O, hertz):
+            return layout.OUTPUT_FULL
         gather(C, n, S, now)
         # ---- steps in configuration C until an event (status 0), the chunk end, the run's end or a full
         # buffer (written here, not as an inline function: numba copies an inline function's whole IR
@@ -323,12 +271,12 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
         status = 0
         while True:
             if t >= t_end - 1e-9 * dt:
-                status = FINISHED
+                status = layout.FINISHED
                 break
-            if t >= fst[F_CHUNK_END]:
-                status = CHUNK_END
+            if t >= fst[layout.F_CHUNK_END]:
+                status = layout.CHUNK_END
                 break
-            h, target, grid_next, j_target, quiet = step_length(prob, S, t, C.ci[CI_HERTZ])
+            h, target, grid_next, j_target, quiet = step_length(prob, S, t, C.ci[layout.CI_HERTZ])
             if quiet:  # quiet steps may follow; off the grid, after an event, the call would return at once
                 t_quiet = advance(prob, C, W, S, O, hertz)
                 if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
@@ -336,67 +284,68 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
                     sources(prob, t, src0)
                     continue
             if h <= 1e-9 * dt:  # at a grid point but for round-off
-                t = arrive(S, target, grid_next, ist[I_GRID], j_target)
+                t = arrive(S, target, grid_next, ist[layout.I_GRID], j_target)
                 continue
             sources(prob, t + h, src1)
             which = STANDARD
             if h != dt:
-                if h == dt / int(fp[FP_REFINE] + 0.5):
+                if h == dt / int(fp[layout.FP_REFINE] + 0.5):
                     which = REFINED
                 else:
                     which = CHOLESKY
-                    factor_effective(C.cm, C.ci[CI_NF], fp[FP_BETA], fp[FP_GAMMA], h, W.L)
+                    factor_effective(C.cm, C.ci[layout.CI_NF], fp[layout.FP_BETA], fp[layout.FP_GAMMA], h, W.L)
             layer_step(prob, C, W, h, which, hertz)
-            monitors(prob, C, end, src1, fp[FP_GAPNOISE], phi, hertz)
+            monitors(prob, C, end, src1, fp[layout.FP_GAPNOISE], phi, hertz)
             fired = False
             for k in range(ncl):
-                if prob.cl[k, CL_MON] and phi[k] < 0.0:
+                if prob.cl[k, layout.CL_MON] and phi[k] < 0.0:
                     fired = True
             if fired:  # locate every sign change; the earliest is taken
                 h = event_step(prob, C, W, t, h, hertz)
             if h > 0.0:
-                for j in range(C.ci[CI_NF]):
-                    if not (abs(end[Z, j]) <= x_limit):  # the state at the divergence into S
+                for j in range(C.ci[layout.CI_NF]):
+                    if not (abs(end[layout.Z, j]) <= x_limit):  # the state at the divergence into S
                         scatter(C, n, end, S)
-                        fst[F_T] = t + h
-                        return DIVERGED
+                        fst[layout.F_T] = t + h
+                        return layout.DIVERGED
                 # outputs inside (t, t + h]
-                if prob.ip[IP_EVERY]:
-                    if ist[I_NOUT] >= O.t.shape[0]:
-                        status = OUTPUT_FULL
+                if prob.ip[layout.IP_EVERY]:
+                    if ist[layout.I_NOUT] >= O.t.shape[0]:
+                        status = layout.OUTPUT_FULL
                         break
-                    record_row(prob, C, t + h, end, src1, O, ist[I_NOUT], hertz)
-                    ist[I_NOUT] += 1
+                    record_row(prob, C, t + h, end, src1, O, ist[layout.I_NOUT], hertz)
+                    ist[layout.I_NOUT] += 1
                 else:
-                    t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant: a call only when one is due
+                    t_out = ist[layout.I_NEXT_OUT] * out_dt  # the next output instant: a call only when one is due
                     if (t_out <= t + h + 1e-9 * dt and t_out <= t_end + 1e-9 * dt
-                            and not step_rows(prob, C, t, h, W.y, W.src[SRC_OUT], O, ist, hertz)):
-                        status = OUTPUT_FULL
+                            and not step_rows(prob, C, t, h, W.y, W.src[layout.SRC_OUT], O, ist, hertz)):
+                        status = layout.OUTPUT_FULL
                         break
                 if hertz is None:  # linear contacts: the quiet loop's peaks (no call to compile)
-                    raise_peaks(C.mk, C.mon, n, prob.ip[IP_NS], t + h >= t_rev, fp[FP_GAPNOISE], phi, end[Z], end[ZD],
-                                end[ZDD], src1, O.peak)
+                    raise_peaks(C.mk, C.mon, n, prob.ip[layout.IP_NS], t + h >= t_rev, fp[layout.FP_GAPNOISE], phi,
+                                end[layout.Z], end[layout.ZD], end[layout.ZDD], src1, O.peak)
                 else:
                     track_peaks(prob, C, t + h >= t_rev, phi, end, src1, O.peak, hertz)
-                ist[I_STEPS] += 1
+                ist[layout.I_STEPS] += 1
                 copy_state(n, end, src1, now, src0)
                 t = t + h
-                fst[F_T] = t
+                fst[layout.F_T] = t
                 if abs(t - target) <= 1e-9 * dt:
-                    t = arrive(S, target, grid_next, ist[I_GRID], j_target)
+                    t = arrive(S, target, grid_next, ist[layout.I_GRID], j_target)
             if fired:
                 break
         scatter(C, n, now, S)
-        if status == CHUNK_END and fp[FP_CHUNK] > 0.0:  # no caller to report to: the next chunk as a new call
-            fst[F_CHUNK_END] = fst[F_T] + fp[FP_CHUNK]  # would start it (KernelRun.execute), without the call
+        if status == layout.CHUNK_END and fp[layout.FP_CHUNK] > 0.0:
+            # no caller to report to: the next chunk as a new call would start it (KernelRun.execute)
+            fst[layout.F_CHUNK_END] = fst[layout.F_T] + fp[layout.FP_CHUNK]
             continue
         if status != 0:
             return status
         # ---- the events at t (within the tolerance) ----
-        t = fst[F_T]
+        t = fst[layout.F_T]
         new_c = take_events(prob, c, t, h, W, S, O, momentum)
         if new_c < 0:
-            return CHATTER
-        ist[I_CFG] = new_c
-        ist[I_NEED_SETTLE] = 1
-        fst[F_FINE_UNTIL] = t + prob.fp[FP_REFWIN]
+            return layout.CHATTER
+        ist[layout.I_CFG] = new_c
+        ist[layout.I_NEED_SETTLE] = 1
+        fst[layout.F_FINE_UNTIL] = t + prob.fp[layout.FP_REFWIN]

@@ -5,34 +5,9 @@ from __future__ import annotations
 import math
 
 from vtool.jit import jit, jit_inline
+from vtool.solvers.newmark import layout
 from vtool.solvers.newmark.kernel.forces import compliant_force, linear_force, rigid_force
 from vtool.solvers.newmark.kernel.step import harmonics, interpolate, prescribed
-from vtool.solvers.newmark.layout import (
-    CI_HEAD,
-    CI_NF,
-    FP_DT,
-    FP_GAPNOISE,
-    FP_OMEGA,
-    FP_OUTDT,
-    FP_TEND,
-    I_NEXT_OUT,
-    I_NOUT,
-    IP_N,
-    IP_NS,
-    MK_FORCE,
-    MK_KIND,
-    MK_M,
-    MK_OVERLAP,
-    PEAK_ALL,
-    PEAK_LATE,
-    PEAK_OVERLAP,
-    Y_END,
-    Y_NOW,
-    Y_OUT,
-    ZD,
-    ZDD,
-    Z,
-)
 
 
 @jit_inline
@@ -40,7 +15,7 @@ def put_state(ci, n, ns, row, z, zd, zdd, src, q):
     """Row ``row`` of the output planes q (x, v, a): the full coordinates of the layer state
     (z, ż, z̈) in the configuration whose integer row is ci, then the sources."""
     for i in range(n):
-        j = ci[CI_HEAD + n + i]
+        j = ci[layout.CI_HEAD + n + i]
         q[0, row, i] = z[j]
         q[1, row, i] = zd[j]
         q[2, row, i] = zdd[j]
@@ -54,19 +29,20 @@ def put_state(ci, n, ns, row, z, zd, zdd, src, q):
 def record_row(prob, C, t, y, src, O, row, hertz):
     """Output row ``row``: time, configuration, the full coordinates (x, v, a planes) and the sources,
     and every clearance's contact force (0 when open)."""
-    n, ns = prob.ip[IP_N], prob.ip[IP_NS]
+    n, ns = prob.ip[layout.IP_N], prob.ip[layout.IP_NS]
     O.t[row] = t
     O.c[row] = C.mask
-    put_state(C.ci, n, ns, row, y[Z], y[ZD], y[ZDD], src, O.q)
+    put_state(C.ci, n, ns, row, y[layout.Z], y[layout.ZD], y[layout.ZDD], src, O.q)
     for k in range(prob.cl.shape[0]):
-        kind = C.mk[k, MK_KIND]
+        kind = C.mk[k, layout.MK_KIND]
         force = 0.0
         if hertz is None:  # (with no Hertz contact, a closed contact's force is its linear row)
-            if kind == MK_FORCE or kind == MK_OVERLAP:
-                force = linear_force(C.mon, k, n, ns, C.mk[k, MK_M], y[Z], y[ZD], y[ZDD], src)
-        elif kind == MK_FORCE:
+            if kind == layout.MK_FORCE or kind == layout.MK_OVERLAP:
+                force = linear_force(C.mon, k, n, ns, C.mk[k, layout.MK_M], y[layout.Z], y[layout.ZD], y[layout.ZDD],
+                                     src)
+        elif kind == layout.MK_FORCE:
             force = rigid_force(prob, C, k, y, src, hertz)
-        elif kind == MK_OVERLAP:
+        elif kind == layout.MK_OVERLAP:
             force = compliant_force(prob, C, k, y, src, hertz)
         O.F[row, k] = force
 
@@ -79,21 +55,22 @@ def step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
     the buffer filled first (the rows before are written). :func:`record_row`'s row, on arrays taken
     out of the records once. It is handed only what it uses, not the scratch and state records: a
     non-inline call passes every array of its records, field by field (less code to compile)."""
-    dt, t_end, out_dt, omega = prob.fp[FP_DT], prob.fp[FP_TEND], prob.fp[FP_OUTDT], prob.fp[FP_OMEGA]
-    n, ns, ncl = prob.ip[IP_N], prob.ip[IP_NS], prob.cl.shape[0]
+    fp = prob.fp
+    dt, t_end, out_dt, omega = fp[layout.FP_DT], fp[layout.FP_TEND], fp[layout.FP_OUTDT], fp[layout.FP_OMEGA]
+    n, ns, ncl = prob.ip[layout.IP_N], prob.ip[layout.IP_NS], prob.cl.shape[0]
     sc, sa, sb = prob.sc, prob.sa, prob.sb
     ci, mk, mon = C.ci, C.mk, C.mon
-    y, out, zdd1 = Y[Y_NOW], Y[Y_OUT], Y[Y_END, ZDD]
-    z, zd, zdd = y[Z], y[ZD], y[ZDD]
-    zo, zdo, zddo = out[Z], out[ZD], out[ZDD]
+    y, out, zdd1 = Y[layout.Y_NOW], Y[layout.Y_OUT], Y[layout.Y_END, layout.ZDD]
+    z, zd, zdd = y[layout.Z], y[layout.ZD], y[layout.ZDD]
+    zo, zdo, zddo = out[layout.Z], out[layout.ZD], out[layout.ZDD]
     out_t, out_q, out_F, out_c = O.t, O.q, O.F, O.c
-    nf = ci[CI_NF]
+    nf = ci[layout.CI_NF]
     while True:
-        j_out = ist[I_NEXT_OUT]
+        j_out = ist[layout.I_NEXT_OUT]
         t_out = j_out * out_dt
         if t_out > t + h + 1e-9 * dt or t_out > t_end + 1e-9 * dt:
             return True
-        row = ist[I_NOUT]
+        row = ist[layout.I_NOUT]
         if row >= out_t.shape[0]:
             return False
         interpolate(nf, t_out - t, h, z, zd, zdd, zdd1, out)
@@ -103,18 +80,18 @@ def step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
         out_c[row] = C.mask
         put_state(ci, n, ns, row, zo, zdo, zddo, srco, out_q)
         for k in range(ncl):
-            kind = mk[k, MK_KIND]
+            kind = mk[k, layout.MK_KIND]
             force = 0.0
             if hertz is None:  # (the branches below are pruned before typing: see layout.laws)
-                if kind == MK_FORCE or kind == MK_OVERLAP:
-                    force = linear_force(mon, k, n, ns, mk[k, MK_M], zo, zdo, zddo, srco)
-            elif kind == MK_FORCE:
+                if kind == layout.MK_FORCE or kind == layout.MK_OVERLAP:
+                    force = linear_force(mon, k, n, ns, mk[k, layout.MK_M], zo, zdo, zddo, srco)
+            elif kind == layout.MK_FORCE:
                 force = rigid_force(prob, C, k, out, srco, hertz)
-            elif kind == MK_OVERLAP:
+            elif kind == layout.MK_OVERLAP:
                 force = compliant_force(prob, C, k, out, srco, hertz)
             out_F[row, k] = force
-        ist[I_NOUT] = row + 1
-        ist[I_NEXT_OUT] = j_out + 1
+        ist[layout.I_NOUT] = row + 1
+        ist[layout.I_NEXT_OUT] = j_out + 1
 
 
 @jit_inline
@@ -122,17 +99,17 @@ def raise_peaks(mk, mon, n, ns, after, gap_noise, phi, z, zd, zdd, src, peak):
     """:func:`track_peaks` with linear contacts only (no Hertz law): a closed rigid contact's force is
     its monitor phi[k], a compliant one's its linear row at the step's end (z, ż, z̈, sources src)."""
     for k in range(phi.shape[0]):
-        kind = mk[k, MK_KIND]
-        if kind == MK_FORCE:
+        kind = mk[k, layout.MK_KIND]
+        if kind == layout.MK_FORCE:
             force = phi[k]
-        elif kind == MK_OVERLAP:
-            force = linear_force(mon, k, n, ns, mk[k, MK_M], z, zd, zdd, src)
-            peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
+        elif kind == layout.MK_OVERLAP:
+            force = linear_force(mon, k, n, ns, mk[k, layout.MK_M], z, zd, zdd, src)
+            peak[layout.PEAK_OVERLAP, k] = max(peak[layout.PEAK_OVERLAP, k], phi[k] - gap_noise)
         else:
             continue
-        peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], force)
+        peak[layout.PEAK_ALL, k] = max(peak[layout.PEAK_ALL, k], force)
         if after:
-            peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], force)
+            peak[layout.PEAK_LATE, k] = max(peak[layout.PEAK_LATE, k], force)
 
 
 @jit
@@ -141,16 +118,16 @@ def track_peaks(prob, C, after, phi, y, src, peak, hertz):
     (state y, sources src); ``after``: the step ends after the first cam revolution. A compliant
     contact's force by its own law (:func:`compliant_force`): the run loop calls this with Hertz
     contacts, :func:`raise_peaks` with linear ones."""
-    gap_noise = prob.fp[FP_GAPNOISE]
+    gap_noise = prob.fp[layout.FP_GAPNOISE]
     mk = C.mk
     for k in range(prob.cl.shape[0]):
-        kind = mk[k, MK_KIND]
+        kind = mk[k, layout.MK_KIND]
         force = phi[k]
-        if kind == MK_OVERLAP:
+        if kind == layout.MK_OVERLAP:
             force = compliant_force(prob, C, k, y, src, hertz)
-            peak[PEAK_OVERLAP, k] = max(peak[PEAK_OVERLAP, k], phi[k] - gap_noise)
-        elif kind != MK_FORCE:
+            peak[layout.PEAK_OVERLAP, k] = max(peak[layout.PEAK_OVERLAP, k], phi[k] - gap_noise)
+        elif kind != layout.MK_FORCE:
             continue
-        peak[PEAK_ALL, k] = max(peak[PEAK_ALL, k], force)
+        peak[layout.PEAK_ALL, k] = max(peak[layout.PEAK_ALL, k], force)
         if after:
-            peak[PEAK_LATE, k] = max(peak[PEAK_LATE, k], force)
+            peak[layout.PEAK_LATE, k] = max(peak[layout.PEAK_LATE, k], force)

@@ -15,55 +15,11 @@ from __future__ import annotations
 import math
 
 from vtool.jit import jit
+from vtool.solvers.newmark import layout
 from vtool.solvers.newmark.kernel.algebra import apply_operator
 from vtool.solvers.newmark.kernel.forces import signed_gap
 from vtool.solvers.newmark.kernel.output import raise_peaks, step_rows
 from vtool.solvers.newmark.kernel.step import corrected, harmonics, predict, prescribed
-from vtool.solvers.newmark.layout import (
-    CI_M,
-    CI_NF,
-    CI_ROWS,
-    CI_SRCSTEP,
-    CL_MON,
-    CLF_OPEN,
-    CLF_SIGN,
-    CP_FINE,
-    CP_STD,
-    F_CHUNK_END,
-    F_FINE_UNTIL,
-    F_T,
-    FP_BETA,
-    FP_DT,
-    FP_GAMMA,
-    FP_GAPNOISE,
-    FP_OMEGA,
-    FP_OUTDT,
-    FP_REFINE,
-    FP_TEND,
-    FP_TREV,
-    FP_XLIM,
-    I_GRID,
-    I_NEXT_OUT,
-    I_STEPS,
-    I_SUB,
-    IP_N,
-    IP_NS,
-    MK_AHEAD,
-    MK_BEHIND,
-    MK_FORCE,
-    MK_GAP,
-    MK_KIND,
-    MK_OVERLAP,
-    MK_ROW,
-    PHI,
-    SRC_END,
-    SRC_OUT,
-    Y_END,
-    Y_NOW,
-    ZD,
-    ZDD,
-    Z,
-)
 
 #: Quiet steps between fresh evaluations of cos and sin of the cam angle (see :func:`advance`).
 ANCHOR_STEPS = 64
@@ -91,21 +47,22 @@ def advance(prob, C, W, S, O, hertz):
     ip, fp, ist, fst = prob.ip, prob.fp, S.ist, S.fst
     sc, sa, sb, cl, clf = prob.sc, prob.sa, prob.sb, prob.cl, prob.clf
     ci, cp, mk, mon = C.ci, C.cp, C.mk, C.mon
-    now, end = W.y[Y_NOW], W.y[Y_END]
+    now, end = W.y[layout.Y_NOW], W.y[layout.Y_END]
     now_values, end_values = now.reshape(now.size), end.reshape(end.size)  # (views: the rows are contiguous)
     state_size = now.size
-    z, zd, zdd = now[Z], now[ZD], now[ZDD]
-    z1, zd1, zdd1 = end[Z], end[ZD], end[ZDD]
-    rhs, phi, src1, peak = W.rhs, W.cross[PHI], W.src[SRC_END], O.peak
-    Y, srco = W.y, W.src[SRC_OUT]
-    n, ns, ncl = ip[IP_N], ip[IP_NS], cl.shape[0]
-    beta, gamma, dt, t_end, out_dt = fp[FP_BETA], fp[FP_GAMMA], fp[FP_DT], fp[FP_TEND], fp[FP_OUTDT]
-    omega, gap_noise, x_limit, t_rev = fp[FP_OMEGA], fp[FP_GAPNOISE], fp[FP_XLIM], fp[FP_TREV]
-    refine = int(fp[FP_REFINE] + 0.5)
+    z, zd, zdd = now[layout.Z], now[layout.ZD], now[layout.ZDD]
+    z1, zd1, zdd1 = end[layout.Z], end[layout.ZD], end[layout.ZDD]
+    rhs, phi, src1, peak = W.rhs, W.cross[layout.PHI], W.src[layout.SRC_END], O.peak
+    Y, srco = W.y, W.src[layout.SRC_OUT]
+    n, ns, ncl = ip[layout.IP_N], ip[layout.IP_NS], cl.shape[0]
+    beta, gamma, dt, t_end = fp[layout.FP_BETA], fp[layout.FP_GAMMA], fp[layout.FP_DT], fp[layout.FP_TEND]
+    out_dt, omega, gap_noise = fp[layout.FP_OUTDT], fp[layout.FP_OMEGA], fp[layout.FP_GAPNOISE]
+    x_limit, t_rev = fp[layout.FP_XLIM], fp[layout.FP_TREV]
+    refine = int(fp[layout.FP_REFINE] + 0.5)
     fine = dt / refine
-    m, nf, nrows, coupled = ci[CI_M], ci[CI_NF], ci[CI_ROWS], ci[CI_SRCSTEP]
+    m, nf, nrows, coupled = ci[layout.CI_M], ci[layout.CI_NF], ci[layout.CI_ROWS], ci[layout.CI_SRCSTEP]
     constant = 3 * n + 3 * ns  # a force row's constant term, in its monitor row
-    t = fst[F_T]
+    t = fst[layout.F_T]
     # cos, sin of omega t, carried from step to step by the rotation through one step's angle (libm's
     # sincos took a seventh of a quiet step), and taken afresh every ANCHOR_STEPS steps: the rotation's
     # round-off grows by an ulp or two a step, so they stay within about 1e-13 of libm's, the round-off
@@ -117,28 +74,28 @@ def advance(prob, C, W, S, O, hertz):
     c_fine = math.cos(omega * fine)
     s_fine = math.sin(omega * fine)
     rotated = 0
-    t_out = ist[I_NEXT_OUT] * out_dt  # the next output instant (moved on only by step_rows)
+    t_out = ist[layout.I_NEXT_OUT] * out_dt  # the next output instant (moved on only by step_rows)
     while True:
-        k_grid = ist[I_GRID]
-        sub = ist[I_SUB]
-        if sub > 0 or t < fst[F_FINE_UNTIL]:  # refined steps on their grid, on to the next grid point
+        k_grid = ist[layout.I_GRID]
+        sub = ist[layout.I_SUB]
+        if sub > 0 or t < fst[layout.F_FINE_UNTIL]:  # refined steps on their grid, on to the next grid point
             if t != k_grid * dt + sub * fine:
                 break
             h = fine
-            plane = CP_FINE
+            plane = layout.CP_FINE
             t1 = (k_grid + 1) * dt if sub + 1 == refine else k_grid * dt + (sub + 1) * fine
         elif t == k_grid * dt:
             h = dt
-            plane = CP_STD
+            plane = layout.CP_STD
             t1 = (k_grid + 1) * dt
         else:
             break
-        if t1 > t_end or t >= fst[F_CHUNK_END]:
+        if t1 > t_end or t >= fst[layout.F_CHUNK_END]:
             break
         if rotated == ANCHOR_STEPS:
             c1 = math.cos(omega * t1)
             s1 = math.sin(omega * t1)
-        elif plane == CP_STD:
+        elif plane == layout.CP_STD:
             c1 = c0 * c_dt - s0 * s_dt
             s1 = s0 * c_dt + c0 * s_dt
         else:
@@ -165,36 +122,36 @@ def advance(prob, C, W, S, O, hertz):
             break
         stop = False
         for k in range(ncl):  # monitors (see forces.monitors): stop before a sign change
-            kind = mk[k, MK_KIND]
+            kind = mk[k, layout.MK_KIND]
             value = 0.0
-            if kind == MK_GAP or kind == MK_OVERLAP:
-                behind = mk[k, MK_BEHIND]
+            if kind == layout.MK_GAP or kind == layout.MK_OVERLAP:
+                behind = mk[k, layout.MK_BEHIND]
                 other = z1[behind] if behind >= 0 else src1[3 * (-1 - behind)]
-                value = signed_gap(kind, clf[k, CLF_SIGN] * (z1[mk[k, MK_AHEAD]] - other) + clf[k, CLF_OPEN],
-                                   gap_noise)
+                gap = clf[k, layout.CLF_SIGN] * (z1[mk[k, layout.MK_AHEAD]] - other) + clf[k, layout.CLF_OPEN]
+                value = signed_gap(kind, gap, gap_noise)
                 stop |= value < 0.0
-            elif kind == MK_FORCE:  # its force row of the step's product, and the row's constant
-                value = mon[k, constant] + rhs[mk[k, MK_ROW]]
-                stop |= value < 0.0 and cl[k, CL_MON] != 0
+            elif kind == layout.MK_FORCE:  # its force row of the step's product, and the row's constant
+                value = mon[k, constant] + rhs[mk[k, layout.MK_ROW]]
+                stop |= value < 0.0 and cl[k, layout.CL_MON] != 0
             phi[k] = value
         if stop:
             break
         if t_out <= t1 + 1e-9 * dt and t_out <= t_end + 1e-9 * dt:  # output rows inside (t, t1]
             if not step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
                 break
-            t_out = ist[I_NEXT_OUT] * out_dt
+            t_out = ist[layout.I_NEXT_OUT] * out_dt
         # accept: peaks (the rigid contacts' forces from the step's product), state, time
         raise_peaks(mk, mon, n, ns, t1 >= t_rev, gap_noise, phi, z1, zd1, zdd1, src1, peak)
         for j in range(state_size):  # the whole (3, n) block as one run of values (vector copies)
             now_values[j] = end_values[j]
-        ist[I_STEPS] += 1
-        if plane == CP_STD or sub + 1 == refine:
-            ist[I_GRID] = k_grid + 1
-            ist[I_SUB] = 0
+        ist[layout.I_STEPS] += 1
+        if plane == layout.CP_STD or sub + 1 == refine:
+            ist[layout.I_GRID] = k_grid + 1
+            ist[layout.I_SUB] = 0
         else:
-            ist[I_SUB] = sub + 1
+            ist[layout.I_SUB] = sub + 1
         t = t1
-        fst[F_T] = t
+        fst[layout.F_T] = t
         c0 = c1
         s0 = s1
         rotated = 0 if rotated == ANCHOR_STEPS else rotated + 1

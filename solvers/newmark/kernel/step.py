@@ -16,33 +16,9 @@ import math
 import numpy as np
 
 from vtool.jit import jit, jit_inline
+from vtool.solvers.newmark import layout
 from vtool.solvers.newmark.kernel.algebra import apply_operator, cholesky_solve
 from vtool.solvers.newmark.kernel.forces import hertz_correction, hertz_force, overlap_and_rate
-from vtool.solvers.newmark.layout import (
-    CI_HEAD,
-    CI_HERTZ,
-    CI_M,
-    CI_NF,
-    CI_SRC,
-    CL_SOFT,
-    CM_MINVFF,
-    CP_FINE,
-    CP_RAW,
-    CP_STD,
-    FP_BETA,
-    FP_GAMMA,
-    FP_OMEGA,
-    IP_N,
-    MK_KIND,
-    MK_OVERLAP,
-    SOFT_HERTZ,
-    SRC_END,
-    Y_END,
-    Y_NOW,
-    ZD,
-    ZDD,
-    Z,
-)
 from vtool.solvers.newmark.records import Config
 
 # how a step solves S z̈ = rhs (layer_step's ``which``): stored inverses of the standard and refined
@@ -98,36 +74,36 @@ def harmonics(sc, sa, sb, omega, c1, s1, src):
 @jit
 def sources(prob, t, src):
     """src = (x, v, a) of every source at t."""
-    omega = prob.fp[FP_OMEGA]
+    omega = prob.fp[layout.FP_OMEGA]
     harmonics(prob.sc, prob.sa, prob.sb, omega, math.cos(omega * t), math.sin(omega * t), src)
 
 
 @jit_inline
 def gather(C, n, S, y):
     """The layer state y of the full state (S.x, S.v, S.a)."""
-    for j in range(C.ci[CI_M]):
-        i = C.ci[CI_HEAD + j]
-        y[Z, j] = S.x[i]
-        y[ZD, j] = S.v[i]
-        y[ZDD, j] = S.a[i]
+    for j in range(C.ci[layout.CI_M]):
+        i = C.ci[layout.CI_HEAD + j]
+        y[layout.Z, j] = S.x[i]
+        y[layout.ZD, j] = S.v[i]
+        y[layout.ZDD, j] = S.a[i]
 
 
 @jit_inline
 def scatter(C, n, y, S):
     """The full state (S.x, S.v, S.a) of the layer state y."""
     for i in range(n):
-        j = C.ci[CI_HEAD + n + i]
-        S.x[i] = y[Z, j]
-        S.v[i] = y[ZD, j]
-        S.a[i] = y[ZDD, j]
+        j = C.ci[layout.CI_HEAD + n + i]
+        S.x[i] = y[layout.Z, j]
+        S.v[i] = y[layout.ZD, j]
+        S.a[i] = y[layout.ZDD, j]
 
 
 @jit_inline
 def prescribed(ci, n, src, z, zd, zdd):
     """The prescribed entries of (z, ż, z̈) (z indices nf..m-1 of the configuration whose integer row
     is ci) from their sources."""
-    for j in range(ci[CI_NF], ci[CI_M]):
-        s = ci[CI_HEAD + 2 * n + j]
+    for j in range(ci[layout.CI_NF], ci[layout.CI_M]):
+        s = ci[layout.CI_HEAD + 2 * n + j]
         z[j] = src[3 * s]
         zd[j] = src[3 * s + 1]
         zdd[j] = src[3 * s + 2]
@@ -169,7 +145,8 @@ def correct(nf, h, beta, gamma, acc, z1, zd1, zdd1):
 def free_rhs(C, src, y, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
     right, and the sources' pull through closed compliant contacts (``layout.CP_RAW``)."""
-    apply_operator(C.cp, C.ci, CP_RAW, C.ci[CI_NF], C.ci[CI_SRC], src, y[Z], y[ZD], y[ZDD], rhs)
+    apply_operator(C.cp, C.ci, layout.CP_RAW, C.ci[layout.CI_NF], C.ci[layout.CI_SRC], src, y[layout.Z], y[layout.ZD],
+                   y[layout.ZDD], rhs)
 
 
 @jit
@@ -181,34 +158,34 @@ def layer_step(prob, C, W, h, which, hertz):
     REFINED of the refined step, CHOLESKY a Cholesky factor already in W.L. Closed Hertz contacts
     are added by Newton iteration (:func:`~vtool.solvers.newmark.kernel.forces.hertz_correction`).
     """
-    beta, gamma = prob.fp[FP_BETA], prob.fp[FP_GAMMA]
-    ci, y, y1, src1 = C.ci, W.y[Y_NOW], W.y[Y_END], W.src[SRC_END]
-    nf = ci[CI_NF]
-    predict(ci[CI_M], h, beta, gamma, y[Z], y[ZD], y[ZDD], y1[Z], y1[ZD])
-    prescribed(ci, prob.ip[IP_N], src1, y1[Z], y1[ZD], y1[ZDD])
+    beta, gamma = prob.fp[layout.FP_BETA], prob.fp[layout.FP_GAMMA]
+    ci, y, y1, src1 = C.ci, W.y[layout.Y_NOW], W.y[layout.Y_END], W.src[layout.SRC_END]
+    nf = ci[layout.CI_NF]
+    predict(ci[layout.CI_M], h, beta, gamma, y[layout.Z], y[layout.ZD], y[layout.ZDD], y1[layout.Z], y1[layout.ZD])
+    prescribed(ci, prob.ip[layout.IP_N], src1, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD])
     # CHOLESKY: ΔP (free_rhs's product) into W.rhs, then solved; else z̈_F = S⁻¹ ΔP as one product with the
     # stored G = S⁻¹R into W.sol. One product written for both (each row sums in the same order either way).
-    plane = CP_RAW if which == CHOLESKY else (CP_STD if which == STANDARD else CP_FINE)
+    plane = layout.CP_RAW if which == CHOLESKY else (layout.CP_STD if which == STANDARD else layout.CP_FINE)
     out = W.rhs if which == CHOLESKY else W.sol
-    apply_operator(C.cp, ci, plane, nf, ci[CI_SRC], src1, y1[Z], y1[ZD], y1[ZDD], out)
+    apply_operator(C.cp, ci, plane, nf, ci[layout.CI_SRC], src1, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD], out)
     if which == CHOLESKY:
         cholesky_solve(nf, W.L, W.rhs, W.sol)
-    correct(nf, h, beta, gamma, W.sol, y1[Z], y1[ZD], y1[ZDD])
+    correct(nf, h, beta, gamma, W.sol, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD])
     if hertz is not None:
-        if C.ci[CI_HERTZ]:
+        if C.ci[layout.CI_HERTZ]:
             hertz_correction(prob, C, W, h, which)
 
 
 @jit
 def consistent_acceleration(prob, C, src, y, rhs, hertz):
     """Free accelerations of configuration C from its equations of motion (prescribed set from src)."""
-    prescribed(C.ci, prob.ip[IP_N], src, y[Z], y[ZD], y[ZDD])
+    prescribed(C.ci, prob.ip[layout.IP_N], src, y[layout.Z], y[layout.ZD], y[layout.ZDD])
     free_rhs(C, src, y, rhs)
-    nf = C.ci[CI_NF]
+    nf = C.ci[layout.CI_NF]
     if hertz is not None:
-        if C.ci[CI_HERTZ]:  # the Hertz forces of the present overlaps, on the free rows (w = -mon row)
+        if C.ci[layout.CI_HERTZ]:  # the Hertz forces of the present overlaps, on the free rows (w = -mon row)
             for k in range(prob.cl.shape[0]):
-                if C.mk[k, MK_KIND] == MK_OVERLAP and prob.cl[k, CL_SOFT] == SOFT_HERTZ:
+                if C.mk[k, layout.MK_KIND] == layout.MK_OVERLAP and prob.cl[k, layout.CL_SOFT] == layout.SOFT_HERTZ:
                     delta, rate = overlap_and_rate(prob, C, k, y, src)
                     force = hertz_force(prob.clf, k, delta, rate)[0]
                     for f in range(nf):
@@ -216,8 +193,8 @@ def consistent_acceleration(prob, C, src, y, rhs, hertz):
     for f in range(nf):
         s = 0.0
         for g in range(nf):
-            s += C.cm[CM_MINVFF, f, g] * rhs[g]
-        y[ZDD, f] = s
+            s += C.cm[layout.CM_MINVFF, f, g] * rhs[g]
+        y[layout.ZDD, f] = s
 
 
 @jit_inline
@@ -225,7 +202,7 @@ def interpolate(nf, s_out, h, z, zd, zdd, zdd1, out):
     """The free coordinates at s_out into a step of length h from (z, ż, z̈) whose end acceleration is
     z̈1, into the layer state ``out``: the linear-acceleration interpolant (exact for beta = 1/6;
     thesis eqs. B.3-B.5)."""
-    zo, zdo, zddo = out[Z], out[ZD], out[ZDD]
+    zo, zdo, zddo = out[layout.Z], out[layout.ZD], out[layout.ZDD]
     r = s_out / h
     for j in range(nf):
         da = zdd1[j] - zdd[j]
