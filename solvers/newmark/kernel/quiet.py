@@ -75,10 +75,12 @@ def advance(prob, C, W, S, O, hertz):
     s_fine = math.sin(omega * fine)
     rotated = 0
     t_out = ist[layout.I_NEXT_OUT] * out_dt  # the next output instant (moved on only by step_rows)
+    # the grid position and the step count in locals, stored once when the loop ends (a store to the
+    # state array and its load at the next step's start went through memory: numba's arrays may alias)
+    k_grid, sub, steps = ist[layout.I_GRID], ist[layout.I_SUB], ist[layout.I_STEPS]
+    fine_until, chunk_end = fst[layout.F_FINE_UNTIL], fst[layout.F_CHUNK_END]
     while True:
-        k_grid = ist[layout.I_GRID]
-        sub = ist[layout.I_SUB]
-        if sub > 0 or t < fst[layout.F_FINE_UNTIL]:  # refined steps on their grid, on to the next grid point
+        if sub > 0 or t < fine_until:  # refined steps on their grid, on to the next grid point
             if t != k_grid * dt + sub * fine:
                 break
             h = fine
@@ -90,7 +92,7 @@ def advance(prob, C, W, S, O, hertz):
             t1 = (k_grid + 1) * dt
         else:
             break
-        if t1 > t_end or t >= fst[layout.F_CHUNK_END]:
+        if t1 > t_end or t >= chunk_end:
             break
         if rotated == ANCHOR_STEPS:
             c1 = math.cos(omega * t1)
@@ -144,15 +146,16 @@ def advance(prob, C, W, S, O, hertz):
         raise_peaks(mk, mon, n, ns, t1 >= t_rev, gap_noise, phi, z1, zd1, zdd1, src1, peak)
         for j in range(state_size):  # the whole (3, n) block as one run of values (vector copies)
             now_values[j] = end_values[j]
-        ist[layout.I_STEPS] += 1
+        steps += 1
         if plane == layout.CP_STD or sub + 1 == refine:
-            ist[layout.I_GRID] = k_grid + 1
-            ist[layout.I_SUB] = 0
+            k_grid += 1
+            sub = 0
         else:
-            ist[layout.I_SUB] = sub + 1
+            sub += 1
         t = t1
-        fst[layout.F_T] = t
         c0 = c1
         s0 = s1
         rotated = 0 if rotated == ANCHOR_STEPS else rotated + 1
+    ist[layout.I_GRID], ist[layout.I_SUB], ist[layout.I_STEPS] = k_grid, sub, steps
+    fst[layout.F_T] = t
     return t
