@@ -150,7 +150,7 @@ def speed_block(results: list[PresetStudy], second_process: tuple[float, float] 
     rows = [cells for _, cells in body]
     if second_process is not None:
         total, ratio = second_process
-        rows.append(["`vtool solve gnilka-1a` in a second process (numba's cache), median of seven",
+        rows.append(["`vtool solve gnilka-1a` in a second process (numba's cache and Python's bytecode), median of seven",
                      f"{total * 1e3:.0f} with interpreter start-up, {ratio:.2f} x `python3 -c \"import numpy, numba\"`",
                      "", "", "", ""])
     head = ["preset (Newmark, the preset's dt, with refinement after events)", "warm wall time (ms)", "steps",
