@@ -6,7 +6,6 @@ import math
 
 from vtool.jit import borrowed, jit, jit_inline
 from vtool.solvers.newmark import layout
-from vtool.solvers.newmark.kernel.algebra import factor_effective
 from vtool.solvers.newmark.kernel.forces import (
     linear_force,
     monitors,
@@ -73,10 +72,9 @@ def locate_event(prob, C, W, k, t, h, hertz):
         else:
             tau = (lo * fhi - hi * flo) / (fhi - flo)
         tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
-        # the trial step from t: sources at t + tau, S(tau) factored by Cholesky (written here, not as an
-        # inline helper of the records: its records' arrays were counted in and out at every trial)
+        # the trial step from t: sources at t + tau, a step of length tau (layer_step factors S(tau)); written
+        # here, not as an inline helper of the records: its records' arrays were counted in and out at every trial
         sources(prob, t + tau, W.src[layout.SRC_END])
-        factor_effective(C.cm, C.ci[layout.CI_NF], fp[layout.FP_BETA], fp[layout.FP_GAMMA], tau, W.L)
         layer_step(prob, C, W, tau, CHOLESKY, hertz)
         # monitor k (see forces.monitors), on the arrays
         if kind == layout.MK_GAP or kind == layout.MK_OVERLAP:
@@ -190,7 +188,6 @@ def event_step(prob, C, W, t, h, hertz):
     h = tau_min
     if h > 0.0:
         sources(prob, t + h, W.src[layout.SRC_END])  # the step to the earliest crossing (as locate_event's trials)
-        factor_effective(C.cm, C.ci[layout.CI_NF], prob.fp[layout.FP_BETA], prob.fp[layout.FP_GAMMA], h, W.L)
         layer_step(prob, C, W, h, CHOLESKY, hertz)
         # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
         monitors(prob, C, W.y[layout.Y_END], W.src[layout.SRC_END], gap_noise, W.cross[layout.PHI], hertz)
@@ -289,11 +286,7 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
             sources(prob, t + h, src1)
             which = STANDARD
             if h != dt:
-                if h == dt / int(fp[layout.FP_REFINE] + 0.5):
-                    which = REFINED
-                else:
-                    which = CHOLESKY
-                    factor_effective(C.cm, C.ci[layout.CI_NF], fp[layout.FP_BETA], fp[layout.FP_GAMMA], h, W.L)
+                which = REFINED if h == dt / int(fp[layout.FP_REFINE] + 0.5) else CHOLESKY
             layer_step(prob, C, W, h, which, hertz)
             monitors(prob, C, end, src1, fp[layout.FP_GAPNOISE], phi, hertz)
             fired = False

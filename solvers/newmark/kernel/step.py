@@ -17,7 +17,7 @@ import numpy as np
 
 from vtool.jit import jit, jit_inline
 from vtool.solvers.newmark import layout
-from vtool.solvers.newmark.kernel.algebra import apply_operator, cholesky_solve
+from vtool.solvers.newmark.kernel.algebra import apply_operator, cholesky_solve, factor_effective
 from vtool.solvers.newmark.kernel.forces import hertz_correction, hertz_force, overlap_and_rate
 from vtool.solvers.newmark.records import Config
 
@@ -155,12 +155,15 @@ def layer_step(prob, C, W, h, which, hertz):
     in W.src[SRC_END].
 
     ``which``: STANDARD the stored S⁻¹ of the standard step (as one product with G = S⁻¹R),
-    REFINED of the refined step, CHOLESKY a Cholesky factor already in W.L. Closed Hertz contacts
-    are added by Newton iteration (:func:`~vtool.solvers.newmark.kernel.forces.hertz_correction`).
+    REFINED of the refined step, CHOLESKY S(h) factored here by Cholesky into W.L (every step of another
+    length: event location's trials, the step to an event, the return to the step grid). Closed Hertz
+    contacts are added by Newton iteration (:func:`~vtool.solvers.newmark.kernel.forces.hertz_correction`).
     """
     beta, gamma = prob.fp[layout.FP_BETA], prob.fp[layout.FP_GAMMA]
     ci, y, y1, src1 = C.ci, W.y[layout.Y_NOW], W.y[layout.Y_END], W.src[layout.SRC_END]
     nf = ci[layout.CI_NF]
+    if which == CHOLESKY:
+        factor_effective(C.cm, nf, beta, gamma, h, W.L)
     predict(ci[layout.CI_M], h, beta, gamma, y[layout.Z], y[layout.ZD], y[layout.ZDD], y1[layout.Z], y1[layout.ZD])
     prescribed(ci, prob.ip[layout.IP_N], src1, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD])
     # CHOLESKY: ΔP (free_rhs's product) into W.rhs, then solved; else z̈_F = S⁻¹ ΔP as one product with the
