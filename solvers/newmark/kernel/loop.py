@@ -240,14 +240,10 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
     while True:
         t = fst[layout.F_T]
         c = ist[layout.I_CFG]
-        slot = find_slot(T.index, c)
-        if slot < 0:
-            ist[layout.I_WANT_CFG] = c
-            return layout.NEED_CONFIG
         if ist[layout.I_NEV] + 3 * ncl + 2 >= O.ev_f.shape[0]:
             return layout.OUTPUT_FULL
         sources(prob, t, src0)
-        if ist[layout.I_NEED_SETTLE]:
+        if ist[layout.I_NEED_SETTLE]:  # (release_pulling asks for every configuration it reaches to be built)
             settled = release_pulling(prob, T, c, t, S, src0, O, now, W.rhs, hertz)
             if settled < 0:
                 ist[layout.I_CFG] = -1 - settled
@@ -256,7 +252,10 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
             c = settled
             ist[layout.I_CFG] = c
             ist[layout.I_NEED_SETTLE] = 0
-            slot = find_slot(T.index, c)
+        slot = find_slot(T.index, c)
+        if slot < 0:
+            ist[layout.I_WANT_CFG] = c
+            return layout.NEED_CONFIG
         C = configuration(T, c, slot)
         if not ist[layout.I_STARTED] and not start(prob, C, W, S, O, hertz):
             return layout.OUTPUT_FULL
