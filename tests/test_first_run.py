@@ -177,6 +177,28 @@ def test_the_notice_quotes_the_last_measured_compile(tmp_path: Path, monkeypatch
     assert json.loads((tmp_path / numba_cache.TIMES).read_text()) == {"run_chunk": 7.4}
 
 
+@pytest.mark.parametrize(("before", "inside"), [
+    ((700, 10, 10), (100_000, 50, 100)),  # Python's own: raised to the CLI's
+    ((200_000, 5, 500), (200_000, 50, 500)),  # each threshold raised, never lowered
+    ((0, 10, 10), (0, 10, 10)),  # collection turned off by the process: left off
+])
+def test_a_compile_raises_the_collector_thresholds_and_restores_them(before: tuple[int, int, int],
+                                                                     inside: tuple[int, int, int]) -> None:
+    """``jit.fewer_collections`` (around every compiling call, ``jit.timed_call``): the process' own thresholds
+    restored after."""
+    import gc
+
+    kept = gc.get_threshold()
+    try:
+        gc.set_threshold(*before)
+        with jit.fewer_collections():
+            seen = gc.get_threshold()
+        after = gc.get_threshold()
+    finally:
+        gc.set_threshold(*kept)
+    assert seen == inside and after == before
+
+
 def test_elapsed_seconds_show_on_a_terminal_only(monkeypatch: pytest.MonkeyPatch) -> None:
     from vtool.app.cli.progress import DelayedProgress
 

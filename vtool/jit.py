@@ -12,7 +12,10 @@ first run's notice (a ``.done`` mark per entry point and law pair, written by
 
 from __future__ import annotations
 
+import gc
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +49,26 @@ else:
 
 #: A first compile's length (s) when none was measured yet on this machine.
 FIRST_GUESS = "5-20"
+#: Python's collector thresholds while a kernel compiles (``gc.set_threshold``; Python's own: 700, 10, 10),
+#: those ``vtool``'s CLI sets for its whole process (``vtool.app.cli.main.GC_THRESHOLDS``).
+COMPILE_GC_THRESHOLDS = (100_000, 50, 100)
+
+
+@contextmanager
+def fewer_collections() -> Iterator[None]:
+    """Python's collector passes less often inside the block (never more often than the process had it),
+    its thresholds restored after. numba's compile makes millions of short-lived objects: with Python's
+    own thresholds, the collector's passes over them and over everything imported were about a sixth of
+    a first compile (docs/developer.md, "Compile")."""
+    before = gc.get_threshold()
+    if before[0] == 0:  # collection turned off by the process: left so
+        yield
+        return
+    gc.set_threshold(*(max(now, wanted) for now, wanted in zip(before, COMPILE_GC_THRESHOLDS, strict=True)))
+    try:
+        yield
+    finally:
+        gc.set_threshold(*before)
 
 
 def law_key(hertz: bool | None, momentum: bool | None) -> str:
@@ -99,7 +122,8 @@ def timed_call(function: Any, name: str, key: str, *args: Any) -> tuple[Any, flo
     if is_compiled(function, name, key):
         return function(*args), 0.0
     started = time.perf_counter()
-    result = function(*args)
+    with fewer_collections():
+        result = function(*args)
     seconds = time.perf_counter() - started
     compiled(name, key, seconds)
     return result, seconds
