@@ -57,9 +57,8 @@ COMPILE_GC_THRESHOLDS = (100_000, 50, 100)
 @contextmanager
 def fewer_collections() -> Iterator[None]:
     """Python's collector passes less often inside the block (never more often than the process had it),
-    its thresholds restored after. numba's compile makes millions of short-lived objects: with Python's
-    own thresholds, the collector's passes over them and over everything imported were about a sixth of
-    a first compile (docs/developer.md, "Compile")."""
+    its thresholds restored after: numba's compile makes millions of short-lived objects (docs/developer.md,
+    "Compile")."""
     before = gc.get_threshold()
     if before[0] == 0:  # collection turned off by the process: left so
         yield

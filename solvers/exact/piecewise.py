@@ -24,6 +24,7 @@ every event): only the integration differs. A back end subclasses
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 import weakref
@@ -298,7 +299,8 @@ class PiecewiseRun(ABC):
         key = jit.law_key(self.problem.hertz, self.problem.momentum)
         compiled = jit.is_compiled(self.rules.release_pulling, "rules", key)
         started = time.perf_counter()
-        self.integrate(progress, cancel)
+        with contextlib.nullcontext() if compiled else jit.fewer_collections():
+            self.integrate(progress, cancel)
         if not compiled:
             jit.compiled("rules", key, time.perf_counter() - started)
 
