@@ -199,6 +199,26 @@ def test_a_compile_raises_the_collector_thresholds_and_restores_them(before: tup
     assert seen == inside and after == before
 
 
+def test_overlapping_compiles_restore_the_thresholds_when_the_last_ends() -> None:
+    """Two threads compiling at once (a threaded sweep's first points): the first to end leaves the
+    thresholds raised for the other, the last restores the process' own."""
+    import gc
+
+    kept = gc.get_threshold()
+    try:
+        gc.set_threshold(700, 10, 10)
+        first, second = jit.fewer_collections(), jit.fewer_collections()
+        first.__enter__()
+        second.__enter__()
+        first.__exit__(None, None, None)
+        between = gc.get_threshold()
+        second.__exit__(None, None, None)
+        after = gc.get_threshold()
+    finally:
+        gc.set_threshold(*kept)
+    assert between == jit.COMPILE_GC_THRESHOLDS and after == (700, 10, 10)
+
+
 def test_elapsed_seconds_show_on_a_terminal_only(monkeypatch: pytest.MonkeyPatch) -> None:
     from vtool.app.cli.progress import DelayedProgress
 

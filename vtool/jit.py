@@ -13,6 +13,7 @@ first run's notice (a ``.done`` mark per entry point and law pair, written by
 from __future__ import annotations
 
 import gc
+import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -54,20 +55,29 @@ FIRST_GUESS = "5-20"
 COMPILE_GC_THRESHOLDS = (100_000, 50, 100)
 
 
+#: [blocks inside fewer_collections, the thresholds they found], for blocks in several threads at once
+_RAISED: list = [0, None]
+_RAISED_LOCK = threading.Lock()
+
+
 @contextmanager
 def fewer_collections() -> Iterator[None]:
     """Python's collector passes less often inside the block (never more often than the process had it),
-    its thresholds restored after: numba's compile makes millions of short-lived objects (docs/developer.md,
-    "Compile")."""
-    before = gc.get_threshold()
-    if before[0] == 0:  # collection turned off by the process: left so
-        yield
-        return
-    gc.set_threshold(*(max(now, wanted) for now, wanted in zip(before, COMPILE_GC_THRESHOLDS, strict=True)))
+    its thresholds restored when the last such block (of any thread) ends: numba's compile makes
+    millions of short-lived objects (docs/developer.md, "Compile")."""
+    with _RAISED_LOCK:
+        if _RAISED[0] == 0:
+            _RAISED[1] = before = gc.get_threshold()
+            if before[0] != 0:  # (0: collection turned off by the process, left so)
+                gc.set_threshold(*(max(now, wanted) for now, wanted in zip(before, COMPILE_GC_THRESHOLDS, strict=True)))
+        _RAISED[0] += 1
     try:
         yield
     finally:
-        gc.set_threshold(*before)
+        with _RAISED_LOCK:
+            _RAISED[0] -= 1
+            if _RAISED[0] == 0:
+                gc.set_threshold(*_RAISED[1])
 
 
 def law_key(hertz: bool | None, momentum: bool | None) -> str:
