@@ -72,3 +72,30 @@ def test_ctrl_c_inside_code_that_cannot_unwind_it_still_exits_130_with_one_line(
                           timeout=60)
     assert done.returncode == 130, done.stderr  # -2 (exec) or 0 (callback) with Python's own handler
     assert done.stderr == "interrupted: nothing was written\n"
+
+
+def test_an_interrupt_waits_while_a_cache_file_is_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """numba writes a cache file as NAME.tmp.ID and renames it when whole; an interrupt while this process
+    holds one open is delivered again later (the file would be left half-written), at once otherwise."""
+    import inspect
+    import signal
+
+    from vtool import numba_cache
+    from vtool.app.cli import main
+
+    folder = tmp_path / "kernels-0123"
+    folder.mkdir()
+    monkeypatch.setattr(numba_cache, "FOLDER", folder)
+    again: list[int] = []
+    monkeypatch.setattr(main, "deliver_again", again.append)
+    frame = inspect.currentframe()
+    with open(folder / "step.layer_step-1.py311.1.nbc.tmp.0123456789abcdef", "wb"):
+        assert main._writing_cache()
+        main._interrupt(signal.SIGINT, frame)  # held back: no KeyboardInterrupt here
+    assert again == [signal.SIGINT] and not main._writing_cache()
+    for elsewhere in (tmp_path / "kernels-01234" / "a.nbc.tmp.0123", tmp_path / "b.nbc.tmp.0123"):
+        elsewhere.parent.mkdir(exist_ok=True)
+        with open(elsewhere, "wb"):  # a temporary file outside the cache folder: at once
+            assert not main._writing_cache()
+            with pytest.raises(KeyboardInterrupt):
+                main._interrupt(signal.SIGINT, frame)

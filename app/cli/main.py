@@ -25,8 +25,9 @@ handled like Ctrl+C (:class:`Terminated`, a KeyboardInterrupt): every file
 being written is cleaned up the same way (no hidden temporary is left, an
 existing output is kept), the message is ``terminated: ...`` and the exit
 code 143 (128 + 15). Both signals raise their interrupt where Python is, except inside code
-that cannot unwind it (:func:`_held_back`), where it is delivered again 20 ms later: Ctrl+C
-always ends with the one line and 130 (143), never with a traceback or a lost interrupt.
+that cannot unwind it (:func:`_held_back`) or while a file of numba's cache is being written
+(:func:`_writing_cache`), where it is delivered again 20 ms later: Ctrl+C always ends with the one
+line and 130 (143), never with a traceback, a lost interrupt or a half-written file.
 """
 
 from __future__ import annotations
@@ -97,10 +98,33 @@ def _held_back(frame: Any) -> bool:
     return False
 
 
+def _writing_cache() -> bool:
+    """Whether this process holds a temporary file of numba's cache folder open: numba writes each cache
+    file under a temporary name (``NAME.tmp.ID``) and renames it when whole, and removes it on an error but
+    not on an interrupt, which left it in the folder. (Linux's ``/proc/self/fd``; elsewhere False.)"""
+    cache = sys.modules.get("vtool.numba_cache")  # not imported: nothing compiles
+    folder = getattr(cache, "FOLDER", None)
+    if folder is None:
+        return False
+    try:
+        descriptors = os.listdir("/proc/self/fd")
+    except OSError:
+        return False
+    for descriptor in descriptors:
+        try:
+            target = os.readlink(f"/proc/self/fd/{descriptor}")
+        except OSError:
+            continue
+        if target.startswith(os.path.join(folder, "")) and ".tmp." in os.path.basename(target):
+            return True
+    return False
+
+
 def _interrupt(signum: int, frame: Any) -> None:
     """SIGINT and SIGTERM: KeyboardInterrupt (:class:`Terminated`) where the program is, or the same signal
-    again :data:`RETRY_SECONDS` later when it is where the interrupt cannot unwind (:func:`_held_back`)."""
-    if frame is not None and _held_back(frame):
+    again :data:`RETRY_SECONDS` later when it is where the interrupt cannot unwind (:func:`_held_back`) or
+    while a cache file is being written (:func:`_writing_cache`)."""
+    if frame is not None and (_held_back(frame) or _writing_cache()):
         deliver_again(signum)
         return
     raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
