@@ -12,7 +12,11 @@ smaller and before the single tests: the longest tests (the valve-train
 tables' studies, mypy) start at once and the
 short ones fill in at the end, so that neither worker idles at the end of a run
 (mypy last took 16 s of tail, 2026-11-26). tests/test_tables_valvetrain.py
-checks that pytest-xdist still sees the groups.
+checks that pytest-xdist still sees the groups. The single tests go out in
+collection order, and :func:`pytest_collection_modifyitems` puts those
+marked ``slow`` (a few seconds or more) first: a long test sent last kept one
+worker busy 4-8 s after the other had finished (three empty-cache runs,
+2026-11-28).
 
 Compiles shared out: in a whole run on pytest-xdist workers (at least
 :data:`SHARED_OUT_FROM` tests), each worker first compiles its share of the
@@ -30,6 +34,14 @@ messages, strips), and the collector's passes over them and over the
 imported modules were a sixth to a fifth of the TUI tests' time (the two
 valve-train TUI files: 73 s, then 60 s with these settings, one run each). What the
 tests check does not depend on when cycles are collected.
+
+At the session's end pytest collects five times over (its check for
+exceptions raised in finalizers, at unconfigure), and each pass scanned the
+worker's whole heap, numba's compile state included: 2-4 s after the last
+test, while the run waited for the worker to exit. :func:`pytest_sessionfinish`
+collects first, until a pass finds nothing (pytest's hook for those exceptions
+is in place then, so any is reported as before), and freezes what lives:
+pytest's own passes then scan only what is made after.
 """
 
 import gc
@@ -48,8 +60,27 @@ def pytest_configure(config) -> None:  # type: ignore[no-untyped-def]  # noqa: A
     tune_collector()
 
 
+def pytest_collection_modifyitems(items) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
+    """The tests marked ``slow`` first, the others after them, each in collection order (see the module
+    doc, "Scheduling")."""
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+
+
 def pytest_collection_finish(session) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
     """The test modules and what they import (numpy, numba, Textual, vtool) frozen too."""
+    gc.freeze()
+
+
+#: full collections at the session's end at most, until one finds nothing (see pytest_sessionfinish)
+FINAL_COLLECTIONS = 5
+
+
+def pytest_sessionfinish(session) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
+    """Every unreachable cycle collected now, and what lives frozen (see the module doc, "Python's
+    garbage collector")."""
+    for _ in range(FINAL_COLLECTIONS):
+        if not gc.collect():
+            break
     gc.freeze()
 
 

@@ -32,6 +32,7 @@ def test_docs_api_examples_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, 
     assert "4 points" in out and "['run.html', 'run.png']" in out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("script", EXAMPLES, ids=[p.stem for p in EXAMPLES])
 def test_example_script_runs(script: Path, tmp_path: Path) -> None:
     env = dict(os.environ, PYTHONWARNINGS="ignore")

@@ -74,6 +74,7 @@ def test_two_windows_of_contact_loss_are_two_intervals_each_where_a_fine_scan_pu
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["gnilka-1a", "ramped-cam", "ohv-pushrod-1a", "direct-acting-bucket",
                                   "ohc-finger-follower"])
+@pytest.mark.slow
 def test_jump_speed_is_the_lowest_speed_a_brute_force_scan_shows_the_follower_off_the_cam(name: str) -> None:
     """The thesis mechanism, the ramped cam and the train-type presets."""
     make = preset_at(name)

@@ -108,6 +108,7 @@ def pump_up(cycles: int):  # noqa: ANN201
 
 @pytest.mark.parametrize("cycles", [2, pytest.param(4, marks=pytest.mark.skipif(
     not os.environ.get("VTOOL_SLOW_TESTS"), reason="a minute: VTOOL_SLOW_TESTS=1"))])
+@pytest.mark.slow
 def test_pump_up_closes_the_lash_and_settles(cycles: int):
     """Supply pressure and the seat's 0.08 mm lash: the plunger extends in the first cycle until the lash
     closes (the cam contact carries the adjuster's push on every base circle), and the drift per cycle

@@ -179,6 +179,7 @@ def test_boom_report_has_its_sections_allowables_and_checks(tmp_path: Path) -> N
     assert result.output.strip() == f"wrote {out}: 5 sections, {len(report.figures)} figures"
 
 
+@pytest.mark.slow
 def test_plate_report_has_its_sections_study_and_convergence_checks(tmp_path: Path) -> None:
     """`vtool report plate-table2 -o r.pdf`: the study's tables, a check per exact reference (acceleration
     converged: uniform load 7.6 %, so it fails), the transient figures on pages of their own."""
@@ -200,6 +201,7 @@ def test_plate_report_has_its_sections_study_and_convergence_checks(tmp_path: Pa
     assert sum(what.startswith("figure:") for what in pages) == len(report.figures) >= 1
 
 
+@pytest.mark.slow
 @pytest.mark.asyncio
 @pytest.mark.parametrize("preset, kind", [("boom-brick-wall", "boom"), ("plate-table3", "plate")])
 async def test_tui_boom_and_plate_screens_save_the_report(tmp_path: Path, preset: str, kind: str) -> None:

@@ -62,6 +62,7 @@ async def test_bad_range_shows_one_line_and_runs_nothing() -> None:
         assert pane.plan is None and pane.outcome is None  # checked in the worker: nothing ran
 
 
+@pytest.mark.slow
 async def test_cancel_stops_and_keeps_finished_points() -> None:
     app = PaneApp(values="9000:12000:5", fixed="run.degrees=4000")  # ~20 s of work: still running at the cancel
     async with app.run_test(size=(140, 50)) as pilot:
@@ -126,6 +127,7 @@ async def test_descriptor_stderr_changes_nothing_when_stderr_has_a_descriptor() 
         sys.stderr = before
 
 
+@pytest.mark.slow
 async def test_points_are_checked_off_the_ui_thread_and_cancel_stops_a_large_sweep(monkeypatch) -> None:  # type: ignore[no-untyped-def]
     """Checking a point costs about 10 ms: 100,000 points froze the screen for minutes on the UI
     thread, and Cancel was not seen. The check runs in the worker (a range's ends and the grid's corners:

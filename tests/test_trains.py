@@ -137,6 +137,7 @@ def test_checks_fail_with_a_negative_margin_and_unknown_names_are_refused() -> N
         load_document(doc)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NEW)
 def test_new_presets_agree_on_every_back_end(name: str) -> None:
     from vtool.solvers.backends import available

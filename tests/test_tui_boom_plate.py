@@ -38,6 +38,7 @@ async def export(pilot, app, path) -> None:  # type: ignore[no-untyped-def]
     await pilot.pause()
 
 
+@pytest.mark.slow
 async def test_boom_screen_limits_daf_and_csv_match_the_library_and_cli(tmp_path) -> None:  # type: ignore[no-untyped-def]
     app = create_app("boom-brick-wall", remember=False, chart_color=False)
     async with app.run_test(size=(100, 30)) as pilot:
@@ -99,6 +100,7 @@ async def test_boom_edits_pulse_switch_and_invalid_damping() -> None:
         assert "pulse N" in screen.results.source
 
 
+@pytest.mark.slow
 async def test_plate_screen_frequencies_transient_and_csv(tmp_path) -> None:  # type: ignore[no-untyped-def]
     app = create_app("plate-irs", remember=False, chart_color=False)
     async with app.run_test(size=(100, 30)) as pilot:

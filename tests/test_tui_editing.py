@@ -38,6 +38,7 @@ async def test_typing_into_a_field_reached_by_focus_replaces_its_value() -> None
         assert rpm.value == "10501"
 
 
+@pytest.mark.slow
 async def test_a_path_typed_in_the_open_dialog_is_what_opens(tmp_path: Path) -> None:
     """The list has the focus when the dialog opens: the typed characters went to it and enter
     chose its highlighted preset (boom-brick-wall). Typing now goes to the path field."""
@@ -82,6 +83,7 @@ async def _shot_after_run(preset: str, tabs: int) -> tuple[object, str]:
         return app.screen.results, svg_text(app.export_screenshot(), 120)
 
 
+@pytest.mark.slow
 async def test_at_120x40_with_the_form_the_peak_forces_and_plate_errors_are_in_view() -> None:
     """Beside the 50-column form the valve-train summary's peak-force column and every error of
     the plate's frequency table were cut at the right edge."""

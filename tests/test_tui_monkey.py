@@ -291,6 +291,7 @@ def quick_pilot(monkeypatch, tmp_path) -> None:  # type: ignore[no-untyped-def]
     monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path))
 
 
+@pytest.mark.slow
 async def test_monkey_finds_no_crash_and_no_unexpected_error(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
     quick_pilot(monkeypatch, tmp_path)
     found = Found()
@@ -315,6 +316,7 @@ async def test_monkey_finds_no_crash_and_no_unexpected_error(tmp_path, monkeypat
     assert not found.unexpected, "\n".join(found.unexpected)
 
 
+@pytest.mark.slow
 async def test_the_monkey_fails_on_an_error_no_input_asked_for(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
     """The sweep tab's pool failing to start (issue 37: "bad value(s) in fds_to_keep" on every Run, shown
     in the status line, no exception: the old monkey saw nothing) fails the monkey's sweep sequence."""

@@ -66,6 +66,7 @@ def untimed(summary: str) -> str:
     return re.sub(r" \(\+ [0-9.]+ s compiling or loading the solver\)", "", summary)
 
 
+@pytest.mark.slow
 async def test_opens_on_valvetrain_and_1a_run_draws_the_library_charts() -> None:
     app = make_app(None)
     async with app.run_test(size=(100, 30)) as pilot:
@@ -160,6 +161,7 @@ INVALID = [("members.pushrod.length", "-5", "9"), ("run.rpm", "fast", "11000"),
            ("clearances[1].restitution", "1.5", "0")]
 
 
+@pytest.mark.slow
 async def test_invalid_fields_show_the_cli_message_and_block_the_run(tmp_path) -> None:  # type: ignore[no-untyped-def]
     app = make_app("gnilka-1c")
     async with app.run_test(size=(80, 24)) as pilot:

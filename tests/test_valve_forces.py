@@ -60,6 +60,7 @@ def test_cylinder_pressure_table_by_crank_angle():
     assert math.isclose(float(cylinder_pressure(vf, 270.0)), 0.1, rel_tol=1e-12)
 
 
+@pytest.mark.slow
 def test_whole_model_power_balance_with_friction_and_gas():
     """Between two events the cam's work plus the gas force's equals the change of kinetic and spring energy
     plus the modal damping's and the friction's dissipation (everything integrated by Simpson's rule on 0.02 deg
@@ -99,6 +100,7 @@ def test_whole_model_power_balance_with_friction_and_gas():
     assert checked >= 1
 
 
+@pytest.mark.slow
 def test_the_gas_force_pushes_the_valve_to_its_seat():
     """Cylinder pressure on the head's cylinder side pushes towards the seat: the valve seats earlier at the end
     of the lift (the port side: later)."""
