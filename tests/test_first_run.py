@@ -219,6 +219,18 @@ def test_overlapping_compiles_restore_the_thresholds_when_the_last_ends() -> Non
     assert between == jit.COMPILE_GC_THRESHOLDS and after == (700, 10, 10)
 
 
+@pytest.mark.parametrize("given", [None, "yes"])
+def test_numba_highlights_no_error_messages_unless_the_user_asks(given: str | None) -> None:
+    """vtool sets numba's documented switch before numba is imported, and keeps a value the user set."""
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING"}
+    if given is not None:
+        env["NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING"] = given
+    script = ("import os, sys, vtool.jit; assert 'numba' in sys.modules; "
+              "print(os.environ['NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING'])")
+    done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == (given or "1")
+
+
 def test_elapsed_seconds_show_on_a_terminal_only(monkeypatch: pytest.MonkeyPatch) -> None:
     from vtool.app.cli.progress import DelayedProgress
 

@@ -13,6 +13,7 @@ first run's notice (a ``.done`` mark per entry point and law pair, written by
 from __future__ import annotations
 
 import gc
+import os
 import threading
 import time
 from collections.abc import Iterator
@@ -23,6 +24,9 @@ from typing import Any
 from vtool import numba_cache
 
 numba_cache.configure()
+#: numba's documented switch, set unless the user set it: typing the kernels tries about 20,000 overloads
+#: that do not apply, and numba made each failure's message with colorama's streams set up and torn down
+os.environ.setdefault("NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING", "1")
 
 from cffi import FFI  # noqa: E402
 from numba import carray, config, njit  # noqa: E402 (after the cache folder is chosen)
