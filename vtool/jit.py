@@ -24,7 +24,7 @@ from typing import Any
 from vtool import numba_cache
 
 numba_cache.configure()
-#: numba's documented switch, set unless the user set it: typing the kernels tries about 20,000 overloads
+#: numba's documented switch, set unless the user set it: typing the kernels tries thousands of overloads
 #: that do not apply, and numba made each failure's message with colorama's streams set up and torn down
 os.environ.setdefault("NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING", "1")
 
