@@ -178,7 +178,7 @@ def prescribed_velocity(cl, c, ncl, coordinate, src):
     return math.nan
 
 
-@jit
+@jit_inline
 def impact_local(prob, c, k, src, S, stick, O, t):
     """The thesis' local law at one closing clearance k (see the module doc); returns the new mask.
 

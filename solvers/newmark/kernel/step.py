@@ -179,7 +179,7 @@ def layer_step(prob, C, W, h, which, hertz):
             hertz_correction(prob, C, W, h, which)
 
 
-@jit
+@jit_inline
 def consistent_acceleration(prob, C, src, y, rhs, hertz):
     """Free accelerations of configuration C from its equations of motion (prescribed set from src)."""
     prescribed(C.ci, prob.ip[layout.IP_N], src, y[layout.Z], y[layout.ZD], y[layout.ZDD])
