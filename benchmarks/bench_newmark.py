@@ -263,9 +263,9 @@ def main(argv: list[str]) -> None:
               f"{len(trace.events)} events")
     print("  " + ratio_line(step_rounds()))
     if "--no-compile" not in argv:
-        runs = [first_compile() for _ in range(COMPILES)]
+        runs = sorted(first_compile() for _ in range(COMPILES))
         compile_s = [run[0] for run in runs]
-        _, cpu, wall, events, functions, specialisations = runs[compile_s.index(statistics.median(compile_s))]
+        _, cpu, wall, events, functions, specialisations = runs[len(runs) // 2]  # the median run (COMPILES odd)
         print(f"  first run with an empty cache, `vtool solve gnilka-1a` {COMPILES} times: kernel compile median "
               f"{statistics.median(compile_s):.1f} s wall (range {min(compile_s):.1f}-{max(compile_s):.1f}; target <= "
               f"{TARGET_COMPILE_S:.0f} s); that process {wall:.1f} s wall, {cpu:.1f} s CPU; {events} events; "
