@@ -52,6 +52,12 @@ def apply_operator(cp, ci, plane, nrows, coupled, src, z, zd, zdd, out):
                 out[f] -= cp[plane, layout.PART_S, j, f] * a
 
 
+@jit
+def operator_product(cp, ci, plane, nrows, coupled, src, z, zd, zdd, out):
+    """:func:`apply_operator` as a call, for the event path's steps (one compiled copy, not one per caller)."""
+    apply_operator(cp, ci, plane, nrows, coupled, src, z, zd, zdd, out)
+
+
 @jit_inline
 def factor_effective(cm, nf, beta, gamma, h, L):
     """Cholesky factor (lower, in place in L) of S = M_FF + gamma h C_FF + beta h² K_FF (the nf free

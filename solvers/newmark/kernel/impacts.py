@@ -228,7 +228,7 @@ def impact_local(prob, c, k, src, S, stick, O, t):
     return mask
 
 
-@jit
+@jit_inline
 def shut_gap(cl, clf, k, x, src):
     """Clearance k's gap (or overlap) set to exactly zero: it is within the time tolerance of zero
     (sense (x_ahead - x_behind) + opening = 0)."""
@@ -236,7 +236,7 @@ def shut_gap(cl, clf, k, x, src):
     x[cl[k, layout.CL_AHEAD]] = other - clf[k, layout.CLF_SIGN] * clf[k, layout.CLF_OPEN]
 
 
-@jit
+@jit_inline
 def gap_velocity(cl, clf, k, v, src):
     """Velocity of clearance k's gap: sense (v_ahead - v_behind (or the source's))."""
     behind = cl[k, layout.CL_BEHIND]

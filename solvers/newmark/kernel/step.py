@@ -17,7 +17,7 @@ import numpy as np
 
 from vtool.jit import jit, jit_inline
 from vtool.solvers.newmark import layout
-from vtool.solvers.newmark.kernel.algebra import apply_operator, cholesky_solve, factor_effective
+from vtool.solvers.newmark.kernel.algebra import cholesky_solve, factor_effective, operator_product
 from vtool.solvers.newmark.kernel.forces import hertz_correction, hertz_force, overlap_and_rate
 from vtool.solvers.newmark.records import Config
 
@@ -145,7 +145,7 @@ def correct(nf, h, beta, gamma, acc, z1, zd1, zdd1):
 def free_rhs(C, src, y, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
     right, and the sources' pull through closed compliant contacts (``layout.CP_RAW``)."""
-    apply_operator(C.cp, C.ci, layout.CP_RAW, C.ci[layout.CI_NF], C.ci[layout.CI_SRC], src, y[layout.Z], y[layout.ZD],
+    operator_product(C.cp, C.ci, layout.CP_RAW, C.ci[layout.CI_NF], C.ci[layout.CI_SRC], src, y[layout.Z], y[layout.ZD],
                    y[layout.ZDD], rhs)
 
 
@@ -170,7 +170,7 @@ def layer_step(prob, C, W, h, which, hertz):
     # stored G = S⁻¹R into W.sol. One product written for both (each row sums in the same order either way).
     plane = layout.CP_RAW if which == CHOLESKY else (layout.CP_STD if which == STANDARD else layout.CP_FINE)
     out = W.rhs if which == CHOLESKY else W.sol
-    apply_operator(C.cp, ci, plane, nf, ci[layout.CI_SRC], src1, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD], out)
+    operator_product(C.cp, ci, plane, nf, ci[layout.CI_SRC], src1, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD], out)
     if which == CHOLESKY:
         cholesky_solve(nf, W.L, W.rhs, W.sol)
     correct(nf, h, beta, gamma, W.sol, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD])
