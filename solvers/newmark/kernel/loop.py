@@ -274,7 +274,7 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
                 break
             h, target, grid_next, j_target, quiet = step_length(prob, S, t, C.ci[layout.CI_HERTZ])
             if quiet:  # quiet steps may follow; off the grid, after an event, the call would return at once
-                t_quiet = advance(prob, C, W, S, O, hertz)
+                t_quiet = advance(prob, C, W, S, O)
                 if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
                     t = t_quiet
                     sources(prob, t, src0)

@@ -26,7 +26,7 @@ ANCHOR_STEPS = 64
 
 
 @jit
-def advance(prob, C, W, S, O, hertz):
+def advance(prob, C, W, S, O):
     """Standard and refined steps in configuration C from W.y[Y_NOW] while nothing happens; returns the time
     reached (the state there in W.y[Y_NOW]).
 
@@ -36,7 +36,10 @@ def advance(prob, C, W, S, O, hertz):
     overflow the output buffer; :func:`~vtool.solvers.newmark.kernel.loop.run_chunk`
     takes that step with full handling. Not called in every-step mode, nor in
     a configuration with closed Hertz contacts (each of their steps goes
-    through layer_step's iteration).
+    through layer_step's iteration). So its forces are the linear ones under
+    every law pair: it takes no ``hertz`` switch, and numba compiles it once for
+    all the kernels of :func:`~vtool.solvers.newmark.layout.laws` (the Hertz
+    kernel loads it from the cache when a linear one compiled it first).
 
     Every array is taken out of its record once, before the loop: numba counts references, and a
     record's field read inside the loop would take and drop one at every step. The step's end is
@@ -139,7 +142,7 @@ def advance(prob, C, W, S, O, hertz):
         if stop:
             break
         if t_out <= t1 + 1e-9 * dt and t_out <= t_end + 1e-9 * dt:  # output rows inside (t, t1]
-            if not step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
+            if not step_rows(prob, C, t, h, Y, srco, O, ist, None):  # (no closed Hertz contact: see above)
                 break
             t_out = ist[layout.I_NEXT_OUT] * out_dt
         # accept: peaks (the rigid contacts' forces from the step's product), state, time
