@@ -430,6 +430,7 @@ class ContactProblem:
         self.tables = mechanism.shared(ConfigurationTables, lambda: ConfigurationTables(mechanism))
         self.series = source_series(mechanism)
         self.ns, self.nh = self.series.n_sources, self.series.n_harmonics
+        self.series_table = layout.series_table(self.series.const, self.series.cos, self.series.sin)
         self.source_numbers = self.series.numbers
         cl = np.zeros((self.ncl, layout.CL_SIZE), dtype=np.int64)
         clf = np.zeros((self.ncl, layout.CLF_SIZE))
@@ -505,8 +506,7 @@ class ContactProblem:
         :meth:`parameters`' defaults)."""
         if ip is None or fp is None:
             ip, fp = self.parameters()
-        s = self.series
-        return Problem(ip, fp, self.cl, self.clf, s.const, s.cos, s.sin, self.mass)
+        return Problem(ip, fp, self.cl, self.clf, self.series_table, self.mass)
 
     def sources_at(self, t: float) -> np.ndarray:
         """(x, v, a) of every source at t, as the kernel's src vector."""

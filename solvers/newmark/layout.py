@@ -79,6 +79,12 @@ SRC_NOW, SRC_END, SRC_OUT = range(3)
 PHI, PHI_START, TAU = range(3)
 
 
+def series_table(const: np.ndarray, cos: np.ndarray, sin: np.ndarray) -> np.ndarray:
+    """The sources' Fourier series as the kernel reads them: row s is source s's constant, then its
+    nh cosine and its nh sine coefficients (one array of the problem's record, not three)."""
+    return np.ascontiguousarray(np.hstack([const[:, None], cos, sin]), dtype=np.float64)
+
+
 def laws(cl: np.ndarray) -> tuple[bool | None, bool | None]:
     """The ``hertz`` and ``momentum`` switches of the kernel's entry points for clearance table ``cl``:
     True when some clearance uses that law, None when none does. numba prunes the branches under a

@@ -5,7 +5,8 @@ name; Python builds them once per run. The slots inside the arrays are in
 :mod:`vtool.solvers.newmark.layout`.
 
 * :class:`Problem`: a mechanism's constant tables (parameters, clearance tables,
-  the sources' Fourier series, the mass matrix and its inverse);
+  the sources' Fourier series as one table (:func:`~vtool.solvers.newmark.layout.series_table`),
+  the mass matrix and its inverse);
 * :class:`Tables`: every built configuration's operators, one slot each, and the
   map ``index[h] = (mask, slot)`` (open addressing, -1 where empty:
   :func:`mask_hash`), grown by :class:`vtool.solvers.model.contact.ConfigurationTables`;
@@ -22,7 +23,7 @@ from collections import namedtuple
 
 import numpy as np
 
-Problem = namedtuple("Problem", "ip fp cl clf sc sa sb mass")
+Problem = namedtuple("Problem", "ip fp cl clf series mass")
 Tables = namedtuple("Tables", "index ci cm cp mk mon")
 Config = namedtuple("Config", "mask ci cm cp mk mon")
 State = namedtuple("State", "x v a ist fst")

@@ -205,7 +205,7 @@ def borrow(prob, T, W, S, O):
     carry them go to calls made once per quiet run or event, where a count costs nothing that shows),
     so that there is less code to compile (about 0.2 s of first compile)."""
     b = borrowed
-    prob = Problem(b(prob.ip), b(prob.fp), b(prob.cl), b(prob.clf), b(prob.sc), b(prob.sa), b(prob.sb), b(prob.mass))
+    prob = Problem(b(prob.ip), b(prob.fp), b(prob.cl), b(prob.clf), b(prob.series), b(prob.mass))
     T = Tables(T.index, b(T.ci), b(T.cm), b(T.cp), b(T.mk), b(T.mon))
     W = Scratch(b(W.y), b(W.src), b(W.cross), b(W.rhs), b(W.sol), b(W.L), b(W.closing))
     S = State(S.x, S.v, S.a, b(S.ist), b(S.fst))

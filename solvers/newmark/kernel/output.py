@@ -58,7 +58,7 @@ def step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
     fp = prob.fp
     dt, t_end, out_dt, omega = fp[layout.FP_DT], fp[layout.FP_TEND], fp[layout.FP_OUTDT], fp[layout.FP_OMEGA]
     n, ns, ncl = prob.ip[layout.IP_N], prob.ip[layout.IP_NS], prob.cl.shape[0]
-    sc, sa, sb = prob.sc, prob.sa, prob.sb
+    series = prob.series
     ci, mk, mon = C.ci, C.mk, C.mon
     y, out, zdd1 = Y[layout.Y_NOW], Y[layout.Y_OUT], Y[layout.Y_END, layout.ZDD]
     z, zd, zdd = y[layout.Z], y[layout.ZD], y[layout.ZDD]
@@ -74,7 +74,7 @@ def step_rows(prob, C, t, h, Y, srco, O, ist, hertz):
         if row >= out_t.shape[0]:
             return False
         interpolate(nf, t_out - t, h, z, zd, zdd, zdd1, out)
-        harmonics(sc, sa, sb, omega, math.cos(omega * t_out), math.sin(omega * t_out), srco)
+        harmonics(series, omega, math.cos(omega * t_out), math.sin(omega * t_out), srco)
         prescribed(ci, n, srco, zo, zdo, zddo)
         out_t[row] = t_out
         out_c[row] = C.mask

@@ -48,7 +48,7 @@ def advance(prob, C, W, S, O):
     three rows did not: LLVM's vector loop for three arrays needs more entries than a layer has).
     """
     ip, fp, ist, fst = prob.ip, prob.fp, S.ist, S.fst
-    sc, sa, sb, cl, clf = prob.sc, prob.sa, prob.sb, prob.cl, prob.clf
+    series, cl, clf = prob.series, prob.cl, prob.clf
     ci, cp, mk, mon = C.ci, C.cp, C.mk, C.mon
     now, end = W.y[layout.Y_NOW], W.y[layout.Y_END]
     now_values, end_values = now.reshape(now.size), end.reshape(end.size)  # (views: the rows are contiguous)
@@ -107,7 +107,7 @@ def advance(prob, C, W, S, O):
             c1 = c0 * c_fine - s0 * s_fine
             s1 = s0 * c_fine + c0 * s_fine
         # the step (layer_step's, with the stored operator: its force rows give the contact forces too)
-        harmonics(sc, sa, sb, omega, c1, s1, src1)
+        harmonics(series, omega, c1, s1, src1)
         predict(m, h, beta, gamma, z, zd, zdd, z1, zd1)
         prescribed(ci, n, src1, z1, zd1, zdd1)
         apply_operator(cp, ci, plane, nrows, coupled, src1, z1, zd1, zdd1, rhs)

@@ -50,12 +50,13 @@ def configuration(T, mask, slot):
 
 
 @jit_inline
-def harmonics(sc, sa, sb, omega, c1, s1, src):
-    """src[3s : 3s + 3] = (x, v, a) of every source s (constants sc, cosine and sine coefficients sa,
-    sb) at the angle whose cos and sin are c1, s1 (harmonics by angle addition)."""
-    ns, nh = sa.shape[0], sa.shape[1]
+def harmonics(series, omega, c1, s1, src):
+    """src[3s : 3s + 3] = (x, v, a) of every source s (the row ``series[s]``: its constant, then the
+    cosine and the sine coefficients, see :func:`~vtool.solvers.newmark.layout.series_table`) at the
+    angle whose cos and sin are c1, s1 (harmonics by angle addition)."""
+    ns, nh = series.shape[0], (series.shape[1] - 1) // 2
     for s in range(ns):
-        src[3 * s] = sc[s]
+        src[3 * s] = series[s, 0]
         src[3 * s + 1] = 0.0
         src[3 * s + 2] = 0.0
     ck = 1.0
@@ -64,8 +65,8 @@ def harmonics(sc, sa, sb, omega, c1, s1, src):
         ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1  # cos, sin of (k + 1) omega t
         wk = (k + 1) * omega
         for s in range(ns):
-            a = sa[s, k]
-            b = sb[s, k]
+            a = series[s, 1 + k]
+            b = series[s, 1 + nh + k]
             src[3 * s] += a * ck + b * sk
             src[3 * s + 1] += wk * (b * ck - a * sk)
             src[3 * s + 2] -= wk * wk * (a * ck + b * sk)
@@ -75,7 +76,7 @@ def harmonics(sc, sa, sb, omega, c1, s1, src):
 def sources(prob, t, src):
     """src = (x, v, a) of every source at t."""
     omega = prob.fp[layout.FP_OMEGA]
-    harmonics(prob.sc, prob.sa, prob.sb, omega, math.cos(omega * t), math.sin(omega * t), src)
+    harmonics(prob.series, omega, math.cos(omega * t), math.sin(omega * t), src)
 
 
 @jit_inline
