@@ -77,6 +77,7 @@ Z, ZD, ZDD = range(3)
 Y_NOW, Y_END, Y_OUT = range(3)
 SRC_NOW, SRC_END, SRC_OUT = range(3)
 PHI, PHI_START, TAU = range(3)
+RHS, SOL = range(2)  # the rows of the scratch's system: a step's right side and its solution
 
 
 def series_table(const: np.ndarray, cos: np.ndarray, sin: np.ndarray) -> np.ndarray:

@@ -28,7 +28,7 @@ Tables = namedtuple("Tables", "index ci cm cp mk mon")
 Config = namedtuple("Config", "mask ci cm cp mk mon")
 State = namedtuple("State", "x v a ist fst")
 Output = namedtuple("Output", "t q F c ev_f ev_i peak")
-Scratch = namedtuple("Scratch", "y src cross rhs sol L closing")
+Scratch = namedtuple("Scratch", "y src cross system L closing")
 
 
 def mask_hash(mask: int, capacity: int) -> int:
@@ -42,19 +42,20 @@ def scratch(n: int, ns: int, ncl: int) -> tuple[Scratch, np.ndarray]:
     ``y[Y_NOW]`` (the step's start), ``y[Y_END]`` (its end), ``y[Y_OUT]`` (an output row's), each a
     layer state (rows Z, ZD, ZDD); the sources' (x, v, a) at those instants ``src[SRC_NOW]``,
     ``src[SRC_END]``, ``src[SRC_OUT]``; per clearance ``cross[PHI]`` (the monitors at the step's end),
-    ``cross[PHI_START]`` (at its start), ``cross[TAU]`` (a located crossing); the right side and
-    solution of a step's system, a Cholesky factor, and the closing clearances of an event.
+    ``cross[PHI_START]`` (at its start), ``cross[TAU]`` (a located crossing); the right side
+    ``system[RHS]`` and the solution ``system[SOL]`` of a step's system, a Cholesky factor, and the
+    closing clearances of an event.
 
     Returns the record and the one buffer its float arrays are views of: the caller zeroes the
     buffer and ``closing`` before each kernel call but one that goes on after a chunk's end (two
     fills), so that such a call starts as with fresh arrays (zeroing them in the kernel compiled four
     ``fill`` specialisations into its first compile)."""
-    sizes = (9 * n, 9 * ns, 3 * ncl, n + ncl, n, n * n)
+    sizes = (9 * n, 9 * ns, 3 * ncl, 2 * (n + ncl), n * n)
     buffer = np.zeros(sum(sizes))
     parts, start = [], 0
     for size in sizes:  # (np.split's Python around the same slices took longer than the kernel's setup)
         parts.append(buffer[start:start + size])
         start += size
-    y, src, cross, rhs, sol, L = parts
-    return Scratch(y.reshape(3, 3, n), src.reshape(3, 3 * ns), cross.reshape(3, ncl), rhs, sol, L.reshape(n, n),
-                   np.zeros(ncl, dtype=np.int64)), buffer
+    y, src, cross, system, L = parts
+    return Scratch(y.reshape(3, 3, n), src.reshape(3, 3 * ns), cross.reshape(3, ncl), system.reshape(2, n + ncl),
+                   L.reshape(n, n), np.zeros(ncl, dtype=np.int64)), buffer

@@ -207,7 +207,7 @@ def borrow(prob, T, W, S, O):
     b = borrowed
     prob = Problem(b(prob.ip), b(prob.fp), b(prob.cl), b(prob.clf), b(prob.series), b(prob.mass))
     T = Tables(T.index, b(T.ci), b(T.cm), b(T.cp), b(T.mk), b(T.mon))
-    W = Scratch(b(W.y), b(W.src), b(W.cross), b(W.rhs), b(W.sol), b(W.L), b(W.closing))
+    W = Scratch(b(W.y), b(W.src), b(W.cross), b(W.system), b(W.L), b(W.closing))
     S = State(S.x, S.v, S.a, b(S.ist), b(S.fst))
     O = Output(b(O.t), b(O.q), b(O.F), b(O.c), b(O.ev_f), b(O.ev_i), b(O.peak))  # noqa: E741
     return prob, T, W, S, O
@@ -244,7 +244,7 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
             return layout.OUTPUT_FULL
         sources(prob, t, src0)
         if ist[layout.I_NEED_SETTLE]:  # (release_pulling asks for every configuration it reaches to be built)
-            settled = release_pulling(prob, T, c, t, S, src0, O, now, W.rhs, hertz)
+            settled = release_pulling(prob, T, c, t, S, src0, O, now, W.system[layout.RHS], hertz)
             if settled < 0:
                 ist[layout.I_CFG] = -1 - settled
                 ist[layout.I_WANT_CFG] = -1 - settled

@@ -55,7 +55,7 @@ def advance(prob, C, W, S, O):
     state_size = now.size
     z, zd, zdd = now[layout.Z], now[layout.ZD], now[layout.ZDD]
     z1, zd1, zdd1 = end[layout.Z], end[layout.ZD], end[layout.ZDD]
-    rhs, phi, src1, peak = W.rhs, W.cross[layout.PHI], W.src[layout.SRC_END], O.peak
+    rhs, phi, src1, peak = W.system[layout.RHS], W.cross[layout.PHI], W.src[layout.SRC_END], O.peak
     Y, srco = W.y, W.src[layout.SRC_OUT]
     n, ns, ncl = ip[layout.IP_N], ip[layout.IP_NS], cl.shape[0]
     beta, gamma, dt, t_end = fp[layout.FP_BETA], fp[layout.FP_GAMMA], fp[layout.FP_DT], fp[layout.FP_TEND]

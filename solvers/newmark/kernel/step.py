@@ -167,14 +167,15 @@ def layer_step(prob, C, W, h, which, hertz):
         factor_effective(C.cm, nf, beta, gamma, h, W.L)
     predict(ci[layout.CI_M], h, beta, gamma, y[layout.Z], y[layout.ZD], y[layout.ZDD], y1[layout.Z], y1[layout.ZD])
     prescribed(ci, prob.ip[layout.IP_N], src1, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD])
-    # CHOLESKY: ΔP (free_rhs's product) into W.rhs, then solved; else z̈_F = S⁻¹ ΔP as one product with the
-    # stored G = S⁻¹R into W.sol. One product written for both (each row sums in the same order either way).
+    # CHOLESKY: ΔP (free_rhs's product) into the system's RHS row, then solved; else z̈_F = S⁻¹ ΔP as one product
+    # with the stored G = S⁻¹R into its SOL row. One product for both (each row sums in the same order either way).
     plane = layout.CP_RAW if which == CHOLESKY else (layout.CP_STD if which == STANDARD else layout.CP_FINE)
-    out = W.rhs if which == CHOLESKY else W.sol
+    rhs, sol = W.system[layout.RHS], W.system[layout.SOL]
+    out = rhs if which == CHOLESKY else sol
     operator_product(C.cp, ci, plane, nf, ci[layout.CI_SRC], src1, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD], out)
     if which == CHOLESKY:
-        cholesky_solve(nf, W.L, W.rhs, W.sol)
-    correct(nf, h, beta, gamma, W.sol, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD])
+        cholesky_solve(nf, W.L, rhs, sol)
+    correct(nf, h, beta, gamma, sol, y1[layout.Z], y1[layout.ZD], y1[layout.ZDD])
     if hertz is not None:
         if C.ci[layout.CI_HERTZ]:
             hertz_correction(prob, C, W, h, which)
