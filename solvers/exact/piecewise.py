@@ -232,7 +232,7 @@ class PiecewiseRun(ABC):
 
     def sources(self, t: float) -> np.ndarray:
         src = np.zeros(3 * self.problem.ns)
-        self.rules.sources(self.record, t, src)
+        self.rules.sources(self.problem.series_table, self.problem.omega, t, src)
         return src
 
     # ----- output -----

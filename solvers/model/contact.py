@@ -512,11 +512,8 @@ class ContactProblem:
         """(x, v, a) of every source at t, as the kernel's src vector."""
         from vtool.solvers.newmark import kernel  # numba: only the back ends that call it load it
 
-        record = self.__dict__.get("_sources_record")
-        if record is None:  # made once: numba reads a fresh record's arrays anew on every call
-            record = self.__dict__["_sources_record"] = self.record()
         src = np.zeros(3 * self.ns)
-        kernel.sources(record, t, src)
+        kernel.sources(self.series_table, self.omega, t, src)
         return src
 
     def impact(self, mask: int, closing: list[int], t: float, x: np.ndarray, v: np.ndarray,

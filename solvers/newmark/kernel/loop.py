@@ -74,7 +74,7 @@ def locate_event(prob, C, W, k, t, h, hertz):
         tau = min(max(tau, lo + 0.25 * tol), hi - 0.25 * tol)
         # the trial step from t: sources at t + tau, a step of length tau (layer_step factors S(tau)); written
         # here, not as an inline helper of the records: its records' arrays were counted in and out at every trial
-        sources(prob, t + tau, W.src[layout.SRC_END])
+        sources(prob.series, fp[layout.FP_OMEGA], t + tau, W.src[layout.SRC_END])
         layer_step(prob, C, W, tau, CHOLESKY, hertz)
         # monitor k (see forces.monitors), on the arrays
         if kind == layout.MK_GAP or kind == layout.MK_OVERLAP:
@@ -187,7 +187,8 @@ def event_step(prob, C, W, t, h, hertz):
             tau_min = min(tau_min, W.cross[layout.TAU, k])
     h = tau_min
     if h > 0.0:
-        sources(prob, t + h, W.src[layout.SRC_END])  # the step to the earliest crossing (as locate_event's trials)
+        # the step to the earliest crossing (as locate_event's trials)
+        sources(prob.series, prob.fp[layout.FP_OMEGA], t + h, W.src[layout.SRC_END])
         layer_step(prob, C, W, h, CHOLESKY, hertz)
         # (the gaps' values too: only the forces' and overlaps' are used, by the peaks)
         monitors(prob, C, W.y[layout.Y_END], W.src[layout.SRC_END], gap_noise, W.cross[layout.PHI], hertz)
@@ -234,7 +235,7 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
     fp, ist, fst = prob.fp, S.ist, S.fst
     n, ncl = prob.ip[layout.IP_N], prob.cl.shape[0]
     dt, t_end, out_dt = fp[layout.FP_DT], fp[layout.FP_TEND], fp[layout.FP_OUTDT]
-    x_limit, t_rev = fp[layout.FP_XLIM], fp[layout.FP_TREV]
+    x_limit, t_rev, omega = fp[layout.FP_XLIM], fp[layout.FP_TREV], fp[layout.FP_OMEGA]
     now, end, src0, src1 = W.y[layout.Y_NOW], W.y[layout.Y_END], W.src[layout.SRC_NOW], W.src[layout.SRC_END]
     phi = W.cross[layout.PHI]
     while True:
@@ -242,7 +243,7 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
         c = ist[layout.I_CFG]
         if ist[layout.I_NEV] + 3 * ncl + 2 >= O.ev_f.shape[0]:
             return layout.OUTPUT_FULL
-        sources(prob, t, src0)
+        sources(prob.series, omega, t, src0)
         if ist[layout.I_NEED_SETTLE]:  # (release_pulling asks for every configuration it reaches to be built)
             settled = release_pulling(prob, T, c, t, S, src0, O, now, W.system[layout.RHS], hertz)
             if settled < 0:
@@ -277,12 +278,12 @@ def run_chunk(prob, T, W, S, O, hertz, momentum):
                 t_quiet = advance(prob, C, W, S, O)
                 if t_quiet != t:  # quiet steps taken: sources at the new time, then the end checks again
                     t = t_quiet
-                    sources(prob, t, src0)
+                    sources(prob.series, omega, t, src0)
                     continue
             if h <= 1e-9 * dt:  # at a grid point but for round-off
                 t = arrive(S, target, grid_next, ist[layout.I_GRID], j_target)
                 continue
-            sources(prob, t + h, src1)
+            sources(prob.series, omega, t + h, src1)
             which = STANDARD
             if h != dt:
                 which = REFINED if h == dt / int(fp[layout.FP_REFINE] + 0.5) else CHOLESKY

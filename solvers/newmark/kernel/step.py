@@ -73,10 +73,10 @@ def harmonics(series, omega, c1, s1, src):
 
 
 @jit
-def sources(prob, t, src):
-    """src = (x, v, a) of every source at t."""
-    omega = prob.fp[layout.FP_OMEGA]
-    harmonics(prob.series, omega, math.cos(omega * t), math.sin(omega * t), src)
+def sources(series, omega, t, src):
+    """src = (x, v, a) of every source at t (the problem's ``series`` table at cam speed ``omega``): on
+    the arrays it reads, not the record (a call passes, and numba's Python wrapper unboxes, one array)."""
+    harmonics(series, omega, math.cos(omega * t), math.sin(omega * t), src)
 
 
 @jit_inline
