@@ -146,8 +146,8 @@ def correct(nf, h, beta, gamma, acc, z1, zd1, zdd1):
 def free_rhs(C, src, y, rhs):
     """rhs_F = -C_FF ż_F - K_FF z_F - (M_FP z̈_P + C_FP ż_P + K_FP z_P) - S_F src: the thesis' ΔP on the
     right, and the sources' pull through closed compliant contacts (``layout.CP_RAW``)."""
-    operator_product(C.cp, C.ci, layout.CP_RAW, C.ci[layout.CI_NF], C.ci[layout.CI_SRC], src, y[layout.Z], y[layout.ZD],
-                   y[layout.ZDD], rhs)
+    operator_product(C.cp, C.ci, layout.CP_RAW, C.ci[layout.CI_NF], C.ci[layout.CI_SRC], src, y[layout.Z],
+                     y[layout.ZD], y[layout.ZDD], rhs)
 
 
 @jit
