@@ -5,6 +5,13 @@ output row of the runs in ``tests/fixtures/newmark_reference.py`` (the six gnilk
 cam, the compliant runs, 1A on the exact back end and under the momentum law), written by that script
 from the kernel as it was. The rewritten kernel must give the same events (kinds, clearances,
 configurations) and the same numbers within 1e-12 relative.
+
+That holds in the NumPy the reference was recorded with (the file's ``numpy``). NumPy's linear
+algebra builds the step operators, so under another NumPy the set-up's round-off can differ, and a
+chaotic run carries it on: with NumPy 2.0.2 (what numba 0.60, the lowest numba allowed, installs
+with) every case was still bit-identical but ``gnilka-1a linear 1e7``, whose numbers moved by up to
+1.75e-8 relative (its events the same). Under another NumPy the numbers are therefore held to
+:data:`OTHER_NUMPY` relative; the events must still be the same.
 """
 
 from __future__ import annotations
@@ -12,12 +19,15 @@ from __future__ import annotations
 import json
 import math
 
+import numpy
 import pytest
 
 from tests.fixtures.newmark_reference import CASES, OUTPUT, results
 
 REFERENCE = json.loads(OUTPUT.read_text())
-RELATIVE = 1e-12
+#: relative tolerance under another NumPy than the reference's (see the module doc: 1.75e-8 measured)
+OTHER_NUMPY = 1e-6
+RELATIVE = 1e-12 if REFERENCE["numpy"] == numpy.__version__ else OTHER_NUMPY
 
 
 def close(a: float | None, b: float | None, scale: float) -> bool:
@@ -27,7 +37,7 @@ def close(a: float | None, b: float | None, scale: float) -> bool:
 
 
 def test_the_reference_comes_from_the_kernel_before_the_rewrite() -> None:
-    assert REFERENCE["source_commit"] == "5077ed9"
+    assert REFERENCE["source_commit"] == "5077ed9" and REFERENCE["numpy"] == "2.4.6"
     assert set(REFERENCE["cases"]) == set(CASES)
     assert len(REFERENCE["cases"]["gnilka-1a"]["events"]) == 59
 
