@@ -163,7 +163,7 @@ class PiecewiseRun(ABC):
         self.monitored = problem.cl[:, layout.CL_MON].astype(bool)
         self.closed_bit = problem.cl[:, layout.CL_BIT]
         self.transitions = problem.transitions(builder)  # the shared event and impact rules
-        self.rules = self.transitions.rules  # the compiled kernel's sources and Hertz law
+        self.rules = self.transitions.rules  # the compiled kernel's Hertz law and event rules
 
     # ----- configuration data -----
     def space(self, mask: int) -> StateSpace:
@@ -231,9 +231,7 @@ class PiecewiseRun(ABC):
         return np.concatenate([x[cols], v[cols]])
 
     def sources(self, t: float) -> np.ndarray:
-        src = np.zeros(3 * self.problem.ns)
-        self.rules.sources(self.problem.series_table, self.problem.omega, t, src)
-        return src
+        return self.problem.sources_at(t)
 
     # ----- output -----
     def track_peaks(self, ss: StateSpace, values: np.ndarray, t: float) -> None:
