@@ -39,7 +39,7 @@ def add_event(O, S, t, k, kind, u, c_from, c_to):
     S.ist[layout.I_NEV] = row + 1
 
 
-@jit
+@jit_inline
 def solve_impulse_lcp(W, u, b, eq, scale, P, uplus):
     """Impulses P >= 0 with u + W P - b >= 0 and complementarity (equalities: = b).
 
@@ -81,7 +81,7 @@ def solve_impulse_lcp(W, u, b, eq, scale, P, uplus):
         uplus[r] = u[r]
 
 
-@jit
+@jit_inline
 def impact_momentum(prob, c, closing, src, S, stick, O, t):
     """Newton impact with restitution, impulses of all contacts together on the consistent mass matrix.
 
