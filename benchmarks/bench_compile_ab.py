@@ -68,12 +68,19 @@ def metadata(tree: Path, entry: Path) -> None:
     (info / "entry_points.txt").write_text("\n".join(lines) + "\n")
 
 
-def compile_seconds(path_entry: Path | None, prefix: str) -> float:
-    env = dict(os.environ, VTOOL_KERNEL="compiled", VTOOL_NATIVE="0")  # (an old REF: compile in-process)
+def environment(path_entry: Path | None, cache: str) -> dict[str, str]:
+    """A child process's environment: numba's cache in ``cache``, and ``path_entry`` (from :func:`layout`)
+    first on its path when not None. An old REF runs numba's kernel in the process, as this checkout does
+    (``VTOOL_KERNEL=compiled VTOOL_NATIVE=0``: its own switches then)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache, VTOOL_KERNEL="compiled", VTOOL_NATIVE="0")
     if path_entry is not None:
         env["PYTHONPATH"] = os.pathsep.join([str(path_entry), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    return env
+
+
+def compile_seconds(path_entry: Path | None, prefix: str) -> float:
     with tempfile.TemporaryDirectory() as cache:
-        env["NUMBA_CACHE_DIR"] = cache
+        env = environment(path_entry, cache)
         out = subprocess.run([sys.executable, "-c", COMPILE.format(prefix=prefix)], capture_output=True,
                              text=True, env=env, cwd=tempfile.gettempdir())
     if out.returncode != 0:

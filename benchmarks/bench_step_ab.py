@@ -13,13 +13,12 @@ figure does (assembly, contact problem, kernel, trace; the best of 4 rounds of 5
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
-from bench_compile_ab import ROOT, arguments, layout
+from bench_compile_ab import ROOT, arguments, environment, layout
 
 TIMING = """
 import sys
@@ -57,9 +56,7 @@ print(best)
 
 
 def per_step(path_entry: Path | None, prefix: str, cache: str, whole: bool = False) -> float:
-    env = dict(os.environ, NUMBA_CACHE_DIR=cache, VTOOL_KERNEL="compiled", VTOOL_NATIVE="0")  # (an old REF)
-    if path_entry is not None:
-        env["PYTHONPATH"] = os.pathsep.join([str(path_entry), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    env = environment(path_entry, cache)
     out = subprocess.run([sys.executable, "-c", (WHOLE if whole else TIMING).format(benchmarks=str(ROOT / "benchmarks"), prefix=prefix)],
                          capture_output=True, text=True, env=env, cwd=tempfile.gettempdir())
     if out.returncode != 0:

@@ -23,14 +23,13 @@ the output rows and the events alone put on the step ratio.
 from __future__ import annotations
 
 import dataclasses
-import os
 import statistics
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
-from bench_compile_ab import layout
+from bench_compile_ab import environment, layout
 from bench_newmark import REPEAT, TARGET_STEP_RATIO, floor_seconds, floor_setup, kernel_seconds
 
 from vtool.presets import load_preset
@@ -92,12 +91,10 @@ def main(with_floor: bool = True) -> None:
 
 
 def earlier(ref: str) -> None:
-    """The split of commit ``ref``'s kernel, in a child process on its own sources and numba cache (an old
-    REF runs with numba's kernel in the process: ``VTOOL_KERNEL=compiled VTOOL_NATIVE=0``)."""
+    """The split of commit ``ref``'s kernel, in a child process on its own sources and numba cache."""
     with tempfile.TemporaryDirectory() as folder, tempfile.TemporaryDirectory() as cache:
         entry = layout(ref, Path(folder))
-        env = dict(os.environ, NUMBA_CACHE_DIR=cache, VTOOL_KERNEL="compiled", VTOOL_NATIVE="0",
-                   PYTHONPATH=os.pathsep.join([str(entry), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep))
+        env = environment(entry, cache)
         child = [sys.executable, str(Path(__file__).resolve()), "--no-floor"]
         out = subprocess.run(child, capture_output=True, text=True, env=env, cwd=tempfile.gettempdir())
         if out.returncode != 0:

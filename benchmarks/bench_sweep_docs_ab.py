@@ -20,13 +20,12 @@ intervals, the gap thresholds), and the CPU time a run when they do not.
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
-from bench_compile_ab import ROOT, arguments, layout
+from bench_compile_ab import ROOT, arguments, environment, layout
 
 WORK = """
 import json, time
@@ -72,8 +71,7 @@ def run(ref: str) -> dict:
     """The old scope's second pass in a fresh tree of ``ref``: CPU and wall seconds, and what it found."""
     with tempfile.TemporaryDirectory() as folder:
         entry = layout(ref, Path(folder))
-        env = dict(os.environ, VTOOL_KERNEL="compiled", VTOOL_NATIVE="0", NUMBA_CACHE_DIR=str(Path(folder) / "cache"))
-        env["PYTHONPATH"] = os.pathsep.join([str(entry), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+        env = environment(entry, str(Path(folder) / "cache"))
         out = subprocess.run([sys.executable, "-c", WORK], cwd=folder, env=env, capture_output=True, text=True)
     if out.returncode != 0:
         raise SystemExit(f"the old scope's regeneration failed in {ref}:\n{out.stderr[-3000:]}")
